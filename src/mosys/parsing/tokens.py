@@ -1,0 +1,215 @@
+"""The one tokenizer and error type shared by every spec kind (.fig, .ssc, .anim, .bsr, .comp).
+
+Specs are line based: ``keyword positional-args key=value ...``; ``#`` starts a comment, blank lines
+are ignored. Tokens are separated by whitespace and keep their 1-based line and column, so every
+grammar can report ``file:line:column: expected ..., found ...``.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+NUMBER = re.compile(r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?")
+NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+END_OF_FILE = "\x00end of file"  # the 'found' of an error about a line that never came
+
+
+class SpecError(Exception):
+    """A spec that does not parse: names the file, the 1-based line and column, what the grammar
+    expected there and what it found (``None`` for the end of the line, ``END_OF_FILE``)."""
+
+    def __init__(self, path: str, line: int, column: int, expected: str, found: str | None):
+        self.path = str(path)
+        self.line = line
+        self.column = column
+        self.expected = expected
+        self.found = found
+        shown = {None: "end of line", END_OF_FILE: "end of file"}.get(found, repr(found))
+        super().__init__(f"{self.path}:{line}:{column}: expected {expected}, found {shown}")
+
+
+@dataclass(frozen=True)
+class Token:
+    """One whitespace-separated word of a spec, with its 1-based line and column."""
+
+    text: str
+    line: int
+    column: int
+
+
+@dataclass(frozen=True)
+class Line:
+    """One non-blank spec line with its comment removed; ``tokens[0]`` is the keyword."""
+
+    path: str
+    number: int
+    tokens: tuple[Token, ...]
+    end_column: int  # the column just past the last token, where 'end of line' errors point
+
+    @property
+    def keyword(self) -> Token:
+        return self.tokens[0]
+
+    def reader(self) -> LineReader:
+        """A cursor over the arguments after the keyword."""
+        return LineReader(self)
+
+
+def tokenize(text: str, path: str) -> list[Line]:
+    """Split spec text into lines of tokens. Comments (``#`` to the end of the line) and blank
+    lines are dropped; line and column numbers refer to the original text."""
+    lines = []
+    for number, raw in enumerate(text.splitlines(), start=1):
+        content = raw.split("#", 1)[0]
+        tokens = tuple(
+            Token(match.group(), number, match.start() + 1)
+            for match in re.finditer(r"\S+", content)
+        )
+        if tokens:
+            end = tokens[-1].column + len(tokens[-1].text)
+            lines.append(Line(str(path), number, tokens, end))
+    return lines
+
+
+def read_spec(path: str | Path) -> list[Line]:
+    """Read and tokenize a spec file; unreadable or non-UTF-8 files raise SpecError at 1:1."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise SpecError(str(path), 1, 1, "an existing spec file", None) from None
+    except UnicodeDecodeError as error:
+        raise SpecError(str(path), 1, 1, "UTF-8 text", f"byte {error.start}") from None
+    return tokenize(text, str(path))
+
+
+def parse_number(token: Token, path: str, what: str, text: str | None = None) -> float:
+    """A finite decimal number (``1``, ``-2.5``, ``1e-3``); ``what`` names it in the error.
+    ``text`` overrides the token's text (for parts of a token such as ``-135`` in ``-135,350``)."""
+    text = token.text if text is None else text
+    if NUMBER.fullmatch(text) is None:
+        raise SpecError(path, token.line, token.column, f"a number for {what}", text)
+    value = float(text)
+    if not math.isfinite(value):
+        raise SpecError(path, token.line, token.column, f"a finite number for {what}", text)
+    return value
+
+
+def parse_int(token: Token, path: str, what: str, minimum: int | None = None) -> int:
+    """A whole number (no sign, point or exponent), at least ``minimum`` if given."""
+    if re.fullmatch(r"[+-]?\d+", token.text) is None:
+        raise SpecError(path, token.line, token.column, f"a whole number for {what}", token.text)
+    value = int(token.text)
+    if minimum is not None and value < minimum:
+        raise SpecError(
+            path, token.line, token.column, f"a whole number >= {minimum} for {what}", token.text
+        )
+    return value
+
+
+def parse_name(token: Token, path: str, what: str) -> str:
+    """An identifier: a letter or underscore, then letters, digits or underscores."""
+    if NAME.fullmatch(token.text) is None:
+        raise SpecError(path, token.line, token.column, f"a name for {what}", token.text)
+    return token.text
+
+
+class LineReader:
+    """A cursor over one line's arguments (everything after the keyword).
+
+    Grammar modules read positional arguments with ``word``/``number``/``integer``/``name``,
+    then ``key_values`` for trailing ``key=value`` options, then ``end``.
+    """
+
+    def __init__(self, line: Line):
+        self.line = line
+        self.path = line.path
+        self.position = 1
+
+    def _take(self, expected: str) -> Token:
+        if self.position >= len(self.line.tokens):
+            raise SpecError(self.path, self.line.number, self.line.end_column, expected, None)
+        token = self.line.tokens[self.position]
+        self.position += 1
+        return token
+
+    def peek(self) -> Token | None:
+        """The next token without consuming it, or None at the end of the line."""
+        if self.position >= len(self.line.tokens):
+            return None
+        return self.line.tokens[self.position]
+
+    def at_end(self) -> bool:
+        return self.position >= len(self.line.tokens)
+
+    def word(self, expected: str) -> Token:
+        """The next token, whatever it is."""
+        return self._take(expected)
+
+    def number(self, what: str) -> float:
+        return parse_number(self._take(f"a number for {what}"), self.path, what)
+
+    def integer(self, what: str, minimum: int | None = None) -> int:
+        return parse_int(self._take(f"a whole number for {what}"), self.path, what, minimum)
+
+    def name(self, what: str) -> str:
+        return parse_name(self._take(f"a name for {what}"), self.path, what)
+
+    def remaining(self) -> Iterator[Token]:
+        """Consume and yield every remaining token."""
+        while not self.at_end():
+            yield self._take("a token")
+
+    def key_values(self, allowed: dict[str, str]) -> dict[str, tuple[Token, str]]:
+        """Consume every remaining token as ``key=value``. ``allowed`` maps each permitted key to
+        a description used in errors. Returns key -> (token, value text); repeated keys and
+        unknown keys are errors."""
+        found: dict[str, tuple[Token, str]] = {}
+        choices = ", ".join(f"'{key}='" for key in allowed)
+        for token in self.remaining():
+            key, sep, value = token.text.partition("=")
+            if not sep or key not in allowed:
+                raise SpecError(self.path, token.line, token.column, f"one of {choices}", token.text)
+            if key in found:
+                raise SpecError(
+                    self.path, token.line, token.column, f"'{key}=' only once", token.text
+                )
+            if not value:
+                raise SpecError(
+                    self.path,
+                    token.line,
+                    token.column + len(key) + 1,
+                    allowed[key],
+                    None,
+                )
+            found[key] = (token, value)
+        return found
+
+    def end(self) -> None:
+        """Fail if anything is left on the line."""
+        token = self.peek()
+        if token is not None:
+            raise SpecError(self.path, token.line, token.column, "end of line", token.text)
+
+
+def value_token(token: Token, key: str) -> Token:
+    """The value part of a ``key=value`` token, with its own column, for precise errors."""
+    return Token(token.text[len(key) + 1 :], token.line, token.column + len(key) + 1)
+
+
+def unknown_keyword(line: Line, keywords: tuple[str, ...]) -> SpecError:
+    """The error for a line whose keyword the grammar does not know."""
+    choices = ", ".join(f"'{keyword}'" for keyword in keywords)
+    return SpecError(
+        line.path, line.number, line.keyword.column, f"one of {choices}", line.keyword.text
+    )
+
+
+def missing_line(path: str, lines: list[Line], keyword: str) -> SpecError:
+    """The error for a required line that never came: points just past the last line."""
+    last = lines[-1].number + 1 if lines else 1
+    return SpecError(path, last, 1, f"a '{keyword}' line", END_OF_FILE)

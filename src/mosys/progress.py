@@ -1,0 +1,53 @@
+"""Progress lines for long work: count, rate and ETA on stderr, at most every ``interval`` s."""
+
+from __future__ import annotations
+
+import sys
+import time
+
+
+class Progress:
+    """Report ``done/total`` with rate and ETA; ``update`` is cheap to call often.
+
+    >>> progress = Progress("value iteration", total=100, unit="sweeps")
+    >>> progress.update(10)  # prints at most every `interval` seconds
+    >>> progress.finish()
+    """
+
+    def __init__(self, label: str, total: int, unit: str = "items", interval: float = 1.0):
+        self.label = label
+        self.total = max(int(total), 1)
+        self.unit = unit
+        self.interval = interval
+        self.start = time.perf_counter()
+        self.last = self.start
+        self.done = 0
+
+    def update(self, done: int, note: str = "") -> None:
+        self.done = done
+        now = time.perf_counter()
+        if now - self.last >= self.interval:
+            self.last = now
+            self._print(now, note)
+
+    def _print(self, now: float, note: str) -> None:
+        elapsed = max(now - self.start, 1e-9)
+        rate = self.done / elapsed
+        eta = (self.total - self.done) / rate if rate > 0 else float("inf")
+        extra = f" {note}" if note else ""
+        print(
+            f"{self.label}: {self.done}/{self.total} {self.unit} "
+            f"({rate:.1f} {self.unit}/s, ETA {eta:.1f} s){extra}",
+            file=sys.stderr,
+            flush=True,
+        )
+
+    def finish(self, note: str = "") -> None:
+        now = time.perf_counter()
+        elapsed = now - self.start
+        extra = f" {note}" if note else ""
+        print(
+            f"{self.label}: done, {self.done} {self.unit} in {elapsed:.2f} s{extra}",
+            file=sys.stderr,
+            flush=True,
+        )
