@@ -173,7 +173,9 @@ class LineReader:
         for token in self.remaining():
             key, sep, value = token.text.partition("=")
             if not sep or key not in allowed:
-                raise SpecError(self.path, token.line, token.column, f"one of {choices}", token.text)
+                raise SpecError(
+                    self.path, token.line, token.column, f"one of {choices}", token.text
+                )
             if key in found:
                 raise SpecError(
                     self.path, token.line, token.column, f"'{key}=' only once", token.text

@@ -1,0 +1,35 @@
+# mosys: the pipeline. Targets are plain paths under results/, e.g.
+#   snakemake results/pendulum_all     (profiles/default sets the cores)
+configfile: "config/config.yaml"
+
+
+include: "workflow/rules/common.smk"
+include: "workflow/rules/dynamics.smk"
+include: "workflow/rules/ssc.smk"
+include: "workflow/rules/scripts.smk"
+include: "workflow/rules/plots.smk"
+include: "workflow/rules/tables.smk"
+
+
+rule all:
+    input:
+        "results/pendulum_all",
+        "results/paper_tables",
+
+
+rule pendulum_all:
+    input:
+        pendulum_targets(),
+    output:
+        "results/pendulum_all",
+    shell:
+        "mosys index {input} -o {output}"
+
+
+rule paper_tables:
+    input:
+        paper_table_targets(),
+    output:
+        "results/paper_tables",
+    shell:
+        "mosys index {input} -o {output}"

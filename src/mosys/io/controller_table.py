@@ -1,0 +1,95 @@
+"""The controller table contract (DESIGN.md, ``results/controllers/F/C.h5``): write and read."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from mosys.io.atomic import write_atomically
+from mosys.io.attributes import string_tuple
+
+FORMAT_VERSION = 1
+
+
+@dataclass(frozen=True)
+class ControllerTable:
+    """A state-space controller as stored on disk; spec units throughout.
+
+    axes: one (n_k,) float64 grid per state dimension, in ``state_order``; axis_units: 'deg',
+    'deg/s', 'm' or 'm/s'; wrap: periodic axes (period n_k * step). torque: (n_1, ..., n_d, m)
+    float64, N·m or N; value: (n_1, ..., n_d) cost-to-go, s (inf: destination unreachable).
+    attrs: every other root attribute (figure, dest, K, timings, ...), as read.
+    """
+
+    state_order: tuple[str, ...]
+    control_names: tuple[str, ...]
+    axes: tuple[np.ndarray, ...]
+    axis_units: tuple[str, ...]
+    wrap: tuple[bool, ...]
+    torque: np.ndarray
+    value: np.ndarray
+    control_min: np.ndarray
+    control_max: np.ndarray
+    effort_weight: np.ndarray
+    dest: dict[str, float]
+    figure: str
+    attrs: dict
+
+
+def write_controller_table(path: str | Path, table: ControllerTable) -> None:
+    """Write ``table`` to ``path`` atomically (a hidden partial file, then a rename)."""
+
+    def write(partial: Path) -> None:
+        with h5py.File(partial, "w") as h5:
+            axes = h5.create_group("axes")
+            for name, axis, unit, wrap in zip(
+                table.state_order, table.axes, table.axis_units, table.wrap, strict=True
+            ):
+                dataset = axes.create_dataset(name, data=np.asarray(axis, dtype=np.float64))
+                dataset.attrs["unit"] = unit
+                dataset.attrs["wrap"] = bool(wrap)
+            h5.create_dataset("torque", data=table.torque.astype(np.float64))
+            h5.create_dataset("value", data=table.value.astype(np.float64))
+            h5.attrs["format_version"] = FORMAT_VERSION
+            h5.attrs["state_order"] = list(table.state_order)
+            h5.attrs["control_names"] = list(table.control_names)
+            h5.attrs["control_min"] = np.asarray(table.control_min, dtype=np.float64)
+            h5.attrs["control_max"] = np.asarray(table.control_max, dtype=np.float64)
+            h5.attrs["K"] = np.asarray(table.effort_weight, dtype=np.float64)
+            h5.attrs["dest"] = json.dumps(table.dest)
+            h5.attrs["figure"] = table.figure
+            for key, value in table.attrs.items():
+                h5.attrs[key] = value
+
+    write_atomically(path, write)
+
+
+def read_controller_table(path: str | Path) -> ControllerTable:
+    """Read a controller table written by ``write_controller_table`` (or any file that meets the
+    contract)."""
+    with h5py.File(path, "r") as h5:
+        state_order = string_tuple(h5.attrs["state_order"])
+        axes = tuple(np.asarray(h5["axes"][name][()], dtype=np.float64) for name in state_order)
+        units = tuple(str(h5["axes"][name].attrs["unit"]) for name in state_order)
+        wrap = tuple(bool(h5["axes"][name].attrs["wrap"]) for name in state_order)
+        known = {"state_order", "control_names", "control_min", "control_max", "K", "dest"}
+        attrs = {key: h5.attrs[key] for key in h5.attrs if key not in known}
+        return ControllerTable(
+            state_order=state_order,
+            control_names=string_tuple(h5.attrs["control_names"]),
+            axes=axes,
+            axis_units=units,
+            wrap=wrap,
+            torque=np.asarray(h5["torque"][()], dtype=np.float64),
+            value=np.asarray(h5["value"][()], dtype=np.float64),
+            control_min=np.atleast_1d(np.asarray(h5.attrs["control_min"], dtype=np.float64)),
+            control_max=np.atleast_1d(np.asarray(h5.attrs["control_max"], dtype=np.float64)),
+            effort_weight=np.atleast_1d(np.asarray(h5.attrs["K"], dtype=np.float64)),
+            dest=json.loads(h5.attrs["dest"]),
+            figure=str(h5.attrs["figure"]),
+            attrs=attrs,
+        )

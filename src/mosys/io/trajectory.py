@@ -1,0 +1,123 @@
+"""The trajectory contract (DESIGN.md, ``results/trajectories/S.h5``) and the ``figure_motion``
+group every moving articulated figure writes."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from mosys.io.atomic import write_atomically
+from mosys.io.attributes import string_tuple
+
+FORMAT_VERSION = 1
+
+
+@dataclass(frozen=True)
+class FigureMotion:
+    """An articulated figure moving. t: (N,) s, non-decreasing; endpoints: (N, n_rods, 2, 2) m,
+    per rod its proximal then distal end (x, y), y up; com: (N, 2) m. The rod and world
+    properties are the group attributes of the contract."""
+
+    t: np.ndarray
+    endpoints: np.ndarray
+    com: np.ndarray
+    rod_names: tuple[str, ...]
+    rod_mass: np.ndarray
+    rod_length: np.ndarray
+    rod_com: np.ndarray
+    rod_inertia: np.ndarray
+    gravity: float
+    terrain: list
+    contact: str
+
+
+def write_figure_motion(group: h5py.Group, motion: FigureMotion) -> None:
+    """Fill an open HDF5 group with the ``figure_motion`` contract."""
+    group.create_dataset("t", data=np.asarray(motion.t, dtype=np.float64))
+    group.create_dataset("endpoints", data=np.asarray(motion.endpoints, dtype=np.float64))
+    group.create_dataset("com", data=np.asarray(motion.com, dtype=np.float64))
+    group.attrs["rod_names"] = list(motion.rod_names)
+    group.attrs["rod_mass"] = np.asarray(motion.rod_mass, dtype=np.float64)
+    group.attrs["rod_length"] = np.asarray(motion.rod_length, dtype=np.float64)
+    group.attrs["rod_com"] = np.asarray(motion.rod_com, dtype=np.float64)
+    group.attrs["rod_inertia"] = np.asarray(motion.rod_inertia, dtype=np.float64)
+    group.attrs["gravity"] = float(motion.gravity)
+    group.attrs["terrain"] = json.dumps(motion.terrain)
+    group.attrs["contact"] = motion.contact
+
+
+def read_figure_motion(group: h5py.Group) -> FigureMotion:
+    """Read a ``figure_motion`` group."""
+    names = string_tuple(group.attrs["rod_names"])
+    return FigureMotion(
+        t=group["t"][()],
+        endpoints=group["endpoints"][()],
+        com=group["com"][()],
+        rod_names=names,
+        rod_mass=np.atleast_1d(group.attrs["rod_mass"]),
+        rod_length=np.atleast_1d(group.attrs["rod_length"]),
+        rod_com=np.atleast_1d(group.attrs["rod_com"]),
+        rod_inertia=np.atleast_1d(group.attrs["rod_inertia"]),
+        gravity=float(group.attrs["gravity"]),
+        terrain=json.loads(group.attrs["terrain"]),
+        contact=str(group.attrs["contact"]),
+    )
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """A script's trajectory. t: (N,) s; state: (N, d) spec units in ``state_order``; control:
+    (N, m); controller: (N,) int64 index into ``controllers`` (table file stems); attrs: extra
+    root attributes; motion: the figure's ``figure_motion`` (None for non-articulated figures)."""
+
+    t: np.ndarray
+    state: np.ndarray
+    control: np.ndarray
+    controller: np.ndarray
+    state_order: tuple[str, ...]
+    control_names: tuple[str, ...]
+    controllers: tuple[str, ...]
+    attrs: dict
+    motion: FigureMotion | None
+
+
+def write_trajectory(path: str | Path, trajectory: Trajectory) -> None:
+    """Write a trajectory file atomically."""
+
+    def write(partial: Path) -> None:
+        with h5py.File(partial, "w") as h5:
+            h5.create_dataset("t", data=np.asarray(trajectory.t, dtype=np.float64))
+            h5.create_dataset("state", data=np.asarray(trajectory.state, dtype=np.float64))
+            h5.create_dataset("control", data=np.asarray(trajectory.control, dtype=np.float64))
+            h5.create_dataset("controller", data=np.asarray(trajectory.controller, np.int64))
+            h5.attrs["format_version"] = FORMAT_VERSION
+            h5.attrs["state_order"] = list(trajectory.state_order)
+            h5.attrs["control_names"] = list(trajectory.control_names)
+            h5.attrs["controllers"] = list(trajectory.controllers)
+            for key, value in trajectory.attrs.items():
+                h5.attrs[key] = value
+            if trajectory.motion is not None:
+                write_figure_motion(h5.create_group("figure_motion"), trajectory.motion)
+
+    write_atomically(path, write)
+
+
+def read_trajectory(path: str | Path) -> Trajectory:
+    """Read a trajectory file."""
+    with h5py.File(path, "r") as h5:
+        known = {"state_order", "control_names", "controllers"}
+        return Trajectory(
+            t=h5["t"][()],
+            state=h5["state"][()],
+            control=h5["control"][()],
+            controller=h5["controller"][()],
+            state_order=string_tuple(h5.attrs["state_order"]),
+            control_names=string_tuple(h5.attrs["control_names"]),
+            controllers=string_tuple(h5.attrs["controllers"]),
+            attrs={k: h5.attrs[k] for k in h5.attrs if k not in known},
+            motion=read_figure_motion(h5["figure_motion"]) if "figure_motion" in h5 else None,
+        )

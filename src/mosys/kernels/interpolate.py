@@ -1,0 +1,150 @@
+"""n-linear interpolation on a uniform grid with periodic (wrap) axes.
+
+Grids are described by four (d,) arrays in one consistent unit system: ``axis_min`` (the first
+node), ``axis_step`` (node spacing), ``axis_count`` (nodes per axis, int64) and ``wrap`` (bool: the
+axis is periodic with period ``axis_count * axis_step``). Node values are stored flat in C order
+(the last axis varies fastest).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def grid_strides(axis_count, out):
+    """C-order strides of a grid, in nodes. axis_count: (d,) int64; out: (d,) int64."""
+    stride = 1
+    for k in range(axis_count.shape[0] - 1, -1, -1):
+        out[k] = stride
+        stride *= axis_count[k]
+
+
+@njit(cache=True)
+def inside_domain(axis_min, axis_step, axis_count, wrap, state, tolerance):
+    """True when every non-wrap coordinate of ``state`` (d,) lies within [min, max] of its axis,
+    allowing ``tolerance`` grid steps of slack."""
+    for k in range(state.shape[0]):
+        if wrap[k]:
+            continue
+        u = (state[k] - axis_min[k]) / axis_step[k]
+        if u < -tolerance or u > axis_count[k] - 1 + tolerance:
+            return False
+    return True
+
+
+@njit(cache=True)
+def clamp_to_domain(axis_min, axis_step, axis_count, wrap, state, out):
+    """Copy ``state`` (d,) into ``out`` (d,), moving each non-wrap coordinate onto the nearest
+    point of its axis range. Returns True when nothing had to move."""
+    unchanged = True
+    for k in range(state.shape[0]):
+        value = state[k]
+        if not wrap[k]:
+            top = axis_min[k] + axis_step[k] * (axis_count[k] - 1)
+            if value < axis_min[k]:
+                value = axis_min[k]
+                unchanged = False
+            elif value > top:
+                value = top
+                unchanged = False
+        out[k] = value
+    return unchanged
+
+
+@njit(cache=True)
+def corner_weights(
+    axis_min, axis_step, axis_count, wrap, strides, state, on_node_axis, corner_index, corner_weight
+):
+    """The grid nodes around ``state`` and their n-linear weights.
+
+    state: (d,) inside the domain (non-wrap axes within [min, max]); on_node_axis: an axis on which
+    ``state`` lies exactly on a node layer (its weights would be 0 on one side), or -1.
+    corner_index: (2**d,) int64 flat node indices out; corner_weight: (2**d,) float64 out.
+    Returns the number of corners written: 2**d, or 2**(d-1) when ``on_node_axis`` >= 0.
+    Weights are non-negative and sum to 1.
+    """
+    d = state.shape[0]
+    low = np.empty(d, np.int64)
+    high = np.empty(d, np.int64)
+    fraction = np.empty(d)
+    for k in range(d):
+        n = axis_count[k]
+        u = (state[k] - axis_min[k]) / axis_step[k]
+        if wrap[k]:
+            u = u - n * np.floor(u / n)
+            if k == on_node_axis:
+                i = np.int64(np.floor(u + 0.5)) % n
+                low[k] = i
+                high[k] = i
+                fraction[k] = 0.0
+                continue
+            i = np.int64(np.floor(u))
+            if i >= n:  # u rounded up to exactly n
+                i = n - 1
+            low[k] = i
+            high[k] = (i + 1) % n
+            fraction[k] = min(max(u - i, 0.0), 1.0)
+        else:
+            u = min(max(u, 0.0), n - 1.0)
+            if k == on_node_axis or n == 1:
+                i = np.int64(np.floor(u + 0.5))
+                low[k] = i
+                high[k] = i
+                fraction[k] = 0.0
+                continue
+            i = min(np.int64(np.floor(u)), n - 2)
+            low[k] = i
+            high[k] = i + 1
+            fraction[k] = u - i
+    free = 0
+    free_axes = np.empty(d, np.int64)
+    for k in range(d):
+        if k != on_node_axis:
+            free_axes[free] = k
+            free += 1
+    count = 1 << free
+    for corner in range(count):
+        index = 0
+        weight = 1.0
+        for k in range(d):
+            if k == on_node_axis:
+                index += low[k] * strides[k]
+        for bit in range(free):
+            k = free_axes[bit]
+            if (corner >> bit) & 1:
+                index += high[k] * strides[k]
+                weight *= fraction[k]
+            else:
+                index += low[k] * strides[k]
+                weight *= 1.0 - fraction[k]
+        corner_index[corner] = index
+        corner_weight[corner] = weight
+    return count
+
+
+@njit(cache=True)
+def interpolate_into(axis_min, axis_step, axis_count, wrap, table, state, out):
+    """n-linear interpolation of a node table at one state, written into out.
+
+    table: (prod(axis_count), m) float64, nodes in C order; state: (d,), inside the domain
+    (clamp first with ``clamp_to_domain``); out: (m,) float64.
+    """
+    d = state.shape[0]
+    strides = np.empty(d, np.int64)
+    grid_strides(axis_count, strides)
+    corner_index = np.empty(1 << d, np.int64)
+    corner_weight = np.empty(1 << d)
+    count = corner_weights(
+        axis_min, axis_step, axis_count, wrap, strides, state, -1, corner_index, corner_weight
+    )
+    for j in range(out.shape[0]):
+        out[j] = 0.0
+    for c in range(count):
+        w = corner_weight[c]
+        if w == 0.0:
+            continue
+        row = corner_index[c]
+        for j in range(out.shape[0]):
+            out[j] += w * table[row, j]

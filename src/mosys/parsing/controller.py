@@ -1,0 +1,460 @@
+"""The controller spec (``.ssc``): the 1990 paper's Figure 12, plus a few optional settings.
+
+::
+
+    dyn link1                          # the figure: specs/figures/link1.fig
+    ssd omega -500.0 500.0 21          # state dimension: name min max samples
+    ssd angle -180 170 36 wrap         # 'wrap': periodic dimension (period samples * step)
+    torq torque -10.0 10.0 11 0.1      # control: name min max samples K
+    dest angle=0 omega=0               # destination state (grid nodes)
+    tol 1e-6                           # optional: convergence tolerance, s (default 1e-6)
+    maxiter 1000                       # optional: iteration cap (default 1000)
+    dt 0.001                           # optional: DP integration step, s (default 0.001)
+
+Values are in spec units: degrees for angles, deg/s for angular rates, metres and m/s otherwise
+(the figure says which). The full grammar is in ``docs/controller-spec.md``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from mosys.parsing.tokens import (
+    Line,
+    LineReader,
+    SpecError,
+    Token,
+    missing_line,
+    parse_number,
+    read_spec,
+    tokenize,
+    unknown_keyword,
+    value_token,
+)
+
+KEYWORDS = ("dyn", "ssd", "torq", "dest", "tol", "maxiter", "dt")
+DEFAULT_TOLERANCE = (
+    1e-6  # s: largest change of the cost-to-go in one sweep that counts as converged
+)
+DEFAULT_MAX_ITERATIONS = 1000
+DEFAULT_DT = 0.001  # s
+GRID_TOLERANCE = 1e-9  # a destination lies on a node if within GRID_TOLERANCE * step of it
+
+
+@dataclass(frozen=True)
+class StateDimension:
+    """One ``ssd`` line: a uniformly sampled state variable of the figure.
+
+    ``minimum``/``maximum`` are the first and last grid nodes, in spec units (degrees, deg/s,
+    metres, m/s). ``samples`` >= 2 nodes, so ``step = (maximum - minimum) / (samples - 1)``.
+    A ``wrap`` dimension is periodic with period ``samples * step`` (node ``samples`` would be
+    node 0 again: ``-180 170 36 wrap`` covers the whole circle). ``token`` is the name's token.
+    """
+
+    name: str
+    minimum: float
+    maximum: float
+    samples: int
+    wrap: bool
+    token: Token
+
+    @property
+    def step(self) -> float:
+        """Distance between neighbouring nodes, spec units."""
+        return (self.maximum - self.minimum) / (self.samples - 1)
+
+    @property
+    def period(self) -> float | None:
+        """``samples * step`` for a wrap dimension (spec units), else None."""
+        return self.samples * self.step if self.wrap else None
+
+    def node(self, index: int) -> float:
+        """The coordinate of node ``index`` (0 .. samples-1), spec units."""
+        return self.minimum + index * self.step
+
+    def nodes(self) -> tuple[float, ...]:
+        """All node coordinates, spec units; the last is exactly ``maximum``."""
+        return tuple(self.node(k) for k in range(self.samples - 1)) + (self.maximum,)
+
+
+@dataclass(frozen=True)
+class ControlDimension:
+    """One ``torq`` line: a control (torque or force) sampled at ``samples`` values.
+
+    The DP tries ``samples`` evenly spaced values from ``minimum`` to ``maximum`` (N·m for a
+    torque, N for a force); one sample means the constant ``minimum`` (== ``maximum``).
+    ``effort_weight`` is the paper's K >= 0, in 1/(N·m): the cost ``f = t + ∫ K·|T| dt`` (s).
+    ``token`` is the name's token.
+    """
+
+    name: str
+    minimum: float
+    maximum: float
+    samples: int
+    effort_weight: float
+    token: Token
+
+    def values(self) -> tuple[float, ...]:
+        """The sampled control values, from ``minimum`` to ``maximum`` inclusive."""
+        if self.samples == 1:
+            return (self.minimum,)
+        step = (self.maximum - self.minimum) / (self.samples - 1)
+        inner = tuple(self.minimum + k * step for k in range(self.samples - 1))
+        return inner + (self.maximum,)
+
+
+@dataclass(frozen=True)
+class Destination:
+    """One ``name=value`` of the ``dest`` line: the destination of one state dimension.
+
+    ``value`` is the number as written (spec units); ``index`` is the grid node it lies on
+    (after wrapping, for a wrap dimension). ``token`` is the whole ``name=value`` token;
+    ``value_token`` its value part.
+    """
+
+    name: str
+    value: float
+    index: int
+    token: Token
+
+    @property
+    def value_token(self) -> Token:
+        return value_token(self.token, self.name)
+
+
+@dataclass(frozen=True)
+class ControllerSpec:
+    """A parsed ``.ssc`` file.
+
+    ``state`` is in file order; the controller's state order (its table's axes) is the figure's
+    state order restricted to these dimensions: see ``ordered_state``. ``destination`` is in
+    ``dest`` order; dimensions it does not name are free. ``tolerance`` (s) stops the DP when
+    no cost-to-go changes by more than it in one sweep; ``max_iterations`` caps the sweeps;
+    ``dt`` (s) is the integration step of the DP's simulations. ``spec_sha256`` is the hex
+    SHA-256 of the file's bytes.
+    """
+
+    path: str
+    figure: str
+    figure_token: Token
+    state: tuple[StateDimension, ...]
+    controls: tuple[ControlDimension, ...]
+    destination: tuple[Destination, ...]
+    tolerance: float
+    max_iterations: int
+    dt: float
+    spec_sha256: str
+
+    @property
+    def name(self) -> str:
+        """The controller's name: the spec file's stem (``A`` for ``A.ssc``)."""
+        return Path(self.path).stem
+
+    def dimension(self, name: str) -> StateDimension:
+        """The ``ssd`` dimension called ``name`` (KeyError if there is none)."""
+        for dimension in self.state:
+            if dimension.name == name:
+                return dimension
+        raise KeyError(name)
+
+    def destination_values(self) -> dict[str, float]:
+        """``dest`` as {name: value}, spec units, as written."""
+        return {entry.name: entry.value for entry in self.destination}
+
+    def error(self, token: Token, expected: str) -> SpecError:
+        """A SpecError at ``token`` of this spec, found its text: for checks made after
+        parsing (against the figure, say)."""
+        return SpecError(self.path, token.line, token.column, expected, token.text)
+
+    def ordered_state(self, figure_state: Sequence[str]) -> tuple[StateDimension, ...]:
+        """The ``ssd`` dimensions in the figure's state order (``figure_state``: the figure's
+        coordinate names, then its rate names). An ``ssd`` name that is not in
+        ``figure_state`` raises SpecError at that name."""
+        known = set(figure_state)
+        choices = ", ".join(f"'{name}'" for name in figure_state)
+        for dimension in self.state:
+            if dimension.name not in known:
+                raise self.error(
+                    dimension.token,
+                    f"a state variable of figure '{self.figure}' (one of {choices})",
+                )
+        rank = {name: position for position, name in enumerate(figure_state)}
+        return tuple(sorted(self.state, key=lambda dimension: rank[dimension.name]))
+
+
+def read_spec_with_sha256(path: str | Path) -> tuple[str, str]:
+    """The text of a spec file and the hex SHA-256 of its bytes, read once. A missing or
+    non-UTF-8 file raises the shared SpecError of ``read_spec``."""
+    try:
+        data = Path(path).read_bytes()
+        text = data.decode("utf-8")
+    except (FileNotFoundError, UnicodeDecodeError):
+        read_spec(path)  # raises the shared SpecError for these cases
+        raise
+    return text, hashlib.sha256(data).hexdigest()
+
+
+def parse_controller_spec(path: str | Path) -> ControllerSpec:
+    """Parse a ``.ssc`` file; any problem raises SpecError naming file, line and column."""
+    text, digest = read_spec_with_sha256(path)
+    return parse_controller_text(text, str(path), digest)
+
+
+def parse_controller_text(
+    text: str, path: str = "<text>", spec_sha256: str | None = None
+) -> ControllerSpec:
+    """Parse ``.ssc`` text; ``path`` names it in errors. ``spec_sha256`` defaults to the
+    SHA-256 of the text's UTF-8 encoding."""
+    if spec_sha256 is None:
+        spec_sha256 = hashlib.sha256(text.encode("utf-8")).hexdigest()
+    return _Parser(path).parse(tokenize(text, path), spec_sha256)
+
+
+def _fmt(value: float) -> str:
+    """A number for an error message: ``-500``, ``0.1``."""
+    return f"{value:.12g}"
+
+
+class _Parser:
+    def __init__(self, path: str):
+        self.path = path
+        self.figure: Token | None = None
+        self.state: list[StateDimension] = []
+        self.controls: list[ControlDimension] = []
+        self.dest_line: Line | None = None
+        self.options: dict[str, float | int] = {}
+        self.first_line: dict[str, int] = {}  # once-only keyword -> its line number
+        self.names: dict[str, int] = {}  # ssd/torq name -> its line number
+
+    def error(self, token: Token, expected: str, found: str | None) -> SpecError:
+        return SpecError(self.path, token.line, token.column, expected, found)
+
+    def parse(self, lines: list[Line], spec_sha256: str) -> ControllerSpec:
+        for line in lines:
+            keyword = line.keyword.text
+            if keyword not in KEYWORDS:
+                raise unknown_keyword(line, KEYWORDS)
+            if keyword in ("dyn", "dest", "tol", "maxiter", "dt"):
+                self.once(line)
+            getattr(self, f"line_{keyword}")(line)
+        for keyword, given in (
+            ("dyn", self.figure),
+            ("ssd", self.state),
+            ("torq", self.controls),
+            ("dest", self.dest_line),
+        ):
+            if not given:
+                raise missing_line(self.path, lines, keyword)
+        assert self.figure is not None and self.dest_line is not None
+        return ControllerSpec(
+            path=self.path,
+            figure=self.figure.text,
+            figure_token=self.figure,
+            state=tuple(self.state),
+            controls=tuple(self.controls),
+            destination=self.destination(self.dest_line),
+            tolerance=float(self.options.get("tol", DEFAULT_TOLERANCE)),
+            max_iterations=int(self.options.get("maxiter", DEFAULT_MAX_ITERATIONS)),
+            dt=float(self.options.get("dt", DEFAULT_DT)),
+            spec_sha256=spec_sha256,
+        )
+
+    def once(self, line: Line) -> None:
+        keyword = line.keyword
+        if keyword.text in self.first_line:
+            first = self.first_line[keyword.text]
+            raise self.error(
+                keyword, f"one '{keyword.text}' line only (the first is line {first})", keyword.text
+            )
+        self.first_line[keyword.text] = line.number
+
+    def new_name(self, reader: LineReader, what: str) -> Token:
+        """A name for an ssd or torq line, unused by any other ssd or torq line."""
+        token = reader.peek()
+        reader.name(what)
+        assert token is not None
+        if token.text in self.names:
+            raise self.error(
+                token,
+                f"a name for {what} not used by another ssd or torq line "
+                f"(line {self.names[token.text]})",
+                token.text,
+            )
+        self.names[token.text] = token.line
+        return token
+
+    def number_token(self, reader: LineReader, what: str) -> tuple[float, Token]:
+        token = reader.peek()
+        value = reader.number(what)
+        assert token is not None
+        return value, token
+
+    def finite_range(self, minimum: float, maximum: float, token: Token) -> None:
+        if not math.isfinite(maximum - minimum):
+            raise self.error(token, "a max with a finite max - min", token.text)
+
+    def line_dyn(self, line: Line) -> None:
+        reader = line.reader()
+        token = reader.peek()
+        reader.name("the figure")
+        reader.end()
+        self.figure = token
+
+    def line_ssd(self, line: Line) -> None:
+        reader = line.reader()
+        name = self.new_name(reader, "the state dimension")
+        minimum = reader.number("min")
+        maximum, maximum_token = self.number_token(reader, "max")
+        if not maximum > minimum:
+            raise self.error(
+                maximum_token, f"a number > min ({_fmt(minimum)}) for max", maximum_token.text
+            )
+        self.finite_range(minimum, maximum, maximum_token)
+        samples_token = reader.peek()
+        samples = reader.integer("samples", minimum=2)
+        if not (maximum - minimum) / (samples - 1) > 0:
+            assert samples_token is not None
+            raise self.error(
+                samples_token,
+                "fewer samples (the step (max - min) / (samples - 1) is 0)",
+                samples_token.text,
+            )
+        wrap = False
+        token = reader.peek()
+        if token is not None:
+            if token.text != "wrap":
+                raise self.error(token, "'wrap' or end of line", token.text)
+            wrap = True
+            reader.word("'wrap'")
+            reader.end()
+        self.state.append(StateDimension(name.text, minimum, maximum, samples, wrap, name))
+
+    def line_torq(self, line: Line) -> None:
+        reader = line.reader()
+        name = self.new_name(reader, "the control")
+        minimum = reader.number("min")
+        maximum, maximum_token = self.number_token(reader, "max")
+        if not maximum >= minimum:
+            raise self.error(
+                maximum_token, f"a number >= min ({_fmt(minimum)}) for max", maximum_token.text
+            )
+        self.finite_range(minimum, maximum, maximum_token)
+        samples_token = reader.peek()
+        samples = reader.integer("samples", minimum=1)
+        if samples == 1 and maximum != minimum:
+            assert samples_token is not None
+            raise self.error(
+                samples_token,
+                f"samples >= 2 for a range from {_fmt(minimum)} to {_fmt(maximum)} "
+                "(1 sample needs max equal to min)",
+                samples_token.text,
+            )
+        weight, weight_token = self.number_token(reader, "K")
+        if weight < 0:
+            raise self.error(weight_token, "a number >= 0 for K", weight_token.text)
+        reader.end()
+        self.controls.append(ControlDimension(name.text, minimum, maximum, samples, weight, name))
+
+    def line_dest(self, line: Line) -> None:
+        if len(line.tokens) == 1:
+            raise SpecError(
+                self.path, line.number, line.end_column, "a 'name=value' destination", None
+            )
+        self.dest_line = line  # checked against the ssd lines once all are read
+
+    def destination(self, line: Line) -> tuple[Destination, ...]:
+        dimensions = {dimension.name: dimension for dimension in self.state}
+        choices = ", ".join(f"'{name}'" for name in dimensions)
+        entries: list[Destination] = []
+        seen: set[str] = set()
+        for token in line.tokens[1:]:
+            name, sep, _ = token.text.partition("=")
+            if not sep:
+                raise self.error(token, "a 'name=value' destination", token.text)
+            if name not in dimensions:
+                raise self.error(token, f"an ssd name (one of {choices}) before '='", name)
+            if name in seen:
+                raise self.error(token, f"'{name}=' only once", token.text)
+            seen.add(name)
+            part = value_token(token, name)
+            value = parse_number(part, self.path, f"dest {name}")
+            index = self.node_index(dimensions[name], value, part)
+            entries.append(Destination(name, value, index, token))
+        return tuple(entries)
+
+    def node_index(self, dimension: StateDimension, value: float, token: Token) -> int:
+        """The node ``value`` lies on, within GRID_TOLERANCE * step (wrapped first if periodic)."""
+        offset = value - dimension.minimum
+        if dimension.wrap and math.isfinite(offset):
+            offset %= dimension.samples * dimension.step
+        position = offset / dimension.step  # in steps from the first node
+        last = dimension.samples - 1
+        if not dimension.wrap and not -GRID_TOLERANCE <= position <= last + GRID_TOLERANCE:
+            raise self.error(
+                token,
+                f"a value from {_fmt(dimension.minimum)} to {_fmt(dimension.maximum)} "
+                f"(ssd {dimension.name}) for dest {dimension.name}",
+                token.text,
+            )
+        if not math.isfinite(position) or abs(position - round(position)) > GRID_TOLERANCE:
+            raise self.error(
+                token,
+                f"a grid node of ssd {dimension.name} ({_fmt(dimension.minimum)} + k * "
+                f"{_fmt(dimension.step)}) for dest {dimension.name}",
+                token.text,
+            )
+        return round(position) % dimension.samples
+
+    def line_tol(self, line: Line) -> None:
+        self.options["tol"] = self.positive(line, "tol (s)")
+
+    def line_dt(self, line: Line) -> None:
+        self.options["dt"] = self.positive(line, "dt (s)")
+
+    def line_maxiter(self, line: Line) -> None:
+        reader = line.reader()
+        self.options["maxiter"] = reader.integer("maxiter", minimum=1)
+        reader.end()
+
+    def positive(self, line: Line, what: str) -> float:
+        reader = line.reader()
+        value, token = self.number_token(reader, what)
+        if not value > 0:
+            raise self.error(token, f"a number > 0 for {what}", token.text)
+        reader.end()
+        return value
+
+
+def render_controller_spec(spec: ControllerSpec) -> str:
+    """The ``.ssc`` text of ``spec`` (parsing it gives back the same values). Optional settings
+    are written only when they differ from the defaults."""
+
+    def number(value: float) -> str:
+        return repr(float(value))
+
+    lines = [f"dyn {spec.figure}"]
+    for dimension in spec.state:
+        wrap = " wrap" if dimension.wrap else ""
+        lines.append(
+            f"ssd {dimension.name} {number(dimension.minimum)} {number(dimension.maximum)} "
+            f"{dimension.samples}{wrap}"
+        )
+    for control in spec.controls:
+        lines.append(
+            f"torq {control.name} {number(control.minimum)} {number(control.maximum)} "
+            f"{control.samples} {number(control.effort_weight)}"
+        )
+    lines.append(
+        "dest " + " ".join(f"{entry.name}={number(entry.value)}" for entry in spec.destination)
+    )
+    if spec.tolerance != DEFAULT_TOLERANCE:
+        lines.append(f"tol {number(spec.tolerance)}")
+    if spec.max_iterations != DEFAULT_MAX_ITERATIONS:
+        lines.append(f"maxiter {spec.max_iterations}")
+    if spec.dt != DEFAULT_DT:
+        lines.append(f"dt {number(spec.dt)}")
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,826 @@
+"""The figure spec (``.fig``): a planar tree of rigid rods joined by hinges.
+
+::
+
+    gravity 9.81                                       # m/s², pointing down (-y); default 9.81
+    rod link length=1 mass=1                           # uniform rod: com=0.5, inertia=m*l²/12
+    pin link at=0,0 angle=angle rate=omega actuator=torque
+
+Keywords: ``gravity``, ``rod``, ``pin`` or ``free`` (the root), ``hinge``, ``limit``,
+``contact``, ``terrain``. Lengths in metres, masses in kg, angles in degrees (radians in the parsed
+``Figure``). The full grammar, with every default and convention, is in ``docs/figure-spec.md``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from mosys.parsing.tokens import (
+    END_OF_FILE,
+    Line,
+    LineReader,
+    SpecError,
+    Token,
+    parse_name,
+    parse_number,
+    read_spec,
+    tokenize,
+    unknown_keyword,
+    value_token,
+)
+
+KEYWORDS = ("gravity", "rod", "pin", "free", "hinge", "limit", "contact", "terrain")
+DEFAULT_GRAVITY = 9.81  # m/s²
+DEFAULT_COM = 0.5  # fraction of the rod from its proximal end
+DEFAULT_SLIP = 0.01  # m/s: tangential speed at which contact friction reaches friction * normal
+TERRAIN_HALF_WIDTH = 1000.0  # m: 'floor' and 'steps' run from x = -1000 to x = +1000
+TERRAIN_KINDS = ("floor", "steps", "polyline")
+
+_NO_TOKEN = Token("", 0, 0)
+
+
+@dataclass(frozen=True)
+class Rod:
+    """One ``rod`` line: a rigid rod. ``length`` m, ``mass`` kg, ``com`` the fraction of the way
+    from the proximal to the distal end where its centre of mass sits, ``inertia`` kg·m² about
+    its own centre of mass."""
+
+    name: str
+    length: float
+    mass: float
+    com: float
+    inertia: float
+    token: Token = field(default=_NO_TOKEN, compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class Coordinate:
+    """One generalized coordinate: ``kind`` is ``x`` or ``y`` (metres, the free root's proximal
+    end) or ``angle`` (radians: absolute, CCW from +x, for the root; relative to the parent for a
+    hinge). ``rate`` names its time derivative; ``actuator`` names the control that drives it
+    (``""``: unactuated)."""
+
+    name: str
+    rate: str
+    kind: str
+    rod: str
+    actuator: str = ""
+
+    @property
+    def is_angle(self) -> bool:
+        return self.kind == "angle"
+
+
+@dataclass(frozen=True)
+class Joint:
+    """How one rod hangs in the tree: a ``pin`` (root hinged to a fixed ``pivot`` (x, y), m),
+    a ``free`` root (floating base: coordinates x, y, angle) or a ``hinge`` on ``parent`` at
+    ``position`` metres along the parent from its proximal end, with a fixed ``offset`` (rad):
+    child absolute angle = parent absolute angle + offset + coordinate."""
+
+    kind: str
+    rod: str
+    coordinates: tuple[Coordinate, ...]
+    parent: str | None = None
+    position: float = 0.0
+    offset: float = 0.0
+    pivot: tuple[float, float] = (0.0, 0.0)
+    token: Token = field(default=_NO_TOKEN, compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class JointLimit:
+    """One ``limit`` line: a one-sided spring-damper on the angle coordinate ``coordinate`` of
+    rod ``rod``'s joint, active below ``lower`` or above ``upper`` (radians, ±inf: no limit).
+    ``stiffness`` N·m/rad, ``damping`` N·m·s/rad."""
+
+    rod: str
+    coordinate: str
+    lower: float
+    upper: float
+    stiffness: float
+    damping: float
+    token: Token = field(default=_NO_TOKEN, compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class ContactPoint:
+    """One ``contact`` line: a point ``fraction`` of the way along rod ``rod`` (0 proximal, 1
+    distal) that the terrain pushes with a penalty spring (``stiffness`` N/m) and damper
+    (``damping`` N·s/m), and drags with Coulomb ``friction`` (coefficient) regularized below the
+    tangential speed ``slip`` (m/s)."""
+
+    rod: str
+    fraction: float
+    stiffness: float
+    damping: float
+    friction: float
+    slip: float
+    token: Token = field(default=_NO_TOKEN, compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class Terrain:
+    """The ground: solid below a polyline of (x, y) vertices (metres, x non-decreasing).
+
+    ``kind`` is ``none``, ``floor`` (flat at ``height``), ``steps`` (``height`` left of the first
+    step; each step (x, y): from x on the ground is at height y) or ``polyline`` (``points`` are
+    the vertices)."""
+
+    kind: str = "none"
+    height: float = 0.0
+    points: tuple[tuple[float, float], ...] = ()
+
+    @property
+    def vertices(self) -> tuple[tuple[float, float], ...]:
+        """The ground polyline, metres; ``()`` for no ground."""
+        if self.kind == "floor":
+            return ((-TERRAIN_HALF_WIDTH, self.height), (TERRAIN_HALF_WIDTH, self.height))
+        if self.kind == "steps":
+            vertices = [(-TERRAIN_HALF_WIDTH, self.height)]
+            level = self.height
+            for x, y in self.points:
+                vertices.append((x, level))
+                if y != level:
+                    vertices.append((x, y))
+                level = y
+            vertices.append((TERRAIN_HALF_WIDTH, level))
+            return tuple(vertices)
+        return self.points
+
+
+@dataclass(frozen=True)
+class Figure:
+    """A parsed ``.fig`` file (SI units: metres, kg, radians).
+
+    ``rods`` are in file order (the order of ``endpoints``); ``joints`` in file order, one per rod,
+    exactly one of them the root (``pin`` or ``free``); ``coordinates`` follow the joints' order
+    (a free root gives x, y, angle). ``spec_sha256`` is the hex SHA-256 of the file's bytes.
+    """
+
+    path: str = field(compare=False)
+    gravity: float
+    rods: tuple[Rod, ...]
+    joints: tuple[Joint, ...]
+    limits: tuple[JointLimit, ...] = ()
+    contacts: tuple[ContactPoint, ...] = ()
+    terrain: Terrain = Terrain()
+    spec_sha256: str = field(default="", compare=False)
+
+    @property
+    def name(self) -> str:
+        """The figure's name: the spec file's stem (``link1`` for ``link1.fig``)."""
+        return Path(self.path).stem
+
+    @property
+    def root(self) -> Joint:
+        return next(joint for joint in self.joints if joint.kind != "hinge")
+
+    @property
+    def coordinates(self) -> tuple[Coordinate, ...]:
+        return tuple(coordinate for joint in self.joints for coordinate in joint.coordinates)
+
+    @property
+    def q_names(self) -> tuple[str, ...]:
+        return tuple(coordinate.name for coordinate in self.coordinates)
+
+    @property
+    def qd_names(self) -> tuple[str, ...]:
+        return tuple(coordinate.rate for coordinate in self.coordinates)
+
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        """The figure's state order: coordinate names, then rate names."""
+        return self.q_names + self.qd_names
+
+    @property
+    def tau_names(self) -> tuple[str, ...]:
+        """The actuator of each coordinate, ``""`` where unactuated."""
+        return tuple(coordinate.actuator for coordinate in self.coordinates)
+
+    def rod(self, name: str) -> Rod:
+        return next(rod for rod in self.rods if rod.name == name)
+
+    def rod_index(self, name: str) -> int:
+        return next(index for index, rod in enumerate(self.rods) if rod.name == name)
+
+    def joint(self, rod: str) -> Joint:
+        """The joint that attaches rod ``rod`` (its hinge, or the root's pin/free line)."""
+        return next(joint for joint in self.joints if joint.rod == rod)
+
+    def parent_index(self) -> tuple[int, ...]:
+        """Per rod (file order): the index of its parent rod, -1 for the root."""
+        return tuple(
+            -1 if (parent := self.joint(rod.name).parent) is None else self.rod_index(parent)
+            for rod in self.rods
+        )
+
+    def coordinate_index(self, name: str) -> int:
+        return self.q_names.index(name)
+
+
+def parse_figure_spec(path: str | Path) -> Figure:
+    """Parse a ``.fig`` file; any problem raises SpecError naming file, line and column."""
+    try:
+        data = Path(path).read_bytes()
+        text = data.decode("utf-8")
+    except (FileNotFoundError, IsADirectoryError, UnicodeDecodeError):
+        read_spec(path)  # raises the shared SpecError for a missing or non-UTF-8 file
+        raise
+    return parse_figure_text(text, str(path), hashlib.sha256(data).hexdigest())
+
+
+def parse_figure_text(text: str, path: str = "<text>", spec_sha256: str | None = None) -> Figure:
+    """Parse ``.fig`` text; ``path`` names it in errors. ``spec_sha256`` defaults to the SHA-256
+    of the text's UTF-8 encoding."""
+    if spec_sha256 is None:
+        spec_sha256 = hashlib.sha256(text.encode("utf-8")).hexdigest()
+    return _Parser(path).parse(tokenize(text, path), spec_sha256)
+
+
+def _fmt(value: float) -> str:
+    """A number in spec text: the shortest repr that reads back to the same float."""
+    text = repr(float(value))
+    return text[:-2] if text.endswith(".0") else text
+
+
+def render_figure_spec(figure: Figure) -> str:
+    """Spec text that parses back to ``figure`` (angles round-trip through degrees)."""
+    out = [f"gravity {_fmt(figure.gravity)}"]
+    for rod in figure.rods:
+        out.append(
+            f"rod {rod.name} length={_fmt(rod.length)} mass={_fmt(rod.mass)} "
+            f"com={_fmt(rod.com)} inertia={_fmt(rod.inertia)}"
+        )
+    for joint in figure.joints:
+        angle = joint.coordinates[-1]
+        names = f"angle={angle.name} rate={angle.rate}"
+        actuator = f" actuator={angle.actuator}" if angle.actuator else ""
+        if joint.kind == "pin":
+            at = f"{_fmt(joint.pivot[0])},{_fmt(joint.pivot[1])}"
+            out.append(f"pin {joint.rod} at={at} {names}{actuator}")
+        elif joint.kind == "free":
+            x, y = joint.coordinates[0], joint.coordinates[1]
+            out.append(
+                f"free {joint.rod} x={x.name} y={y.name} {names} x_rate={x.rate} y_rate={y.rate}"
+            )
+        else:
+            out.append(
+                f"hinge {joint.rod} on={joint.parent} at={_fmt(joint.position)} "
+                f"offset={_fmt(math.degrees(joint.offset))} {names}{actuator}"
+            )
+    for limit in figure.limits:
+        bounds = "".join(
+            f" {key}={_fmt(math.degrees(value))}"
+            for key, value in (("lower", limit.lower), ("upper", limit.upper))
+            if math.isfinite(value)
+        )
+        out.append(
+            f"limit {limit.rod}{bounds} stiffness={_fmt(limit.stiffness)} "
+            f"damping={_fmt(limit.damping)}"
+        )
+    for contact in figure.contacts:
+        out.append(
+            f"contact {contact.rod} fraction={_fmt(contact.fraction)} "
+            f"stiffness={_fmt(contact.stiffness)} damping={_fmt(contact.damping)} "
+            f"friction={_fmt(contact.friction)} slip={_fmt(contact.slip)}"
+        )
+    terrain = figure.terrain
+    points = " ".join(f"{_fmt(x)},{_fmt(y)}" for x, y in terrain.points)
+    if terrain.kind == "floor":
+        out.append(f"terrain floor height={_fmt(terrain.height)}")
+    elif terrain.kind == "steps":
+        out.append(f"terrain steps {points} height={_fmt(terrain.height)}")
+    elif terrain.kind == "polyline":
+        out.append(f"terrain polyline {points}")
+    return "\n".join(out) + "\n"
+
+
+# --- the parser -------------------------------------------------------------------------------
+
+
+@dataclass
+class _RawJoint:
+    """A joint line as read, before its references are resolved."""
+
+    kind: str
+    keyword: Token
+    rod: Token
+    coordinates: list[Coordinate]
+    names: list[tuple[str, str, Token]]  # (what, name, the token that named it)
+    parent: Token | None = None
+    position: tuple[float, Token] | None = None
+    offset: float = 0.0
+    pivot: tuple[float, float] = (0.0, 0.0)
+
+
+@dataclass
+class _RawLimit:
+    rod: Token
+    lower: float
+    upper: float
+    stiffness: float
+    damping: float
+
+
+@dataclass
+class _RawContact:
+    rod: Token
+    fraction: float
+    stiffness: float
+    damping: float
+    friction: float
+    slip: float
+
+
+class _Parser:
+    def __init__(self, path: str):
+        self.path = path
+        self.gravity = DEFAULT_GRAVITY
+        self.rods: list[Rod] = []
+        self.joints: list[_RawJoint] = []
+        self.limits: list[_RawLimit] = []
+        self.contacts: list[_RawContact] = []
+        self.terrain = Terrain()
+        self.first_line: dict[str, int] = {}  # once-only keyword -> its line number
+
+    def error(self, token: Token, expected: str) -> SpecError:
+        return SpecError(self.path, token.line, token.column, expected, token.text)
+
+    def parse(self, lines: list[Line], spec_sha256: str) -> Figure:
+        for line in lines:
+            keyword = line.keyword.text
+            if keyword not in KEYWORDS:
+                raise unknown_keyword(line, KEYWORDS)
+            if keyword in ("gravity", "terrain"):
+                self.once(line)
+            getattr(self, f"line_{keyword}")(line)
+        end = Token(END_OF_FILE, lines[-1].number + 1 if lines else 1, 1)
+        if not self.rods:
+            raise SpecError(self.path, end.line, 1, "a 'rod' line", END_OF_FILE)
+        rods = {rod.name: rod for rod in self.rods}
+        joints = self.resolve_joints(rods, end)
+        self.check_names()
+        by_rod = {joint.rod: joint for joint in joints}
+        return Figure(
+            path=self.path,
+            gravity=self.gravity,
+            rods=tuple(self.rods),
+            joints=joints,
+            limits=tuple(self.resolve_limit(limit, rods, by_rod) for limit in self.limits),
+            contacts=tuple(self.resolve_contact(contact, rods) for contact in self.contacts),
+            terrain=self.terrain,
+            spec_sha256=spec_sha256,
+        )
+
+    # --- helpers
+
+    def once(self, line: Line) -> None:
+        keyword = line.keyword
+        if keyword.text in self.first_line:
+            first = self.first_line[keyword.text]
+            raise self.error(keyword, f"one '{keyword.text}' line only (the first is line {first})")
+        self.first_line[keyword.text] = line.number
+
+    def name_token(self, reader: LineReader, what: str) -> Token:
+        token = reader.peek()
+        reader.name(what)
+        assert token is not None
+        return token
+
+    def number(self, token: Token, key: str, what: str, check: str | None = None) -> float:
+        """The number of a ``key=value`` token; ``check`` is one of ``>0``, ``>=0``, ``0..1``."""
+        part = value_token(token, key)
+        value = parse_number(part, self.path, what)
+        bad = {
+            ">0": (value <= 0, f"a number > 0 for {what}"),
+            ">=0": (value < 0, f"a number >= 0 for {what}"),
+            "0..1": (not 0 <= value <= 1, f"a number from 0 to 1 for {what}"),
+            None: (False, ""),
+        }[check]
+        if bad[0]:
+            raise self.error(part, bad[1])
+        return value
+
+    def point(self, token: Token, what: str, key: str | None = None) -> tuple[float, float]:
+        """An ``x,y`` pair (metres), from a bare token or the value of ``key=x,y``."""
+        part = value_token(token, key) if key is not None else token
+        pieces = part.text.split(",")
+        if len(pieces) != 2:
+            raise self.error(part, f"a point 'x,y' in metres for {what}")
+        x = parse_number(
+            Token(pieces[0], part.line, part.column), self.path, f"{what} x", pieces[0]
+        )
+        y_token = Token(pieces[1], part.line, part.column + len(pieces[0]) + 1)
+        y = parse_number(y_token, self.path, f"{what} y")
+        return x, y
+
+    def options(self, reader: LineReader, allowed: dict[str, str]) -> dict[str, Token]:
+        return {key: token for key, (token, _) in reader.key_values(allowed).items()}
+
+    def required(self, line: Line, found: dict[str, Token], key: str, what: str) -> Token:
+        if key not in found:
+            raise SpecError(self.path, line.number, line.end_column, f"'{key}=' ({what})", None)
+        return found[key]
+
+    def coordinate(
+        self, found: dict[str, Token], key: str, default: str, rod: Token, what: str
+    ) -> tuple[str, Token]:
+        """A coordinate or rate name from ``key=name``, else ``default`` (blamed on ``rod``)."""
+        if key not in found:
+            return default, rod
+        part = value_token(found[key], key)
+        return parse_name(part, self.path, what), part
+
+    # --- one method per keyword
+
+    def line_gravity(self, line: Line) -> None:
+        reader = line.reader()
+        token = reader.peek()
+        value = reader.number("gravity (m/s²)")
+        assert token is not None
+        if value < 0:
+            raise self.error(token, "a number >= 0 for gravity (m/s², pointing down)")
+        reader.end()
+        self.gravity = value
+
+    def line_rod(self, line: Line) -> None:
+        reader = line.reader()
+        name = self.name_token(reader, "the rod")
+        for rod in self.rods:
+            if rod.name == name.text:
+                raise self.error(name, f"a rod name not used before (line {rod.token.line})")
+        found = self.options(
+            reader,
+            {
+                "length": "the length in metres",
+                "mass": "the mass in kg",
+                "com": "the centre of mass as a fraction from the proximal end",
+                "inertia": "the inertia about the centre of mass in kg·m²",
+            },
+        )
+        length_token = self.required(line, found, "length", "the rod's length in metres")
+        mass_token = self.required(line, found, "mass", "the rod's mass in kg")
+        length = self.number(length_token, "length", "length (m)", ">0")
+        mass = self.number(mass_token, "mass", "mass (kg)", ">0")
+        com = DEFAULT_COM
+        if "com" in found:
+            com = self.number(found["com"], "com", "com (fraction of the length)", "0..1")
+        inertia = mass * length**2 / 12.0
+        if "inertia" in found:
+            inertia = self.number(found["inertia"], "inertia", "inertia (kg·m²)", ">0")
+        self.rods.append(Rod(name.text, length, mass, com, inertia, name))
+
+    def line_pin(self, line: Line) -> None:
+        reader = line.reader()
+        rod = self.name_token(reader, "the root rod")
+        found = self.options(
+            reader,
+            {
+                "at": "the pivot 'x,y' in metres",
+                "angle": "a name for the angle coordinate",
+                "rate": "a name for the angle's rate",
+                "actuator": "a name for the hinge's actuator",
+            },
+        )
+        pivot = self.point(found["at"], "at", "at") if "at" in found else (0.0, 0.0)
+        angle, names = self.angle_coordinate(found, rod)
+        self.joints.append(_RawJoint("pin", line.keyword, rod, [angle], names, pivot=pivot))
+
+    def line_free(self, line: Line) -> None:
+        reader = line.reader()
+        rod = self.name_token(reader, "the root rod")
+        found = self.options(
+            reader,
+            {
+                "x": "a name for the x coordinate",
+                "y": "a name for the y coordinate",
+                "angle": "a name for the angle coordinate",
+                "x_rate": "a name for x's rate",
+                "y_rate": "a name for y's rate",
+                "rate": "a name for the angle's rate",
+            },
+        )
+        coordinates = []
+        names = []
+        for axis in ("x", "y"):
+            name, name_token = self.coordinate(found, axis, axis, rod, f"the {axis} coordinate")
+            rate, rate_token = self.coordinate(
+                found, f"{axis}_rate", f"{name}_rate", rod, f"{axis}'s rate"
+            )
+            coordinates.append(Coordinate(name, rate, axis, rod.text))
+            names += [("coordinate", name, name_token), ("rate", rate, rate_token)]
+        angle, angle_names = self.angle_coordinate(found, rod)
+        coordinates.append(angle)
+        self.joints.append(_RawJoint("free", line.keyword, rod, coordinates, names + angle_names))
+
+    def angle_coordinate(
+        self, found: dict[str, Token], rod: Token
+    ) -> tuple[Coordinate, list[tuple[str, str, Token]]]:
+        """The angle coordinate of a joint line (its rate and actuator inside), and its names
+        with the tokens that gave them (the rod's token for a default name)."""
+        name, name_token = self.coordinate(found, "angle", rod.text, rod, "the angle coordinate")
+        rate, rate_token = self.coordinate(found, "rate", f"{name}_rate", rod, "the angle's rate")
+        names = [("coordinate", name, name_token), ("rate", rate, rate_token)]
+        actuator = ""
+        if "actuator" in found:
+            actuator, actuator_token = self.coordinate(found, "actuator", "", rod, "the actuator")
+            names.append(("actuator", actuator, actuator_token))
+        return Coordinate(name, rate, "angle", rod.text, actuator), names
+
+    def line_hinge(self, line: Line) -> None:
+        reader = line.reader()
+        rod = self.name_token(reader, "the child rod")
+        found = self.options(
+            reader,
+            {
+                "on": "the parent rod's name",
+                "at": "the hinge's distance along the parent in metres",
+                "offset": "the fixed angle offset in degrees",
+                "angle": "a name for the angle coordinate",
+                "rate": "a name for the angle's rate",
+                "actuator": "a name for the hinge's actuator",
+            },
+        )
+        on = self.required(line, found, "on", "the parent rod")
+        parent = value_token(on, "on")
+        parse_name(parent, self.path, "the parent rod")
+        position = None
+        if "at" in found:
+            at = found["at"]
+            position = (self.number(at, "at", "at (m along the parent)"), value_token(at, "at"))
+        offset = 0.0
+        if "offset" in found:
+            offset = math.radians(self.number(found["offset"], "offset", "offset (degrees)"))
+        angle, names = self.angle_coordinate(found, rod)
+        self.joints.append(
+            _RawJoint(
+                "hinge",
+                line.keyword,
+                rod,
+                [angle],
+                names,
+                parent=parent,
+                position=position,
+                offset=offset,
+            )
+        )
+
+    def line_limit(self, line: Line) -> None:
+        reader = line.reader()
+        rod = self.name_token(reader, "the limited joint's rod")
+        found = self.options(
+            reader,
+            {
+                "lower": "the lower limit in degrees",
+                "upper": "the upper limit in degrees",
+                "stiffness": "the spring stiffness in N·m/rad",
+                "damping": "the damping in N·m·s/rad",
+            },
+        )
+        if "lower" not in found and "upper" not in found:
+            raise SpecError(
+                self.path, line.number, line.end_column, "'lower=' or 'upper=' (degrees)", None
+            )
+        stiffness_token = self.required(line, found, "stiffness", "N·m/rad")
+        lower, upper = -math.inf, math.inf
+        if "lower" in found:
+            lower = math.radians(self.number(found["lower"], "lower", "lower (degrees)"))
+        if "upper" in found:
+            upper_degrees = self.number(found["upper"], "upper", "upper (degrees)")
+            upper = math.radians(upper_degrees)
+            if not upper > lower:
+                raise self.error(
+                    value_token(found["upper"], "upper"),
+                    f"a number > lower ({math.degrees(lower):g}) for upper (degrees)",
+                )
+        stiffness = self.number(stiffness_token, "stiffness", "stiffness (N·m/rad)", ">0")
+        damping = 0.0
+        if "damping" in found:
+            damping = self.number(found["damping"], "damping", "damping (N·m·s/rad)", ">=0")
+        self.limits.append(_RawLimit(rod, lower, upper, stiffness, damping))
+
+    def line_contact(self, line: Line) -> None:
+        reader = line.reader()
+        rod = self.name_token(reader, "the contact point's rod")
+        found = self.options(
+            reader,
+            {
+                "fraction": "the point's fraction of the way along the rod",
+                "stiffness": "the spring stiffness in N/m",
+                "damping": "the damping in N·s/m",
+                "friction": "the friction coefficient",
+                "slip": "the slip speed in m/s",
+            },
+        )
+        fraction_token = self.required(line, found, "fraction", "0 proximal end .. 1 distal end")
+        stiffness_token = self.required(line, found, "stiffness", "N/m")
+        fraction = self.number(fraction_token, "fraction", "fraction", "0..1")
+        stiffness = self.number(stiffness_token, "stiffness", "stiffness (N/m)", ">0")
+        values = {"damping": 0.0, "friction": 0.0, "slip": DEFAULT_SLIP}
+        checks = {"damping": ("damping (N·s/m)", ">=0"), "friction": ("friction", ">=0")}
+        checks["slip"] = ("slip (m/s)", ">0")
+        for key in values:
+            if key in found:
+                values[key] = self.number(found[key], key, *checks[key])
+        self.contacts.append(
+            _RawContact(
+                rod, fraction, stiffness, values["damping"], values["friction"], values["slip"]
+            )
+        )
+
+    def line_terrain(self, line: Line) -> None:
+        reader = line.reader()
+        kind_token = reader.peek()
+        kind = reader.word("'floor', 'steps' or 'polyline'").text
+        assert kind_token is not None
+        if kind not in TERRAIN_KINDS:
+            raise self.error(kind_token, "'floor', 'steps' or 'polyline'")
+        points: list[tuple[float, float]] = []
+        point_tokens: list[Token] = []
+        if kind != "floor":
+            while (token := reader.peek()) is not None and "=" not in token.text:
+                reader.word("a point")
+                points.append(
+                    self.point(token, "a terrain vertex" if kind == "polyline" else "a step")
+                )
+                point_tokens.append(token)
+        height = 0.0
+        if kind != "polyline":
+            found = self.options(reader, {"height": "the ground height in metres"})
+            if "height" in found:
+                height = self.number(found["height"], "height", "height (m)")
+        reader.end()
+        if kind == "polyline":
+            self.check_polyline(line, points, point_tokens)
+        elif kind == "steps":
+            self.check_steps(line, points, point_tokens)
+        self.terrain = Terrain(kind, height, tuple(points))
+
+    def check_polyline(
+        self, line: Line, points: list[tuple[float, float]], tokens: list[Token]
+    ) -> None:
+        if len(points) < 2:
+            raise SpecError(
+                self.path, line.number, line.end_column, "at least two vertices 'x,y'", None
+            )
+        for (x0, y0), (x1, y1), token in zip(points, points[1:], tokens[1:], strict=False):
+            if x1 < x0:
+                raise self.error(token, f"a vertex with x >= {x0:g} (vertices run left to right)")
+            if (x1, y1) == (x0, y0):
+                raise self.error(token, f"a vertex different from the previous one ({x0:g},{y0:g})")
+        for (x, y), token in zip(points, tokens, strict=True):
+            if abs(x) > 1e6 or abs(y) > 1e6:
+                raise self.error(token, "a vertex within 1e6 m of the origin")
+
+    def check_steps(
+        self, line: Line, points: list[tuple[float, float]], tokens: list[Token]
+    ) -> None:
+        if not points:
+            raise SpecError(self.path, line.number, line.end_column, "a step 'x,y'", None)
+        previous = -TERRAIN_HALF_WIDTH
+        for (x, y), token in zip(points, tokens, strict=True):
+            if not previous < x < TERRAIN_HALF_WIDTH or abs(y) > 1e6:
+                raise self.error(
+                    token,
+                    f"a step with {previous:g} < x < {TERRAIN_HALF_WIDTH:g} and |y| <= 1e6",
+                )
+            previous = x
+
+    # --- checks that need the whole file
+
+    def rod_reference(self, token: Token, rods: dict[str, Rod], what: str) -> Rod:
+        if token.text not in rods:
+            choices = ", ".join(f"'{name}'" for name in rods)
+            raise self.error(token, f"{what} named by a 'rod' line (one of {choices})")
+        return rods[token.text]
+
+    def resolve_joints(self, rods: dict[str, Rod], end: Token) -> tuple[Joint, ...]:
+        joint_line: dict[str, int] = {}
+        root: _RawJoint | None = None
+        for raw in self.joints:
+            self.rod_reference(raw.rod, rods, "a rod")
+            if raw.rod.text in joint_line:
+                raise self.error(
+                    raw.rod,
+                    f"a rod without a joint yet ('{raw.rod.text}' has one on line "
+                    f"{joint_line[raw.rod.text]})",
+                )
+            joint_line[raw.rod.text] = raw.rod.line
+            if raw.kind != "hinge":
+                if root is not None:
+                    raise self.error(
+                        raw.keyword,
+                        f"one root ('pin' or 'free') only (the first is line {root.rod.line})",
+                    )
+                root = raw
+            else:
+                assert raw.parent is not None
+                self.rod_reference(raw.parent, rods, "a parent rod")
+        if root is None:
+            raise SpecError(self.path, end.line, 1, "a root line ('pin' or 'free')", END_OF_FILE)
+        for rod in self.rods:
+            if rod.name not in joint_line:
+                raise SpecError(
+                    self.path,
+                    end.line,
+                    1,
+                    f"a joint line ('hinge', 'pin' or 'free') for rod '{rod.name}' (line "
+                    f"{rod.token.line})",
+                    END_OF_FILE,
+                )
+        parents = {raw.rod.text: raw for raw in self.joints if raw.kind == "hinge"}
+        for raw in self.joints:
+            chain = [raw.rod.text]
+            current = raw
+            while current.kind == "hinge":
+                assert current.parent is not None
+                parent = current.parent.text
+                if parent in chain:
+                    cycle = " -> ".join([*chain[chain.index(parent) :], parent])
+                    raise self.error(
+                        current.parent, f"a parent that does not close a cycle ({cycle})"
+                    )
+                chain.append(parent)
+                if parent not in parents:
+                    break
+                current = parents[parent]
+        joints = []
+        for raw in self.joints:
+            position = 0.0
+            if raw.kind == "hinge":
+                assert raw.parent is not None
+                parent_rod = rods[raw.parent.text]
+                position = parent_rod.length
+                if raw.position is not None:
+                    position, token = raw.position
+                    if not 0 <= position <= parent_rod.length:
+                        raise self.error(
+                            token,
+                            f"a number from 0 to {parent_rod.length:g} (the length of "
+                            f"'{parent_rod.name}') for at (m along the parent)",
+                        )
+            joints.append(
+                Joint(
+                    kind=raw.kind,
+                    rod=raw.rod.text,
+                    coordinates=tuple(raw.coordinates),
+                    parent=None if raw.parent is None else raw.parent.text,
+                    position=position,
+                    offset=raw.offset,
+                    pivot=raw.pivot,
+                    token=raw.rod,
+                )
+            )
+        return tuple(joints)
+
+    def check_names(self) -> None:
+        """Coordinate, rate and actuator names are all different."""
+        seen: dict[str, int] = {}
+        for raw in self.joints:
+            for what, name, token in raw.names:
+                if name in seen:
+                    raise SpecError(
+                        self.path,
+                        token.line,
+                        token.column,
+                        f"a {what} name not used by another coordinate, rate or actuator "
+                        f"(line {seen[name]})",
+                        name,
+                    )
+                seen[name] = token.line
+
+    def resolve_limit(
+        self, raw: _RawLimit, rods: dict[str, Rod], joints: dict[str, Joint]
+    ) -> JointLimit:
+        rod = self.rod_reference(raw.rod, rods, "a rod")
+        joint = joints[rod.name]
+        if joint.kind == "free":
+            raise self.error(
+                raw.rod, "a rod with a 'pin' or 'hinge' joint (a free root has no limit)"
+            )
+        for other in self.limits:
+            if other is raw:
+                break
+            if other.rod.text == raw.rod.text:
+                raise self.error(
+                    raw.rod, f"one limit per joint (the first is line {other.rod.line})"
+                )
+        return JointLimit(
+            rod.name,
+            joint.coordinates[-1].name,
+            raw.lower,
+            raw.upper,
+            raw.stiffness,
+            raw.damping,
+            raw.rod,
+        )
+
+    def resolve_contact(self, raw: _RawContact, rods: dict[str, Rod]) -> ContactPoint:
+        rod = self.rod_reference(raw.rod, rods, "a rod")
+        return ContactPoint(
+            rod.name, raw.fraction, raw.stiffness, raw.damping, raw.friction, raw.slip, raw.rod
+        )

@@ -1,0 +1,74 @@
+"""Steps of the pipeline that join parsing, simulation and file writing (one per ``mosys`` verb
+that is more than a single call)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from types import ModuleType
+
+from mosys import __version__
+from mosys.animation import load_controllers, run_script
+from mosys.dynamics.load import load_dynamics
+from mosys.dynamics.motion import figure_motion
+from mosys.io.controller_table import read_controller_table
+from mosys.io.trajectory import Trajectory, write_trajectory
+from mosys.parsing.script import SwapController, parse_script
+from mosys.parsing.tokens import SpecError, Token
+
+
+def figure_dynamics(
+    figure: str,
+    dynamics_dir: str | Path,
+    error: Callable[[Token, str], SpecError],
+    token: Token,
+) -> ModuleType:
+    """Load ``dynamics_dir/FIGURE.py``; if it is missing, raise ``error(token, ...)`` so the
+    message points at the spec line that named the figure."""
+    path = Path(dynamics_dir) / f"{figure}.py"
+    if not path.exists():
+        raise error(token, f"a compiled figure ({path} does not exist: run 'mosys compile')")
+    return load_dynamics(path)
+
+
+def run_animation_script(
+    script_path: str | Path,
+    controller_dir: str | Path,
+    dynamics_dir: str | Path,
+    out_path: str | Path,
+    dt: float,
+) -> Trajectory:
+    """Run a ``.anim`` script with the tables in ``controller_dir`` (their figure's dynamics from
+    ``dynamics_dir``) and write its trajectory, ``figure_motion`` included."""
+    script = parse_script(script_path)
+    first = next(c for c in script.commands if isinstance(c, SwapController))
+    table_path = Path(controller_dir) / f"{first.controller}.h5"
+    if not table_path.exists():
+        raise script.error(first.table_token, f"a controller table ({table_path} does not exist)")
+    figure = read_controller_table(table_path).figure
+    dynamics = figure_dynamics(figure, dynamics_dir, script.error, first.table_token)
+    controllers = load_controllers(script, controller_dir, dynamics)
+    run = run_script(script, controllers, dt)
+    trajectory = Trajectory(
+        t=run.t,
+        state=run.state,
+        control=run.control,
+        controller=run.controller,
+        state_order=run.state_order,
+        control_names=run.control_names,
+        controllers=run.controllers,
+        attrs={
+            "format_version": 1,
+            "script": str(script_path),
+            "spec_sha256": script.spec_sha256,
+            "figure": next(iter(controllers.values())).table.figure,
+            "dt": dt,
+            "switch_times": [time for time, _ in run.switches],
+            "switch_controllers": [name for _, name in run.switches],
+            "samples_outside_domain": int(run.outside.sum()),
+            "mosys_version": __version__,
+        },
+        motion=figure_motion(dynamics, run.t, run.figure_states),
+    )
+    write_trajectory(out_path, trajectory)
+    return trajectory

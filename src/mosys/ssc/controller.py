@@ -1,0 +1,129 @@
+"""The controller at run time: torques for any state, and closed-loop simulation.
+
+Policy outside the domain: a state beyond a non-wrap axis is clamped onto the domain's boundary
+(the torque of the nearest state the table covers) and the sample is flagged; wrap axes are taken
+modulo their period. Interpolated torques are clamped to the controls' limits.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from types import ModuleType
+
+import numpy as np
+
+from mosys.io.controller_table import ControllerTable, read_controller_table
+from mosys.kernels.interpolate import clamp_to_domain, interpolate_into
+from mosys.kernels.simulate import simulate_controlled
+from mosys.ssc.grid import FigureGrid, figure_grid
+
+
+@dataclass(frozen=True)
+class ClosedLoopRun:
+    """One simulated stretch: ``states`` (S+1, 2n) figure state q‖qd, SI, the first row the start;
+    ``controls`` (S, m) the controls held over each step; ``outside`` (S,) True where the state was
+    outside the table's domain and was clamped."""
+
+    states: np.ndarray
+    controls: np.ndarray
+    outside: np.ndarray
+
+
+class Controller:
+    """A state-space controller table bound to its figure's dynamics module."""
+
+    def __init__(self, name: str, table: ControllerTable, dynamics: ModuleType):
+        self.name = name
+        self.table = table
+        self.dynamics = dynamics
+        axes = table.axes
+        self.grid: FigureGrid = figure_grid(
+            dynamics,
+            table.state_order,
+            np.array([axis[0] for axis in axes]),
+            np.array([(axis[-1] - axis[0]) / (len(axis) - 1) for axis in axes]),
+            np.array([len(axis) for axis in axes]),
+            np.array(table.wrap),
+        )
+        m = len(table.control_names)
+        self.torque_table = np.ascontiguousarray(table.torque.reshape(-1, m))
+        actuators = tuple(dynamics.TAU_NAMES)
+        self.control_slot = np.array(
+            [actuators.index(name) for name in table.control_names], dtype=np.int64
+        )
+
+    @classmethod
+    def load(cls, path: str | Path, dynamics: ModuleType) -> Controller:
+        """Read a controller table; its name is the file stem (``B`` for ``B.h5``)."""
+        return cls(Path(path).stem, read_controller_table(path), dynamics)
+
+    @property
+    def state_order(self) -> tuple[str, ...]:
+        return self.table.state_order
+
+    def torque(self, state: np.ndarray) -> np.ndarray:
+        """Controls (m,) at a controller state (d,) in spec units (deg, deg/s, m, m/s)."""
+        grid = self.grid
+        si = np.asarray(state, dtype=np.float64) * grid.scale
+        clamped = np.empty_like(si)
+        clamp_to_domain(grid.axis_min, grid.axis_step, grid.axis_count, grid.wrap, si, clamped)
+        out = np.empty(len(self.table.control_names))
+        interpolate_into(
+            grid.axis_min,
+            grid.axis_step,
+            grid.axis_count,
+            grid.wrap,
+            self.torque_table,
+            clamped,
+            out,
+        )
+        return np.clip(out, self.table.control_min, self.table.control_max)
+
+    def figure_state(self, state: np.ndarray) -> np.ndarray:
+        """A full figure state q‖qd (2n,), SI, from a controller state (d,) in spec units; figure
+        state variables the controller does not name are 0."""
+        full = np.zeros(2 * len(self.dynamics.Q_NAMES))
+        full[self.grid.state_slot] = np.asarray(state, dtype=np.float64) * self.grid.scale
+        return full
+
+    def controller_states(self, figure_states: np.ndarray) -> np.ndarray:
+        """Controller states (S, d) in spec units from figure states (S, 2n) SI; wrap axes are
+        reduced into [first node, first node + period)."""
+        grid = self.grid
+        states = figure_states[:, grid.state_slot] / grid.scale
+        for k in np.flatnonzero(grid.wrap):
+            first = grid.axis_min[k] / grid.scale[k]
+            period = grid.axis_count[k] * grid.axis_step[k] / grid.scale[k]
+            states[:, k] = first + np.mod(states[:, k] - first, period)
+        return states
+
+    def simulate(self, figure_state: np.ndarray, seconds: float, dt: float) -> ClosedLoopRun:
+        """Run the figure from ``figure_state`` (2n,) SI under this controller for ``seconds``
+        (rounded to whole steps of ``dt``)."""
+        steps = int(round(seconds / dt))
+        n2 = len(figure_state)
+        state = np.ascontiguousarray(figure_state, dtype=np.float64).copy()
+        states = np.empty((steps + 1, n2))
+        controls = np.empty((steps, len(self.table.control_names)))
+        outside = np.empty(steps, dtype=np.bool_)
+        grid = self.grid
+        simulate_controlled(
+            self.dynamics.qdd_into,
+            grid.axis_min,
+            grid.axis_step,
+            grid.axis_count,
+            grid.wrap,
+            self.torque_table,
+            np.ascontiguousarray(self.table.control_min),
+            np.ascontiguousarray(self.table.control_max),
+            grid.state_slot,
+            self.control_slot,
+            state,
+            float(dt),
+            states[:-1],
+            controls,
+            outside,
+        )
+        states[-1] = state
+        return ClosedLoopRun(states, controls, outside)

@@ -1,0 +1,268 @@
+"""Controller generation (paper §3.4–3.5): a ``.ssc`` spec and a figure's dynamics → a table.
+
+Validation against the figure, array set-up and the HDF5 write live here; the numeric work is in
+``mosys.kernels.dp``.
+"""
+
+from __future__ import annotations
+
+import itertools
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from types import ModuleType
+
+import numpy as np
+
+from mosys import __version__
+from mosys.io.controller_table import ControllerTable, write_controller_table
+from mosys.kernels.dp import (
+    bellman_sweep,
+    best_controls,
+    exit_transitions,
+    interpolate_known_values_only,
+    reach_sweep,
+)
+from mosys.parsing.controller import ControllerSpec
+from mosys.progress import Progress
+from mosys.ssc.grid import FigureGrid, figure_grid, figure_state_names
+
+UNKNOWN = 1.0e9  # s: cost-to-go of a reachable node whose value is not known yet
+MAX_SEGMENT_SECONDS = 2.0  # a simulated segment that stays in its cell longer is discarded
+PROGRESS_CHUNKS = 20
+
+
+@dataclass(frozen=True)
+class Problem:
+    """Everything the DP kernels need for one spec, SI units."""
+
+    spec: ControllerSpec
+    grid: FigureGrid
+    base_state: np.ndarray  # (2n,) values of the figure state slots the controller leaves out
+    control_samples: np.ndarray  # (U, m) every combination of the sampled controls
+    control_slot: np.ndarray  # (m,) coordinate driven by each control
+    is_destination: np.ndarray  # (N,) bool
+
+
+def build_problem(spec: ControllerSpec, dynamics: ModuleType) -> Problem:
+    """Check the spec against the figure (SpecError naming the line) and lay out the arrays."""
+    names = figure_state_names(dynamics)
+    ordered = spec.ordered_state(names)
+    grid = figure_grid(
+        dynamics,
+        tuple(d.name for d in ordered),
+        np.array([d.minimum for d in ordered]),
+        np.array([d.step for d in ordered]),
+        np.array([d.samples for d in ordered]),
+        np.array([d.wrap for d in ordered]),
+    )
+    for k, dimension in enumerate(ordered):
+        if dimension.wrap and grid.units[k] == "deg" and abs(dimension.period - 360.0) > 1e-9:
+            raise spec.error(
+                dimension.token,
+                f"an angle whose wrap period samples*step is 360 deg (it is {dimension.period:g})",
+            )
+    actuators = tuple(dynamics.TAU_NAMES)
+    control_slot = []
+    for control in spec.controls:
+        if control.name not in actuators or not control.name:
+            choices = ", ".join(f"'{a}'" for a in actuators if a)
+            raise spec.error(
+                control.token, f"an actuator of figure '{spec.figure}' (one of {choices})"
+            )
+        control_slot.append(actuators.index(control.name))
+    samples = np.array(
+        list(itertools.product(*(control.values() for control in spec.controls))),
+        dtype=np.float64,
+    ).reshape(-1, len(spec.controls))
+    destination = np.ones(grid.shape, dtype=bool)
+    for entry in spec.destination:
+        axis = grid.names.index(entry.name)
+        on_node = np.zeros(grid.shape[axis], dtype=bool)
+        on_node[entry.index] = True
+        broadcast = [1] * len(grid.names)
+        broadcast[axis] = grid.shape[axis]
+        destination &= on_node.reshape(broadcast)
+    return Problem(
+        spec=spec,
+        grid=grid,
+        base_state=np.zeros(len(names)),
+        control_samples=np.ascontiguousarray(samples),
+        control_slot=np.array(control_slot, dtype=np.int64),
+        is_destination=np.ascontiguousarray(destination.reshape(-1)),
+    )
+
+
+def reachable_nodes(
+    exit_index: np.ndarray,
+    exit_weight: np.ndarray,
+    segment_cost: np.ndarray,
+    destination: np.ndarray,
+    valid: np.ndarray,
+) -> np.ndarray:
+    """(N,) bool: the nodes from which some sequence of controls leads to the destination (every
+    step onto a face with a weight on a node already known to lead there)."""
+    reached = destination & valid
+    spare = np.empty_like(reached)
+    while reach_sweep(exit_index, exit_weight, segment_cost, valid, reached, spare):
+        reached, spare = spare, reached
+    return reached
+
+
+@dataclass(frozen=True)
+class Solution:
+    """The DP's result: cost-to-go (N,) s, inf where unreachable; best control index (N,)."""
+
+    value: np.ndarray
+    best_control: np.ndarray
+    iterations: int
+    residual: float
+    transition_seconds: float
+    iteration_seconds: float
+
+
+def solve(
+    problem: Problem,
+    dynamics: ModuleType,
+    tolerance: float,
+    max_iterations: int,
+    dt: float,
+    node_valid: np.ndarray | None = None,
+    quiet: bool = False,
+) -> Solution:
+    """Exit transitions once, then Bellman sweeps until the largest decrease < tolerance (s) or
+    ``max_iterations`` sweeps. ``node_valid``: (N,) bool, False for nodes removed from the domain.
+    """
+    grid = problem.grid
+    nodes = grid.node_count
+    controls = problem.control_samples.shape[0]
+    corners = 1 << (len(grid.names) - 1)
+    valid = np.ones(nodes, dtype=np.bool_) if node_valid is None else node_valid
+    exit_index = np.zeros((nodes, controls, corners), dtype=np.int64)
+    exit_weight = np.zeros((nodes, controls, corners))
+    segment_cost = np.empty((nodes, controls))
+    max_steps = int(np.ceil(MAX_SEGMENT_SECONDS / dt))
+    effort = np.array([c.effort_weight for c in problem.spec.controls], dtype=np.float64)
+    started = time.perf_counter()
+    progress = Progress("exit transitions", nodes * controls, "simulations")
+    chunks = np.array_split(np.arange(nodes, dtype=np.int64), min(PROGRESS_CHUNKS, nodes))
+    done = 0
+    for chunk in chunks:
+        exit_transitions(
+            dynamics.qdd_into,
+            grid.axis_min,
+            grid.axis_step,
+            grid.axis_count,
+            grid.wrap,
+            grid.state_slot,
+            problem.base_state,
+            problem.control_samples,
+            problem.control_slot,
+            effort,
+            float(dt),
+            max_steps,
+            np.ascontiguousarray(chunk),
+            valid,
+            exit_index,
+            exit_weight,
+            segment_cost,
+        )
+        done += chunk.size * controls
+        if not quiet:
+            progress.update(done)
+    transition_seconds = time.perf_counter() - started
+    if not quiet:
+        progress.finish()
+
+    reachable = reachable_nodes(
+        exit_index, exit_weight, segment_cost, problem.is_destination, valid
+    )
+    interpolate_known_values_only(exit_index, exit_weight, segment_cost, reachable)
+
+    value = np.where(problem.is_destination, 0.0, np.where(reachable, UNKNOWN, np.inf))
+    new_value = np.empty(nodes)
+    change = np.empty(nodes)
+    progress = Progress("value iteration", max_iterations, "sweeps")
+    residual = np.inf
+    iterations = 0
+    while iterations < max_iterations:
+        residual = bellman_sweep(
+            exit_index, exit_weight, segment_cost, problem.is_destination, value, new_value, change
+        )
+        value, new_value = new_value, value
+        iterations += 1
+        if not quiet:
+            progress.update(iterations, f"largest change {residual:.3g} s")
+        if residual < tolerance:
+            break
+    best_control = np.empty(nodes, dtype=np.int64)
+    best_controls(exit_index, exit_weight, segment_cost, value, best_control)
+    iteration_seconds = time.perf_counter() - started - transition_seconds
+    if not quiet:
+        progress.finish(f"largest change {residual:.3g} s")
+    value = np.where(reachable, value, np.inf)
+    return Solution(
+        value, best_control, iterations, float(residual), transition_seconds, iteration_seconds
+    )
+
+
+def generate_controller(
+    spec: ControllerSpec,
+    dynamics: ModuleType,
+    out_path: str | Path,
+    tolerance: float | None = None,
+    max_iterations: int | None = None,
+    quiet: bool = False,
+) -> ControllerTable:
+    """Run the DP of a parsed spec on ``dynamics`` and write the table to ``out_path``.
+    ``tolerance``/``max_iterations`` override the spec's. Raises SpecError where the spec does
+    not fit the figure."""
+    started = time.perf_counter()
+    problem = build_problem(spec, dynamics)
+    solution = solve(
+        problem,
+        dynamics,
+        spec.tolerance if tolerance is None else tolerance,
+        spec.max_iterations if max_iterations is None else max_iterations,
+        spec.dt,
+        quiet=quiet,
+    )
+    generation_seconds = time.perf_counter() - started
+    grid = problem.grid
+    lower = np.array([c.minimum for c in spec.controls])
+    upper = np.array([c.maximum for c in spec.controls])
+    torque = problem.control_samples[solution.best_control]
+    unreachable = ~np.isfinite(solution.value)
+    torque[unreachable] = np.clip(0.0, lower, upper)
+    table = ControllerTable(
+        state_order=grid.names,
+        control_names=tuple(c.name for c in spec.controls),
+        axes=grid.axis_values(),
+        axis_units=grid.units,
+        wrap=tuple(bool(w) for w in grid.wrap),
+        torque=torque.reshape(grid.shape + (len(spec.controls),)),
+        value=solution.value.reshape(grid.shape),
+        control_min=lower,
+        control_max=upper,
+        effort_weight=np.array([c.effort_weight for c in spec.controls]),
+        dest=spec.destination_values(),
+        figure=spec.figure,
+        attrs={
+            "spec_sha256": spec.spec_sha256,
+            "generation_seconds": generation_seconds,
+            "transition_seconds": solution.transition_seconds,
+            "iteration_seconds": solution.iteration_seconds,
+            "iterations": solution.iterations,
+            "residual": solution.residual,
+            "converged": bool(
+                solution.residual < (spec.tolerance if tolerance is None else tolerance)
+            ),
+            "tolerance": spec.tolerance if tolerance is None else tolerance,
+            "dt": spec.dt,
+            "control_samples": np.array([c.samples for c in spec.controls], dtype=np.int64),
+            "unreachable_nodes": int(unreachable.sum()),
+            "mosys_version": __version__,
+        },
+    )
+    write_controller_table(out_path, table)
+    return table

@@ -1,0 +1,70 @@
+"""Shared fixtures: the real pendulum compiled from specs/ into a temporary results tree."""
+
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SPECS = ROOT / "specs"
+
+DOUBLE_INTEGRATOR = textwrap.dedent(
+    '''
+    """A unit point mass on a line, x'' = force: the textbook minimum-time problem."""
+    import numpy as np
+    from numba import njit, types
+
+    Q_NAMES = ("x",)
+    QD_NAMES = ("v",)
+    Q_IS_ANGLE = (False,)
+    TAU_NAMES = ("force",)
+    VECTOR = types.float64[::1]
+
+
+    @njit(types.void(VECTOR, VECTOR, VECTOR, VECTOR), cache=True)
+    def qdd_into(q, qd, tau, out):
+        out[0] = tau[0]
+    '''
+)
+
+
+@pytest.fixture(scope="session")
+def double_integrator(tmp_path_factory):
+    """The double integrator as a dynamics module (test input written by hand: only the names
+    the DP uses, so it is imported directly rather than through load_dynamics' checks)."""
+    import importlib.util
+    import sys
+
+    path = tmp_path_factory.mktemp("dynamics") / "double_integrator.py"
+    path.write_text(DOUBLE_INTEGRATOR)
+    spec = importlib.util.spec_from_file_location("mosys_test_double_integrator", path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="session")
+def link1(tmp_path_factory):
+    """The pendulum's dynamics, compiled from specs/figures/link1.fig."""
+    from mosys.dynamics.compile import compile_figure
+    from mosys.dynamics.load import load_dynamics
+
+    path = tmp_path_factory.mktemp("dynamics") / "link1.py"
+    compile_figure(SPECS / "figures" / "link1.fig", path)
+    return load_dynamics(path)
+
+
+@pytest.fixture(scope="session")
+def pendulum_tables(tmp_path_factory, link1):
+    """The six pendulum controllers A–F generated from specs/controllers/pendulum."""
+    from mosys.parsing.controller import parse_controller_spec
+    from mosys.ssc.generate import generate_controller
+
+    directory = tmp_path_factory.mktemp("controllers")
+    for name in "ABCDEF":
+        spec = parse_controller_spec(SPECS / "controllers" / "pendulum" / f"{name}.ssc")
+        generate_controller(spec, link1, directory / f"{name}.h5", quiet=True)
+    return directory

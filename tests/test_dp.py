@@ -1,0 +1,132 @@
+"""The DP of §3.5 against known answers."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mosys.io.controller_table import read_controller_table
+from mosys.parsing.controller import parse_controller_text
+from mosys.ssc.generate import generate_controller
+
+DOUBLE_INTEGRATOR_SPEC = """
+dyn double_integrator
+ssd x -2 2 41
+ssd v -2 2 41
+torq force -1 1 3 0
+dest x=0 v=0
+"""
+
+
+def minimum_time_to_the_origin(x: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Bang-bang minimum time to the origin of x'' = u, |u| <= 1 (the textbook solution)."""
+    above = x + v * np.abs(v) / 2 > 0
+    return np.where(
+        above, v + 2 * np.sqrt(np.abs(x + v**2 / 2)), -v + 2 * np.sqrt(np.abs(-x + v**2 / 2))
+    )
+
+
+def minimum_time_to_the_line(x: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Minimum time to reach x = 0 at any speed: full force towards the line."""
+    return np.where(x > 0, v + np.sqrt(v**2 + 2 * np.abs(x)), -v + np.sqrt(v**2 + 2 * np.abs(x)))
+
+
+def generate(double_integrator, path, text):
+    spec = parse_controller_text(text, "double_integrator.ssc")
+    return generate_controller(spec, double_integrator, path, quiet=True)
+
+
+@pytest.fixture(scope="module")
+def to_the_line(double_integrator, tmp_path_factory):
+    """dest names x only: every node with x = 0, whatever its speed, is a destination."""
+    path = tmp_path_factory.mktemp("dp") / "line.h5"
+    return generate(double_integrator, path, DOUBLE_INTEGRATOR_SPEC.replace(" v=0", ""))
+
+
+@pytest.fixture(scope="module")
+def to_the_origin(double_integrator, tmp_path_factory):
+    path = tmp_path_factory.mktemp("dp") / "origin.h5"
+    generate(double_integrator, path, DOUBLE_INTEGRATOR_SPEC)
+    return read_controller_table(path)
+
+
+def test_cost_to_go_matches_the_minimum_time_to_a_line(to_the_line):
+    x, v = np.meshgrid(*to_the_line.axes, indexing="ij")
+    exact = minimum_time_to_the_line(x, v)
+    reachable = np.isfinite(to_the_line.value)
+    # where full force reaches the line without leaving the domain (|v| <= 2 on the way)
+    compared = reachable & (exact > 0.2) & (x != 0) & (np.abs(x) <= 1.0) & (np.abs(v) <= 1.0)
+    relative = np.abs(to_the_line.value - exact)[compared] / exact[compared]
+    assert np.median(relative) < 0.005
+    assert relative.max() < 0.1
+    # every destination node costs 0; states that must leave the domain to stop are unreachable
+    assert np.all(to_the_line.value[x == 0] == 0)
+    assert reachable[(np.abs(x) <= 1.0) & (np.abs(v) <= 1.0)].all()
+    # only states that cannot stop inside the domain are unreachable (stopping point past ±2 m)
+    cannot_stop = np.abs(x + v * np.abs(v) / 2) > 2.0
+    assert (~reachable).any()
+    assert np.all(cannot_stop[~reachable])
+
+
+def test_single_node_destination_converges_with_the_grid(
+    double_integrator, to_the_origin, tmp_path
+):
+    """Reaching one node exactly is the hard case for an interpolating DP (the paper's method):
+    the cost-to-go overestimates the exact minimum time, and less so on a finer grid."""
+    finer = generate(
+        double_integrator,
+        tmp_path / "finer.h5",
+        DOUBLE_INTEGRATOR_SPEC.replace("41", "81") + "dt 0.0005\n",
+    )
+    errors = []
+    for table in (to_the_origin, finer):
+        x, v = np.meshgrid(*table.axes, indexing="ij")
+        inner = (np.abs(x) <= 1.0) & (np.abs(v) <= 1.0) & (minimum_time_to_the_origin(x, v) > 0.5)
+        exact = minimum_time_to_the_origin(x, v)[inner]
+        assert np.isfinite(table.value[inner]).all()
+        errors.append(np.median((table.value[inner] - exact) / exact))
+    assert 0 < errors[1] < errors[0] < 0.35
+
+
+def test_policy_is_bang_bang_on_the_right_side_of_the_switching_curve(to_the_origin):
+    table = to_the_origin
+    x, v = np.meshgrid(*table.axes, indexing="ij")
+    switching = x + v * np.abs(v) / 2
+    force = table.torque[..., 0]
+    inner = (np.abs(x) <= 1.5) & (np.abs(v) <= 1.0) & np.isfinite(table.value)
+    assert np.all(force[(switching > 0.3) & inner] == -1.0)
+    assert np.all(force[(switching < -0.3) & inner] == 1.0)
+
+
+def test_table_meets_the_contract(to_the_origin):
+    """The table as read back from disk has the contract's layout."""
+    table = to_the_origin
+    assert table.state_order == ("x", "v")
+    assert table.torque.shape == (41, 41, 1)
+    assert table.value.shape == (41, 41)
+    assert table.axis_units == ("m", "m/s")
+    assert table.attrs["residual"] < table.attrs["tolerance"]
+    for key in ("format_version", "spec_sha256", "generation_seconds", "iterations"):
+        assert key in table.attrs
+
+
+def test_unreachable_states_keep_infinite_cost(double_integrator, tmp_path):
+    """With force limited to [0.5, 1] the mass always accelerates to the right: from x > 0 moving
+    right it can never come back to the origin."""
+    spec = parse_controller_text(
+        DOUBLE_INTEGRATOR_SPEC.replace("torq force -1 1 3 0", "torq force 0.5 1 2 0"),
+        "one_way.ssc",
+    )
+    table = generate_controller(spec, double_integrator, tmp_path / "one_way.h5", quiet=True)
+    x, v = np.meshgrid(*table.axes, indexing="ij")
+    assert np.all(np.isinf(table.value[(x > 0.05) & (v >= 0)]))
+    assert table.attrs["unreachable_nodes"] == int(np.isinf(table.value).sum())
+    assert table.attrs["unreachable_nodes"] > 0
+
+
+def test_same_spec_gives_the_same_table_bit_for_bit(double_integrator, tmp_path):
+    spec = parse_controller_text(DOUBLE_INTEGRATOR_SPEC, "double_integrator.ssc")
+    first = generate_controller(spec, double_integrator, tmp_path / "a.h5", quiet=True)
+    second = generate_controller(spec, double_integrator, tmp_path / "b.h5", quiet=True)
+    assert np.array_equal(first.value, second.value)
+    assert np.array_equal(first.torque, second.torque)

@@ -1,0 +1,327 @@
+"""The .anim grammar: Figure 15, whole-message errors, and hypothesis fuzzing."""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from mosys.parsing.script import (
+    AnimationScript,
+    SetState,
+    Simulate,
+    SwapController,
+    parse_script,
+    parse_script_text,
+    render_script,
+)
+from mosys.parsing.tokens import SpecError, Token
+
+ROOT = Path(__file__).resolve().parents[1]
+PENDULUM = ROOT / "specs" / "scripts" / "pendulum.anim"
+FIGURE_15 = [("B", 0.4), ("A", 0.7), ("D", 0.6), ("E", 0.4), ("C", 0.4), ("F", 0.7)]
+BASE = """\
+state link -135,350
+swapcon link conB.ctab
+sim 0.4
+"""
+
+
+def values(script: AnimationScript) -> tuple:
+    """The commands without tokens."""
+    out = []
+    for command in script.commands:
+        if isinstance(command, SetState):
+            out.append(("state", command.object, command.values))
+        elif isinstance(command, SwapController):
+            out.append(("swapcon", command.object, command.table, command.controller))
+        else:
+            out.append(("sim", command.seconds))
+    return tuple(out)
+
+
+def test_pendulum_script():
+    script = parse_script(PENDULUM)
+    expected = [("state", "link", (-135.0, 350.0))]
+    for name, seconds in FIGURE_15:
+        expected += [("swapcon", "link", f"con{name}.ctab", name), ("sim", seconds)]
+    assert values(script) == tuple(expected)
+    assert script.path == str(PENDULUM)
+    assert script.name == "pendulum"
+    assert script.object == "link"
+    assert script.controllers() == ("B", "A", "D", "E", "C", "F")
+    assert script.duration() == pytest.approx(3.2)
+    assert script.spec_sha256 == hashlib.sha256(PENDULUM.read_bytes()).hexdigest()
+    state, swap, sim = script.commands[:3]
+    assert state.token == Token("state", 1, 1)
+    assert state.object_token == Token("link", 1, 7)
+    assert state.value_tokens == (Token("-135", 1, 12), Token("350", 1, 17))
+    assert swap.table_token == Token("conB.ctab", 2, 14)
+    assert sim.seconds_token == Token("0.4", 3, 5)
+
+
+def test_pendulum_script_is_figure_15_verbatim():
+    lines = ["state link -135,350\t# starting state"]
+    for name, seconds in FIGURE_15:
+        lines.append(f"swapcon link con{name}.ctab\t# invoke controller {name}")
+        lines.append(f"sim {seconds}\t# simulate {seconds} seconds")
+    assert PENDULUM.read_text() == "\n".join(lines) + "\n"
+
+
+@pytest.mark.parametrize(
+    "written", ["-135,350", "-135, 350", "-135 ,350", "-135 , 350", "-135 350", "-135,\t350"]
+)
+def test_state_value_spellings(written):
+    script = parse_script_text(BASE.replace("-135,350", written))
+    assert script.commands[0].values == (-135.0, 350.0)
+
+
+def test_plain_controller_names_restates_and_trailing_commands():
+    script = parse_script_text(
+        "state link 1e1\nswapcon link B\nsim 1\nstate link -5,5,6\nsim 2\nswapcon link con_x.ctab\n"
+    )
+    assert values(script) == (
+        ("state", "link", (10.0,)),
+        ("swapcon", "link", "B", "B"),
+        ("sim", 1.0),
+        ("state", "link", (-5.0, 5.0, 6.0)),
+        ("sim", 2.0),
+        ("swapcon", "link", "con_x.ctab", "_x"),
+    )
+    assert script.controllers() == ("B", "_x")
+
+
+def test_error_helper_points_at_tokens():
+    script = parse_script_text(BASE, "x.anim")
+    assert str(script.error(script.commands[1].table_token, "a built controller of link1")) == (
+        "x.anim:2:14: expected a built controller of link1, found 'conB.ctab'"
+    )
+
+
+ERRORS = [
+    (
+        "sim 0.4\n" + BASE,
+        "x.anim:1:1: expected a 'state' line before the first 'sim', found 'sim'",
+    ),
+    (
+        "state link -135,350\nsim 0.4\n",
+        "x.anim:2:1: expected a 'swapcon' line before the first 'sim', found 'sim'",
+    ),
+    (
+        "swapcon link conB.ctab\n" + BASE,
+        "x.anim:1:9: expected an object declared by an earlier 'state' line, found 'link'",
+    ),
+    (
+        BASE.replace("conB.ctab", "B.h5"),
+        "x.anim:2:14: expected a controller table 'conX.ctab' or a controller name, found 'B.h5'",
+    ),
+    (
+        BASE.replace("conB.ctab", "con.ctab"),
+        "x.anim:2:14: expected a controller table 'conX.ctab' or a controller name, "
+        "found 'con.ctab'",
+    ),
+    (
+        BASE.replace(" conB.ctab", ""),
+        "x.anim:2:13: expected a controller table 'conX.ctab' or a controller name, "
+        "found end of line",
+    ),
+    (
+        BASE.replace("conB.ctab", "conB.ctab conA.ctab"),
+        "x.anim:2:24: expected end of line, found 'conA.ctab'",
+    ),
+    (BASE.replace("sim 0.4", "sim 0"), "x.anim:3:5: expected a number > 0 for seconds, found '0'"),
+    (
+        BASE.replace("sim 0.4", "sim -0.4"),
+        "x.anim:3:5: expected a number > 0 for seconds, found '-0.4'",
+    ),
+    (
+        BASE.replace("sim 0.4", "sim 0.4s"),
+        "x.anim:3:5: expected a number for seconds, found '0.4s'",
+    ),
+    (
+        BASE.replace("sim 0.4", "sim"),
+        "x.anim:3:4: expected a number for seconds, found end of line",
+    ),
+    (
+        BASE.replace("sim 0.4", "sim 0.4 0.5"),
+        "x.anim:3:9: expected end of line, found '0.5'",
+    ),
+    (
+        BASE.replace("-135,350", "-135,,350"),
+        "x.anim:1:17: expected a number for state value 2 of 'link', found ','",
+    ),
+    (
+        BASE.replace("-135,350", "-135, ,350"),
+        "x.anim:1:18: expected a number for state value 2 of 'link', found ','",
+    ),
+    (
+        BASE.replace("-135,350", ",-135,350"),
+        "x.anim:1:12: expected a number for state value 1 of 'link', found ','",
+    ),
+    (
+        BASE.replace("-135,350", "-135,"),
+        "x.anim:1:17: expected a number for state value 2 of 'link', found end of line",
+    ),
+    (
+        BASE.replace("-135,350", "-135,fast"),
+        "x.anim:1:17: expected a number for state value 2 of 'link', found 'fast'",
+    ),
+    (
+        BASE.replace(" -135,350", ""),
+        "x.anim:1:11: expected a number for state value 1 of 'link', found end of line",
+    ),
+    (
+        "state\n",
+        "x.anim:1:6: expected a name for the object, found end of line",
+    ),
+    (
+        BASE.replace("swapcon link", "swapcon cart"),
+        "x.anim:2:9: expected object 'link' (a script animates one object; line 1), found 'cart'",
+    ),
+    (
+        BASE + "state 2link 0,0\n",
+        "x.anim:4:7: expected a name for the object, found '2link'",
+    ),
+    (
+        BASE + "simulate 0.4\n",
+        "x.anim:4:1: expected one of 'state', 'swapcon', 'sim', found 'simulate'",
+    ),
+    ("", "x.anim:1:1: expected a 'state' line, found end of file"),
+    ("# nothing\n\n", "x.anim:1:1: expected a 'state' line, found end of file"),
+    ("state link 0,0\n", "x.anim:2:1: expected a 'swapcon' line, found end of file"),
+    (
+        "state link 0,0\nswapcon link conA.ctab # no sim\n\n",
+        "x.anim:3:1: expected a 'sim' line, found end of file",
+    ),
+]
+
+
+@pytest.mark.parametrize(("text", "message"), ERRORS)
+def test_error_messages(text, message):
+    with pytest.raises(SpecError) as error:
+        parse_script_text(text, "x.anim")
+    assert str(error.value) == message
+
+
+def test_file_errors(tmp_path):
+    missing = tmp_path / "missing.anim"
+    with pytest.raises(SpecError) as error:
+        parse_script(missing)
+    assert str(error.value) == f"{missing}:1:1: expected an existing spec file, found end of line"
+    bad = tmp_path / "bad.anim"
+    bad.write_text(BASE.replace("sim 0.4", "sim 0"))
+    with pytest.raises(SpecError) as error:
+        parse_script(bad)
+    assert str(error.value) == f"{bad}:3:5: expected a number > 0 for seconds, found '0'"
+
+
+# --- hypothesis -----------------------------------------------------------------------------
+
+SOURCE = PENDULUM.read_text()
+WORDS = [
+    *("state", "swapcon", "sim", "link", "conB.ctab", "con.ctab", "B", "-135,350", ","),
+    *("1,", ",2", "0", "-0.4", "0.4", "1e999", "nan", "#", "=", "cart"),
+]
+garbage = st.one_of(
+    st.sampled_from(WORDS),
+    st.text(st.characters(codec="utf-8"), min_size=1, max_size=8),
+    st.floats(allow_nan=True, allow_infinity=True).map(repr),
+    st.lists(st.floats(-1e3, 1e3).map(repr), min_size=1, max_size=3).map(",".join),
+)
+FAST = settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+
+def parses_or_spec_error(text: str) -> None:
+    try:
+        script = parse_script_text(text, "fuzz.anim")
+    except SpecError as error:
+        assert str(error).startswith("fuzz.anim:")
+        assert 1 <= error.line <= len(text.splitlines()) + 1 and error.column >= 1
+    else:
+        assert any(isinstance(command, Simulate) for command in script.commands)
+        assert values(parse_script_text(render_script(script))) == values(script)
+
+
+@FAST
+@given(st.text())
+def test_any_text_parses_or_raises_spec_error(text):
+    parses_or_spec_error(text)
+
+
+@FAST
+@given(st.lists(st.lists(garbage, max_size=5).map(" ".join), max_size=8).map("\n".join))
+def test_keyword_soup_parses_or_raises_spec_error(text):
+    parses_or_spec_error(text)
+
+
+@st.composite
+def mutated_scripts(draw):
+    lines = [line.split() for line in SOURCE.splitlines()]
+    for _ in range(draw(st.integers(1, 4))):
+        row = draw(st.integers(0, len(lines) - 1))
+        kind = draw(st.sampled_from(["delete", "duplicate", "replace", "swap", "dup_line"]))
+        tokens = lines[row]
+        if kind == "swap":
+            other = draw(st.integers(0, len(lines) - 1))
+            lines[row], lines[other] = lines[other], lines[row]
+        elif kind == "dup_line":
+            lines.insert(row, list(tokens))
+        elif tokens:
+            column = draw(st.integers(0, len(tokens) - 1))
+            if kind == "delete":
+                del tokens[column]
+            elif kind == "duplicate":
+                tokens.insert(column, tokens[column])
+            else:
+                tokens[column] = draw(garbage)
+    return "\n".join(" ".join(tokens) for tokens in lines)
+
+
+@FAST
+@given(mutated_scripts())
+def test_mutated_scripts_parse_or_raise_spec_error(text):
+    parses_or_spec_error(text)
+
+
+NAMES = st.from_regex(r"[A-Za-z_][A-Za-z0-9_]{0,5}", fullmatch=True)
+NUMBERS = st.floats(allow_nan=False, allow_infinity=False)
+
+
+@st.composite
+def scripts(draw) -> AnimationScript:
+    token = Token("x", 1, 1)
+    target = draw(NAMES)
+
+    def state():
+        return SetState(
+            target, tuple(draw(st.lists(NUMBERS, min_size=1, max_size=5))), token, token, ()
+        )
+
+    def swap():
+        controller = draw(NAMES)
+        table = draw(st.sampled_from([f"con{controller}.ctab", controller]))
+        return SwapController(target, table, controller, token, token, token)
+
+    def sim():
+        seconds = draw(st.floats(min_value=1e-6, max_value=1e6, allow_nan=False))
+        return Simulate(seconds, token, token)
+
+    commands = [state(), swap(), sim()]
+    for _ in range(draw(st.integers(0, 8))):
+        commands.insert(
+            draw(st.integers(3, len(commands))), draw(st.sampled_from([state, swap, sim]))()
+        )
+    return AnimationScript("generated.anim", tuple(commands), "")
+
+
+@FAST
+@given(scripts())
+def test_render_then_parse_round_trips(script):
+    text = render_script(script)
+    parsed = parse_script_text(text, "generated.anim")
+    assert values(parsed) == values(script)
+    assert parsed.spec_sha256 == hashlib.sha256(text.encode()).hexdigest()
+    assert render_script(parsed) == text

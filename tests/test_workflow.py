@@ -1,0 +1,143 @@
+"""The real Snakemake workflow on a temporary copy: it builds results/pendulum_all, and editing
+one spec rebuilds exactly what depends on it."""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PENDULUM_CONTROLLERS = "ABCDEF"
+
+
+@pytest.fixture(scope="module")
+def workflow(tmp_path_factory) -> Path:
+    """A copy of the workflow, its specs and sources (their mtimes are rule inputs), built once."""
+    work = tmp_path_factory.mktemp("workflow")
+    for name in ("Snakefile", "workflow", "config", "profiles", "specs", "src"):
+        source = ROOT / name
+        if source.is_dir():
+            shutil.copytree(source, work / name, ignore=shutil.ignore_patterns("__pycache__"))
+        else:
+            shutil.copy2(source, work / name)
+    snakemake(work, "results/pendulum_all")
+    return work
+
+
+def snakemake(work: Path, *args: str) -> str:
+    done = subprocess.run(
+        ["snakemake", "-c2", *args],
+        cwd=work,
+        capture_output=True,
+        text=True,
+        env=dict(os.environ),
+    )
+    assert done.returncode == 0, done.stdout + done.stderr
+    return done.stdout + done.stderr
+
+
+def planned_jobs(work: Path) -> dict[str, int]:
+    """Rule name -> job count of a dry run of results/pendulum_all ({} when nothing to do)."""
+    output = snakemake(work, "--dry-run", "results/pendulum_all")
+    if "Nothing to be done" in output:
+        return {}
+    stats = output.split("Job stats:", 1)[1]
+    return {
+        rule: int(count)
+        for rule, count in re.findall(r"^(\w+)\s+(\d+)$", stats, re.M)
+        if rule != "total"
+    }
+
+
+def mtimes(work: Path) -> dict[str, int]:
+    return {
+        str(p.relative_to(work)): p.stat().st_mtime_ns
+        for p in (work / "results").rglob("*")
+        if p.is_file()
+        and "logs" not in p.parts
+        and "benchmarks" not in p.parts
+        and "__pycache__" not in p.parts
+    }
+
+
+def test_pendulum_all_lists_every_output(workflow):
+    index = (workflow / "results/pendulum_all").read_text().split()
+    for name in PENDULUM_CONTROLLERS:
+        assert f"results/controllers/pendulum/{name}.h5" in index
+        assert f"results/plots/pendulum/{name}_portrait.png" in index
+        assert f"results/plots/pendulum/{name}_torque.png" in index
+    for path in (
+        "results/trajectories/pendulum.h5",
+        "results/plots/pendulum/pendulum.gif",
+        "results/plots/pendulum/pendulum_path.png",
+        "results/tables/pendulum_controllers.md",
+    ):
+        assert path in index
+    for path in index:
+        assert (workflow / path).stat().st_size > 0
+
+
+def test_nothing_runs_when_nothing_changed(workflow):
+    assert planned_jobs(workflow) == {}
+
+
+def test_editing_one_controller_rebuilds_only_its_dependents(workflow):
+    spec = workflow / "specs/controllers/pendulum/B.ssc"
+    spec.write_text(spec.read_text().replace("dest angle=120 omega=0", "dest angle=110 omega=0"))
+    jobs = planned_jobs(workflow)
+    assert jobs.get("dp_controller") == 1
+    assert jobs.get("portrait_plot") == 1 and jobs.get("torque_plot") == 1
+    assert "compile_dynamics" not in jobs
+    before = mtimes(workflow)
+    snakemake(workflow, "results/pendulum_all")
+    after = mtimes(workflow)
+    changed = {path for path in after if after[path] != before.get(path)}
+    assert changed == {
+        "results/controllers/pendulum/B.h5",
+        "results/plots/pendulum/B_portrait.png",
+        "results/plots/pendulum/B_torque.png",
+        "results/trajectories/pendulum.h5",  # the script uses B
+        "results/plots/pendulum/pendulum_path.png",
+        "results/plots/pendulum/pendulum.gif",
+        "results/tables/pendulum_controllers.csv",
+        "results/tables/pendulum_controllers.md",
+        "results/pendulum_all",
+    }
+    assert planned_jobs(workflow) == {}
+
+
+def test_editing_the_figure_rebuilds_all_six_controllers(workflow):
+    figure = workflow / "specs/figures/link1.fig"
+    figure.write_text(figure.read_text() + "\n# an edit\n")
+    jobs = planned_jobs(workflow)
+    assert jobs.get("compile_dynamics") == 1
+    assert jobs.get("dp_controller") == len(PENDULUM_CONTROLLERS)
+    assert jobs.get("portrait_plot") == len(PENDULUM_CONTROLLERS)
+
+
+def test_broken_spec_fails_with_its_location_and_leaves_no_output(workflow):
+    spec = workflow / "specs/controllers/pendulum/C.ssc"
+    spec.write_text(
+        spec.read_text().replace(
+            "torq torque -10.0 10.0 11 0.1", "torq torque -10.0 10.0 eleven 0.1"
+        )
+    )
+    done = subprocess.run(
+        ["snakemake", "-c2", "results/controllers/pendulum/C.h5"],
+        cwd=workflow,
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode != 0
+    line = next(n for n, text in enumerate(spec.read_text().splitlines(), 1) if "eleven" in text)
+    expected = (
+        f"specs/controllers/pendulum/C.ssc:{line}:23: expected a whole number for "
+        "samples, found 'eleven'"
+    )
+    assert expected in done.stdout + done.stderr
+    assert not (workflow / "results/controllers/pendulum/C.h5").exists()

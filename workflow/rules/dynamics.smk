@@ -1,0 +1,12 @@
+rule compile_dynamics:
+    input:
+        spec="specs/figures/{figure}.fig",
+        code=package_sources("dynamics"),
+    output:
+        "results/dynamics/{figure}.py",
+    log:
+        "results/logs/dynamics/{figure}.log",
+    benchmark:
+        "results/benchmarks/dynamics/{figure}.tsv"
+    shell:
+        "mosys compile {input.spec} -o {output} 2> {log} || (cat {log} >&2; exit 1)"

@@ -1,0 +1,16 @@
+rule run_script:
+    input:
+        script="specs/scripts/{script}.anim",
+        needs=script_inputs,
+        code=package_sources("ssc", "scripts"),
+    output:
+        "results/trajectories/{script}.h5",
+    log:
+        "results/logs/scripts/{script}.log",
+    params:
+        controllers=lambda wildcards: f"results/controllers/{script_group(wildcards.script)}",
+        dt=config["simulation"]["dt"],
+    shell:
+        "mosys run {input.script} --controllers {params.controllers}"
+        " --dynamics-dir results/dynamics --dt {params.dt} -o {output} 2> {log}"
+        " || (cat {log} >&2; exit 1)"

@@ -1,0 +1,14 @@
+rule dp_controller:
+    input:
+        spec="specs/controllers/{group}/{name}.ssc",
+        dynamics=controller_dynamics,
+        code=package_sources("ssc"),
+    output:
+        "results/controllers/{group}/{name}.h5",
+    log:
+        "results/logs/dp/{group}/{name}.log",
+    benchmark:
+        "results/benchmarks/dp/{group}/{name}.tsv"
+    shell:
+        "mosys dp {input.spec} --dynamics-dir results/dynamics -o {output} 2> {log}"
+        " || (cat {log} >&2; exit 1)"

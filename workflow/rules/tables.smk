@@ -1,0 +1,15 @@
+rule pendulum_table:
+    input:
+        tables=pendulum_controller_tables(),
+        dynamics=f"results/dynamics/{config['pendulum']['figure']}.py",
+        code=package_sources("ssc", "scripts", "tables"),
+    output:
+        csv="results/tables/pendulum_controllers.csv",
+        md="results/tables/pendulum_controllers.md",
+    log:
+        "results/logs/tables/pendulum_controllers.log",
+    params:
+        budget=config["budget"],
+    shell:
+        "mosys table {input.tables} --dynamics {input.dynamics} --budget {params.budget}"
+        " --csv {output.csv} --md {output.md} 2> {log} || (cat {log} >&2; exit 1)"
