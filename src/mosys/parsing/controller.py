@@ -30,7 +30,7 @@ from mosys.parsing.tokens import (
     Token,
     missing_line,
     parse_number,
-    read_spec,
+    read_spec_text,
     tokenize,
     unknown_keyword,
     value_token,
@@ -186,21 +186,9 @@ class ControllerSpec:
         return tuple(sorted(self.state, key=lambda dimension: rank[dimension.name]))
 
 
-def read_spec_with_sha256(path: str | Path) -> tuple[str, str]:
-    """The text of a spec file and the hex SHA-256 of its bytes, read once. A missing or
-    non-UTF-8 file raises the shared SpecError of ``read_spec``."""
-    try:
-        data = Path(path).read_bytes()
-        text = data.decode("utf-8")
-    except (FileNotFoundError, UnicodeDecodeError):
-        read_spec(path)  # raises the shared SpecError for these cases
-        raise
-    return text, hashlib.sha256(data).hexdigest()
-
-
 def parse_controller_spec(path: str | Path) -> ControllerSpec:
     """Parse a ``.ssc`` file; any problem raises SpecError naming file, line and column."""
-    text, digest = read_spec_with_sha256(path)
+    text, digest = read_spec_text(path)
     return parse_controller_text(text, str(path), digest)
 
 

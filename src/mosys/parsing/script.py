@@ -19,7 +19,6 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from mosys.parsing.controller import read_spec_with_sha256
 from mosys.parsing.tokens import (
     NAME,
     Line,
@@ -27,6 +26,7 @@ from mosys.parsing.tokens import (
     Token,
     missing_line,
     parse_number,
+    read_spec_text,
     tokenize,
     unknown_keyword,
 )
@@ -112,7 +112,7 @@ class AnimationScript:
 
 def parse_script(path: str | Path) -> AnimationScript:
     """Parse a ``.anim`` file; any problem raises SpecError naming file, line and column."""
-    text, digest = read_spec_with_sha256(path)
+    text, digest = read_spec_text(path)
     return parse_script_text(text, str(path), digest)
 
 

@@ -7,6 +7,7 @@ grammar can report ``file:line:column: expected ..., found ...``.
 
 from __future__ import annotations
 
+import hashlib
 import math
 import re
 from collections.abc import Iterator
@@ -63,7 +64,9 @@ def tokenize(text: str, path: str) -> list[Line]:
     """Split spec text into lines of tokens. Comments (``#`` to the end of the line) and blank
     lines are dropped; line and column numbers refer to the original text."""
     lines = []
-    for number, raw in enumerate(text.splitlines(), start=1):
+    # lines end at '\n' only (as editors count them), not at every character splitlines() knows
+    for number, raw in enumerate(text.split("\n"), start=1):
+        raw = raw.removesuffix("\r")
         content = raw.split("#", 1)[0]
         tokens = tuple(
             Token(match.group(), number, match.start() + 1)
@@ -75,16 +78,26 @@ def tokenize(text: str, path: str) -> list[Line]:
     return lines
 
 
-def read_spec(path: str | Path) -> list[Line]:
-    """Read and tokenize a spec file; unreadable or non-UTF-8 files raise SpecError at 1:1."""
+def read_spec_text(path: str | Path) -> tuple[str, str]:
+    """The text of a spec file and the hex SHA-256 of its bytes, read once. A file that is
+    missing, unreadable or not UTF-8 raises SpecError at 1:1."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        data = path.read_bytes()
     except FileNotFoundError:
         raise SpecError(str(path), 1, 1, "an existing spec file", None) from None
+    except OSError as error:
+        raise SpecError(str(path), 1, 1, "a readable spec file", error.strerror) from None
+    try:
+        text = data.decode("utf-8")
     except UnicodeDecodeError as error:
         raise SpecError(str(path), 1, 1, "UTF-8 text", f"byte {error.start}") from None
-    return tokenize(text, str(path))
+    return text, hashlib.sha256(data).hexdigest()
+
+
+def read_spec(path: str | Path) -> list[Line]:
+    """Read and tokenize a spec file (errors as ``read_spec_text``)."""
+    return tokenize(read_spec_text(path)[0], str(path))
 
 
 def parse_number(token: Token, path: str, what: str, text: str | None = None) -> float:
