@@ -7,6 +7,7 @@ import os
 import re
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -29,14 +30,21 @@ def workflow(tmp_path_factory) -> Path:
     return work
 
 
-def snakemake(work: Path, *args: str) -> str:
-    done = subprocess.run(
-        ["snakemake", "-c2", *args],
+def run_snakemake(work: Path, *args: str) -> subprocess.CompletedProcess:
+    """Snakemake of this interpreter, with its scripts (mosys) first on PATH."""
+    bin_dir = str(Path(sys.executable).parent)
+    env = dict(os.environ, PATH=bin_dir + os.pathsep + os.environ.get("PATH", ""))
+    return subprocess.run(
+        [sys.executable, "-m", "snakemake", "-c2", *args],
         cwd=work,
         capture_output=True,
         text=True,
-        env=dict(os.environ),
+        env=env,
     )
+
+
+def snakemake(work: Path, *args: str) -> str:
+    done = run_snakemake(work, *args)
     assert done.returncode == 0, done.stdout + done.stderr
     return done.stdout + done.stderr
 
@@ -127,12 +135,7 @@ def test_broken_spec_fails_with_its_location_and_leaves_no_output(workflow):
             "torq torque -10.0 10.0 11 0.1", "torq torque -10.0 10.0 eleven 0.1"
         )
     )
-    done = subprocess.run(
-        ["snakemake", "-c2", "results/controllers/pendulum/C.h5"],
-        cwd=workflow,
-        capture_output=True,
-        text=True,
-    )
+    done = run_snakemake(workflow, "results/controllers/pendulum/C.h5")
     assert done.returncode != 0
     line = next(n for n, text in enumerate(spec.read_text().splitlines(), 1) if "eleven" in text)
     expected = (

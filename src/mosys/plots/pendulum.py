@@ -1,0 +1,730 @@
+"""The pendulum plots of the 1990 paper (§5.2), regenerated: ``mosys plot KIND INPUTS -o OUT``.
+
+- ``portrait``: state-space paths under one controller from a spread of start states (Figure 14).
+- ``torque``: a controller's torque table as a heat map, with cost-to-go contours.
+- ``script``: an animation script's path through state space, controller by controller (Figure 16).
+- ``gif``: the pendulum swinging through a script, drawn from the trajectory's ``figure_motion``.
+
+State-space plots put the table's first state variable (the angle θ, deg) across and the second
+(the rate ω, deg/s) up. A wrap axis is cylindrical, as in the paper: its left and right edges are
+the same angle, and a path that crosses them leaves at one edge and comes back at the other.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from types import ModuleType
+
+import matplotlib
+import numpy as np
+from matplotlib import patheffects
+from matplotlib.axes import Axes
+from matplotlib.lines import Line2D
+from matplotlib.ticker import MultipleLocator
+from matplotlib.transforms import Bbox
+
+from mosys.io.atomic import write_atomically
+from mosys.io.attributes import string_tuple
+from mosys.io.controller_table import ControllerTable, read_controller_table
+from mosys.io.trajectory import Trajectory, read_trajectory
+from mosys.plots.style import (
+    DESTINATION_COLOR,
+    SYMBOLS,
+    add_legend,
+    axis_label,
+    controller_colors,
+    destination_handle,
+    mark_destination,
+    mark_start,
+    new_figure,
+    plot_style,
+    save_png,
+    start_style,
+)
+
+PORTRAIT_STARTS = 8  # start states per portrait
+PORTRAIT_SECONDS = 3.0  # s simulated from each start
+CYCLE_SECONDS = (3.0, 5.0)  # s: a periodic destination's cycle is drawn over this window
+GIF_FPS = 25  # frames per second of the animations
+GIF_DPI = 80  # dots per inch of the animation frames
+DEFAULT_DT = 0.001  # s: simulator step when a table does not record its own
+
+
+class PlotInputError(ValueError):
+    """The inputs cannot make the requested plot (wrong count, wrong kind of file...)."""
+
+
+@dataclass(frozen=True)
+class StateAxis:
+    """One axis of a state-space plot: the state variable, its spec unit, the plotted range
+    [low, high] (spec units) and its wrap period (None: not periodic)."""
+
+    name: str
+    unit: str
+    low: float
+    high: float
+    period: float | None
+
+
+# --------------------------------------------------------------------------- cylindrical paths
+
+
+def split_at_wraps(angle: np.ndarray, period: float) -> list[slice]:
+    """Cut a wrapped angle (N,) into runs of consecutive samples wherever it jumps between
+    neighbours by more than half the ``period`` (same unit): the path went round the cylinder.
+    Within a run no step exceeds period / 2; the runs, in order, cover every sample once. Plot
+    each run as its own line so that no line streaks across a cylindrical plot."""
+    angle = np.asarray(angle, dtype=np.float64)
+    if angle.ndim != 1:
+        raise ValueError(f"angle must be 1-D, got shape {angle.shape}")
+    if not period > 0:
+        raise ValueError(f"period must be positive, got {period!r}")
+    return _slices(_wrap_breaks(angle, period), len(angle))
+
+
+def _wrap_breaks(angle: np.ndarray, period: float) -> np.ndarray:
+    """Indices i where |angle[i] - angle[i-1]| > period / 2."""
+    return np.flatnonzero(np.abs(np.diff(angle)) > period / 2) + 1
+
+
+def _slices(breaks, count: int) -> list[slice]:
+    bounds = [0, *sorted(int(b) for b in breaks), count]
+    return [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:], strict=True) if b > a]
+
+
+def _unwrap_near(point: np.ndarray, reference: np.ndarray, axes: Sequence[StateAxis]):
+    """``point`` shifted by whole periods along the wrap axes to lie nearest ``reference``."""
+    shifted = np.array(point, dtype=np.float64)
+    for k, axis in enumerate(axes):
+        if axis.period:
+            shifted[k] += axis.period * np.round((reference[k] - shifted[k]) / axis.period)
+    return shifted
+
+
+def cylinder_pieces(points: np.ndarray, axes: Sequence[StateAxis]) -> list[np.ndarray]:
+    """Split a path (N, 2) at every wrap of a periodic axis into pieces (M_k, 2) to plot one by
+    one. Each piece is extended by its neighbour sample, shifted by a period, so that it runs
+    on to the plot's edge (where the axes clip it) instead of stopping one sample short."""
+    points = np.asarray(points, dtype=np.float64)
+    breaks: set[int] = set()
+    for k, axis in enumerate(axes):
+        if axis.period:
+            breaks.update(_wrap_breaks(points[:, k], axis.period).tolist())
+    pieces = []
+    for piece in _slices(breaks, len(points)):
+        rows = [points[piece]]
+        if piece.start > 0:
+            rows.insert(0, _unwrap_near(points[piece.start - 1], points[piece.start], axes)[None])
+        if piece.stop < len(points):
+            rows.append(_unwrap_near(points[piece.stop], points[piece.stop - 1], axes)[None])
+        pieces.append(np.concatenate(rows))
+    return pieces
+
+
+def _plot_path(ax: Axes, points: np.ndarray, axes: Sequence[StateAxis], **style) -> None:
+    """Plot a path on cylindrical axes; ``label`` (if any) goes on the first piece only."""
+    for piece in cylinder_pieces(points, axes):
+        ax.plot(piece[:, 0], piece[:, 1], **style)
+        style.pop("label", None)
+
+
+# --------------------------------------------------------------------------- axes and labels
+
+
+def table_axes(table: ControllerTable, path: str | Path = "") -> tuple[StateAxis, StateAxis]:
+    """The two plot axes of a 2-D controller table; PlotInputError for any other dimension."""
+    if len(table.state_order) != 2:
+        raise PlotInputError(
+            f"{path}: a pendulum plot needs a 2-D controller table, this one has state "
+            f"{', '.join(table.state_order)}"
+        )
+    axes = []
+    for name, grid, unit, wrap in zip(
+        table.state_order, table.axes, table.axis_units, table.wrap, strict=True
+    ):
+        if wrap:
+            period = len(grid) * (grid[-1] - grid[0]) / (len(grid) - 1)
+            axes.append(StateAxis(name, unit, float(grid[0]), float(grid[0] + period), period))
+        else:
+            axes.append(StateAxis(name, unit, float(grid[0]), float(grid[-1]), None))
+    return tuple(axes)
+
+
+def trajectory_axes(trajectory: Trajectory) -> tuple[StateAxis, StateAxis]:
+    """Plot axes for a pendulum trajectory read without its controller tables: the first state
+    variable an angle in degrees, periodic over 360 (the range of the data: [-180, 180) or
+    [0, 360)); the second a rate in deg/s, over at least [-500, 500] (the paper's scale)."""
+    if trajectory.state.ndim != 2 or trajectory.state.shape[1] != 2:
+        raise PlotInputError(f"a pendulum plot needs a 2-D state, got {trajectory.state_order}")
+    angle, rate = trajectory.state[:, 0], trajectory.state[:, 1]
+    low = -180.0 if angle.min() >= -180.0 and angle.max() < 180.0 else 0.0
+    reach = max(500.0, float(np.abs(rate).max()) * 1.05)
+    names = trajectory.state_order
+    return (
+        StateAxis(names[0], "deg", low, low + 360.0, 360.0),
+        StateAxis(names[1], "deg/s", -reach, reach, None),
+    )
+
+
+def _format_state_axes(ax: Axes, axes: Sequence[StateAxis], data: np.ndarray | None = None):
+    """Limits, labels and ticks of a state-space plot. A periodic axis spans exactly one period;
+    a non-periodic one its range (widened to ``data`` (N, 2) if that strays outside, the
+    range's edges then dashed) plus a 2 % margin so that lines along the edge stay visible."""
+    for k, (axis, limits, ticker) in enumerate(
+        zip(axes, (ax.set_xlim, ax.set_ylim), (ax.xaxis, ax.yaxis), strict=True)
+    ):
+        low, high = axis.low, axis.high
+        if not axis.period:
+            if data is not None and len(data):
+                low, high = min(low, float(data[:, k].min())), max(high, float(data[:, k].max()))
+                for edge in (axis.low, axis.high) if (low, high) != (axis.low, axis.high) else ():
+                    line = ax.axvline if k == 0 else ax.axhline
+                    line(edge, color="0.4", linestyle="--", linewidth=0.8, zorder=2)
+            margin = 0.02 * (high - low)
+            low, high = low - margin, high + margin
+        limits(low, high)
+        if axis.unit == "deg":
+            ticker.set_major_locator(MultipleLocator(60.0 if high - low > 200 else 30.0))
+        elif axis.unit == "deg/s" and high - low >= 500:
+            ticker.set_major_locator(MultipleLocator(100.0))
+    labels = [axis_label(a.name, a.unit) + (" — cylindrical" if a.period else "") for a in axes]
+    ax.set_xlabel(labels[0])
+    ax.set_ylabel(labels[1])
+
+
+def _format_value(value: float) -> str:
+    return f"{value:g}"
+
+
+def describe_state(values: dict[str, float], units: dict[str, str]) -> str:
+    """``θ = 120 deg, ω = 0 deg/s`` for a dict of named state values (spec units)."""
+    return ", ".join(
+        f"{SYMBOLS.get(name, name)} = {_format_value(value)} {units.get(name, '')}".rstrip()
+        for name, value in values.items()
+    )
+
+
+def destination_point(table: ControllerTable, axes: Sequence[StateAxis]) -> list[float | None]:
+    """The destination's coordinate along each plot axis (None: the destination leaves that
+    state variable free), wrapped into the plotted range."""
+    point: list[float | None] = []
+    for axis in axes:
+        value = table.dest.get(axis.name)
+        if value is not None and axis.period:
+            value = axis.low + (value - axis.low) % axis.period
+        point.append(None if value is None else float(value))
+    return point
+
+
+def _mark_table_destination(ax: Axes, table: ControllerTable, axes, color=DESTINATION_COLOR):
+    """Mark the destination (a line if it leaves one plotted variable free); returns its legend
+    handle, or None if it names neither plotted variable."""
+    x, y = destination_point(table, axes)
+    if x is not None and y is not None:
+        mark_destination(ax, x, y, color=color)
+        return destination_handle(color)
+    if x is None and y is None:
+        return None
+    line = ax.axvline(x) if x is not None else ax.axhline(y)
+    line.set(color=color, linestyle="--", linewidth=1.4, zorder=5)
+    return line
+
+
+def _destination_is_periodic(table: ControllerTable) -> bool:
+    """A destination with a non-zero rate is passed through, not held: a periodic motion."""
+    units = dict(zip(table.state_order, table.axis_units, strict=True))
+    return any(units.get(name, "").endswith("/s") and value for name, value in table.dest.items())
+
+
+def _halton(index: int, base: int) -> float:
+    fraction, result = 1.0, 0.0
+    while index > 0:
+        fraction /= base
+        result += fraction * (index % base)
+        index //= base
+    return result
+
+
+def portrait_starts(axes: Sequence[StateAxis], count: int = PORTRAIT_STARTS) -> np.ndarray:
+    """``count`` start states (count, 2), spec units, spread evenly and deterministically over
+    the plot: the Halton sequence in bases 2 and 3, kept 10 % inside the non-periodic edges."""
+    starts = np.empty((count, 2))
+    for i in range(count):
+        for k, (axis, base) in enumerate(zip(axes, (2, 3), strict=True)):
+            fraction = _halton(i + 1, base)
+            if not axis.period:
+                fraction = 0.1 + 0.8 * fraction
+            starts[i, k] = axis.low + fraction * (axis.high - axis.low)
+    return starts
+
+
+# --------------------------------------------------------------------------- the four plots
+
+
+def plot_portrait(
+    table_path: str | Path,
+    dynamics: ModuleType,
+    out_path: str | Path,
+    seconds: float = PORTRAIT_SECONDS,
+    starts: int = PORTRAIT_STARTS,
+) -> None:
+    """Figure 14: closed-loop paths in state space under the controller in ``table_path``, from
+    ``starts`` start states (small squares) for ``seconds`` each, to the destination (encircled
+    X). A periodic destination's cycle (the path from the destination itself, between
+    ``CYCLE_SECONDS``) is drawn as a thick grey line. Writes a PNG to ``out_path``."""
+    from mosys.ssc.controller import Controller
+
+    controller = Controller.load(table_path, dynamics)
+    table = controller.table
+    axes = table_axes(table, table_path)
+    dt = float(table.attrs.get("dt", DEFAULT_DT))
+    units = dict(zip(table.state_order, table.axis_units, strict=True))
+    palette = matplotlib.colormaps["tab10"]
+    with plot_style():
+        figure = new_figure(7.0, 5.8)
+        ax = figure.add_subplot()
+        legend = []
+        drawn = []
+        if _destination_is_periodic(table):
+            dest_state = np.array([table.dest.get(name, 0.0) for name in table.state_order])
+            first, last = (int(round(s / dt)) for s in CYCLE_SECONDS)
+            run = controller.simulate(controller.figure_state(dest_state), last * dt, dt)
+            cycle = controller.controller_states(run.states[first:])
+            cycle_style = {"color": "0.45", "linewidth": 5.0, "alpha": 0.5}
+            _plot_path(ax, cycle, axes, zorder=1, solid_capstyle="round", **cycle_style)
+            legend.append((Line2D([], [], **cycle_style), "cycle through the destination"))
+            drawn.append(cycle)
+        for k, start in enumerate(portrait_starts(axes, starts)):
+            run = controller.simulate(controller.figure_state(start), seconds, dt)
+            path = controller.controller_states(run.states)
+            color = palette(k % palette.N)
+            _plot_path(ax, path, axes, color=color, linewidth=1.3, zorder=3)
+            mark_start(ax, start[0], start[1], color)
+            drawn.append(path)
+        legend.append((Line2D([], [], **start_style("white")), "start state (one colour per path)"))
+        handle = _mark_table_destination(ax, table, axes)
+        if handle is not None:
+            legend.append((handle, "destination"))
+        _format_state_axes(ax, axes, np.concatenate(drawn))
+        ax.set_title(
+            f"Controller {controller.name}: destination {describe_state(table.dest, units)}\n"
+            f"closed-loop paths, {seconds:g} s from each of {starts} start states"
+        )
+        add_legend(figure, legend)
+        save_png(figure, out_path)
+
+
+def plot_torque(table_path: str | Path, out_path: str | Path, contours: bool = True) -> None:
+    """A controller's torque table as a heat map over its two state variables: one cell per
+    table node (the value the DP stored there; between nodes the controller interpolates),
+    a diverging colour scale centred on 0 N·m, the destination marked, and the cost-to-go as
+    labelled contour lines (s). One panel per control. Writes a PNG to ``out_path``."""
+    table = read_controller_table(table_path)
+    axes = table_axes(table, table_path)
+    name = Path(table_path).stem
+    units = dict(zip(table.state_order, table.axis_units, strict=True))
+    centres = []
+    for axis, grid in zip(axes, table.axes, strict=True):
+        # a periodic axis repeats its first node at the far edge, so the plot closes up
+        centres.append(np.append(grid, grid[0] + axis.period) if axis.period else grid)
+    torque, value = table.torque, table.value
+    if axes[0].period:
+        torque = np.concatenate([torque, torque[:1]], axis=0)
+        value = np.concatenate([value, value[:1]], axis=0)
+    if axes[1].period:
+        torque = np.concatenate([torque, torque[:, :1]], axis=1)
+        value = np.concatenate([value, value[:, :1]], axis=1)
+    edges = [_cell_edges(c) for c in centres]
+    finite = np.isfinite(value)
+    halo = [patheffects.withStroke(linewidth=2.4, foreground="white")]
+    controls = len(table.control_names)
+    with plot_style():
+        figure = new_figure(7.0 * controls, 5.8)
+        legend = []
+        for c, control in enumerate(table.control_names):
+            ax = figure.add_subplot(1, controls, c + 1)
+            reach = float(max(abs(table.control_min[c]), abs(table.control_max[c]), 1e-12))
+            mesh = ax.pcolormesh(
+                edges[0],
+                edges[1],
+                torque[..., c].T,
+                cmap="RdBu_r",
+                vmin=-reach,
+                vmax=reach,
+                shading="flat",
+                rasterized=True,
+                zorder=0,
+            )
+            ax.grid(False)
+            colorbar = figure.colorbar(mesh, ax=ax, pad=0.02)
+            colorbar.set_label(f"{control} (N·m)")
+            legend = []
+            if contours and finite.sum() > 3 and np.ptp(value[finite]) > 0:
+                lines = ax.contour(
+                    centres[0],
+                    centres[1],
+                    np.ma.masked_invalid(value).T,
+                    levels=_contour_levels(value[finite]),
+                    colors="black",
+                    linewidths=0.9,
+                    zorder=2,
+                )
+                lines.set(path_effects=halo)
+                labels = ax.clabel(lines, fmt=lambda v: f"{v:g} s", fontsize=8, inline_spacing=3)
+                for text in labels:
+                    text.set(path_effects=halo)
+                legend.append(
+                    (
+                        Line2D([], [], color="black", linewidth=0.9),
+                        "cost-to-go, contours labelled in s",
+                    )
+                )
+            handle = _mark_table_destination(ax, table, axes)
+            if handle is not None:
+                legend.append((handle, "destination"))
+            _format_state_axes(ax, axes)
+            ax.set_title(
+                f"Controller {name}: {control} table, "
+                f"{' × '.join(str(len(g)) for g in table.axes)} nodes\n"
+                f"destination {describe_state(table.dest, units)}"
+            )
+        add_legend(figure, legend)
+        save_png(figure, out_path)
+
+
+def _cell_edges(centres: np.ndarray) -> np.ndarray:
+    """Edges of cells centred on uniformly spaced nodes."""
+    step = (centres[-1] - centres[0]) / (len(centres) - 1) if len(centres) > 1 else 1.0
+    return np.append(centres - step / 2, centres[-1] + step / 2)
+
+
+def _contour_levels(values: np.ndarray) -> np.ndarray:
+    """Six to a dozen round contour levels (steps of 1, 2, 2.5 or 5 times a power of ten)
+    strictly inside the range (0, max] of the finite cost-to-go."""
+    top = float(values.max())
+    raw = top / 6
+    magnitude = 10 ** math.floor(math.log10(raw))
+    step = max(m * magnitude for m in (1, 2, 2.5, 5) if m * magnitude <= raw)
+    return np.arange(step, top, step)
+
+
+def _switches(trajectory: Trajectory) -> list[tuple[int, str]]:
+    """(sample index, controller name) at each controller invocation: from the root attrs
+    ``switch_times``/``switch_controllers`` when present, else wherever ``/controller``
+    changes."""
+    attrs = trajectory.attrs
+    if "switch_times" in attrs and "switch_controllers" in attrs:
+        times = np.atleast_1d(np.asarray(attrs["switch_times"], dtype=np.float64))
+        names = string_tuple(attrs["switch_controllers"])
+        index = np.searchsorted(trajectory.t, times - 1e-9)
+        last = len(trajectory.t) - 1
+        return [(min(int(i), last), n) for i, n in zip(index, names, strict=True)]
+    changes = np.flatnonzero(np.diff(trajectory.controller)) + 1
+    starts = [0, *changes.tolist()] if len(trajectory.t) else []
+    return [(i, trajectory.controllers[trajectory.controller[i]]) for i in starts]
+
+
+def _controller_runs(trajectory: Trajectory) -> list[tuple[int, int, str]]:
+    """(first sample, last sample + 1, controller name) of each stretch under one controller;
+    each stretch also takes the next stretch's first sample, so the drawn path is unbroken."""
+    index = trajectory.controller
+    bounds = [0, *(np.flatnonzero(np.diff(index)) + 1).tolist(), len(index)]
+    return [
+        (a, min(b + 1, len(index)), trajectory.controllers[index[a]])
+        for a, b in zip(bounds[:-1], bounds[1:], strict=True)
+        if b > a
+    ]
+
+
+LABEL_OFFSETS = ((6, 6), (6, -16), (-26, 6), (-26, -16), (10, -5), (-30, -5), (-9, 10), (-9, -22))
+"""Candidate places (points from the anchor) of a point label, in order of preference."""
+
+
+def place_labels(figure, ax: Axes, labels, obstacles) -> None:
+    """Annotate points without letting labels overlap each other or the markers: each label,
+    in turn, takes the first of ``LABEL_OFFSETS`` whose text box meets nothing already placed
+    and stays inside the axes (else the one with the least overlap). ``labels``: (x, y, text,
+    color) in data units; ``obstacles``: (x, y, radius in points) of markers to keep clear."""
+    figure.draw_without_rendering()  # fixes the layout, hence the data-to-pixel transform
+    renderer = figure.canvas.get_renderer()
+    pixels_per_point = figure.dpi / 72.0
+    inside = ax.get_window_extent(renderer)
+    taken = []
+    for x, y, radius in obstacles:
+        centre = ax.transData.transform((x, y))
+        r = radius * pixels_per_point
+        taken.append(Bbox.from_extents(*(centre - r), *(centre + r)))
+    box_style = {
+        "boxstyle": "round,pad=0.12",
+        "facecolor": "white",
+        "alpha": 0.8,
+        "edgecolor": "none",
+    }
+    for x, y, text, color in labels:
+        best = None
+        for offset in LABEL_OFFSETS:
+            note = ax.annotate(
+                text,
+                (x, y),
+                xytext=offset,
+                textcoords="offset points",
+                fontsize=9.5,
+                fontweight="bold",
+                color=color,
+                bbox=box_style,
+                zorder=7,
+                annotation_clip=False,
+            )
+            note.set_in_layout(False)
+            box = note.get_window_extent(renderer).expanded(1.1, 1.15)
+            clash = sum(_overlap(box, other) for other in taken)
+            clash += box.width * box.height - _overlap(box, inside)  # the part outside the axes
+            if best is None or clash < best[0]:
+                if best is not None:
+                    best[1].remove()
+                best = (clash, note, box)
+            else:
+                note.remove()
+            if clash == 0:
+                break
+        taken.append(best[2])
+
+
+def _overlap(a: Bbox, b: Bbox) -> float:
+    width = min(a.x1, b.x1) - max(a.x0, b.x0)
+    height = min(a.y1, b.y1) - max(a.y0, b.y0)
+    return max(width, 0.0) * max(height, 0.0)
+
+
+def plot_script(
+    trajectory_path: str | Path,
+    table_paths: Sequence[str | Path],
+    out_path: str | Path,
+) -> None:
+    """Figure 16: an animation script's path in state space, each controller's stretch in its
+    own colour; ``sX`` marks where controller X is invoked and ``dX`` its destination (read
+    from the controller tables in ``table_paths``, matched to the script's controllers by file
+    stem; without them no destinations are drawn, and the axes are the pendulum's: see
+    ``trajectory_axes``). Writes a PNG to ``out_path``."""
+    trajectory = read_trajectory(trajectory_path)
+    if len(trajectory.t) == 0:
+        raise PlotInputError(f"{trajectory_path}: the trajectory has no samples")
+    paths = {Path(p).stem: p for p in table_paths}
+    tables = {name: read_controller_table(path) for name, path in paths.items()}
+    used = [n for n in dict.fromkeys(trajectory.controllers) if n in tables]
+    if used:
+        axes = table_axes(tables[used[0]], paths[used[0]])
+        if tuple(a.name for a in axes) != tuple(trajectory.state_order):
+            raise PlotInputError(
+                f"{trajectory_path}: state order {trajectory.state_order} differs from that of "
+                f"its controller {used[0]}, {tuple(a.name for a in axes)}"
+            )
+    else:
+        axes = trajectory_axes(trajectory)
+    colors = controller_colors(trajectory.controllers)
+    state = trajectory.state
+    switches = _switches(trajectory)
+    with plot_style():
+        figure = new_figure(7.6, 6.4)
+        ax = figure.add_subplot()
+        legend = []
+        for first, stop, name in _controller_runs(trajectory):
+            _plot_path(ax, state[first:stop], axes, color=colors[name], linewidth=1.8, zorder=3)
+        for name in dict.fromkeys(trajectory.controllers):
+            legend.append((Line2D([], [], color=colors[name], linewidth=2), f"controller {name}"))
+        labels, obstacles = [], []
+        for i, name in switches:
+            mark_start(ax, state[i, 0], state[i, 1], colors[name], zorder=6.5)  # over dX
+            labels.append((state[i, 0], state[i, 1], f"s{name}", colors[name]))
+            obstacles.append((state[i, 0], state[i, 1], 4.0))
+        legend.append((Line2D([], [], **start_style("white")), "sX: controller X invoked"))
+        for name in used:
+            x, y = destination_point(tables[name], axes)
+            if x is None or y is None:
+                continue
+            mark_destination(ax, x, y, color=colors[name])
+            labels.append((x, y, f"d{name}", colors[name]))
+            obstacles.append((x, y, 7.0))
+        if used:
+            legend.append((destination_handle(), "dX: destination of controller X"))
+        ax.plot(state[-1, 0], state[-1, 1], marker="o", markersize=5, color="black", zorder=6)
+        obstacles.append((state[-1, 0], state[-1, 1], 3.0))
+        legend.append(
+            (
+                Line2D([], [], marker="o", markersize=5, color="black", linestyle="none"),
+                f"end, t = {trajectory.t[-1]:.2f} s",
+            )
+        )
+        _format_state_axes(ax, axes, state)
+        script = str(trajectory.attrs.get("script", Path(trajectory_path).name))
+        ax.set_title(
+            f"State-space path of the animation script {Path(script).name}\n"
+            f"{len(switches)} controller invocations over "
+            f"{trajectory.t[-1] - trajectory.t[0]:.2f} s"
+        )
+        add_legend(figure, legend, ncols=4)
+        place_labels(figure, ax, labels, obstacles)
+        save_png(figure, out_path)
+
+
+def write_script_gif(trajectory_path: str | Path, out_path: str | Path, fps: int = GIF_FPS):
+    """An animated GIF of the figure moving through the script, drawn only from the
+    trajectory's ``figure_motion`` group: rods as thick lines coloured by the active controller,
+    the pivot (rod 0's proximal end), the centre of mass and the terrain; fixed, equal-aspect
+    limits from the data; a caption with the time and active controller. ``fps`` frames per
+    second of motion time (the sample at or after each frame time); loops forever.
+
+    Frames are blitted: the static figure is drawn once and each frame redraws only the moving
+    artists, many times faster than matplotlib's animation writers, which redraw the whole
+    figure (title, axes, legend) for every frame; Pillow writes the GIF (as PillowWriter
+    does), with one palette for all frames.
+    """
+    from PIL import Image
+
+    trajectory = read_trajectory(trajectory_path)
+    motion = trajectory.motion
+    if motion is None or len(motion.t) == 0:
+        raise PlotInputError(f"{trajectory_path}: no figure_motion group to animate")
+    frame_times = np.arange(motion.t[0], motion.t[-1] + 0.5 / fps, 1.0 / fps)
+    samples = np.minimum(np.searchsorted(motion.t, frame_times - 1e-9), len(motion.t) - 1)
+    sample_index = np.clip(np.searchsorted(trajectory.t, motion.t + 1e-9) - 1, 0, None)
+    active = [trajectory.controllers[trajectory.controller[sample_index[s]]] for s in samples]
+    colors = controller_colors(trajectory.controllers)
+    endpoints, com = motion.endpoints, motion.com
+    corners = np.concatenate([endpoints.reshape(-1, 2), com])
+    centre = (corners.min(axis=0) + corners.max(axis=0)) / 2
+    half = max(float(np.ptp(corners, axis=0).max()) / 2 * 1.15, 0.1)
+    with plot_style():
+        figure = new_figure(4.8, 5.4)
+        figure.set_dpi(GIF_DPI)
+        figure.get_layout_engine().set(h_pad=6 / 72)  # at low dpi the default clips the title
+        ax = figure.add_subplot()
+        ax.set_xlim(centre[0] - half, centre[0] + half)
+        ax.set_ylim(centre[1] - half, centre[1] + half)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+        script = str(trajectory.attrs.get("script", Path(trajectory_path).name))
+        figure_name = str(trajectory.attrs.get("figure", "figure"))
+        ax.set_title(f"{figure_name} through the script {Path(script).name}")
+        if motion.terrain:
+            ground = np.asarray(motion.terrain, dtype=np.float64)
+            ax.plot(ground[:, 0], ground[:, 1], color="0.3", linewidth=1.5, zorder=1)
+        rods = [
+            ax.plot([], [], linewidth=7, solid_capstyle="round", zorder=3)[0]
+            for _ in range(endpoints.shape[1])
+        ]
+        joints = ax.plot([], [], "o", color="0.2", markersize=4, zorder=4)[0]
+        pivot_style = {"marker": "o", "color": "black", "markersize": 9, "linestyle": "none"}
+        com_style = {
+            "marker": "o",
+            "markerfacecolor": "gold",
+            "markeredgecolor": "black",
+            "markersize": 7,
+            "linestyle": "none",
+        }
+        pivot = ax.plot([], [], zorder=5, **pivot_style)[0]
+        centre_of_mass = ax.plot([], [], zorder=6, **com_style)[0]
+        caption = ax.text(
+            0.03,
+            0.03,
+            "",
+            transform=ax.transAxes,
+            family="monospace",
+            fontsize=10,
+            zorder=7,
+            bbox={"facecolor": "white", "alpha": 0.85, "edgecolor": "0.6"},
+        )
+        legend = [
+            (Line2D([], [], color=colors[n], linewidth=5), f"controller {n}")
+            for n in dict.fromkeys(active)
+        ]
+        legend += [
+            (Line2D([], [], **pivot_style), "pivot"),
+            (Line2D([], [], **com_style), "centre of mass"),
+        ]
+        add_legend(figure, legend, ncols=3, fontsize=8)
+        moving = [*rods, joints, pivot, centre_of_mass, caption]  # in drawing (z) order
+        for artist in moving:
+            artist.set_animated(True)  # left out of full draws: drawn per frame below
+        canvas = figure.canvas
+        canvas.draw()
+        background = canvas.copy_from_bbox(figure.bbox)
+        frames = []
+        for frame, s in enumerate(samples):
+            for rod, ends in zip(rods, endpoints[s], strict=True):
+                rod.set_data(ends[:, 0], ends[:, 1])
+                rod.set_color(colors[active[frame]])
+            joints.set_data(endpoints[s, :, 1, 0], endpoints[s, :, 1, 1])
+            pivot.set_data([endpoints[s, 0, 0, 0]], [endpoints[s, 0, 0, 1]])
+            centre_of_mass.set_data([com[s, 0]], [com[s, 1]])
+            caption.set_text(f"t = {motion.t[s]:5.2f} s   controller {active[frame]}")
+            canvas.restore_region(background)
+            for artist in moving:
+                figure.draw_artist(artist)
+            rgba = np.asarray(canvas.buffer_rgba())
+            frames.append(Image.fromarray(rgba[..., :3].copy()))
+
+    frames = _shared_palette(frames)
+
+    def write(partial: Path) -> None:
+        frames[0].save(
+            partial,
+            format="GIF",
+            save_all=True,
+            append_images=frames[1:],
+            duration=round(1000 / fps),
+            loop=0,
+        )
+
+    write_atomically(out_path, write)
+
+
+def _shared_palette(frames: list, samples: int = 8) -> list:
+    """The RGB ``frames`` as palette images sharing one 256-colour palette, made from a montage
+    of a few evenly spaced frames: no colour flicker between frames, and far quicker than a
+    palette per frame."""
+    from PIL import Image
+
+    picks = frames[:: max(1, len(frames) // samples)][:samples]
+    width, height = frames[0].size
+    montage = Image.new("RGB", (width, height * len(picks)))
+    for k, frame in enumerate(picks):
+        montage.paste(frame, (0, height * k))
+    palette = montage.quantize(256)
+    return [frame.quantize(palette=palette, dither=Image.Dither.NONE) for frame in frames]
+
+
+# --------------------------------------------------------------------------- the CLI verb
+
+
+def plot_command(args) -> None:
+    """``mosys plot KIND INPUTS... [--dynamics D] -o OUT``: dispatch on ``args.kind``. Bad inputs
+    (wrong count, missing --dynamics, a table that is not 2-D) print a message and exit 2."""
+    kind, inputs = args.kind, list(args.inputs)
+    try:
+        if kind == "portrait":
+            if len(inputs) != 1 or not args.dynamics:
+                raise PlotInputError("needs exactly one controller table and --dynamics")
+            from mosys.dynamics.load import load_dynamics
+
+            plot_portrait(inputs[0], load_dynamics(args.dynamics), args.output)
+        elif kind == "torque":
+            if len(inputs) != 1:
+                raise PlotInputError("needs exactly one controller table")
+            plot_torque(inputs[0], args.output)
+        elif kind == "script":
+            plot_script(inputs[0], inputs[1:], args.output)
+        elif kind == "gif":
+            if len(inputs) != 1:
+                raise PlotInputError("needs exactly one trajectory")
+            write_script_gif(inputs[0], args.output)
+        else:
+            raise PlotInputError(f"unknown plot kind {kind!r}")
+    except PlotInputError as error:
+        print(f"mosys plot {kind}: {error}", file=sys.stderr)
+        raise SystemExit(2) from None

@@ -1,0 +1,148 @@
+"""The shared look of mosys plots: figure sizes, fonts, markers, colours and the atomic PNG write.
+
+Figures are built with matplotlib's object API on an Agg canvas (no pyplot, no global figure
+state), so plotting works headless and in parallel Snakemake jobs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from pathlib import Path
+
+import matplotlib
+from matplotlib.axes import Axes
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from matplotlib.legend_handler import HandlerTuple
+from matplotlib.lines import Line2D
+
+from mosys.io.atomic import write_atomically
+
+DPI = 120  # dots per inch of every PNG
+STYLE = {
+    "font.size": 10,
+    "axes.titlesize": 11,
+    "axes.labelsize": 10,
+    "legend.fontsize": 8.5,
+    "xtick.labelsize": 9,
+    "ytick.labelsize": 9,
+    "axes.grid": True,
+    "grid.alpha": 0.3,
+    "grid.linewidth": 0.6,
+    "savefig.facecolor": "white",
+    "figure.facecolor": "white",
+}
+# state variable name -> the symbol the papers use for it
+SYMBOLS = {"angle": "θ", "omega": "ω", "heading": "φ", "steer": "δ", "speed": "v"}
+DESTINATION_COLOR = "black"
+LEGEND_HANDLERS = {tuple: HandlerTuple(ndivide=1)}  # a tuple handle: its parts overlaid
+
+
+@contextmanager
+def plot_style() -> Iterator[None]:
+    """Apply the mosys rc parameters while a figure is built and saved."""
+    with matplotlib.rc_context(STYLE):
+        yield
+
+
+def new_figure(width: float, height: float) -> Figure:
+    """A figure of ``width`` x ``height`` inches on its own Agg canvas, constrained layout."""
+    figure = Figure(figsize=(width, height), layout="constrained")
+    FigureCanvasAgg(figure)
+    return figure
+
+
+def save_png(figure: Figure, path: str | Path) -> None:
+    """Write ``figure`` as a PNG to ``path`` atomically (a hidden partial file, then a rename)."""
+    write_atomically(path, lambda partial: figure.savefig(partial, format="png", dpi=DPI))
+
+
+def axis_label(name: str, unit: str) -> str:
+    """Axis label of a state variable: its symbol and unit, e.g. ``angle θ (deg)``."""
+    symbol = SYMBOLS.get(name)
+    return f"{name} {symbol} ({unit})" if symbol else f"{name} ({unit})"
+
+
+def controller_colors(names: Sequence[str]) -> dict[str, tuple[float, float, float, float]]:
+    """One distinct colour per controller name, in the order given (tab10, then tab20)."""
+    palette = matplotlib.colormaps["tab10" if len(names) <= 10 else "tab20"]
+    return {name: palette(k % palette.N) for k, name in enumerate(names)}
+
+
+def mark_destination(axes: Axes, x: float, y: float, color=DESTINATION_COLOR, size=11.0) -> None:
+    """The papers' destination marker: an encircled X at (x, y), drawn above the paths on a white
+    halo so that it reads on any background."""
+    for marker, scale in (("o", 1.0), ("x", 0.62)):
+        axes.plot(
+            x,
+            y,
+            marker=marker,
+            markersize=size * scale,
+            fillstyle="none",
+            zorder=5,
+            markeredgecolor="white",
+            markeredgewidth=3.4,
+        )
+    for marker, scale in (("o", 1.0), ("x", 0.62)):
+        axes.plot(
+            x,
+            y,
+            marker=marker,
+            markersize=size * scale,
+            fillstyle="none",
+            zorder=6,
+            markeredgecolor=color,
+            markeredgewidth=1.5,
+        )
+
+
+def destination_handle(color=DESTINATION_COLOR, size: float = 11.0) -> tuple[Line2D, Line2D]:
+    """A legend handle for ``mark_destination`` (draw it with ``LEGEND_HANDLERS``)."""
+    return tuple(
+        Line2D(
+            [],
+            [],
+            marker=marker,
+            markersize=size * scale,
+            fillstyle="none",
+            markeredgecolor=color,
+            markeredgewidth=1.5,
+            linestyle="none",
+        )
+        for marker, scale in (("o", 1.0), ("x", 0.62))
+    )
+
+
+def mark_start(axes: Axes, x: float, y: float, color, size: float = 6.0, zorder=5.0) -> None:
+    """The papers' start marker: a small filled square."""
+    axes.plot(x, y, **start_style(color, size), zorder=zorder)
+
+
+def start_style(color, size: float = 6.0) -> dict:
+    """Line2D keywords of the start marker."""
+    return {
+        "marker": "s",
+        "markersize": size,
+        "markerfacecolor": color,
+        "linestyle": "none",
+        "markeredgecolor": "black",
+        "markeredgewidth": 0.8,
+    }
+
+
+def add_legend(
+    figure: Figure, entries: Sequence[tuple[object, str]], ncols: int = 3, fontsize=None
+) -> None:
+    """The figure's legend from (handle, label) pairs, outside below the axes so that it hides
+    no data; a tuple handle draws its parts overlaid."""
+    handles = [handle for handle, _ in entries]
+    labels = [label for _, label in entries]
+    figure.legend(
+        handles,
+        labels,
+        loc="outside lower center",
+        ncols=ncols,
+        framealpha=0.9,
+        handler_map=LEGEND_HANDLERS,
+    )
