@@ -4,8 +4,6 @@ specs, with a stand-in for the generated pendulum dynamics."""
 
 from __future__ import annotations
 
-import importlib.util
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -33,23 +31,6 @@ from mosys.ssc.generate import generate_controller
 ROOT = Path(__file__).resolve().parents[1]
 PENDULUM_SPECS = ROOT / "specs" / "controllers" / "pendulum"
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
-# The 1 m, 1 kg uniform rod pinned at one end (link1.fig), as the dynamics compiler emits it:
-# I = m l²/3 about the pivot, so qdd = 3 (tau - m g l/2 cos q).
-STAND_IN_DYNAMICS = """\
-import numpy as np
-from numba import njit, types
-
-arr = types.float64[::1]
-Q_NAMES = ("angle",)
-QD_NAMES = ("omega",)
-Q_IS_ANGLE = (True,)
-TAU_NAMES = ("torque",)
-
-
-@njit(types.void(arr, arr, arr, arr), cache=True)
-def qdd_into(q, qd, tau, out):
-    out[0] = 3.0 * (tau[0] - 4.905 * np.cos(q[0]))
-"""
 PENDULUM_AXES = (
     StateAxis("angle", "deg", -180.0, 180.0, 360.0),
     StateAxis("omega", "deg/s", -500.0, 500.0, None),
@@ -60,15 +41,9 @@ PENDULUM_AXES = (
 
 
 @pytest.fixture(scope="module")
-def dynamics(tmp_path_factory):
-    path = tmp_path_factory.mktemp("dynamics") / "link1_plots_stand_in.py"
-    path.write_text(STAND_IN_DYNAMICS)
-    spec = importlib.util.spec_from_file_location(path.stem, path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[path.stem] = module  # numba's cache looks the module up by name
-    spec.loader.exec_module(module)
-    yield module
-    sys.modules.pop(path.stem, None)
+def dynamics(link1):
+    """The real pendulum dynamics, compiled from specs/figures/link1.fig (conftest)."""
+    return link1
 
 
 @pytest.fixture(scope="module")
@@ -258,22 +233,54 @@ def test_gif_is_animated(trajectory, tmp_path):
     assert np.any(first != last)  # the pendulum moved
 
 
-def test_cli_dispatches_every_table_and_trajectory_kind(trajectory, tables, tmp_path):
-    cases = {
-        "torque": [str(tables["D"])],
-        "script": [str(trajectory), str(tables["A"]), str(tables["D"])],
-        "gif": [str(trajectory)],
-    }
-    for kind, inputs in cases.items():
-        out = tmp_path / f"{kind}.{'gif' if kind == 'gif' else 'png'}"
-        assert main(["plot", kind, *inputs, "-o", str(out)]) == 0
-        assert out.stat().st_size > 1000
+def test_cli_makes_every_plot_kind(trajectory, tables, dynamics, tmp_path):
+    portrait, torque = tmp_path / "portrait.png", tmp_path / "torque.png"
+    commands = [
+        [
+            "controller",
+            str(tables["D"]),
+            "--dynamics",
+            dynamics.__file__,
+            "--portrait",
+            str(portrait),
+            "--torque",
+            str(torque),
+        ],
+        [
+            "script",
+            str(trajectory),
+            str(tables["A"]),
+            str(tables["D"]),
+            "-o",
+            str(tmp_path / "script.png"),
+        ],
+        ["gif", str(trajectory), "-o", str(tmp_path / "script.gif")],
+    ]
+    for command in commands:
+        assert main(["plot", *command]) == 0
+    for name in ("portrait.png", "torque.png", "script.png", "script.gif"):
+        assert (tmp_path / name).stat().st_size > 1000
 
 
 def test_cli_portrait_without_dynamics_exits_2_and_writes_nothing(tables, tmp_path, capsys):
     out = tmp_path / "portrait.png"
     with pytest.raises(SystemExit) as exit_:
-        main(["plot", "portrait", str(tables["A"]), "-o", str(out)])
+        main(["plot", "controller", str(tables["A"]), "--portrait", str(out)])
     assert exit_.value.code == 2
-    assert "needs exactly one controller table and --dynamics" in capsys.readouterr().err
+    assert "--portrait needs --dynamics" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_cli_gif_of_a_trajectory_without_figure_motion_exits_2(trajectory, tmp_path, capsys):
+    import shutil
+
+    import h5py
+
+    bare = tmp_path / "bare.h5"
+    shutil.copy(trajectory, bare)
+    with h5py.File(bare, "a") as h5:
+        del h5["figure_motion"]
+    out = tmp_path / "x.gif"
+    assert main(["plot", "gif", str(bare), "-o", str(out)]) == 2
+    assert capsys.readouterr().err.startswith("mosys: ")
     assert not out.exists()

@@ -99,7 +99,7 @@ def test_editing_one_controller_rebuilds_only_its_dependents(workflow):
     spec.write_text(spec.read_text().replace("dest angle=120 omega=0", "dest angle=110 omega=0"))
     jobs = planned_jobs(workflow)
     assert jobs.get("dp_controller") == 1
-    assert jobs.get("portrait_plot") == 1 and jobs.get("torque_plot") == 1
+    assert jobs.get("controller_plots") == 1
     assert "compile_dynamics" not in jobs
     before = mtimes(workflow)
     snakemake(workflow, "results/pendulum_all")
@@ -125,7 +125,7 @@ def test_editing_the_figure_rebuilds_all_six_controllers(workflow):
     jobs = planned_jobs(workflow)
     assert jobs.get("compile_dynamics") == 1
     assert jobs.get("dp_controller") == len(PENDULUM_CONTROLLERS)
-    assert jobs.get("portrait_plot") == len(PENDULUM_CONTROLLERS)
+    assert jobs.get("controller_plots") == len(PENDULUM_CONTROLLERS)
 
 
 def test_broken_spec_fails_with_its_location_and_leaves_no_output(workflow):

@@ -45,10 +45,27 @@ def _run(args: argparse.Namespace) -> None:
     run_animation_script(args.script, args.controllers, args.dynamics_dir, args.output, args.dt)
 
 
-def _plot(args: argparse.Namespace) -> None:
-    from mosys.plots import pendulum
+def _plot_controller(args: argparse.Namespace) -> None:
+    from mosys.plots.pendulum import plot_portrait, plot_torque
 
-    pendulum.plot_command(args)
+    if args.portrait:
+        from mosys.dynamics.load import load_dynamics
+
+        plot_portrait(args.table, load_dynamics(args.dynamics), args.portrait)
+    if args.torque:
+        plot_torque(args.table, args.torque)
+
+
+def _plot_script(args: argparse.Namespace) -> None:
+    from mosys.plots.pendulum import plot_script
+
+    plot_script(args.trajectory, args.tables, args.output)
+
+
+def _plot_gif(args: argparse.Namespace) -> None:
+    from mosys.plots.pendulum import write_script_gif
+
+    write_script_gif(args.trajectory, args.output)
 
 
 def _table(args: argparse.Namespace) -> None:
@@ -92,12 +109,24 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("-o", "--output", required=True)
     run.set_defaults(handler=_run)
 
-    plot = verbs.add_parser("plot", help="pendulum plots")
-    plot.add_argument("kind", choices=["portrait", "torque", "script", "gif"])
-    plot.add_argument("inputs", nargs="+", help="controller table(s) or trajectory")
-    plot.add_argument("--dynamics", help="generated dynamics module (portrait)")
-    plot.add_argument("-o", "--output", required=True)
-    plot.set_defaults(handler=_plot)
+    plot = verbs.add_parser("plot", help="pendulum plots").add_subparsers(
+        dest="kind", required=True
+    )
+    controller = plot.add_parser("controller", help="a controller's portrait and torque map")
+    controller.add_argument("table", help="controller table (.h5)")
+    controller.add_argument("--dynamics", help="generated dynamics module (for --portrait)")
+    controller.add_argument("--portrait", help="state-space portrait PNG (Figure 14 style)")
+    controller.add_argument("--torque", help="torque-table heat map PNG")
+    controller.set_defaults(handler=_plot_controller)
+    script = plot.add_parser("script", help="a script's state-space path (Figure 16 style)")
+    script.add_argument("trajectory")
+    script.add_argument("tables", nargs="*", help="the controller tables (their destinations)")
+    script.add_argument("-o", "--output", required=True)
+    script.set_defaults(handler=_plot_script)
+    gif = plot.add_parser("gif", help="an animated GIF of a trajectory's figure_motion")
+    gif.add_argument("trajectory")
+    gif.add_argument("-o", "--output", required=True)
+    gif.set_defaults(handler=_plot_gif)
 
     table = verbs.add_parser("table", help="the Figure 13 table of the pendulum controllers")
     table.add_argument("controllers", nargs="+")
@@ -115,7 +144,14 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.verb == "plot" and args.kind == "controller":
+        if not (args.portrait or args.torque):
+            parser.error("plot controller: give --portrait and/or --torque")
+        if args.portrait and not args.dynamics:
+            parser.error("plot controller: --portrait needs --dynamics")
+    from mosys.errors import InputError
     from mosys.parsing.tokens import SpecError
 
     try:
@@ -123,7 +159,7 @@ def main(argv: list[str] | None = None) -> int:
     except SpecError as error:
         print(error, file=sys.stderr)  # file:line:column: first, as compilers do
         return 2
-    except (FileNotFoundError, IsADirectoryError, PermissionError) as error:
+    except (FileNotFoundError, IsADirectoryError, PermissionError, InputError) as error:
         print(f"mosys: {error}", file=sys.stderr)
         return 2
     return 0

@@ -227,7 +227,7 @@ def parse_figure_spec(path: str | Path) -> Figure:
     try:
         data = Path(path).read_bytes()
         text = data.decode("utf-8")
-    except (FileNotFoundError, IsADirectoryError, UnicodeDecodeError):
+    except (FileNotFoundError, UnicodeDecodeError):
         read_spec(path)  # raises the shared SpecError for a missing or non-UTF-8 file
         raise
     return parse_figure_text(text, str(path), hashlib.sha256(data).hexdigest())
@@ -469,7 +469,11 @@ class _Parser:
         com = DEFAULT_COM
         if "com" in found:
             com = self.number(found["com"], "com", "com (fraction of the length)", "0..1")
-        inertia = mass * length**2 / 12.0
+        inertia = mass * length * length / 12.0
+        if not math.isfinite(inertia * length):  # the equations multiply these further
+            raise self.error(
+                value_token(length_token, "length"), "a smaller length or mass (they overflow)"
+            )
         if "inertia" in found:
             inertia = self.number(found["inertia"], "inertia", "inertia (kg·m²)", ">0")
         self.rods.append(Rod(name.text, length, mass, com, inertia, name))

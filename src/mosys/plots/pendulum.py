@@ -13,7 +13,6 @@ the same angle, and a path that crosses them leaves at one edge and comes back a
 from __future__ import annotations
 
 import math
-import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -27,6 +26,7 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import MultipleLocator
 from matplotlib.transforms import Bbox
 
+from mosys.errors import InputError
 from mosys.io.atomic import write_atomically
 from mosys.io.attributes import string_tuple
 from mosys.io.controller_table import ControllerTable, read_controller_table
@@ -54,7 +54,7 @@ GIF_DPI = 80  # dots per inch of the animation frames
 DEFAULT_DT = 0.001  # s: simulator step when a table does not record its own
 
 
-class PlotInputError(ValueError):
+class PlotInputError(InputError):
     """The inputs cannot make the requested plot (wrong count, wrong kind of file...)."""
 
 
@@ -700,31 +700,3 @@ def _shared_palette(frames: list, samples: int = 8) -> list:
 
 
 # --------------------------------------------------------------------------- the CLI verb
-
-
-def plot_command(args) -> None:
-    """``mosys plot KIND INPUTS... [--dynamics D] -o OUT``: dispatch on ``args.kind``. Bad inputs
-    (wrong count, missing --dynamics, a table that is not 2-D) print a message and exit 2."""
-    kind, inputs = args.kind, list(args.inputs)
-    try:
-        if kind == "portrait":
-            if len(inputs) != 1 or not args.dynamics:
-                raise PlotInputError("needs exactly one controller table and --dynamics")
-            from mosys.dynamics.load import load_dynamics
-
-            plot_portrait(inputs[0], load_dynamics(args.dynamics), args.output)
-        elif kind == "torque":
-            if len(inputs) != 1:
-                raise PlotInputError("needs exactly one controller table")
-            plot_torque(inputs[0], args.output)
-        elif kind == "script":
-            plot_script(inputs[0], inputs[1:], args.output)
-        elif kind == "gif":
-            if len(inputs) != 1:
-                raise PlotInputError("needs exactly one trajectory")
-            write_script_gif(inputs[0], args.output)
-        else:
-            raise PlotInputError(f"unknown plot kind {kind!r}")
-    except PlotInputError as error:
-        print(f"mosys plot {kind}: {error}", file=sys.stderr)
-        raise SystemExit(2) from None
