@@ -139,7 +139,7 @@ def test_broken_spec_fails_with_its_location_and_leaves_no_output(workflow):
     assert done.returncode != 0
     line = next(n for n, text in enumerate(spec.read_text().splitlines(), 1) if "eleven" in text)
     expected = (
-        f"specs/controllers/pendulum/C.ssc:{line}:23: expected a whole number for "
+        f"specs/controllers/pendulum/C.ssc:{line}:24: expected a whole number for "
         "samples, found 'eleven'"
     )
     assert expected in done.stdout + done.stderr
