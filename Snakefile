@@ -22,8 +22,10 @@ rule pendulum_all:
         pendulum_targets(),
     output:
         "results/pendulum_all",
+    log:
+        "results/logs/pendulum_all.log",
     shell:
-        "mosys index {input} -o {output}"
+        "mosys index {input} -o {output} 2> {log}"
 
 
 rule paper_tables:
@@ -31,5 +33,7 @@ rule paper_tables:
         paper_table_targets(),
     output:
         "results/paper_tables",
+    log:
+        "results/logs/paper_tables.log",
     shell:
-        "mosys index {input} -o {output}"
+        "mosys index {input} -o {output} 2> {log}"

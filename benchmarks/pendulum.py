@@ -61,7 +61,10 @@ def generate(dynamics: Path, spec: Path, out: Path, cache: Path) -> dict:
     env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
     done = subprocess.run(
         [sys.executable, "-c", GENERATE, str(dynamics), str(spec), str(out)],
-        env=env, check=True, capture_output=True, text=True,
+        env=env,
+        check=True,
+        capture_output=True,
+        text=True,
     )
     return json.loads(done.stdout.strip().splitlines()[-1])
 
@@ -71,12 +74,22 @@ def pipeline_seconds(cache: Path, work: Path) -> float:
     workflow."""
     if work.exists():
         shutil.rmtree(work)
-    shutil.copytree(ROOT, work, ignore=shutil.ignore_patterns(
-        "results", ".snakemake", ".git", ".venv", "__pycache__", ".hypothesis"))
+    shutil.copytree(
+        ROOT,
+        work,
+        ignore=shutil.ignore_patterns(
+            "results", ".snakemake", ".git", ".venv", "__pycache__", ".hypothesis"
+        ),
+    )
     env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
     started = time.perf_counter()
-    subprocess.run(["snakemake", "-c2", "results/pendulum_all", "--quiet", "all"], cwd=work,
-                   env=env, check=True, capture_output=True)
+    subprocess.run(
+        ["snakemake", "-c2", "results/pendulum_all", "--quiet", "all"],
+        cwd=work,
+        env=env,
+        check=True,
+        capture_output=True,
+    )
     return time.perf_counter() - started
 
 
@@ -99,31 +112,43 @@ def main() -> None:
             cold = generate(dynamics, spec, tmp / f"{name}.h5", cold_cache)
             generate(dynamics, spec, tmp / f"{name}.h5", warm_cache)  # fill the cache
             warm = generate(dynamics, spec, tmp / f"{name}.h5", warm_cache)
-            rows.append({
-                "case": f"{name} at the paper's grid", "nodes": warm["nodes"],
-                "iterations": warm["iterations"],
-                "dp_s_warm": round(warm["dp_seconds"], 4),
-                "process_s_warm": round(warm["process_seconds"], 3),
-                "dp_s_cold": round(cold["dp_seconds"], 3),
-                "process_s_cold": round(cold["process_seconds"], 2),
-                "paper_s": PAPER_SECONDS[name],
-                "speedup_vs_paper": round(PAPER_SECONDS[name] / warm["dp_seconds"]),
-            })
+            rows.append(
+                {
+                    "case": f"{name} at the paper's grid",
+                    "nodes": warm["nodes"],
+                    "iterations": warm["iterations"],
+                    "dp_s_warm": round(warm["dp_seconds"], 4),
+                    "process_s_warm": round(warm["process_seconds"], 3),
+                    "dp_s_cold": round(cold["dp_seconds"], 3),
+                    "process_s_cold": round(cold["process_seconds"], 2),
+                    "paper_s": PAPER_SECONDS[name],
+                    "speedup_vs_paper": round(PAPER_SECONDS[name] / warm["dp_seconds"]),
+                }
+            )
         for factor in (1, 2) if args.smoke else (1, 2, 4, 8):
             spec = tmp / f"A_x{factor}.ssc"
             spec.write_text(finer_spec(factor))
             warm = generate(dynamics, spec, tmp / f"A_x{factor}.h5", warm_cache)
-            rows.append({
-                "case": f"A, grid {factor}x finer per axis", "nodes": warm["nodes"],
-                "iterations": warm["iterations"], "dp_s_warm": round(warm["dp_seconds"], 3),
-                "process_s_warm": round(warm["process_seconds"], 3),
-            })
+            rows.append(
+                {
+                    "case": f"A, grid {factor}x finer per axis",
+                    "nodes": warm["nodes"],
+                    "iterations": warm["iterations"],
+                    "dp_s_warm": round(warm["dp_seconds"], 3),
+                    "process_s_warm": round(warm["process_seconds"], 3),
+                }
+            )
         if not args.smoke:
             shutil.rmtree(cold_cache, ignore_errors=True)
             cold = pipeline_seconds(cold_cache, tmp / "work")
             warm = pipeline_seconds(cold_cache, tmp / "work")
-            rows.append({"case": "results/pendulum_all from empty results/",
-                         "process_s_cold": round(cold, 1), "process_s_warm": round(warm, 1)})
+            rows.append(
+                {
+                    "case": "results/pendulum_all from empty results/",
+                    "process_s_cold": round(cold, 1),
+                    "process_s_warm": round(warm, 1),
+                }
+            )
     frame = pd.DataFrame(rows)
     out = ROOT / "results" / "benchmarks"
     out.mkdir(parents=True, exist_ok=True)

@@ -17,7 +17,7 @@ from numba import njit, types
 
 import mosys
 from mosys.dynamics.compile import compile_figure, generate_source
-from mosys.dynamics.load import load_dynamics, module_name
+from mosys.dynamics.load import content_addressed_copy, load_dynamics, module_name
 from mosys.parsing.tokens import SpecError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -413,10 +413,29 @@ def test_compile_writes_atomically(tmp_path: Path, monkeypatch: pytest.MonkeyPat
     assert list(tmp_path.iterdir()) == [out]
 
 
-def test_load_registers_a_stable_module_name(built: dict[str, ModuleType]) -> None:
+def test_load_registers_a_content_addressed_module_name(
+    built: dict[str, ModuleType], tmp_path, monkeypatch
+) -> None:
     module = built["free3"]
-    assert module.__name__ == "mosys_dynamics_free3"
-    assert module_name("results/dynamics/my-figure.py") == "mosys_dynamics_my_figure"
+    assert module.__name__.startswith("mosys_dynamics_free3_")
+    assert module_name("results/dynamics/my-figure.py", b"x").startswith(
+        "mosys_dynamics_my_figure_"
+    )
     assert sys.modules[module.__name__].Q_NAMES == module.Q_NAMES
     with pytest.raises(FileNotFoundError):
         load_dynamics(ROOT / "no" / "such.py")
+
+
+def test_regenerating_identical_equations_reuses_the_cached_copy(tmp_path, monkeypatch) -> None:
+    """The imported copy is named by content and written once: compiling the same figure again
+    (a new file, a new mtime) loads the same copy, so numba's cache of it stays valid."""
+    monkeypatch.setenv("MOSYS_CACHE_DIR", str(tmp_path / "cache"))
+    first, second = tmp_path / "a" / "link1.py", tmp_path / "b" / "link1.py"
+    compile_figure(FIGURES / "link1.fig", first)
+    compile_figure(FIGURES / "link1.fig", second)
+    copy = content_addressed_copy(first)
+    stamp = copy.stat().st_mtime_ns
+    assert content_addressed_copy(second) == copy
+    assert copy.stat().st_mtime_ns == stamp
+    assert copy.read_bytes() == first.read_bytes()
+    assert [p.name for p in (tmp_path / "cache").glob("*.py")] == [copy.name]

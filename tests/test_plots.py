@@ -251,10 +251,11 @@ def test_cli_makes_every_plot_kind(trajectory, tables, dynamics, tmp_path):
             str(trajectory),
             str(tables["A"]),
             str(tables["D"]),
-            "-o",
+            "--path",
             str(tmp_path / "script.png"),
+            "--gif",
+            str(tmp_path / "script.gif"),
         ],
-        ["gif", str(trajectory), "-o", str(tmp_path / "script.gif")],
     ]
     for command in commands:
         assert main(["plot", *command]) == 0
@@ -281,6 +282,6 @@ def test_cli_gif_of_a_trajectory_without_figure_motion_exits_2(trajectory, tmp_p
     with h5py.File(bare, "a") as h5:
         del h5["figure_motion"]
     out = tmp_path / "x.gif"
-    assert main(["plot", "gif", str(bare), "-o", str(out)]) == 2
+    assert main(["plot", "script", str(bare), "--gif", str(out)]) == 2
     assert capsys.readouterr().err.startswith("mosys: ")
     assert not out.exists()

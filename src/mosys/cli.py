@@ -18,8 +18,8 @@ def _compile(args: argparse.Namespace) -> None:
 
 
 def _dp(args: argparse.Namespace) -> None:
+    from mosys.dynamics.load import figure_dynamics
     from mosys.parsing.controller import parse_controller_spec
-    from mosys.pipeline import figure_dynamics
     from mosys.ssc.generate import generate_controller
 
     spec = parse_controller_spec(args.spec)
@@ -57,15 +57,12 @@ def _plot_controller(args: argparse.Namespace) -> None:
 
 
 def _plot_script(args: argparse.Namespace) -> None:
-    from mosys.plots.pendulum import plot_script
+    from mosys.plots.pendulum import plot_script, write_script_gif
 
-    plot_script(args.trajectory, args.tables, args.output)
-
-
-def _plot_gif(args: argparse.Namespace) -> None:
-    from mosys.plots.pendulum import write_script_gif
-
-    write_script_gif(args.trajectory, args.output)
+    if args.path:
+        plot_script(args.trajectory, args.tables, args.path)
+    if args.gif:
+        write_script_gif(args.trajectory, args.gif)
 
 
 def _table(args: argparse.Namespace) -> None:
@@ -118,15 +115,12 @@ def build_parser() -> argparse.ArgumentParser:
     controller.add_argument("--portrait", help="state-space portrait PNG (Figure 14 style)")
     controller.add_argument("--torque", help="torque-table heat map PNG")
     controller.set_defaults(handler=_plot_controller)
-    script = plot.add_parser("script", help="a script's state-space path (Figure 16 style)")
+    script = plot.add_parser("script", help="a script's path (Figure 16 style) and its GIF")
     script.add_argument("trajectory")
     script.add_argument("tables", nargs="*", help="the controller tables (their destinations)")
-    script.add_argument("-o", "--output", required=True)
+    script.add_argument("--path", help="state-space path PNG")
+    script.add_argument("--gif", help="animated GIF of the trajectory's figure_motion")
     script.set_defaults(handler=_plot_script)
-    gif = plot.add_parser("gif", help="an animated GIF of a trajectory's figure_motion")
-    gif.add_argument("trajectory")
-    gif.add_argument("-o", "--output", required=True)
-    gif.set_defaults(handler=_plot_gif)
 
     table = verbs.add_parser("table", help="the Figure 13 table of the pendulum controllers")
     table.add_argument("controllers", nargs="+")
@@ -151,6 +145,8 @@ def main(argv: list[str] | None = None) -> int:
             parser.error("plot controller: give --portrait and/or --torque")
         if args.portrait and not args.dynamics:
             parser.error("plot controller: --portrait needs --dynamics")
+    if args.verb == "plot" and args.kind == "script" and not (args.path or args.gif):
+        parser.error("plot script: give --path and/or --gif")
     from mosys.errors import InputError
     from mosys.parsing.tokens import SpecError
 

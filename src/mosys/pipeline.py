@@ -3,32 +3,15 @@ that is more than a single call)."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from pathlib import Path
-from types import ModuleType
 
 from mosys import __version__
 from mosys.animation import load_controllers, run_script
-from mosys.dynamics.load import load_dynamics
+from mosys.dynamics.load import figure_dynamics
 from mosys.dynamics.motion import figure_motion
 from mosys.io.controller_table import read_controller_table
 from mosys.io.trajectory import Trajectory, write_trajectory
 from mosys.parsing.script import SwapController, parse_script
-from mosys.parsing.tokens import SpecError, Token
-
-
-def figure_dynamics(
-    figure: str,
-    dynamics_dir: str | Path,
-    error: Callable[[Token, str], SpecError],
-    token: Token,
-) -> ModuleType:
-    """Load ``dynamics_dir/FIGURE.py``; if it is missing, raise ``error(token, ...)`` so the
-    message points at the spec line that named the figure."""
-    path = Path(dynamics_dir) / f"{figure}.py"
-    if not path.exists():
-        raise error(token, f"a compiled figure ({path} does not exist: run 'mosys compile')")
-    return load_dynamics(path)
 
 
 def run_animation_script(

@@ -1,50 +1,36 @@
-rule portrait_plot:
+rule controller_plots:
     input:
         table="results/controllers/{group}/{name}.h5",
         dynamics=lambda wildcards: f"results/dynamics/{config['pendulum']['figure']}.py",
         code=package_sources("ssc", "scripts", "plots"),
     output:
-        "results/plots/{group}/{name}_portrait.png",
+        portrait="results/plots/{group}/{name}_portrait.png",
+        torque="results/plots/{group}/{name}_torque.png",
     log:
-        "results/logs/plots/{group}/{name}_portrait.log",
+        "results/logs/plots/{group}/{name}.log",
+    benchmark:
+        "results/benchmarks/plots/{group}/{name}.tsv"
+    threads: 1
     shell:
-        "mosys plot portrait {input.table} --dynamics {input.dynamics} -o {output} 2> {log}"
+        "NUMBA_NUM_THREADS={threads} mosys plot controller {input.table} --dynamics {input.dynamics}"
+        " --portrait {output.portrait} --torque {output.torque} 2> {log}"
         " || (cat {log} >&2; exit 1)"
 
 
-rule torque_plot:
-    input:
-        table="results/controllers/{group}/{name}.h5",
-        code=package_sources("plots"),
-    output:
-        "results/plots/{group}/{name}_torque.png",
-    log:
-        "results/logs/plots/{group}/{name}_torque.log",
-    shell:
-        "mosys plot torque {input.table} -o {output} 2> {log} || (cat {log} >&2; exit 1)"
-
-
-rule script_path_plot:
+rule script_plots:
     input:
         trajectory="results/trajectories/{script}.h5",
         tables=lambda wildcards: [p for p in script_inputs(wildcards) if p.endswith(".h5")],
         code=package_sources("plots"),
     output:
-        "results/plots/{group}/{script}_path.png",
+        path="results/plots/{group}/{script}_path.png",
+        gif="results/plots/{group}/{script}.gif",
     log:
-        "results/logs/plots/{group}/{script}_path.log",
+        "results/logs/plots/{group}/{script}.log",
+    benchmark:
+        "results/benchmarks/plots/{group}/{script}.tsv"
+    threads: 1
     shell:
-        "mosys plot script {input.trajectory} {input.tables} -o {output} 2> {log}"
-        " || (cat {log} >&2; exit 1)"
-
-
-rule script_animation:
-    input:
-        trajectory="results/trajectories/{script}.h5",
-        code=package_sources("plots"),
-    output:
-        "results/plots/{group}/{script}.gif",
-    log:
-        "results/logs/plots/{group}/{script}_gif.log",
-    shell:
-        "mosys plot gif {input.trajectory} -o {output} 2> {log} || (cat {log} >&2; exit 1)"
+        "NUMBA_NUM_THREADS={threads} mosys plot script {input.trajectory} {input.tables}"
+        " --path {output.path}"
+        " --gif {output.gif} 2> {log} || (cat {log} >&2; exit 1)"

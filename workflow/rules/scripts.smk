@@ -7,10 +7,13 @@ rule run_script:
         "results/trajectories/{script}.h5",
     log:
         "results/logs/scripts/{script}.log",
+    benchmark:
+        "results/benchmarks/scripts/{script}.tsv"
     params:
         controllers=lambda wildcards: f"results/controllers/{script_group(wildcards.script)}",
         dt=config["simulation"]["dt"],
+    threads: 1
     shell:
-        "mosys run {input.script} --controllers {params.controllers}"
+        "NUMBA_NUM_THREADS={threads} mosys run {input.script} --controllers {params.controllers}"
         " --dynamics-dir results/dynamics --dt {params.dt} -o {output} 2> {log}"
         " || (cat {log} >&2; exit 1)"

@@ -9,6 +9,7 @@ rule dp_controller:
         "results/logs/dp/{group}/{name}.log",
     benchmark:
         "results/benchmarks/dp/{group}/{name}.tsv"
+    threads: 1
     shell:
-        "mosys dp {input.spec} --dynamics-dir results/dynamics -o {output} 2> {log}"
+        "NUMBA_NUM_THREADS={threads} mosys dp {input.spec} --dynamics-dir results/dynamics -o {output} 2> {log}"
         " || (cat {log} >&2; exit 1)"

@@ -8,8 +8,12 @@ rule pendulum_table:
         md="results/tables/pendulum_controllers.md",
     log:
         "results/logs/tables/pendulum_controllers.log",
+    benchmark:
+        "results/benchmarks/tables/pendulum_controllers.tsv"
     params:
         budget=config["budget"],
+    threads: 1
     shell:
-        "mosys table {input.tables} --dynamics {input.dynamics} --budget {params.budget}"
+        "NUMBA_NUM_THREADS={threads} mosys table {input.tables} --dynamics {input.dynamics}"
+        " --budget {params.budget}"
         " --csv {output.csv} --md {output.md} 2> {log} || (cat {log} >&2; exit 1)"

@@ -1,25 +1,65 @@
 """Import a generated dynamics module from its file path.
 
-numba's cache (``cache=True``) records functions by their module's name and must import that
-module again when loading them, so the module is registered in ``sys.modules`` under a stable
-name derived from the file stem (``mosys_dynamics_link1``) before it runs.
+numba's cache (``cache=True``) is keyed by the source file's path and modification time, and a
+generated module is rewritten whenever its figure is compiled again — after ``rm -r results``, say
+— which would throw its compiled code away although the equations are the same. So mosys imports
+a content-addressed copy of the file, ``<cache>/mosys_dynamics_<stem>_<sha256 prefix>.py``, written
+once and never touched again (``<cache>``: ``$MOSYS_CACHE_DIR``, else
+``$XDG_CACHE_HOME/mosys/dynamics``, else ``~/.cache/mosys/dynamics``). numba must also import the
+module again by name when loading cached functions, so the module is registered in
+``sys.modules`` under that name before it runs.
 """
 
 from __future__ import annotations
 
+import contextlib
+import hashlib
 import importlib.util
+import os
 import re
 import sys
+import tempfile
+from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
+
+from mosys.parsing.tokens import SpecError, Token
 
 REQUIRED = ("Q_NAMES", "QD_NAMES", "mass_matrix", "forcing", "qdd", "qdd_into")
 
 
-def module_name(path: str | Path) -> str:
-    """The ``sys.modules`` name of the generated module at ``path``: ``mosys_dynamics_<stem>``,
-    non-identifier characters replaced by ``_``."""
-    return "mosys_dynamics_" + re.sub(r"\W", "_", Path(path).stem)
+def cache_directory() -> Path:
+    """Where content-addressed copies of generated modules live (see the module docstring)."""
+    if os.environ.get("MOSYS_CACHE_DIR"):
+        return Path(os.environ["MOSYS_CACHE_DIR"])
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "mosys" / "dynamics"
+
+
+def module_name(path: str | Path, source: bytes) -> str:
+    """The ``sys.modules`` name of a generated module: ``mosys_dynamics_<stem>_<sha256[:16]>``,
+    non-identifier characters of the stem replaced by ``_``."""
+    stem = re.sub(r"\W", "_", Path(path).stem)
+    return f"mosys_dynamics_{stem}_{hashlib.sha256(source).hexdigest()[:16]}"
+
+
+def content_addressed_copy(path: Path) -> Path:
+    """The copy of ``path`` named by its content, written once if missing (by a hard link of a
+    finished temporary file, so concurrent processes never rewrite a copy another has loaded)."""
+    source = path.read_bytes()
+    directory = cache_directory()
+    copy = directory / f"{module_name(path, source)}.py"
+    if not copy.exists():
+        directory.mkdir(parents=True, exist_ok=True)
+        handle, partial = tempfile.mkstemp(dir=directory, suffix=".partial")
+        try:
+            with os.fdopen(handle, "wb") as stream:
+                stream.write(source)
+            with contextlib.suppress(FileExistsError):  # another process was first: keep theirs
+                os.link(partial, copy)
+        finally:
+            os.unlink(partial)
+    return copy
 
 
 def load_dynamics(path: str | Path) -> ModuleType:
@@ -28,22 +68,35 @@ def load_dynamics(path: str | Path) -> ModuleType:
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"no generated dynamics module at {str(path)!r}")
-    name = module_name(path)
-    spec = importlib.util.spec_from_file_location(name, path)
+    copy = content_addressed_copy(path)
+    name = copy.stem
+    if name in sys.modules:
+        return sys.modules[name]
+    spec = importlib.util.spec_from_file_location(name, copy)
     if spec is None or spec.loader is None:
         raise ValueError(f"{str(path)!r} cannot be imported as a Python module")
     module = importlib.util.module_from_spec(spec)
-    previous = sys.modules.get(name)
     sys.modules[name] = module
     try:
         spec.loader.exec_module(module)
     except BaseException:
-        if previous is None:
-            sys.modules.pop(name, None)
-        else:
-            sys.modules[name] = previous
+        sys.modules.pop(name, None)
         raise
     missing = [attribute for attribute in REQUIRED if not hasattr(module, attribute)]
     if missing:
         raise ValueError(f"{str(path)!r} is not a generated dynamics module (no {missing[0]})")
     return module
+
+
+def figure_dynamics(
+    figure: str,
+    dynamics_dir: str | Path,
+    error: Callable[[Token, str], SpecError],
+    token: Token,
+) -> ModuleType:
+    """Load ``dynamics_dir/FIGURE.py`` for a spec that names ``figure`` at ``token``; if it is
+    missing, raise ``error(token, ...)`` so the message points at that spec line."""
+    path = Path(dynamics_dir) / f"{figure}.py"
+    if not path.exists():
+        raise error(token, f"a compiled figure ({path} does not exist: run 'mosys compile')")
+    return load_dynamics(path)

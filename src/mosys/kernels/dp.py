@@ -17,7 +17,7 @@ import numpy as np
 from numba import njit, prange, types
 
 from mosys.kernels.integrate import QDD_INTO, rk4_scratch, rk4_step
-from mosys.kernels.interpolate import corner_weights, grid_strides
+from mosys.kernels.interpolate import corner_weights, grid_strides, interpolation_scratch
 
 
 @njit(cache=True)
@@ -135,8 +135,7 @@ def exit_transitions(
         qd = np.empty(n)
         tau = np.zeros(n)
         scratch = rk4_scratch(n)
-        corner_index = np.empty(1 << d, np.int64)
-        corner_weight = np.empty(1 << d)
+        integer_scratch, fraction, corner_index, corner_weight = interpolation_scratch(d)
         node_coordinates(axis_min, axis_step, axis_count, node, center)
         for u in range(n_controls):
             _load_state(center, state_slot, base_state, q, qd)
@@ -198,6 +197,8 @@ def exit_transitions(
                         axis,
                         corner_index,
                         corner_weight,
+                        integer_scratch,
+                        fraction,
                     )
                     # weights of rounding size are zero: the exit lies on that node layer
                     total = 0.0

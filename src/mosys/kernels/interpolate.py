@@ -54,21 +54,44 @@ def clamp_to_domain(axis_min, axis_step, axis_count, wrap, state, out):
 
 
 @njit(cache=True)
+def interpolation_scratch(d):
+    """Work arrays for ``corner_weights`` on a d-dimensional grid: (low, high, free_axes) as one
+    (3, d) int64 array, fraction (d,) float64, corner_index (2**d,) int64, corner_weight (2**d,)."""
+    return (
+        np.empty((3, d), np.int64),
+        np.empty(d),
+        np.empty(1 << d, np.int64),
+        np.empty(1 << d),
+    )
+
+
+@njit(cache=True)
 def corner_weights(
-    axis_min, axis_step, axis_count, wrap, strides, state, on_node_axis, corner_index, corner_weight
+    axis_min,
+    axis_step,
+    axis_count,
+    wrap,
+    strides,
+    state,
+    on_node_axis,
+    corner_index,
+    corner_weight,
+    integer_scratch,
+    fraction,
 ):
     """The grid nodes around ``state`` and their n-linear weights.
 
     state: (d,) inside the domain (non-wrap axes within [min, max]); on_node_axis: an axis on which
     ``state`` lies exactly on a node layer (its weights would be 0 on one side), or -1.
     corner_index: (2**d,) int64 flat node indices out; corner_weight: (2**d,) float64 out.
-    Returns the number of corners written: 2**d, or 2**(d-1) when ``on_node_axis`` >= 0.
-    Weights are non-negative and sum to 1.
+    integer_scratch (3, d) int64 and fraction (d,) float64: work arrays
+    (``interpolation_scratch``). Returns the number of corners written: 2**d, or 2**(d-1) when
+    ``on_node_axis`` >= 0. Weights are non-negative and sum to 1.
     """
     d = state.shape[0]
-    low = np.empty(d, np.int64)
-    high = np.empty(d, np.int64)
-    fraction = np.empty(d)
+    low = integer_scratch[0]
+    high = integer_scratch[1]
+    free_axes = integer_scratch[2]
     for k in range(d):
         n = axis_count[k]
         u = (state[k] - axis_min[k]) / axis_step[k]
@@ -99,7 +122,6 @@ def corner_weights(
             high[k] = i + 1
             fraction[k] = u - i
     free = 0
-    free_axes = np.empty(d, np.int64)
     for k in range(d):
         if k != on_node_axis:
             free_axes[free] = k
@@ -125,19 +147,26 @@ def corner_weights(
 
 
 @njit(cache=True)
-def interpolate_into(axis_min, axis_step, axis_count, wrap, table, state, out):
-    """n-linear interpolation of a node table at one state, written into out.
+def interpolate_with(axis_min, axis_step, axis_count, wrap, strides, table, state, scratch, out):
+    """n-linear interpolation of a node table at one state, written into out, with work arrays
+    from ``interpolation_scratch`` (no allocation: for loops over time steps).
 
-    table: (prod(axis_count), m) float64, nodes in C order; state: (d,), inside the domain
-    (clamp first with ``clamp_to_domain``); out: (m,) float64.
+    table: (prod(axis_count), m) float64, nodes in C order; strides: from ``grid_strides``;
+    state: (d,), inside the domain (clamp first with ``clamp_to_domain``); out: (m,) float64.
     """
-    d = state.shape[0]
-    strides = np.empty(d, np.int64)
-    grid_strides(axis_count, strides)
-    corner_index = np.empty(1 << d, np.int64)
-    corner_weight = np.empty(1 << d)
+    integer_scratch, fraction, corner_index, corner_weight = scratch
     count = corner_weights(
-        axis_min, axis_step, axis_count, wrap, strides, state, -1, corner_index, corner_weight
+        axis_min,
+        axis_step,
+        axis_count,
+        wrap,
+        strides,
+        state,
+        -1,
+        corner_index,
+        corner_weight,
+        integer_scratch,
+        fraction,
     )
     for j in range(out.shape[0]):
         out[j] = 0.0
@@ -148,3 +177,17 @@ def interpolate_into(axis_min, axis_step, axis_count, wrap, table, state, out):
         row = corner_index[c]
         for j in range(out.shape[0]):
             out[j] += w * table[row, j]
+
+
+@njit(cache=True)
+def interpolate_into(axis_min, axis_step, axis_count, wrap, table, state, out):
+    """n-linear interpolation of a node table at one state, written into out.
+
+    table: (prod(axis_count), m) float64, nodes in C order; state: (d,), inside the domain
+    (clamp first with ``clamp_to_domain``); out: (m,) float64.
+    """
+    d = state.shape[0]
+    strides = np.empty(d, np.int64)
+    grid_strides(axis_count, strides)
+    scratch = interpolation_scratch(d)
+    interpolate_with(axis_min, axis_step, axis_count, wrap, strides, table, state, scratch, out)

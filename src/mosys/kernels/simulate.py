@@ -7,7 +7,12 @@ from numba import njit, types
 
 from mosys.kernels.dp import _read_state
 from mosys.kernels.integrate import QDD_INTO, rk4_scratch, rk4_step
-from mosys.kernels.interpolate import clamp_to_domain, interpolate_into
+from mosys.kernels.interpolate import (
+    clamp_to_domain,
+    grid_strides,
+    interpolate_with,
+    interpolation_scratch,
+)
 
 F1 = types.float64[::1]
 I1 = types.int64[::1]
@@ -69,6 +74,9 @@ def simulate_controlled(
     controller_state = np.empty(d)
     clamped = np.empty(d)
     control = np.empty(m)
+    strides = np.empty(d, np.int64)
+    grid_strides(axis_count, strides)
+    interpolation = interpolation_scratch(d)
     for i in range(n):
         q[i] = state[i]
         qd[i] = state[n + i]
@@ -79,7 +87,17 @@ def simulate_controlled(
         _read_state(q, qd, state_slot, controller_state)
         inside = clamp_to_domain(axis_min, axis_step, axis_count, wrap, controller_state, clamped)
         record_outside[step] = not inside
-        interpolate_into(axis_min, axis_step, axis_count, wrap, torque_table, clamped, control)
+        interpolate_with(
+            axis_min,
+            axis_step,
+            axis_count,
+            wrap,
+            strides,
+            torque_table,
+            clamped,
+            interpolation,
+            control,
+        )
         for i in range(n):
             tau[i] = 0.0
         for j in range(m):

@@ -601,7 +601,6 @@ def write_script_gif(trajectory_path: str | Path, out_path: str | Path, fps: int
     with plot_style():
         figure = new_figure(4.8, 5.4)
         figure.set_dpi(GIF_DPI)
-        figure.get_layout_engine().set(h_pad=6 / 72)  # at low dpi the default clips the title
         ax = figure.add_subplot()
         ax.set_xlim(centre[0] - half, centre[0] + half)
         ax.set_ylim(centre[1] - half, centre[1] + half)
