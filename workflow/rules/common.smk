@@ -13,9 +13,11 @@ STAGE_MODULES = {
     "parsing": ["parsing/tokens.py"],
     "dynamics": ["parsing/figure.py", "dynamics"],
     "ssc": ["parsing/controller.py", "kernels/dp.py", "kernels/integrate.py",
-            "kernels/interpolate.py", "ssc/generate.py", "ssc/grid.py", "io/controller_table.py"],
+            "kernels/figure_state.py", "kernels/interpolate.py", "ssc/generate.py", "ssc/grid.py",
+            "io/controller_table.py", "dynamics/load.py"],
     "scripts": ["parsing/script.py", "animation.py", "pipeline.py", "ssc/controller.py",
-                "kernels/simulate.py", "kernels/motion.py", "io/trajectory.py"],
+                "kernels/simulate.py", "kernels/motion.py", "io/trajectory.py",
+                "dynamics/motion.py"],
     "plots": ["plots"],
     "tables": ["tables", "ssc/quality.py"],
 }

@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange, types
 
+from mosys.kernels.figure_state import load_state, read_state
 from mosys.kernels.integrate import QDD_INTO, rk4_scratch, rk4_step
 from mosys.kernels.interpolate import corner_weights, grid_strides, interpolation_scratch
 
@@ -27,31 +28,6 @@ def node_coordinates(axis_min, axis_step, axis_count, node, out):
     for k in range(axis_count.shape[0] - 1, -1, -1):
         out[k] = axis_min[k] + axis_step[k] * (rest % axis_count[k])
         rest //= axis_count[k]
-
-
-@njit(cache=True)
-def _load_state(node_state, state_slot, base_state, q, qd):
-    """Full figure state (q, qd) from the controller's state: base_state with the controlled
-    slots (indices into the concatenation q‖qd) overwritten."""
-    n = q.shape[0]
-    for i in range(n):
-        q[i] = base_state[i]
-        qd[i] = base_state[n + i]
-    for k in range(state_slot.shape[0]):
-        slot = state_slot[k]
-        if slot < n:
-            q[slot] = node_state[k]
-        else:
-            qd[slot - n] = node_state[k]
-
-
-@njit(cache=True)
-def _read_state(q, qd, state_slot, out):
-    """The controller's state (d,) out of the full figure state."""
-    n = q.shape[0]
-    for k in range(state_slot.shape[0]):
-        slot = state_slot[k]
-        out[k] = q[slot] if slot < n else qd[slot - n]
 
 
 WEIGHT_EPSILON = 1e-9  # interpolation weights below this are rounding noise
@@ -138,7 +114,7 @@ def exit_transitions(
         integer_scratch, fraction, corner_index, corner_weight = interpolation_scratch(d)
         node_coordinates(axis_min, axis_step, axis_count, node, center)
         for u in range(n_controls):
-            _load_state(center, state_slot, base_state, q, qd)
+            load_state(center, state_slot, base_state, q, qd)
             for i in range(n):
                 tau[i] = 0.0
             effort = 0.0
@@ -150,9 +126,9 @@ def exit_transitions(
                 exit_index[node, u, i] = node
                 exit_weight[node, u, i] = 0.0
             for step in range(max_steps):
-                _read_state(q, qd, state_slot, before)
+                read_state(q, qd, state_slot, before)
                 rk4_step(qdd_into, q, qd, tau, dt, scratch)
-                _read_state(q, qd, state_slot, after)
+                read_state(q, qd, state_slot, after)
                 # earliest crossing of the cell boundary within this step, by linear interpolation
                 crossing = 2.0
                 axis = -1

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, types
 
-from mosys.kernels.dp import _read_state
+from mosys.kernels.figure_state import read_state
 from mosys.kernels.integrate import QDD_INTO, rk4_scratch, rk4_step
 from mosys.kernels.interpolate import (
     clamp_to_domain,
@@ -84,7 +84,7 @@ def simulate_controlled(
         for i in range(n):
             record_state[step, i] = q[i]
             record_state[step, n + i] = qd[i]
-        _read_state(q, qd, state_slot, controller_state)
+        read_state(q, qd, state_slot, controller_state)
         inside = clamp_to_domain(axis_min, axis_step, axis_count, wrap, controller_state, clamped)
         record_outside[step] = not inside
         interpolate_with(
