@@ -130,3 +130,34 @@ def test_same_spec_gives_the_same_table_bit_for_bit(double_integrator, tmp_path)
     second = generate_controller(spec, double_integrator, tmp_path / "b.h5", quiet=True)
     assert np.array_equal(first.value, second.value)
     assert np.array_equal(first.torque, second.torque)
+
+
+def test_dp_is_general_in_state_dimensions_and_controls(tmp_path):
+    """A 4-D state (the double pendulum's two angles and rates) with two controls: the table has
+    the contract's shape, the destination nodes cost 0 and its neighbourhood reaches them."""
+    from conftest import SPECS
+
+    from mosys.dynamics.compile import compile_figure
+    from mosys.dynamics.load import load_dynamics
+
+    compile_figure(SPECS / "figures" / "double_pendulum.fig", tmp_path / "double_pendulum.py")
+    dynamics = load_dynamics(tmp_path / "double_pendulum.py")
+    spec = parse_controller_text(
+        "dyn double_pendulum\n"
+        "ssd shoulder -180 90 4 wrap\n"
+        "ssd elbow -180 90 4 wrap\n"
+        "ssd shoulder_rate -200 200 5\n"
+        "ssd elbow_rate -200 200 5\n"
+        "torq shoulder_torque -40 40 3 0.01\n"
+        "torq elbow_torque -20 20 3 0.01\n"
+        "dest shoulder=-90 elbow=0 shoulder_rate=0 elbow_rate=0\n"
+        "dt 0.002\n"
+        "maxiter 300\n",
+        "hang.ssc",
+    )
+    table = generate_controller(spec, dynamics, tmp_path / "hang.h5", quiet=True)
+    assert table.state_order == ("shoulder", "elbow", "shoulder_rate", "elbow_rate")
+    assert table.torque.shape == (4, 4, 5, 5, 2)
+    assert table.value[1, 2, 2, 2] == 0.0  # shoulder -90, elbow 0, at rest
+    assert np.isfinite(table.value).sum() > table.value.size // 2
+    assert np.all(np.abs(table.torque[..., 0]) <= 40) and np.all(np.abs(table.torque[..., 1]) <= 20)
