@@ -246,6 +246,23 @@ def _expected_value(exit_index, exit_weight, node, u, value):
     return total
 
 
+@njit(cache=True)
+def _bellman(exit_index, exit_weight, segment_cost, value, node):
+    """(min over u of cost(node, u) + Σ w·V(corner), the first minimising u); (inf, 0) where
+    every control costs inf."""
+    best = np.inf
+    choice = 0
+    for u in range(segment_cost.shape[1]):
+        cost = segment_cost[node, u]
+        if cost == np.inf:
+            continue
+        candidate = cost + _expected_value(exit_index, exit_weight, node, u, value)
+        if candidate < best:
+            best = candidate
+            choice = u
+    return best, choice
+
+
 @njit(parallel=True, cache=True)
 def bellman_sweep(exit_index, exit_weight, segment_cost, is_destination, value, new_value, change):
     """One Jacobi sweep of value iteration; returns the largest decrease of the cost-to-go.
@@ -261,13 +278,7 @@ def bellman_sweep(exit_index, exit_weight, segment_cost, is_destination, value, 
     for node in prange(nodes):
         best = value[node]
         if not is_destination[node]:
-            for u in range(segment_cost.shape[1]):
-                cost = segment_cost[node, u]
-                if cost == np.inf:
-                    continue
-                candidate = cost + _expected_value(exit_index, exit_weight, node, u, value)
-                if candidate < best:
-                    best = candidate
+            best = min(best, _bellman(exit_index, exit_weight, segment_cost, value, node)[0])
         new_value[node] = best
         change[node] = 0.0 if best == value[node] else value[node] - best
     largest = 0.0
@@ -282,14 +293,4 @@ def best_controls(exit_index, exit_weight, segment_cost, value, best_control):
     """The minimising control sample index of every node (the first on ties; 0 where every
     sample costs inf). best_control: (N,) int64 out."""
     for node in prange(value.shape[0]):
-        best = np.inf
-        choice = 0
-        for u in range(segment_cost.shape[1]):
-            cost = segment_cost[node, u]
-            if cost == np.inf:
-                continue
-            candidate = cost + _expected_value(exit_index, exit_weight, node, u, value)
-            if candidate < best:
-                best = candidate
-                choice = u
-        best_control[node] = choice
+        best_control[node] = _bellman(exit_index, exit_weight, segment_cost, value, node)[1]
