@@ -41,7 +41,6 @@ def run_animation_script(
         control_names=run.control_names,
         controllers=run.controllers,
         attrs={
-            "format_version": 1,
             "script": str(script_path),
             "spec_sha256": script.spec_sha256,
             "figure": next(iter(controllers.values())).table.figure,
