@@ -69,3 +69,13 @@ def test_script_naming_a_missing_controller(tmp_path):
     assert done.returncode == 2
     assert done.stderr.startswith(f"{script}:2:14: expected a controller table")
     assert not (tmp_path / "t.h5").exists()
+
+
+def test_a_file_that_is_not_a_controller_table(tmp_path):
+    table = tmp_path / "A.h5"
+    table.write_text("not HDF5\n")
+    done = mosys("plot", "controller", str(table), "--torque", "t.png", cwd=tmp_path)
+    assert done.returncode == 2
+    assert done.stderr.startswith("mosys: ")
+    assert "Traceback" not in done.stderr
+    assert not (tmp_path / "t.png").exists()

@@ -155,7 +155,7 @@ def main(argv: list[str] | None = None) -> int:
     except SpecError as error:
         print(error, file=sys.stderr)  # file:line:column: first, as compilers do
         return 2
-    except (FileNotFoundError, IsADirectoryError, PermissionError, InputError) as error:
+    except (OSError, InputError) as error:  # a missing, unreadable or corrupt input file
         print(f"mosys: {error}", file=sys.stderr)
         return 2
     return 0
