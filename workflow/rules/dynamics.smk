@@ -8,5 +8,6 @@ rule compile_dynamics:
         "results/logs/dynamics/{figure}.log",
     benchmark:
         "results/benchmarks/dynamics/{figure}.tsv"
+    priority: 3  # on the path to the script's plots: schedule first
     shell:
         "mosys compile {input.spec} -o {output} 2> {log} || (cat {log} >&2; exit 1)"

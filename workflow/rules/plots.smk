@@ -30,6 +30,7 @@ rule script_plots:
     benchmark:
         "results/benchmarks/plots/{group}/{script}.tsv"
     threads: 1
+    priority: 1  # on the path to the script's plots: schedule first
     shell:
         "NUMBA_NUM_THREADS={threads} mosys plot script {input.trajectory} {input.tables}"
         " --path {output.path}"

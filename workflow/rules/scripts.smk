@@ -13,6 +13,7 @@ rule run_script:
         controllers=lambda wildcards: f"results/controllers/{script_group(wildcards.script)}",
         dt=config["simulation"]["dt"],
     threads: 1
+    priority: 2  # on the path to the script's plots: schedule first
     shell:
         "NUMBA_NUM_THREADS={threads} mosys run {input.script} --controllers {params.controllers}"
         " --dynamics-dir results/dynamics --dt {params.dt} -o {output} 2> {log}"

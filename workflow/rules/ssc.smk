@@ -10,6 +10,7 @@ rule dp_controller:
     benchmark:
         "results/benchmarks/dp/{group}/{name}.tsv"
     threads: 1
+    priority: 3  # on the path to the script's plots: schedule first
     shell:
         "NUMBA_NUM_THREADS={threads} mosys dp {input.spec} --dynamics-dir results/dynamics -o {output} 2> {log}"
         " || (cat {log} >&2; exit 1)"

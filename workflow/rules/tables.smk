@@ -13,6 +13,7 @@ rule pendulum_table:
     params:
         budget=config["budget"],
     threads: 1
+    priority: 1  # a long job: start it before the plots that can fill in around it
     shell:
         "NUMBA_NUM_THREADS={threads} mosys table {input.tables} --dynamics {input.dynamics}"
         " --budget {params.budget}"
