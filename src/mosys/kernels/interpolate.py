@@ -22,19 +22,6 @@ def grid_strides(axis_count, out):
 
 
 @njit(cache=True)
-def inside_domain(axis_min, axis_step, axis_count, wrap, state, tolerance):
-    """True when every non-wrap coordinate of ``state`` (d,) lies within [min, max] of its axis,
-    allowing ``tolerance`` grid steps of slack."""
-    for k in range(state.shape[0]):
-        if wrap[k]:
-            continue
-        u = (state[k] - axis_min[k]) / axis_step[k]
-        if u < -tolerance or u > axis_count[k] - 1 + tolerance:
-            return False
-    return True
-
-
-@njit(cache=True)
 def clamp_to_domain(axis_min, axis_step, axis_count, wrap, state, out):
     """Copy ``state`` (d,) into ``out`` (d,), moving each non-wrap coordinate onto the nearest
     point of its axis range. Returns True when nothing had to move."""
