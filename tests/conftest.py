@@ -16,16 +16,16 @@ DOUBLE_INTEGRATOR = textwrap.dedent(
     import numpy as np
     from numba import njit, types
 
-    Q_NAMES = ("x",)
-    QD_NAMES = ("v",)
-    Q_IS_ANGLE = (False,)
-    TAU_NAMES = ("force",)
+    STATE_NAMES = ("x", "v")
+    STATE_UNITS = ("m", "m/s")
+    INPUT_NAMES = ("force",)
     VECTOR = types.float64[::1]
 
 
-    @njit(types.void(VECTOR, VECTOR, VECTOR, VECTOR), cache=True)
-    def qdd_into(q, qd, tau, out):
-        out[0] = tau[0]
+    @njit(types.void(VECTOR, VECTOR, VECTOR), cache=True)
+    def derivative_into(state, inputs, out):
+        out[0] = state[1]
+        out[1] = inputs[0]
     '''
 )
 

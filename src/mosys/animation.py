@@ -21,7 +21,7 @@ from mosys.ssc.controller import Controller
 
 @dataclass(frozen=True)
 class ScriptRun:
-    """A script's motion. t: (N,) s; figure_states: (N, 2n) SI; state: (N, d) in the controllers'
+    """A script's motion. t: (N,) s; figure_states: (N, S) SI; state: (N, d) in the controllers'
     state order and spec units (wrap axes reduced into the first controller's range); control:
     (N, m); controller: (N,) int64 index into ``controllers``; outside: (N,) bool, the state lay
     outside the active controller's domain; switches: (t, controller name) at each ``swapcon``."""

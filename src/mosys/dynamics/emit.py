@@ -128,6 +128,7 @@ def emit_module(equations: Equations, spec_path: str, spec_sha256: str, version:
         _mass_matrix(equations),
         _forcing(equations, has_contact_forces),
         _qdd(equations, has_contact_forces),
+        _derivative(equations),
         _endpoints(equations),
         _center_of_mass(equations),
         _energy(equations, has_contact_forces),
@@ -195,6 +196,17 @@ def _metadata(figure: Figure, spec_sha256: str, has_contact_forces: bool) -> str
             f"QD_NAMES = {names(figure.qd_names)}",
             f"Q_IS_ANGLE = {_tuple([str(c.is_angle) for c in coordinates])}",
             f"TAU_NAMES = {names(figure.tau_names)}",
+            "",
+            "# The first-order view the controllers use: state = q‖qd, inputs = tau.",
+            "STATE_NAMES = Q_NAMES + QD_NAMES",
+            "STATE_UNITS = "
+            + _tuple(
+                [_string("deg" if c.is_angle else "m") for c in coordinates]
+                + [_string("deg/s" if c.is_angle else "m/s") for c in coordinates]
+            )
+            + "  # spec units",
+            f"COORDINATE_COUNT = {len(coordinates)}  # state[:COORDINATE_COUNT] is q",
+            "INPUT_NAMES = TAU_NAMES",
             "",
             "# The figure, for figure_motion (DESIGN.md): rods in file order, SI units.",
             f"ROD_NAMES = {names([rod.name for rod in rods])}",
@@ -491,6 +503,25 @@ def _qdd(equations: Equations, has_contact_forces: bool) -> str:
         ]
     )
     return f"{fill}\n\n{into}\n\n\n{allocating}"
+
+
+def _derivative(equations: Equations) -> str:
+    n = equations.model.n
+    return "\n".join(
+        _def(
+            "derivative_into",
+            "state, inputs, out",
+            f"The state's time derivative into out: state = q‖qd ({2 * n},) SI, inputs = tau "
+            f"({n},); out ({2 * n},) = qd‖qdd. Explicitly typed: the controllers' cached kernels "
+            "take it as a first-class function.",
+            "types.void(_VECTOR, _VECTOR, _VECTOR)",
+        )
+        + [
+            f"{INDENT}_qdd_fill(state[:{n}], state[{n}:], inputs, out[{n}:])",
+            f"{INDENT}for i in range({n}):",
+            f"{INDENT}{INDENT}out[i] = state[{n} + i]",
+        ]
+    )
 
 
 def _endpoints(equations: Equations) -> str:

@@ -25,7 +25,18 @@ from types import ModuleType
 
 from mosys.parsing.tokens import SpecError, Token
 
-REQUIRED = ("Q_NAMES", "QD_NAMES", "mass_matrix", "forcing", "qdd", "qdd_into")
+REQUIRED = (
+    "Q_NAMES",
+    "QD_NAMES",
+    "mass_matrix",
+    "forcing",
+    "qdd",
+    "qdd_into",
+    "STATE_NAMES",
+    "STATE_UNITS",
+    "INPUT_NAMES",
+    "derivative_into",
+)
 
 
 def cache_directory() -> Path:

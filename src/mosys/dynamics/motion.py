@@ -13,8 +13,9 @@ from mosys.kernels.motion import endpoints_over_time
 
 
 def figure_motion(dynamics: ModuleType, t: np.ndarray, figure_states: np.ndarray) -> FigureMotion:
-    """FigureMotion for samples ``t`` (N,) s of figure states (N, 2n) q‖qd, SI."""
-    n = len(dynamics.Q_NAMES)
+    """FigureMotion for samples ``t`` (N,) s of figure states (N, 2n) q‖qd, SI (the first
+    ``COORDINATE_COUNT`` entries of each state are q)."""
+    n = dynamics.COORDINATE_COUNT
     coordinates = np.ascontiguousarray(figure_states[:, :n])
     endpoints = np.empty((len(t), len(dynamics.ROD_NAMES), 2, 2))
     endpoints_over_time(dynamics.endpoints_into, coordinates, endpoints)

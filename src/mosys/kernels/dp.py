@@ -17,7 +17,7 @@ import numpy as np
 from numba import njit, prange, types
 
 from mosys.kernels.figure_state import load_state, read_state
-from mosys.kernels.integrate import QDD_INTO, rk4_scratch, rk4_step
+from mosys.kernels.integrate import DERIVATIVE_INTO, rk4_scratch, rk4_step
 from mosys.kernels.interpolate import corner_weights, grid_strides, interpolation_scratch
 
 
@@ -35,7 +35,7 @@ F1 = types.float64[::1]
 I1 = types.int64[::1]
 B1 = types.boolean[::1]
 EXIT_TRANSITIONS_SIGNATURE = types.void(
-    QDD_INTO,  # qdd_into
+    DERIVATIVE_INTO,  # derivative_into
     F1,  # axis_min
     F1,  # axis_step
     I1,  # axis_count
@@ -44,6 +44,7 @@ EXIT_TRANSITIONS_SIGNATURE = types.void(
     F1,  # base_state
     types.float64[:, ::1],  # control_samples
     I1,  # control_slot
+    types.int64,  # input_size
     F1,  # effort_weight
     types.float64,  # dt
     types.int64,  # max_steps
@@ -55,11 +56,11 @@ EXIT_TRANSITIONS_SIGNATURE = types.void(
 )
 
 
-# An explicit signature types qdd_into as a first-class function, so this kernel is cached once
-# for every figure (a plain Dispatcher argument would recompile it in every process).
+# An explicit signature types derivative_into as a first-class function, so this kernel is cached
+# once for every model (a plain Dispatcher argument would recompile it in every process).
 @njit(EXIT_TRANSITIONS_SIGNATURE, parallel=True, cache=True)
 def exit_transitions(
-    qdd_into,
+    derivative_into,
     axis_min,
     axis_step,
     axis_count,
@@ -68,6 +69,7 @@ def exit_transitions(
     base_state,
     control_samples,
     control_slot,
+    input_size,
     effort_weight,
     dt,
     max_steps,
@@ -79,11 +81,12 @@ def exit_transitions(
 ):
     """Simulate every (node, control sample) pair until it leaves the node's cell.
 
-    qdd_into: the figure's first-class dynamics (``integrate.QDD_INTO``).
+    derivative_into: the model's first-class dynamics (``integrate.DERIVATIVE_INTO``).
     axis_*: (d,) the controller grid, SI; state_slot: (d,) int64 index of each controller axis in
-    the figure state q‖qd (length 2n); base_state: (2n,) values of the uncontrolled slots.
-    control_samples: (U, m) sampled controls; control_slot: (m,) int64 coordinate each control
-    drives; effort_weight: (m,) K of the cost t + Σ K|u| t.
+    the model's state (length S); base_state: (S,) values of the uncovered slots.
+    control_samples: (U, m) sampled controls; control_slot: (m,) int64 entry of the model's
+    inputs (input_size of them) each control drives; effort_weight: (m,) K of the cost
+    t + Σ K|u| t.
     dt: RK4 step, s; max_steps: a segment that has not left its cell after this many steps is
     discarded (cost inf).
     nodes: (P,) int64 flat node indices to process; node_valid: (N,) bool (False: removed node).
@@ -93,7 +96,7 @@ def exit_transitions(
     the domain.
     """
     d = axis_min.shape[0]
-    n = base_state.shape[0] // 2
+    size = base_state.shape[0]
     n_controls = control_samples.shape[0]
     strides = np.empty(d, np.int64)
     grid_strides(axis_count, strides)
@@ -107,28 +110,27 @@ def exit_transitions(
         before = np.empty(d)
         after = np.empty(d)
         exit_state = np.empty(d)
-        q = np.empty(n)
-        qd = np.empty(n)
-        tau = np.zeros(n)
-        scratch = rk4_scratch(n)
+        state = np.empty(size)
+        inputs = np.zeros(input_size)
+        scratch = rk4_scratch(size)
         integer_scratch, fraction, corner_index, corner_weight = interpolation_scratch(d)
         node_coordinates(axis_min, axis_step, axis_count, node, center)
         for u in range(n_controls):
-            load_state(center, state_slot, base_state, q, qd)
-            for i in range(n):
-                tau[i] = 0.0
+            load_state(center, state_slot, base_state, state)
+            for i in range(input_size):
+                inputs[i] = 0.0
             effort = 0.0
             for j in range(control_slot.shape[0]):
-                tau[control_slot[j]] += control_samples[u, j]
+                inputs[control_slot[j]] += control_samples[u, j]
                 effort += effort_weight[j] * abs(control_samples[u, j])
             segment_cost[node, u] = np.inf
             for i in range(exit_index.shape[2]):
                 exit_index[node, u, i] = node
                 exit_weight[node, u, i] = 0.0
             for step in range(max_steps):
-                read_state(q, qd, state_slot, before)
-                rk4_step(qdd_into, q, qd, tau, dt, scratch)
-                read_state(q, qd, state_slot, after)
+                read_state(state, state_slot, before)
+                rk4_step(derivative_into, state, inputs, dt, scratch)
+                read_state(state, state_slot, after)
                 # earliest crossing of the cell boundary within this step, by linear interpolation
                 crossing = 2.0
                 axis = -1

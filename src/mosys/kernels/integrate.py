@@ -1,8 +1,9 @@
-"""Fixed-step RK4 over a generated dynamics module's ``qdd_into``.
+"""Fixed-step RK4 over a dynamics module's first-order ``derivative_into``.
 
-The dynamics function arrives as a numba first-class function of type ``QDD_INTO`` (the generated
-module declares ``qdd_into`` with exactly this signature), so the kernels that take it are compiled
-once and cached across processes, whatever the figure.
+The dynamics arrive as a numba first-class function of type ``DERIVATIVE_INTO``: every dynamics
+module (generated from a figure spec, or a built-in model) declares ``derivative_into(state,
+inputs, out)`` with exactly this signature, so the kernels that take it are compiled once and
+cached across processes, whatever the model.
 """
 
 from __future__ import annotations
@@ -11,51 +12,34 @@ import numpy as np
 from numba import njit, types
 
 VECTOR = types.float64[::1]
-QDD_INTO = types.FunctionType(types.void(VECTOR, VECTOR, VECTOR, VECTOR))
+DERIVATIVE_INTO = types.FunctionType(types.void(VECTOR, VECTOR, VECTOR))
 
 
 @njit(cache=True)
-def rk4_scratch(n):
-    """Work array for ``rk4_step`` with n coordinates: (10, n) float64, C-contiguous."""
-    return np.empty((10, n))
+def rk4_scratch(size):
+    """Work array for ``rk4_step`` on a state of ``size`` entries: (5, size) float64."""
+    return np.empty((5, size))
 
 
 @njit(cache=True)
-def rk4_step(qdd_into, q, qd, tau, dt, scratch):
-    """Advance (q, qd) in place by one RK4 step of dt seconds, tau held constant.
-
-    q, qd: (n,) SI (m or rad, m/s or rad/s); tau: (n,) generalized forces; scratch: from
-    ``rk4_scratch(n)``.
-    """
-    n = q.shape[0]
-    qa = scratch[0]
-    va = scratch[1]
-    k1q = scratch[2]
-    k1v = scratch[3]
-    k2q = scratch[4]
-    k2v = scratch[5]
-    k3q = scratch[6]
-    k3v = scratch[7]
-    k4q = scratch[8]
-    k4v = scratch[9]
-    for i in range(n):
-        k1q[i] = qd[i]
-    qdd_into(q, qd, tau, k1v)
-    for i in range(n):
-        qa[i] = q[i] + 0.5 * dt * k1q[i]
-        va[i] = qd[i] + 0.5 * dt * k1v[i]
-        k2q[i] = va[i]
-    qdd_into(qa, va, tau, k2v)
-    for i in range(n):
-        qa[i] = q[i] + 0.5 * dt * k2q[i]
-        va[i] = qd[i] + 0.5 * dt * k2v[i]
-        k3q[i] = va[i]
-    qdd_into(qa, va, tau, k3v)
-    for i in range(n):
-        qa[i] = q[i] + dt * k3q[i]
-        va[i] = qd[i] + dt * k3v[i]
-        k4q[i] = va[i]
-    qdd_into(qa, va, tau, k4v)
-    for i in range(n):
-        q[i] += dt / 6.0 * (k1q[i] + 2.0 * k2q[i] + 2.0 * k3q[i] + k4q[i])
-        qd[i] += dt / 6.0 * (k1v[i] + 2.0 * k2v[i] + 2.0 * k3v[i] + k4v[i])
+def rk4_step(derivative_into, state, inputs, dt, scratch):
+    """Advance ``state`` (S,) SI in place by one RK4 step of dt seconds, ``inputs`` held
+    constant. scratch: from ``rk4_scratch(S)``."""
+    k1 = scratch[0]
+    k2 = scratch[1]
+    k3 = scratch[2]
+    k4 = scratch[3]
+    probe = scratch[4]
+    size = state.shape[0]
+    derivative_into(state, inputs, k1)
+    for i in range(size):
+        probe[i] = state[i] + 0.5 * dt * k1[i]
+    derivative_into(probe, inputs, k2)
+    for i in range(size):
+        probe[i] = state[i] + 0.5 * dt * k2[i]
+    derivative_into(probe, inputs, k3)
+    for i in range(size):
+        probe[i] = state[i] + dt * k3[i]
+    derivative_into(probe, inputs, k4)
+    for i in range(size):
+        state[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])

@@ -6,7 +6,7 @@ import numpy as np
 from numba import njit, types
 
 from mosys.kernels.figure_state import read_state
-from mosys.kernels.integrate import QDD_INTO, rk4_scratch, rk4_step
+from mosys.kernels.integrate import DERIVATIVE_INTO, rk4_scratch, rk4_step
 from mosys.kernels.interpolate import (
     clamp_to_domain,
     grid_strides,
@@ -18,7 +18,7 @@ F1 = types.float64[::1]
 I1 = types.int64[::1]
 B1 = types.boolean[::1]
 SIMULATE_SIGNATURE = types.void(
-    QDD_INTO,  # qdd_into
+    DERIVATIVE_INTO,  # derivative_into
     F1,  # axis_min
     F1,  # axis_step
     I1,  # axis_count
@@ -28,6 +28,7 @@ SIMULATE_SIGNATURE = types.void(
     F1,  # control_max
     I1,  # state_slot
     I1,  # control_slot
+    types.int64,  # input_size
     F1,  # state (in/out)
     types.float64,  # dt
     types.float64[:, ::1],  # record_state
@@ -38,7 +39,7 @@ SIMULATE_SIGNATURE = types.void(
 
 @njit(SIMULATE_SIGNATURE, cache=True)
 def simulate_controlled(
-    qdd_into,
+    derivative_into,
     axis_min,
     axis_step,
     axis_count,
@@ -48,6 +49,7 @@ def simulate_controlled(
     control_max,
     state_slot,
     control_slot,
+    input_size,
     state,
     dt,
     record_state,
@@ -56,35 +58,30 @@ def simulate_controlled(
 ):
     """Simulate ``record_state.shape[0]`` RK4 steps of dt seconds under a controller.
 
-    At every step the controller's state is read from the figure state, clamped into the table's
-    domain (non-wrap axes; ``record_outside`` marks the steps where it had to be), the torques are
-    n-linearly interpolated from ``torque_table`` (N, m), clamped to [control_min, control_max]
-    (m,) and held for the step (zero-order hold). SI units throughout; grids as in
+    At every step the controller's state is read from the model's state, clamped into the
+    table's domain (non-wrap axes; ``record_outside`` marks the steps where it had to be), the
+    controls are n-linearly interpolated from ``torque_table`` (N, m), clamped to
+    [control_min, control_max] (m,) and held for the step (zero-order hold) on the model's
+    inputs (``control_slot`` (m,) of ``input_size``). SI units throughout; grids as in
     ``kernels.interpolate``.
-    state: (2n,) figure state q‖qd, advanced in place. Records, one row per step, taken at the
-    step's start: record_state (S, 2n), record_control (S, m), record_outside (S,).
+    state: (S,) the model's state, advanced in place. Records, one row per step, taken at the
+    step's start: record_state (steps, S), record_control (steps, m), record_outside (steps,).
     """
-    n = state.shape[0] // 2
+    size = state.shape[0]
     d = axis_min.shape[0]
     m = control_slot.shape[0]
-    q = np.empty(n)
-    qd = np.empty(n)
-    tau = np.zeros(n)
-    scratch = rk4_scratch(n)
+    inputs = np.zeros(input_size)
+    scratch = rk4_scratch(size)
     controller_state = np.empty(d)
     clamped = np.empty(d)
     control = np.empty(m)
     strides = np.empty(d, np.int64)
     grid_strides(axis_count, strides)
     interpolation = interpolation_scratch(d)
-    for i in range(n):
-        q[i] = state[i]
-        qd[i] = state[n + i]
     for step in range(record_state.shape[0]):
-        for i in range(n):
-            record_state[step, i] = q[i]
-            record_state[step, n + i] = qd[i]
-        read_state(q, qd, state_slot, controller_state)
+        for i in range(size):
+            record_state[step, i] = state[i]
+        read_state(state, state_slot, controller_state)
         inside = clamp_to_domain(axis_min, axis_step, axis_count, wrap, controller_state, clamped)
         record_outside[step] = not inside
         interpolate_with(
@@ -98,13 +95,10 @@ def simulate_controlled(
             interpolation,
             control,
         )
-        for i in range(n):
-            tau[i] = 0.0
+        for i in range(input_size):
+            inputs[i] = 0.0
         for j in range(m):
             value = min(max(control[j], control_min[j]), control_max[j])
             record_control[step, j] = value
-            tau[control_slot[j]] += value
-        rk4_step(qdd_into, q, qd, tau, dt, scratch)
-    for i in range(n):
-        state[i] = q[i]
-        state[n + i] = qd[i]
+            inputs[control_slot[j]] += value
+        rk4_step(derivative_into, state, inputs, dt, scratch)

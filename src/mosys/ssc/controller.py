@@ -21,9 +21,9 @@ from mosys.ssc.grid import FigureGrid, figure_grid
 
 @dataclass(frozen=True)
 class ClosedLoopRun:
-    """One simulated stretch: ``states`` (S+1, 2n) figure state q‖qd, SI, the first row the start;
-    ``controls`` (S, m) the controls held over each step; ``outside`` (S,) True where the state was
-    outside the table's domain and was clamped."""
+    """One simulated stretch: ``states`` (steps+1, S) the model's state, SI, the first row the
+    start; ``controls`` (steps, m) the controls held over each step; ``outside`` (steps,) True
+    where the state was outside the table's domain and was clamped."""
 
     states: np.ndarray
     controls: np.ndarray
@@ -48,7 +48,7 @@ class Controller:
         )
         m = len(table.control_names)
         self.torque_table = np.ascontiguousarray(table.torque.reshape(-1, m))
-        actuators = tuple(dynamics.TAU_NAMES)
+        actuators = tuple(dynamics.INPUT_NAMES)
         self.control_slot = np.array(
             [actuators.index(name) for name in table.control_names], dtype=np.int64
         )
@@ -81,14 +81,14 @@ class Controller:
         return np.clip(out, self.table.control_min, self.table.control_max)
 
     def figure_state(self, state: np.ndarray) -> np.ndarray:
-        """A full figure state q‖qd (2n,), SI, from a controller state (d,) in spec units; figure
+        """A full model state (S,), SI, from a controller state (d,) in spec units; model
         state variables the controller does not name are 0."""
-        full = np.zeros(2 * len(self.dynamics.Q_NAMES))
+        full = np.zeros(len(self.dynamics.STATE_NAMES))
         full[self.grid.state_slot] = np.asarray(state, dtype=np.float64) * self.grid.scale
         return full
 
     def controller_states(self, figure_states: np.ndarray) -> np.ndarray:
-        """Controller states (S, d) in spec units from figure states (S, 2n) SI; wrap axes are
+        """Controller states (N, d) in spec units from model states (N, S) SI; wrap axes are
         reduced into [first node, first node + period)."""
         grid = self.grid
         states = figure_states[:, grid.state_slot] / grid.scale
@@ -99,7 +99,7 @@ class Controller:
         return states
 
     def simulate(self, figure_state: np.ndarray, seconds: float, dt: float) -> ClosedLoopRun:
-        """Run the figure from ``figure_state`` (2n,) SI under this controller for ``seconds``
+        """Run the model from ``figure_state`` (S,) SI under this controller for ``seconds``
         (rounded to whole steps of ``dt``)."""
         steps = int(round(seconds / dt))
         n2 = len(figure_state)
@@ -109,7 +109,7 @@ class Controller:
         outside = np.empty(steps, dtype=np.bool_)
         grid = self.grid
         simulate_controlled(
-            self.dynamics.qdd_into,
+            self.dynamics.derivative_into,
             grid.axis_min,
             grid.axis_step,
             grid.axis_count,
@@ -119,6 +119,7 @@ class Controller:
             np.ascontiguousarray(self.table.control_max),
             grid.state_slot,
             self.control_slot,
+            len(self.dynamics.INPUT_NAMES),
             state,
             float(dt),
             states[:-1],

@@ -38,9 +38,10 @@ class Problem:
 
     spec: ControllerSpec
     grid: FigureGrid
-    base_state: np.ndarray  # (2n,) values of the figure state slots the controller leaves out
+    base_state: np.ndarray  # (S,) values of the state slots the controller leaves out
     control_samples: np.ndarray  # (U, m) every combination of the sampled controls
-    control_slot: np.ndarray  # (m,) coordinate driven by each control
+    control_slot: np.ndarray  # (m,) entry of the model's inputs each control drives
+    input_size: int  # how many inputs the model takes
     is_destination: np.ndarray  # (N,) bool
 
 
@@ -62,7 +63,7 @@ def build_problem(spec: ControllerSpec, dynamics: ModuleType) -> Problem:
                 dimension.token,
                 f"an angle whose wrap period samples*step is 360 deg (it is {dimension.period:g})",
             )
-    actuators = tuple(dynamics.TAU_NAMES)
+    actuators = tuple(dynamics.INPUT_NAMES)
     control_slot = []
     for control in spec.controls:
         if control.name not in actuators or not control.name:
@@ -89,6 +90,7 @@ def build_problem(spec: ControllerSpec, dynamics: ModuleType) -> Problem:
         base_state=np.zeros(len(names)),
         control_samples=np.ascontiguousarray(samples),
         control_slot=np.array(control_slot, dtype=np.int64),
+        input_size=len(actuators),
         is_destination=np.ascontiguousarray(destination.reshape(-1)),
     )
 
@@ -149,7 +151,7 @@ def solve(
     done = 0
     for chunk in chunks:
         exit_transitions(
-            dynamics.qdd_into,
+            dynamics.derivative_into,
             grid.axis_min,
             grid.axis_step,
             grid.axis_count,
@@ -158,6 +160,7 @@ def solve(
             problem.base_state,
             problem.control_samples,
             problem.control_slot,
+            problem.input_size,
             effort,
             float(dt),
             max_steps,

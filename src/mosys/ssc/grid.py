@@ -13,27 +13,22 @@ DEGREE = math.pi / 180.0
 
 
 def figure_state_names(dynamics: ModuleType) -> tuple[str, ...]:
-    """The figure's state variables in state order: coordinates, then rates."""
-    return tuple(dynamics.Q_NAMES) + tuple(dynamics.QD_NAMES)
+    """The model's state variables in state order (for a figure: coordinates, then rates)."""
+    return tuple(dynamics.STATE_NAMES)
 
 
 def state_unit(dynamics: ModuleType, name: str) -> tuple[str, float]:
-    """Spec unit of a figure state variable and its factor to SI: ('deg', π/180),
-    ('deg/s', π/180), ('m', 1) or ('m/s', 1)."""
-    names = figure_state_names(dynamics)
-    slot = names.index(name)
-    n = len(dynamics.Q_NAMES)
-    is_angle = bool(dynamics.Q_IS_ANGLE[slot % n])
-    is_rate = slot >= n
-    unit = ("deg" if is_angle else "m") + ("/s" if is_rate else "")
-    return unit, DEGREE if is_angle else 1.0
+    """Spec unit of a state variable and its factor to SI: ('deg', π/180), ('deg/s', π/180),
+    ('m', 1) or ('m/s', 1)."""
+    unit = dynamics.STATE_UNITS[figure_state_names(dynamics).index(name)]
+    return unit, DEGREE if unit.startswith("deg") else 1.0
 
 
 @dataclass(frozen=True)
 class FigureGrid:
     """A uniform controller grid over some of a figure's state variables, in SI units, ready for
     the kernels. axis_min, axis_step: (d,) float64 SI; axis_count: (d,) int64; wrap: (d,) bool;
-    state_slot: (d,) int64 index of each axis in the figure state q‖qd; scale: (d,) spec unit
+    state_slot: (d,) int64 index of each axis in the model's state; scale: (d,) spec unit
     → SI factors; units: the spec units."""
 
     names: tuple[str, ...]
