@@ -79,3 +79,16 @@ def test_a_file_that_is_not_a_controller_table(tmp_path):
     assert done.stderr.startswith("mosys: ")
     assert "Traceback" not in done.stderr
     assert not (tmp_path / "t.png").exists()
+
+
+def test_dynamics_module_from_an_older_mosys(tmp_path):
+    dynamics = tmp_path / "dynamics"
+    dynamics.mkdir()
+    (dynamics / "link1.py").write_text('Q_NAMES = ("angle",)\n')
+    spec = tmp_path / "A.ssc"
+    spec.write_text((SPECS / "controllers/pendulum/A.ssc").read_text())
+    done = mosys("dp", str(spec), "--dynamics-dir", str(dynamics), "-o", "out.h5", cwd=tmp_path)
+    assert done.returncode == 2
+    assert "is not a dynamics module of this mosys" in done.stderr
+    assert "Traceback" not in done.stderr
+    assert not (tmp_path / "out.h5").exists()

@@ -23,6 +23,7 @@ from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
 
+from mosys.errors import InputError
 from mosys.parsing.tokens import SpecError, Token
 
 REQUIRED = (
@@ -75,7 +76,7 @@ def content_addressed_copy(path: Path) -> Path:
 
 def load_dynamics(path: str | Path) -> ModuleType:
     """Import the generated dynamics module at ``path`` (see the module docstring). Raises
-    FileNotFoundError if it does not exist and ValueError if it lacks the generated names."""
+    FileNotFoundError if it does not exist and InputError if it lacks the generated names."""
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"no generated dynamics module at {str(path)!r}")
@@ -85,7 +86,7 @@ def load_dynamics(path: str | Path) -> ModuleType:
         return sys.modules[name]
     spec = importlib.util.spec_from_file_location(name, copy)
     if spec is None or spec.loader is None:
-        raise ValueError(f"{str(path)!r} cannot be imported as a Python module")
+        raise InputError(f"{path} cannot be imported as a Python module")
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module
     try:
@@ -95,7 +96,10 @@ def load_dynamics(path: str | Path) -> ModuleType:
         raise
     missing = [attribute for attribute in REQUIRED if not hasattr(module, attribute)]
     if missing:
-        raise ValueError(f"{str(path)!r} is not a generated dynamics module (no {missing[0]})")
+        raise InputError(
+            f"{path} is not a dynamics module of this mosys (it lacks {missing[0]}): compile its "
+            "figure again (mosys compile, or snakemake, which does so when mosys changes)"
+        )
     return module
 
 
