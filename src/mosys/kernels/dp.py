@@ -17,7 +17,14 @@ import numpy as np
 from numba import njit, prange, types
 
 from mosys.kernels.figure_state import load_state, read_state
-from mosys.kernels.integrate import DERIVATIVE_INTO, rk4_scratch, rk4_step
+from mosys.kernels.integrate import (
+    DERIVATIVE_INTO,
+    FLAGS,
+    INDICES,
+    VECTOR,
+    rk4_scratch,
+    rk4_step,
+)
 from mosys.kernels.interpolate import corner_weights, grid_strides, interpolation_scratch
 
 
@@ -31,25 +38,22 @@ def node_coordinates(axis_min, axis_step, axis_count, node, out):
 
 
 WEIGHT_EPSILON = 1e-9  # interpolation weights below this are rounding noise
-F1 = types.float64[::1]
-I1 = types.int64[::1]
-B1 = types.boolean[::1]
 EXIT_TRANSITIONS_SIGNATURE = types.void(
     DERIVATIVE_INTO,  # derivative_into
-    F1,  # axis_min
-    F1,  # axis_step
-    I1,  # axis_count
-    B1,  # wrap
-    I1,  # state_slot
-    F1,  # base_state
+    VECTOR,  # axis_min
+    VECTOR,  # axis_step
+    INDICES,  # axis_count
+    FLAGS,  # wrap
+    INDICES,  # state_slot
+    VECTOR,  # base_state
     types.float64[:, ::1],  # control_samples
-    I1,  # control_slot
+    INDICES,  # control_slot
     types.int64,  # input_size
-    F1,  # effort_weight
+    VECTOR,  # effort_weight
     types.float64,  # dt
     types.int64,  # max_steps
-    I1,  # nodes
-    B1,  # node_valid
+    INDICES,  # nodes
+    FLAGS,  # node_valid
     types.int64[:, :, ::1],  # exit_index
     types.float64[:, :, ::1],  # exit_weight
     types.float64[:, ::1],  # segment_cost

@@ -11,7 +11,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, types
 
+# numba types of C-contiguous 1-D arrays, for the kernels' explicit signatures
 VECTOR = types.float64[::1]
+INDICES = types.int64[::1]
+FLAGS = types.boolean[::1]
 DERIVATIVE_INTO = types.FunctionType(types.void(VECTOR, VECTOR, VECTOR))
 
 

@@ -6,7 +6,14 @@ import numpy as np
 from numba import njit, types
 
 from mosys.kernels.figure_state import read_state
-from mosys.kernels.integrate import DERIVATIVE_INTO, rk4_scratch, rk4_step
+from mosys.kernels.integrate import (
+    DERIVATIVE_INTO,
+    FLAGS,
+    INDICES,
+    VECTOR,
+    rk4_scratch,
+    rk4_step,
+)
 from mosys.kernels.interpolate import (
     clamp_to_domain,
     grid_strides,
@@ -14,26 +21,23 @@ from mosys.kernels.interpolate import (
     interpolation_scratch,
 )
 
-F1 = types.float64[::1]
-I1 = types.int64[::1]
-B1 = types.boolean[::1]
 SIMULATE_SIGNATURE = types.void(
     DERIVATIVE_INTO,  # derivative_into
-    F1,  # axis_min
-    F1,  # axis_step
-    I1,  # axis_count
-    B1,  # wrap
+    VECTOR,  # axis_min
+    VECTOR,  # axis_step
+    INDICES,  # axis_count
+    FLAGS,  # wrap
     types.float64[:, ::1],  # torque_table
-    F1,  # control_min
-    F1,  # control_max
-    I1,  # state_slot
-    I1,  # control_slot
+    VECTOR,  # control_min
+    VECTOR,  # control_max
+    INDICES,  # state_slot
+    INDICES,  # control_slot
     types.int64,  # input_size
-    F1,  # state (in/out)
+    VECTOR,  # state (in/out)
     types.float64,  # dt
     types.float64[:, ::1],  # record_state
     types.float64[:, ::1],  # record_control
-    B1,  # record_outside
+    FLAGS,  # record_outside
 )
 
 
