@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from spec_fuzz import token_mutations
 
 from mosys.parsing.controller import (
     DEFAULT_DT,
@@ -392,31 +393,11 @@ def test_keyword_soup_parses_or_raises_spec_error(text):
     parses_or_spec_error(text)
 
 
-@st.composite
-def mutated_specs(draw):
-    lines = [line.split() for line in draw(st.sampled_from(SPECS)).splitlines()]
-    for _ in range(draw(st.integers(1, 4))):
-        row = draw(st.integers(0, len(lines) - 1))
-        kind = draw(st.sampled_from(["delete", "duplicate", "replace", "swap", "dup_line"]))
-        tokens = lines[row]
-        if kind == "swap":
-            other = draw(st.integers(0, len(lines) - 1))
-            lines[row], lines[other] = lines[other], lines[row]
-        elif kind == "dup_line":
-            lines.insert(row, list(tokens))
-        elif tokens:
-            column = draw(st.integers(0, len(tokens) - 1))
-            if kind == "delete":
-                del tokens[column]
-            elif kind == "duplicate":
-                tokens.insert(column, tokens[column])
-            else:
-                tokens[column] = draw(garbage)
-    return "\n".join(" ".join(tokens) for tokens in lines)
+mutated_specs = token_mutations(st.sampled_from(SPECS), garbage)
 
 
 @FAST
-@given(mutated_specs())
+@given(mutated_specs)
 def test_mutated_specs_parse_or_raise_spec_error(text):
     parses_or_spec_error(text)
 

@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from spec_fuzz import token_mutations
 
 from mosys.parsing.script import (
     AnimationScript,
@@ -257,31 +258,11 @@ def test_keyword_soup_parses_or_raises_spec_error(text):
     parses_or_spec_error(text)
 
 
-@st.composite
-def mutated_scripts(draw):
-    lines = [line.split() for line in SOURCE.splitlines()]
-    for _ in range(draw(st.integers(1, 4))):
-        row = draw(st.integers(0, len(lines) - 1))
-        kind = draw(st.sampled_from(["delete", "duplicate", "replace", "swap", "dup_line"]))
-        tokens = lines[row]
-        if kind == "swap":
-            other = draw(st.integers(0, len(lines) - 1))
-            lines[row], lines[other] = lines[other], lines[row]
-        elif kind == "dup_line":
-            lines.insert(row, list(tokens))
-        elif tokens:
-            column = draw(st.integers(0, len(tokens) - 1))
-            if kind == "delete":
-                del tokens[column]
-            elif kind == "duplicate":
-                tokens.insert(column, tokens[column])
-            else:
-                tokens[column] = draw(garbage)
-    return "\n".join(" ".join(tokens) for tokens in lines)
+mutated_scripts = token_mutations(st.just(SOURCE), garbage)
 
 
 @FAST
-@given(mutated_scripts())
+@given(mutated_scripts)
 def test_mutated_scripts_parse_or_raise_spec_error(text):
     parses_or_spec_error(text)
 
