@@ -168,7 +168,7 @@ class ControllerSpec:
     def error(self, token: Token, expected: str) -> SpecError:
         """A SpecError at ``token`` of this spec, found its text: for checks made after
         parsing (against the figure, say)."""
-        return SpecError(self.path, token.line, token.column, expected, token.text)
+        return SpecError.at(self.path, token, expected)
 
     def ordered_state(self, figure_state: Sequence[str]) -> tuple[StateDimension, ...]:
         """The ``ssd`` dimensions in the figure's state order (``figure_state``: the figure's

@@ -348,7 +348,7 @@ class _Parser:
         self.first_line: dict[str, int] = {}  # once-only keyword -> its line number
 
     def error(self, token: Token, expected: str) -> SpecError:
-        return SpecError(self.path, token.line, token.column, expected, token.text)
+        return SpecError.at(self.path, token, expected)
 
     def parse(self, lines: list[Line], spec_sha256: str) -> Figure:
         for line in lines:

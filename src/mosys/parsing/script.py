@@ -107,7 +107,7 @@ class AnimationScript:
     def error(self, token: Token, expected: str) -> SpecError:
         """A SpecError at ``token`` of this script, found its text: for checks made after
         parsing (a controller that does not exist, a state of the wrong length)."""
-        return SpecError(self.path, token.line, token.column, expected, token.text)
+        return SpecError.at(self.path, token, expected)
 
 
 def parse_script(path: str | Path) -> AnimationScript:

@@ -32,6 +32,11 @@ class SpecError(Exception):
         shown = {None: "end of line", END_OF_FILE: "end of file"}.get(found, repr(found))
         super().__init__(f"{self.path}:{line}:{column}: expected {expected}, found {shown}")
 
+    @classmethod
+    def at(cls, path: str, token: Token, expected: str) -> SpecError:
+        """The error at ``token`` of the spec ``path``, having found the token's text."""
+        return cls(path, token.line, token.column, expected, token.text)
+
 
 @dataclass(frozen=True)
 class Token:
