@@ -38,6 +38,17 @@ class ScriptRun:
     switches: tuple[tuple[float, str], ...]
 
 
+def controller_table_path(
+    script: AnimationScript, command: SwapController, controller_dir: str | Path
+) -> Path:
+    """The table a ``swapcon`` names, ``controller_dir/NAME.h5``; SpecError at the line if it
+    does not exist."""
+    path = Path(controller_dir) / f"{command.controller}.h5"
+    if not path.exists():
+        raise script.error(command.table_token, f"a controller table ({path} does not exist)")
+    return path
+
+
 def load_controllers(
     script: AnimationScript, controller_dir: str | Path, dynamics: ModuleType
 ) -> dict[str, Controller]:
@@ -47,9 +58,7 @@ def load_controllers(
     for command in script.commands:
         if not isinstance(command, SwapController) or command.controller in controllers:
             continue
-        path = Path(controller_dir) / f"{command.controller}.h5"
-        if not path.exists():
-            raise script.error(command.table_token, f"a controller table ({path} does not exist)")
+        path = controller_table_path(script, command, controller_dir)
         controller = Controller.load(path, dynamics)
         if controllers:
             first = next(iter(controllers.values()))

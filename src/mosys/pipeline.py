@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from mosys import __version__
-from mosys.animation import load_controllers, run_script
+from mosys.animation import controller_table_path, load_controllers, run_script
 from mosys.dynamics.load import figure_dynamics
 from mosys.dynamics.motion import figure_motion
 from mosys.io.controller_table import read_controller_table
@@ -25,10 +25,7 @@ def run_animation_script(
     ``dynamics_dir``) and write its trajectory, ``figure_motion`` included."""
     script = parse_script(script_path)
     first = next(c for c in script.commands if isinstance(c, SwapController))
-    table_path = Path(controller_dir) / f"{first.controller}.h5"
-    if not table_path.exists():
-        raise script.error(first.table_token, f"a controller table ({table_path} does not exist)")
-    figure = read_controller_table(table_path).figure
+    figure = read_controller_table(controller_table_path(script, first, controller_dir)).figure
     dynamics = figure_dynamics(figure, dynamics_dir, script.error, first.table_token)
     controllers = load_controllers(script, controller_dir, dynamics)
     run = run_script(script, controllers, dt)
