@@ -142,7 +142,7 @@ ROD = "rod a length=1 mass=1\n"
 ROD_B = "rod b length=1 mass=1\n"
 ERRORS = {
     "rods link length=1 mass=1\n": "bad.fig:1:1: expected one of 'gravity', 'rod', 'pin', "
-    "'free', 'hinge', 'limit', 'contact', 'terrain', found 'rods'",
+    "'free', 'hinge', 'limit', 'contact', 'terrain', 'vehicle', found 'rods'",
     "rod link length=one mass=1\npin link\n": "bad.fig:1:17: expected a number for length (m), "
     "found 'one'",
     "rod link length=0 mass=1\npin link\n": "bad.fig:1:17: expected a number > 0 for length "

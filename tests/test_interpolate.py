@@ -29,7 +29,8 @@ def grids(draw):
 def interpolate(grid, state):
     axis_min, axis_step, count, wrap, table = grid
     out = np.empty(table.shape[1])
-    interpolate_into(axis_min, axis_step, count, wrap, table, np.asarray(state, float), out)
+    known = np.ones(table.shape[0], dtype=np.bool_)
+    interpolate_into(axis_min, axis_step, count, wrap, table, known, np.asarray(state, float), out)
     return out
 
 

@@ -13,8 +13,10 @@ import mosys
 from mosys.dynamics.derive import Equations, derive_equations
 from mosys.dynamics.emit import emit_module
 from mosys.dynamics.model import build_model
+from mosys.dynamics.vehicle import vehicle_source
 from mosys.io.atomic import write_text_atomically
 from mosys.parsing.figure import Figure, parse_figure_spec
+from mosys.parsing.vehicle import Vehicle
 
 
 def derive_figure(figure: Figure) -> Equations:
@@ -26,6 +28,8 @@ def generate_source(spec_path: str | Path) -> str:
     """The text of the dynamics module for the figure spec at ``spec_path`` (nothing written).
     Raises SpecError for a spec that does not parse."""
     figure = parse_figure_spec(spec_path)
+    if isinstance(figure, Vehicle):
+        return vehicle_source(figure, str(spec_path), mosys.__version__)
     return emit_module(derive_figure(figure), str(spec_path), figure.spec_sha256, mosys.__version__)
 
 

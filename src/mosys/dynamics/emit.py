@@ -191,6 +191,7 @@ def _metadata(figure: Figure, spec_sha256: str, has_contact_forces: bool) -> str
     contacts = figure.contacts
     return "\n".join(
         [
+            'MODEL_KIND = "figure"  # an articulated figure (a built-in vehicle says "vehicle")',
             f"SPEC_SHA256 = {_string(spec_sha256)}",
             f"Q_NAMES = {names(figure.q_names)}",
             f"QD_NAMES = {names(figure.qd_names)}",
@@ -207,6 +208,9 @@ def _metadata(figure: Figure, spec_sha256: str, has_contact_forces: bool) -> str
             + "  # spec units",
             f"COORDINATE_COUNT = {len(coordinates)}  # state[:COORDINATE_COUNT] is q",
             "INPUT_NAMES = TAU_NAMES",
+            "INPUT_UNITS = "
+            + _tuple([_string("N*m" if c.is_angle else "N") for c in coordinates])
+            + "  # spec units of the controls (SI)",
             "",
             "# The figure, for figure_motion (DESIGN.md): rods in file order, SI units.",
             f"ROD_NAMES = {names([rod.name for rod in rods])}",

@@ -26,18 +26,12 @@ from types import ModuleType
 from mosys.errors import InputError
 from mosys.parsing.tokens import SpecError, Token
 
-REQUIRED = (
-    "Q_NAMES",
-    "QD_NAMES",
-    "mass_matrix",
-    "forcing",
-    "qdd",
-    "qdd_into",
-    "STATE_NAMES",
-    "STATE_UNITS",
-    "INPUT_NAMES",
-    "derivative_into",
-)
+# names every dynamics module defines (the controllers' first-order view), then those of each kind
+REQUIRED = ("STATE_NAMES", "STATE_UNITS", "INPUT_NAMES", "INPUT_UNITS", "derivative_into")
+REQUIRED_BY_KIND = {
+    "figure": ("Q_NAMES", "QD_NAMES", "mass_matrix", "forcing", "qdd", "qdd_into"),
+    "vehicle": ("WHEELBASE", "WHEEL_RADIUS", "STEER_LIMIT", "BODY_OUTLINE"),
+}
 
 
 def cache_directory() -> Path:
@@ -94,7 +88,9 @@ def load_dynamics(path: str | Path) -> ModuleType:
     except BaseException:
         sys.modules.pop(name, None)
         raise
-    missing = [attribute for attribute in REQUIRED if not hasattr(module, attribute)]
+    kind = getattr(module, "MODEL_KIND", "figure")
+    required = REQUIRED + REQUIRED_BY_KIND.get(kind, ())
+    missing = [attribute for attribute in required if not hasattr(module, attribute)]
     if missing:
         raise InputError(
             f"{path} is not a dynamics module of this mosys (it lacks {missing[0]}): compile its "

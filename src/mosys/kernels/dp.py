@@ -17,6 +17,7 @@ import numpy as np
 from numba import njit, prange, types
 
 from mosys.kernels.figure_state import load_state, read_state
+from mosys.kernels.geometry import pose_is_free
 from mosys.kernels.integrate import (
     DERIVATIVE_INTO,
     FLAGS,
@@ -54,8 +55,13 @@ EXIT_TRANSITIONS_SIGNATURE = types.void(
     types.int64,  # max_steps
     INDICES,  # nodes
     FLAGS,  # node_valid
-    types.int64[:, :, ::1],  # exit_index
-    types.float64[:, :, ::1],  # exit_weight
+    INDICES,  # pose_slot
+    types.float64[:, ::1],  # outline
+    types.float64[:, ::1],  # obstacle_vertices
+    INDICES,  # obstacle_start
+    types.float64[:, ::1],  # domain
+    types.int32[:, :, ::1],  # exit_index
+    types.float32[:, :, ::1],  # exit_weight
     types.float64[:, ::1],  # segment_cost
 )
 
@@ -79,6 +85,11 @@ def exit_transitions(
     max_steps,
     nodes,
     node_valid,
+    pose_slot,
+    outline,
+    obstacle_vertices,
+    obstacle_start,
+    domain,
     exit_index,
     exit_weight,
     segment_cost,
@@ -94,10 +105,13 @@ def exit_transitions(
     dt: RK4 step, s; max_steps: a segment that has not left its cell after this many steps is
     discarded (cost inf).
     nodes: (P,) int64 flat node indices to process; node_valid: (N,) bool (False: removed node).
-    Outputs, rows indexed by node: exit_index (N, U, 2**(d-1)) int64 and exit_weight
-    (N, U, 2**(d-1)) float64, the nodes and weights interpolating the exit state on the face it
-    crosses; segment_cost (N, U) float64, inf where the segment never leaves the cell or leaves
-    the domain.
+    pose_slot, outline, obstacle_vertices, obstacle_start, domain: the obstacles, as
+    ``geometry.pose_is_free`` takes them (pose_slot[0] < 0: none); a segment whose state is not
+    free at the end of any integration step is discarded.
+    Outputs, rows indexed by node: exit_index (N, U, 2**(d-1)) int32 and exit_weight
+    (N, U, 2**(d-1)) float32, the nodes and weights interpolating the exit state on the face it
+    crosses; segment_cost (N, U) float64, inf where the segment never leaves the cell, leaves
+    the domain or hits an obstacle.
     """
     d = axis_min.shape[0]
     size = base_state.shape[0]
@@ -117,6 +131,7 @@ def exit_transitions(
         state = np.empty(size)
         inputs = np.zeros(input_size)
         scratch = rk4_scratch(size)
+        body = np.empty_like(outline)
         integer_scratch, fraction, corner_index, corner_weight = interpolation_scratch(d)
         node_coordinates(axis_min, axis_step, axis_count, node, center)
         for u in range(n_controls):
@@ -134,6 +149,10 @@ def exit_transitions(
             for step in range(max_steps):
                 read_state(state, state_slot, before)
                 rk4_step(derivative_into, state, inputs, dt, scratch)
+                if not pose_is_free(
+                    state, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
+                ):
+                    break  # hits an obstacle or leaves the domain polygon: cost stays inf
                 read_state(state, state_slot, after)
                 # earliest crossing of the cell boundary within this step, by linear interpolation
                 crossing = 2.0
@@ -300,3 +319,32 @@ def best_controls(exit_index, exit_weight, segment_cost, value, best_control):
     sample costs inf). best_control: (N,) int64 out."""
     for node in prange(value.shape[0]):
         best_control[node] = _bellman(exit_index, exit_weight, segment_cost, value, node)[1]
+
+
+@njit(parallel=True, cache=True)
+def free_nodes(
+    axis_min,
+    axis_step,
+    axis_count,
+    state_slot,
+    base_state,
+    pose_slot,
+    outline,
+    obstacle_vertices,
+    obstacle_start,
+    domain,
+    out,
+):
+    """out (N,) bool: True for the grid nodes whose state is free of obstacles and inside the
+    domain polygon (``geometry.pose_is_free``); the grid and state slots as in
+    ``exit_transitions``."""
+    d = axis_min.shape[0]
+    for node in prange(out.shape[0]):
+        center = np.empty(d)
+        state = np.empty(base_state.shape[0])
+        body = np.empty_like(outline)
+        node_coordinates(axis_min, axis_step, axis_count, node, center)
+        load_state(center, state_slot, base_state, state)
+        out[node] = pose_is_free(
+            state, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
+        )

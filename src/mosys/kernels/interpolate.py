@@ -134,12 +134,17 @@ def corner_weights(
 
 
 @njit(cache=True)
-def interpolate_with(axis_min, axis_step, axis_count, wrap, strides, table, state, scratch, out):
+def interpolate_with(
+    axis_min, axis_step, axis_count, wrap, strides, table, known, state, scratch, out
+):
     """n-linear interpolation of a node table at one state, written into out, with work arrays
     from ``interpolation_scratch`` (no allocation: for loops over time steps).
 
-    table: (prod(axis_count), m) float64, nodes in C order; strides: from ``grid_strides``;
-    state: (d,), inside the domain (clamp first with ``clamp_to_domain``); out: (m,) float64.
+    table: (prod(axis_count), m) float64, nodes in C order; known: (prod(axis_count),) bool, the
+    nodes whose entries count: the weights of the others are dropped and the rest renormalised
+    (the paper's Figure 10: interpolate between the neighbours whose values are known); where no
+    corner with weight is known, every corner counts. strides: from ``grid_strides``; state:
+    (d,), inside the domain (clamp first with ``clamp_to_domain``); out: (m,) float64.
     """
     integer_scratch, fraction, corner_index, corner_weight = scratch
     count = corner_weights(
@@ -155,26 +160,35 @@ def interpolate_with(axis_min, axis_step, axis_count, wrap, strides, table, stat
         integer_scratch,
         fraction,
     )
+    known_weight = 0.0
+    for c in range(count):
+        if known[corner_index[c]]:
+            known_weight += corner_weight[c]
     for j in range(out.shape[0]):
         out[j] = 0.0
     for c in range(count):
         w = corner_weight[c]
-        if w == 0.0:
-            continue
         row = corner_index[c]
+        if w == 0.0 or (known_weight > 0.0 and not known[row]):
+            continue
+        if known_weight > 0.0:
+            w /= known_weight
         for j in range(out.shape[0]):
             out[j] += w * table[row, j]
 
 
 @njit(cache=True)
-def interpolate_into(axis_min, axis_step, axis_count, wrap, table, state, out):
+def interpolate_into(axis_min, axis_step, axis_count, wrap, table, known, state, out):
     """n-linear interpolation of a node table at one state, written into out.
 
-    table: (prod(axis_count), m) float64, nodes in C order; state: (d,), inside the domain
-    (clamp first with ``clamp_to_domain``); out: (m,) float64.
+    table: (prod(axis_count), m) float64, nodes in C order; known: (prod(axis_count),) bool, as
+    in ``interpolate_with``; state: (d,), inside the domain (clamp first with
+    ``clamp_to_domain``); out: (m,) float64.
     """
     d = state.shape[0]
     strides = np.empty(d, np.int64)
     grid_strides(axis_count, strides)
     scratch = interpolation_scratch(d)
-    interpolate_with(axis_min, axis_step, axis_count, wrap, strides, table, state, scratch, out)
+    interpolate_with(
+        axis_min, axis_step, axis_count, wrap, strides, table, known, state, scratch, out
+    )

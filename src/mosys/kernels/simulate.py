@@ -28,6 +28,7 @@ SIMULATE_SIGNATURE = types.void(
     INDICES,  # axis_count
     FLAGS,  # wrap
     types.float64[:, ::1],  # torque_table
+    FLAGS,  # known
     VECTOR,  # control_min
     VECTOR,  # control_max
     INDICES,  # state_slot
@@ -49,6 +50,7 @@ def simulate_controlled(
     axis_count,
     wrap,
     torque_table,
+    known,
     control_min,
     control_max,
     state_slot,
@@ -64,7 +66,8 @@ def simulate_controlled(
 
     At every step the controller's state is read from the model's state, clamped into the
     table's domain (non-wrap axes; ``record_outside`` marks the steps where it had to be), the
-    controls are n-linearly interpolated from ``torque_table`` (N, m), clamped to
+    controls are n-linearly interpolated from ``torque_table`` (N, m) over the ``known`` (N,)
+    nodes (those with a finite cost-to-go; ``interpolate_with``), clamped to
     [control_min, control_max] (m,) and held for the step (zero-order hold) on the model's
     inputs (``control_slot`` (m,) of ``input_size``). SI units throughout; grids as in
     ``kernels.interpolate``.
@@ -95,6 +98,7 @@ def simulate_controlled(
             wrap,
             strides,
             torque_table,
+            known,
             clamped,
             interpolation,
             control,

@@ -10,6 +10,11 @@
     tol 1e-6                           # optional: convergence tolerance, s (default 1e-6)
     maxiter 1000                       # optional: iteration cap (default 1000)
     dt 0.001                           # optional: DP integration step, s (default 0.001)
+    obstacle curb -20,-1 20,-1 20,0 -20,0   # optional: a polygon the body must not overlap, m
+    domain -4,0.5 8,0.5 8,4 -4,4       # optional: a polygon the reference point stays in, m
+
+``obstacle`` and ``domain`` are for figures with a body outline (the car): their vertices are in
+metres in the frame of the figure's ``x``/``y`` state variables.
 
 Values are in spec units: degrees for angles, deg/s for angular rates, metres and m/s otherwise
 (the figure says which). The full grammar is in ``docs/controller-spec.md``.
@@ -36,7 +41,7 @@ from mosys.parsing.tokens import (
     value_token,
 )
 
-KEYWORDS = ("dyn", "ssd", "torq", "dest", "tol", "maxiter", "dt")
+KEYWORDS = ("dyn", "ssd", "torq", "dest", "tol", "maxiter", "dt", "obstacle", "domain")
 DEFAULT_TOLERANCE = (
     1e-6  # s: largest change of the cost-to-go in one sweep that counts as converged
 )
@@ -127,6 +132,17 @@ class Destination:
 
 
 @dataclass(frozen=True)
+class Polygon:
+    """An ``obstacle`` or the ``domain`` line: a simple polygon, ``vertices`` (x, y) in metres in
+    the frame of the figure's ``x``/``y`` state variables. ``name`` is the obstacle's name
+    (``"domain"`` for the domain); ``token`` the name's token (the keyword's, for the domain)."""
+
+    name: str
+    vertices: tuple[tuple[float, float], ...]
+    token: Token
+
+
+@dataclass(frozen=True)
 class ControllerSpec:
     """A parsed ``.ssc`` file.
 
@@ -135,7 +151,9 @@ class ControllerSpec:
     ``dest`` order; dimensions it does not name are free. ``tolerance`` (s) stops the DP when
     no cost-to-go changes by more than it in one sweep; ``max_iterations`` caps the sweeps;
     ``dt`` (s) is the integration step of the DP's simulations. ``spec_sha256`` is the hex
-    SHA-256 of the file's bytes.
+    SHA-256 of the file's bytes. ``obstacles`` and ``domain`` (None: no such line) restrict a
+    figure with a body outline: states whose body overlaps an obstacle or whose reference point
+    lies outside the domain are removed from the table.
     """
 
     path: str
@@ -148,6 +166,8 @@ class ControllerSpec:
     max_iterations: int
     dt: float
     spec_sha256: str
+    obstacles: tuple[Polygon, ...] = ()
+    domain: Polygon | None = None
 
     @property
     def name(self) -> str:
@@ -217,6 +237,8 @@ class _Parser:
         self.options: dict[str, float | int] = {}
         self.first_line: dict[str, int] = {}  # once-only keyword -> its line number
         self.names: dict[str, int] = {}  # ssd/torq name -> its line number
+        self.obstacles: list[Polygon] = []
+        self.domain: Polygon | None = None
 
     def error(self, token: Token, expected: str, found: str | None) -> SpecError:
         return SpecError(self.path, token.line, token.column, expected, found)
@@ -226,7 +248,7 @@ class _Parser:
             keyword = line.keyword.text
             if keyword not in KEYWORDS:
                 raise unknown_keyword(line, KEYWORDS)
-            if keyword in ("dyn", "dest", "tol", "maxiter", "dt"):
+            if keyword in ("dyn", "dest", "tol", "maxiter", "dt", "domain"):
                 self.once(line)
             getattr(self, f"line_{keyword}")(line)
         for keyword, given in (
@@ -249,6 +271,8 @@ class _Parser:
             max_iterations=int(self.options.get("maxiter", DEFAULT_MAX_ITERATIONS)),
             dt=float(self.options.get("dt", DEFAULT_DT)),
             spec_sha256=spec_sha256,
+            obstacles=tuple(self.obstacles),
+            domain=self.domain,
         )
 
     def once(self, line: Line) -> None:
@@ -397,6 +421,55 @@ class _Parser:
             )
         return round(position) % dimension.samples
 
+    def line_obstacle(self, line: Line) -> None:
+        reader = line.reader()
+        name = reader.peek()
+        reader.name("the obstacle")
+        assert name is not None
+        for other in self.obstacles:
+            if other.name == name.text:
+                raise self.error(
+                    name,
+                    f"a name not used by another obstacle (line {other.token.line})",
+                    name.text,
+                )
+        self.obstacles.append(Polygon(name.text, self.polygon(line, reader), name))
+
+    def line_domain(self, line: Line) -> None:
+        reader = line.reader()
+        self.domain = Polygon("domain", self.polygon(line, reader), line.keyword)
+
+    def polygon(self, line: Line, reader: LineReader) -> tuple[tuple[float, float], ...]:
+        """The rest of the line as the vertices 'x,y' (metres) of a simple polygon."""
+        vertices: list[tuple[float, float]] = []
+        tokens: list[Token] = []
+        for token in reader.remaining():
+            x_text, comma, y_text = token.text.partition(",")
+            if not comma or "," in y_text:
+                raise self.error(token, "a vertex 'x,y' in metres", token.text)
+            x = parse_number(Token(x_text, token.line, token.column), self.path, "vertex x")
+            y_token = Token(y_text, token.line, token.column + len(x_text) + 1)
+            y = parse_number(y_token, self.path, "vertex y")
+            if not (math.isfinite(x) and math.isfinite(y)) or max(abs(x), abs(y)) > 1e6:
+                raise self.error(token, "a vertex within 1e6 m of the origin", token.text)
+            vertices.append((x, y))
+            tokens.append(token)
+        if len(vertices) < 3:
+            raise SpecError(
+                self.path,
+                line.number,
+                line.end_column,
+                f"a vertex 'x,y' (a polygon has at least 3; {len(vertices)} given)",
+                None,
+            )
+        if abs(polygon_area(vertices)) < 1e-12:
+            raise self.error(tokens[0], "vertices enclosing a non-zero area", tokens[0].text)
+        crossing = first_self_crossing(vertices)
+        if crossing is not None:
+            token = tokens[crossing]
+            raise self.error(token, "a simple polygon (its edges cross here)", token.text)
+        return tuple(vertices)
+
     def line_tol(self, line: Line) -> None:
         self.options["tol"] = self.positive(line, "tol (s)")
 
@@ -415,6 +488,37 @@ class _Parser:
             raise self.error(token, f"a number > 0 for {what}", token.text)
         reader.end()
         return value
+
+
+def polygon_area(vertices: Sequence[tuple[float, float]]) -> float:
+    """Signed area (m², positive counter-clockwise) of a polygon (shoelace formula)."""
+    total = 0.0
+    for (x0, y0), (x1, y1) in zip(vertices, [*vertices[1:], vertices[0]], strict=True):
+        total += x0 * y1 - x1 * y0
+    return total / 2.0
+
+
+def _segments_cross(a, b, c, d) -> bool:
+    """True when the open segments ab and cd cross at a single interior point."""
+
+    def side(p, q, r) -> float:
+        return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
+
+    return (side(c, d, a) > 0) != (side(c, d, b) > 0) and (side(a, b, c) > 0) != (side(a, b, d) > 0)
+
+
+def first_self_crossing(vertices: Sequence[tuple[float, float]]) -> int | None:
+    """The index of the vertex that starts the first edge crossing an earlier non-adjacent edge,
+    or None for a simple polygon."""
+    n = len(vertices)
+    edges = [(vertices[i], vertices[(i + 1) % n]) for i in range(n)]
+    for j in range(n):
+        for i in range(j - 1):
+            if i == 0 and j == n - 1:
+                continue  # the first and last edges share vertex 0
+            if _segments_cross(*edges[i], *edges[j]):
+                return j
+    return None
 
 
 def render_controller_spec(spec: ControllerSpec) -> str:
@@ -445,4 +549,12 @@ def render_controller_spec(spec: ControllerSpec) -> str:
         lines.append(f"maxiter {spec.max_iterations}")
     if spec.dt != DEFAULT_DT:
         lines.append(f"dt {number(spec.dt)}")
+
+    def vertices(polygon: Polygon) -> str:
+        return " ".join(f"{number(x)},{number(y)}" for x, y in polygon.vertices)
+
+    for obstacle in spec.obstacles:
+        lines.append(f"obstacle {obstacle.name} {vertices(obstacle)}")
+    if spec.domain is not None:
+        lines.append(f"domain {vertices(spec.domain)}")
     return "\n".join(lines) + "\n"

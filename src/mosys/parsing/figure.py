@@ -7,8 +7,9 @@
     pin link at=0,0 angle=angle rate=omega actuator=torque
 
 Keywords: ``gravity``, ``rod``, ``pin`` or ``free`` (the root), ``hinge``, ``limit``,
-``contact``, ``terrain``. Lengths in metres, masses in kg, angles in degrees (radians in the parsed
-``Figure``). The full grammar, with every default and convention, is in ``docs/figure-spec.md``.
+``contact``, ``terrain``; or a single ``vehicle`` line for the built-in car (``parsing.vehicle``).
+Lengths in metres, masses in kg, angles in degrees (radians in the parsed ``Figure``).
+The full grammar, with every default and convention, is in ``docs/figure-spec.md``.
 """
 
 from __future__ import annotations
@@ -31,8 +32,9 @@ from mosys.parsing.tokens import (
     unknown_keyword,
     value_token,
 )
+from mosys.parsing.vehicle import Vehicle, is_vehicle_spec, parse_vehicle
 
-KEYWORDS = ("gravity", "rod", "pin", "free", "hinge", "limit", "contact", "terrain")
+KEYWORDS = ("gravity", "rod", "pin", "free", "hinge", "limit", "contact", "terrain", "vehicle")
 DEFAULT_GRAVITY = 9.81  # m/s²
 DEFAULT_COM = 0.5  # fraction of the rod from its proximal end
 DEFAULT_SLIP = 0.01  # m/s: tangential speed at which contact friction reaches friction * normal
@@ -222,7 +224,7 @@ class Figure:
         return self.q_names.index(name)
 
 
-def parse_figure_spec(path: str | Path) -> Figure:
+def parse_figure_spec(path: str | Path) -> Figure | Vehicle:
     """Parse a ``.fig`` file; any problem raises SpecError naming file, line and column."""
     try:
         data = Path(path).read_bytes()
@@ -233,12 +235,18 @@ def parse_figure_spec(path: str | Path) -> Figure:
     return parse_figure_text(text, str(path), hashlib.sha256(data).hexdigest())
 
 
-def parse_figure_text(text: str, path: str = "<text>", spec_sha256: str | None = None) -> Figure:
-    """Parse ``.fig`` text; ``path`` names it in errors. ``spec_sha256`` defaults to the SHA-256
-    of the text's UTF-8 encoding."""
+def parse_figure_text(
+    text: str, path: str = "<text>", spec_sha256: str | None = None
+) -> Figure | Vehicle:
+    """Parse ``.fig`` text: a tree of rods, or a built-in ``vehicle`` (``parsing.vehicle``);
+    ``path`` names it in errors. ``spec_sha256`` defaults to the SHA-256 of the text's UTF-8
+    encoding."""
     if spec_sha256 is None:
         spec_sha256 = hashlib.sha256(text.encode("utf-8")).hexdigest()
-    return _Parser(path).parse(tokenize(text, path), spec_sha256)
+    lines = tokenize(text, path)
+    if is_vehicle_spec(lines):
+        return parse_vehicle(lines, path, spec_sha256)
+    return _Parser(path).parse(lines, spec_sha256)
 
 
 def _fmt(value: float) -> str:
@@ -436,6 +444,9 @@ class _Parser:
         return parse_name(part, self.path, what), part
 
     # --- one method per keyword
+
+    def line_vehicle(self, line: Line) -> None:
+        raise self.error(line.keyword, "'vehicle' as the first line of a spec of its own")
 
     def line_gravity(self, line: Line) -> None:
         reader = line.reader()

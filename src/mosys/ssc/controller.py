@@ -16,14 +16,14 @@ import numpy as np
 from mosys.io.controller_table import ControllerTable, read_controller_table
 from mosys.kernels.interpolate import clamp_to_domain, interpolate_into
 from mosys.kernels.simulate import simulate_controlled
-from mosys.ssc.grid import FigureGrid, figure_grid
+from mosys.ssc.grid import FigureGrid, control_scale, figure_grid
 
 
 @dataclass(frozen=True)
 class ClosedLoopRun:
     """One simulated stretch: ``states`` (steps+1, S) the model's state, SI, the first row the
-    start; ``controls`` (steps, m) the controls held over each step; ``outside`` (steps,) True
-    where the state was outside the table's domain and was clamped."""
+    start; ``controls`` (steps, m) the controls held over each step, spec units; ``outside``
+    (steps,) True where the state was outside the table's domain and was clamped."""
 
     states: np.ndarray
     controls: np.ndarray
@@ -48,10 +48,12 @@ class Controller:
         )
         m = len(table.control_names)
         self.torque_table = np.ascontiguousarray(table.torque.reshape(-1, m))
+        self.known = np.ascontiguousarray(np.isfinite(table.value).reshape(-1))
         actuators = tuple(dynamics.INPUT_NAMES)
         self.control_slot = np.array(
             [actuators.index(name) for name in table.control_names], dtype=np.int64
         )
+        self.control_scale = np.array([control_scale(dynamics, n) for n in table.control_names])
 
     @classmethod
     def load(cls, path: str | Path, dynamics: ModuleType) -> Controller:
@@ -75,6 +77,7 @@ class Controller:
             grid.axis_count,
             grid.wrap,
             self.torque_table,
+            self.known,
             clamped,
             out,
         )
@@ -100,7 +103,7 @@ class Controller:
 
     def simulate(self, figure_state: np.ndarray, seconds: float, dt: float) -> ClosedLoopRun:
         """Run the model from ``figure_state`` (S,) SI under this controller for ``seconds``
-        (rounded to whole steps of ``dt``)."""
+        (rounded to whole steps of ``dt``). The run's controls are in spec units."""
         steps = int(round(seconds / dt))
         n2 = len(figure_state)
         state = np.ascontiguousarray(figure_state, dtype=np.float64).copy()
@@ -114,9 +117,10 @@ class Controller:
             grid.axis_step,
             grid.axis_count,
             grid.wrap,
-            self.torque_table,
-            np.ascontiguousarray(self.table.control_min),
-            np.ascontiguousarray(self.table.control_max),
+            np.ascontiguousarray(self.torque_table * self.control_scale),
+            self.known,
+            np.ascontiguousarray(self.table.control_min * self.control_scale),
+            np.ascontiguousarray(self.table.control_max * self.control_scale),
             grid.state_slot,
             self.control_slot,
             len(self.dynamics.INPUT_NAMES),
@@ -127,4 +131,4 @@ class Controller:
             outside,
         )
         states[-1] = state
-        return ClosedLoopRun(states, controls, outside)
+        return ClosedLoopRun(states, controls / self.control_scale, outside)

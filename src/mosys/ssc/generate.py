@@ -7,6 +7,8 @@ Validation against the figure, array set-up and the HDF5 write live here; the nu
 from __future__ import annotations
 
 import itertools
+import json
+import resource
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,12 +22,15 @@ from mosys.kernels.dp import (
     bellman_sweep,
     best_controls,
     exit_transitions,
+    free_nodes,
     interpolate_known_values_only,
+    node_coordinates,
     reach_sweep,
 )
 from mosys.parsing.controller import ControllerSpec
 from mosys.progress import Progress
-from mosys.ssc.grid import FigureGrid, figure_grid, figure_state_names
+from mosys.ssc.grid import FigureGrid, control_scale, figure_grid, figure_state_names
+from mosys.ssc.obstacles import Obstacles, blocked_reason, spec_obstacles
 
 UNKNOWN = 1.0e9  # s: cost-to-go of a reachable node whose value is not known yet
 MAX_SEGMENT_SECONDS = 2.0  # a simulated segment that stays in its cell longer is discarded
@@ -39,10 +44,13 @@ class Problem:
     spec: ControllerSpec
     grid: FigureGrid
     base_state: np.ndarray  # (S,) values of the state slots the controller leaves out
-    control_samples: np.ndarray  # (U, m) every combination of the sampled controls
+    control_samples: np.ndarray  # (U, m) every combination of the sampled controls, spec units
+    control_scale: np.ndarray  # (m,) spec unit -> SI factor of each control
     control_slot: np.ndarray  # (m,) entry of the model's inputs each control drives
     input_size: int  # how many inputs the model takes
     is_destination: np.ndarray  # (N,) bool
+    obstacles: Obstacles
+    node_valid: np.ndarray  # (N,) bool: False for nodes removed (collision, outside the domain)
 
 
 def build_problem(spec: ControllerSpec, dynamics: ModuleType) -> Problem:
@@ -84,14 +92,40 @@ def build_problem(spec: ControllerSpec, dynamics: ModuleType) -> Problem:
         broadcast = [1] * len(grid.names)
         broadcast[axis] = grid.shape[axis]
         destination &= on_node.reshape(broadcast)
+    is_destination = np.ascontiguousarray(destination.reshape(-1))
+    base_state = np.zeros(len(names))
+    obstacles = spec_obstacles(spec, dynamics, grid)
+    node_valid = np.ones(grid.node_count, dtype=np.bool_)
+    if obstacles.active:
+        free_nodes(
+            grid.axis_min,
+            grid.axis_step,
+            grid.axis_count,
+            grid.state_slot,
+            base_state,
+            *obstacles.kernel_arguments(),
+            node_valid,
+        )
+        blocked = np.flatnonzero(is_destination & ~node_valid)
+        if blocked.size:
+            state = np.empty(len(grid.names))
+            node_coordinates(grid.axis_min, grid.axis_step, grid.axis_count, blocked[0], state)
+            pose = np.array([state[grid.names.index(n)] for n in ("x", "y", "heading")])
+            reason = blocked_reason(spec, obstacles, pose)
+            raise spec.error(
+                spec.destination[0].token, f"a destination the car can occupy ({reason})"
+            )
     return Problem(
         spec=spec,
         grid=grid,
-        base_state=np.zeros(len(names)),
+        base_state=base_state,
         control_samples=np.ascontiguousarray(samples),
+        control_scale=np.array([control_scale(dynamics, c.name) for c in spec.controls]),
         control_slot=np.array(control_slot, dtype=np.int64),
         input_size=len(actuators),
-        is_destination=np.ascontiguousarray(destination.reshape(-1)),
+        is_destination=is_destination,
+        obstacles=obstacles,
+        node_valid=node_valid,
     )
 
 
@@ -133,18 +167,21 @@ def solve(
     quiet: bool = False,
 ) -> Solution:
     """Exit transitions once, then Bellman sweeps until the largest decrease < tolerance (s) or
-    ``max_iterations`` sweeps. ``node_valid``: (N,) bool, False for nodes removed from the domain.
+    ``max_iterations`` sweeps. ``node_valid``: (N,) bool, False for further nodes to remove
+    (on top of ``problem.node_valid``).
     """
     grid = problem.grid
     nodes = grid.node_count
     controls = problem.control_samples.shape[0]
     corners = 1 << (len(grid.names) - 1)
-    valid = np.ones(nodes, dtype=np.bool_) if node_valid is None else node_valid
-    exit_index = np.zeros((nodes, controls, corners), dtype=np.int64)
-    exit_weight = np.zeros((nodes, controls, corners))
+    valid = problem.node_valid if node_valid is None else problem.node_valid & node_valid
+    exit_index = np.zeros((nodes, controls, corners), dtype=np.int32)
+    exit_weight = np.zeros((nodes, controls, corners), dtype=np.float32)
     segment_cost = np.empty((nodes, controls))
     max_steps = int(np.ceil(MAX_SEGMENT_SECONDS / dt))
-    effort = np.array([c.effort_weight for c in problem.spec.controls], dtype=np.float64)
+    # the kernels take SI controls; K stays per spec unit: K |u_spec| = (K / scale) |u_SI|
+    samples_si = np.ascontiguousarray(problem.control_samples * problem.control_scale)
+    effort = np.array([c.effort_weight for c in problem.spec.controls]) / problem.control_scale
     started = time.perf_counter()
     progress = Progress("exit transitions", nodes * controls, "simulations")
     chunks = np.array_split(np.arange(nodes, dtype=np.int64), min(PROGRESS_CHUNKS, nodes))
@@ -158,7 +195,7 @@ def solve(
             grid.wrap,
             grid.state_slot,
             problem.base_state,
-            problem.control_samples,
+            samples_si,
             problem.control_slot,
             problem.input_size,
             effort,
@@ -166,6 +203,7 @@ def solve(
             max_steps,
             np.ascontiguousarray(chunk),
             valid,
+            *problem.obstacles.kernel_arguments(),
             exit_index,
             exit_weight,
             segment_cost,
@@ -207,6 +245,27 @@ def solve(
     return Solution(
         value, best_control, iterations, float(residual), transition_seconds, iteration_seconds
     )
+
+
+def peak_rss_bytes() -> int:
+    """This process's peak resident set size so far, bytes (Linux reports KiB)."""
+    return int(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss) * 1024
+
+
+def figure_attributes(problem: Problem, dynamics: ModuleType) -> dict:
+    """Root attrs the contract adds for a vehicle (wheelbase, wheel_radius) and for a spec
+    with obstacles (body_outline, obstacles, and this mosys's domain polygon)."""
+    attrs: dict = {}
+    if getattr(dynamics, "MODEL_KIND", "figure") == "vehicle":
+        attrs["wheelbase"] = float(dynamics.WHEELBASE)
+        attrs["wheel_radius"] = float(dynamics.WHEEL_RADIUS)
+    obstacles = problem.obstacles
+    if obstacles.active:
+        attrs["body_outline"] = json.dumps(obstacles.outline.tolist())
+        attrs["obstacles"] = json.dumps(obstacles.polygons())
+        attrs["obstacle_names"] = list(obstacles.names)
+        attrs["domain"] = json.dumps(obstacles.domain.tolist())
+    return attrs
 
 
 def generate_controller(
@@ -264,7 +323,11 @@ def generate_controller(
             "dt": spec.dt,
             "control_samples": np.array([c.samples for c in spec.controls], dtype=np.int64),
             "unreachable_nodes": int(unreachable.sum()),
+            "removed_nodes": int((~problem.node_valid).sum()),
+            "table_states": int(problem.node_valid.sum()),
+            "peak_rss_bytes": peak_rss_bytes(),
             "mosys_version": __version__,
+            **figure_attributes(problem, dynamics),
         },
     )
     write_controller_table(out_path, table)

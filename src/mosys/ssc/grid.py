@@ -24,6 +24,15 @@ def state_unit(dynamics: ModuleType, name: str) -> tuple[str, float]:
     return unit, DEGREE if unit.startswith("deg") else 1.0
 
 
+def control_scale(dynamics: ModuleType, name: str) -> float:
+    """The spec unit -> SI factor of a control (π/180 for deg/s or deg/s², else 1); a model
+    without INPUT_UNITS takes its controls in SI."""
+    units = getattr(dynamics, "INPUT_UNITS", None)
+    if units is None:
+        return 1.0
+    return DEGREE if units[tuple(dynamics.INPUT_NAMES).index(name)].startswith("deg") else 1.0
+
+
 @dataclass(frozen=True)
 class FigureGrid:
     """A uniform controller grid over some of a figure's state variables, in SI units, ready for

@@ -1,0 +1,144 @@
+"""Did the car park? The outcome of a car trajectory against its controller's obstacles and
+destination (the 1990 paper's §6; the issue's targets): no collision at any instant, and the
+reference point within ``position_m`` of the destination, the heading within ``heading_deg`` and
+the speed within ``speed_m_s`` of rest from some instant to the end of the run."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from mosys.io.controller_table import ControllerTable
+from mosys.io.start_grid import StartGrid
+from mosys.kernels.geometry import first_colliding_sample, pack_polygons
+from mosys.ssc.controller import Controller
+
+TOLERANCE = {"position_m": 0.15, "heading_deg": 5.0, "speed_m_s": 0.05}
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A car controller's world, from its table's attrs: body outline (V, 2) m in the car's
+    frame; obstacles packed for the kernels; their names; the destination pose (x m, y m,
+    heading deg)."""
+
+    outline: np.ndarray
+    obstacle_vertices: np.ndarray
+    obstacle_start: np.ndarray
+    obstacle_names: tuple[str, ...]
+    destination: dict[str, float]
+    wheelbase: float
+
+    @classmethod
+    def from_table(cls, table: ControllerTable) -> Scene:
+        attrs = table.attrs
+        polygons = [np.array(p, dtype=np.float64) for p in json.loads(attrs["obstacles"])]
+        vertices, start = pack_polygons(polygons)
+        return cls(
+            outline=np.ascontiguousarray(json.loads(attrs["body_outline"]), dtype=np.float64),
+            obstacle_vertices=vertices,
+            obstacle_start=start,
+            obstacle_names=tuple(str(n) for n in attrs["obstacle_names"]),
+            destination={k: table.dest.get(k, 0.0) for k in ("x", "y", "heading")},
+            wheelbase=float(attrs["wheelbase"]),
+        )
+
+    def attributes(self) -> dict:
+        """Trajectory root attrs that let a plot draw the scene from the trajectory alone."""
+        obstacles = [
+            self.obstacle_vertices[self.obstacle_start[k] : self.obstacle_start[k + 1]].tolist()
+            for k in range(len(self.obstacle_names))
+        ]
+        return {
+            "body_outline": json.dumps(self.outline.tolist()),
+            "obstacles": json.dumps(obstacles),
+            "obstacle_names": list(self.obstacle_names),
+            "destination": json.dumps(self.destination),
+            "wheelbase": self.wheelbase,
+        }
+
+
+@dataclass(frozen=True)
+class ParkingOutcome:
+    """collision_index: the first sample whose outline overlaps an obstacle (-1: none);
+    collided_with: that obstacle's name (""); parked: at rest within tolerance from some
+    sample to the end, with no collision; parking_seconds: the time of that sample (nan)."""
+
+    collision_index: int
+    collided_with: str
+    parked: bool
+    parking_seconds: float
+
+    def attributes(self) -> dict:
+        return {
+            "collision_index": self.collision_index,
+            "collided_with": self.collided_with,
+            "parked": self.parked,
+            "parking_seconds": self.parking_seconds,
+            "parking_tolerance": json.dumps(TOLERANCE),
+        }
+
+
+def parking_outcome(
+    t: np.ndarray, state: np.ndarray, state_order: tuple[str, ...], scene: Scene
+) -> ParkingOutcome:
+    """The outcome of a car run: t (N,) s; state (N, d) spec units in ``state_order`` (x, y m;
+    heading deg; speed m/s)."""
+    column = {name: state[:, state_order.index(name)] for name in ("x", "y", "heading", "speed")}
+    poses = np.ascontiguousarray(
+        np.column_stack([column["x"], column["y"], np.radians(column["heading"])])
+    )
+    sample, obstacle = first_colliding_sample(
+        poses, scene.outline, scene.obstacle_vertices, scene.obstacle_start
+    )
+    destination = scene.destination
+    heading_error = (column["heading"] - destination["heading"] + 180.0) % 360.0 - 180.0
+    inside = (
+        (
+            np.hypot(column["x"] - destination["x"], column["y"] - destination["y"])
+            <= TOLERANCE["position_m"]
+        )
+        & (np.abs(heading_error) <= TOLERANCE["heading_deg"])
+        & (np.abs(column["speed"]) <= TOLERANCE["speed_m_s"])
+    )
+    # the first sample from which every later sample is inside
+    outside_after = np.flatnonzero(~inside)
+    first_inside = 0 if outside_after.size == 0 else int(outside_after[-1]) + 1
+    parked = sample < 0 and first_inside < len(t)
+    return ParkingOutcome(
+        collision_index=int(sample),
+        collided_with=scene.obstacle_names[obstacle] if sample >= 0 else "",
+        parked=bool(parked),
+        parking_seconds=float(t[first_inside]) if parked else math.nan,
+    )
+
+
+def evaluate_starts(
+    controller: Controller, starts: np.ndarray, seconds: float, dt: float
+) -> StartGrid:
+    """Run ``controller`` (a car's) from every start (n, d) in its state order, spec units, for
+    ``seconds`` with step ``dt``, and judge each run (``parking_outcome``)."""
+    scene = Scene.from_table(controller.table)
+    outcomes = []
+    for start in starts:
+        run = controller.simulate(controller.figure_state(start), seconds, dt)
+        t = dt * np.arange(run.states.shape[0])
+        state = controller.controller_states(run.states)
+        outcomes.append(parking_outcome(t, state, controller.state_order, scene))
+    return StartGrid(
+        start=np.asarray(starts, dtype=np.float64),
+        state_order=controller.state_order,
+        parked=np.array([o.parked for o in outcomes], dtype=np.bool_),
+        collided=np.array([o.collision_index >= 0 for o in outcomes], dtype=np.bool_),
+        parking_seconds=np.array([o.parking_seconds for o in outcomes]),
+        attrs={
+            "controller": controller.name,
+            "simulated_seconds": float(seconds),
+            "dt": float(dt),
+            "parking_tolerance": json.dumps(TOLERANCE),
+            **scene.attributes(),
+        },
+    )
