@@ -9,11 +9,13 @@ include: "workflow/rules/ssc.smk"
 include: "workflow/rules/scripts.smk"
 include: "workflow/rules/plots.smk"
 include: "workflow/rules/tables.smk"
+include: "workflow/rules/car.smk"
 
 
 rule all:
     input:
         "results/pendulum_all",
+        "results/car_all",
         "results/paper_tables",
 
 
@@ -28,9 +30,20 @@ rule pendulum_all:
         "mosys index {input} -o {output} 2> {log}"
 
 
+rule car_all:
+    input:
+        car_targets(),
+    output:
+        "results/car_all",
+    log:
+        "results/logs/car_all.log",
+    shell:
+        "mosys index {input} -o {output} 2> {log}"
+
+
 rule paper_tables:
     input:
-        paper_table_targets(),
+        paper_table_targets() + car_table_targets(),
     output:
         "results/paper_tables",
     log:

@@ -71,6 +71,46 @@ def _table(args: argparse.Namespace) -> None:
     write_pendulum_table(args.controllers, args.dynamics, args.csv, args.md, args.budget)
 
 
+def _starts(args: argparse.Namespace) -> None:
+    import itertools
+
+    import numpy as np
+
+    from mosys.dynamics.load import load_dynamics
+    from mosys.io.start_grid import write_start_grid
+    from mosys.ssc.controller import Controller
+    from mosys.ssc.parking import evaluate_starts
+
+    controller = Controller.load(args.table, load_dynamics(args.dynamics))
+    axes = {
+        "x": np.linspace(*args.x[:2], int(args.x[2])),
+        "y": np.linspace(*args.y[:2], int(args.y[2])),
+        "heading": np.array(args.heading),
+        "steer": np.array(args.steer),
+        "speed": np.array([0.0]),
+    }
+    order = controller.state_order
+    starts = np.array(list(itertools.product(*(axes[name] for name in order))))
+    write_start_grid(args.output, evaluate_starts(controller, starts, args.seconds, args.dt))
+
+
+def _plot_car(args: argparse.Namespace) -> None:
+    from mosys.plots.car import plot_parking_frames, plot_success_map, write_parking_gif
+
+    if args.frames:
+        plot_parking_frames(args.trajectories, args.frames)
+    if args.gif:
+        write_parking_gif(args.trajectories[0], args.gif)
+    if args.map:
+        plot_success_map(args.map[0], args.map[1])
+
+
+def _car_table(args: argparse.Namespace) -> None:
+    from mosys.tables.car import write_car_table
+
+    write_car_table(args.table, args.starts, args.trajectories, args.csv, args.md, args.budget)
+
+
 def _index(args: argparse.Namespace) -> None:
     from mosys.io.atomic import write_text_atomically
 
@@ -106,7 +146,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("-o", "--output", required=True)
     run.set_defaults(handler=_run)
 
-    plot = verbs.add_parser("plot", help="pendulum plots").add_subparsers(
+    plot = verbs.add_parser("plot", help="plots of controllers and motions").add_subparsers(
         dest="kind", required=True
     )
     controller = plot.add_parser("controller", help="a controller's portrait and torque map")
@@ -130,6 +170,41 @@ def build_parser() -> argparse.ArgumentParser:
     table.add_argument("--budget", default="paper", help="name of the config that built it")
     table.set_defaults(handler=_table)
 
+    starts = verbs.add_parser("starts", help="a car controller from a grid of start states")
+    starts.add_argument("table", help="controller table (.h5)")
+    starts.add_argument("--dynamics", required=True, help="generated dynamics module")
+    for axis, unit in (("x", "m"), ("y", "m")):
+        starts.add_argument(
+            f"--{axis}",
+            nargs=3,
+            type=float,
+            required=True,
+            metavar=("MIN", "MAX", "COUNT"),
+            help=f"start {axis} values, {unit}",
+        )
+    starts.add_argument("--heading", nargs="+", type=float, default=[0.0], help="deg")
+    starts.add_argument("--steer", nargs="+", type=float, default=[0.0], help="deg")
+    starts.add_argument("--seconds", type=float, default=20.0, help="simulated time per start")
+    starts.add_argument("--dt", type=float, default=0.01, help="simulator step, s")
+    starts.add_argument("-o", "--output", required=True)
+    starts.set_defaults(handler=_starts)
+
+    car = plot.add_parser("car", help="car frames (Figure 19 style), a GIF, the success map")
+    car.add_argument("trajectories", nargs="*", help="car trajectories (.h5)")
+    car.add_argument("--frames", help="PNG: one panel per trajectory, the car every 0.3 s")
+    car.add_argument("--gif", help="animated GIF of the first trajectory")
+    car.add_argument("--map", nargs=2, metavar=("START_GRID", "PNG"), help="success map")
+    car.set_defaults(handler=_plot_car)
+
+    car_table = verbs.add_parser("car-table", help="the car controller's table")
+    car_table.add_argument("table", help="controller table (.h5)")
+    car_table.add_argument("--starts", required=True, help="start grid (.h5, mosys starts)")
+    car_table.add_argument("trajectories", nargs="*", help="the Figure 19 trajectories")
+    car_table.add_argument("--csv", required=True)
+    car_table.add_argument("--md", required=True)
+    car_table.add_argument("--budget", default="paper", help="name of the config that built it")
+    car_table.set_defaults(handler=_car_table)
+
     index = verbs.add_parser("index", help="write an aggregate target: the list of its files")
     index.add_argument("inputs", nargs="*")
     index.add_argument("-o", "--output", required=True)
@@ -147,6 +222,11 @@ def main(argv: list[str] | None = None) -> int:
             parser.error("plot controller: --portrait needs --dynamics")
     if args.verb == "plot" and args.kind == "script" and not (args.path or args.gif):
         parser.error("plot script: give --path and/or --gif")
+    if args.verb == "plot" and args.kind == "car":
+        if not (args.frames or args.gif or args.map):
+            parser.error("plot car: give --frames, --gif and/or --map")
+        if (args.frames or args.gif) and not args.trajectories:
+            parser.error("plot car: --frames and --gif need trajectories")
     from mosys.errors import InputError
     from mosys.parsing.tokens import SpecError
 

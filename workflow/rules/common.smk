@@ -11,13 +11,14 @@ validate(config, "../schemas/config.schema.yaml")
 PACKAGE = Path("src/mosys")
 STAGE_MODULES = {
     "parsing": ["parsing/tokens.py"],
-    "dynamics": ["parsing/figure.py", "dynamics"],
+    "dynamics": ["parsing/figure.py", "parsing/vehicle.py", "dynamics"],
     "ssc": ["parsing/controller.py", "kernels/dp.py", "kernels/integrate.py",
-            "kernels/figure_state.py", "kernels/interpolate.py", "ssc/generate.py", "ssc/grid.py",
-            "io/controller_table.py", "dynamics/load.py"],
+            "kernels/figure_state.py", "kernels/interpolate.py", "kernels/geometry.py",
+            "ssc/generate.py", "ssc/grid.py", "ssc/obstacles.py", "io/controller_table.py",
+            "dynamics/load.py"],
     "scripts": ["parsing/script.py", "animation.py", "pipeline.py", "ssc/controller.py",
-                "kernels/simulate.py", "kernels/motion.py", "io/trajectory.py",
-                "dynamics/motion.py"],
+                "ssc/parking.py", "kernels/simulate.py", "kernels/motion.py",
+                "io/trajectory.py", "io/start_grid.py", "dynamics/motion.py"],
     "plots": ["plots"],
     "tables": ["tables", "ssc/quality.py"],
 }
@@ -58,9 +59,13 @@ def table_controller(reference):
 
 
 def script_group(script):
-    """The controller directory a script draws on: the configured one for the pendulum script,
-    else the script's own name."""
-    return config["pendulum"]["group"] if script == config["pendulum"]["script"] else script
+    """The controller directory a script draws on: the configured one for the pendulum script
+    and the car's scripts, else the script's own name."""
+    if script == config["pendulum"]["script"]:
+        return config["pendulum"]["group"]
+    if script in config["car"]["scripts"]:
+        return config["car"]["group"]
+    return script
 
 
 def script_inputs(wildcards):
@@ -99,3 +104,25 @@ def pendulum_targets():
 
 def paper_table_targets():
     return ["results/tables/pendulum_controllers.csv", "results/tables/pendulum_controllers.md"]
+
+
+def car_table():
+    return f"results/controllers/{config['car']['group']}/{config['car']['controller']}.h5"
+
+
+def car_trajectories():
+    return [f"results/trajectories/{script}.h5" for script in config["car"]["scripts"]]
+
+
+def car_table_targets():
+    return ["results/tables/car_controller.csv", "results/tables/car_controller.md"]
+
+
+def car_targets():
+    return (
+        [car_table(), "results/car/start_grid.h5"]
+        + car_trajectories()
+        + ["results/plots/car/figure19_frames.png", "results/plots/car/manoeuvre.gif",
+           "results/plots/car/start_map.png"]
+        + car_table_targets()
+    )

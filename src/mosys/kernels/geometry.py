@@ -17,6 +17,12 @@ def _side(ax, ay, bx, by, px, py):
 
 
 @njit(cache=True)
+def _opposite(a, b):
+    """True when a and b have opposite signs or either is 0."""
+    return (a <= 0.0 and b >= 0.0) or (a >= 0.0 and b <= 0.0)
+
+
+@njit(cache=True)
 def segments_cross(ax, ay, bx, by, cx, cy, dx, dy):
     """True when segment ab crosses segment cd (touching counts as crossing)."""
     d1 = _side(cx, cy, dx, dy, ax, ay)
@@ -27,7 +33,8 @@ def segments_cross(ax, ay, bx, by, cx, cy, dx, dy):
         return max(min(ax, bx), min(cx, dx)) <= min(max(ax, bx), max(cx, dx)) and max(
             min(ay, by), min(cy, dy)
         ) <= min(max(ay, by), max(cy, dy))
-    return (d1 * d2 <= 0.0) and (d3 * d4 <= 0.0)
+    # signs, not products: a product of two tiny sides can underflow to 0
+    return _opposite(d1, d2) and _opposite(d3, d4)
 
 
 @njit(cache=True)

@@ -1,0 +1,351 @@
+"""The self-parking car: its figure spec, kinematics, obstacle geometry, the spec lines for
+obstacles and the domain, collision removal in the DP, and the parking judgement."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from conftest import SPECS
+from mosys.dynamics.compile import compile_figure
+from mosys.dynamics.load import load_dynamics
+from mosys.kernels.geometry import (
+    first_collision,
+    pack_polygons,
+    point_in_polygon,
+    polygons_overlap,
+)
+from mosys.kernels.integrate import rk4_scratch, rk4_step
+from mosys.parsing.controller import parse_controller_text
+from mosys.parsing.figure import parse_figure_text
+from mosys.parsing.tokens import SpecError
+from mosys.parsing.vehicle import Vehicle
+from mosys.ssc.generate import build_problem, generate_controller
+from mosys.ssc.parking import Scene, parking_outcome
+
+CAR_LINE = (
+    "vehicle wheelbase=2.5 length=4.0 width=1.7 front_overhang=0.8 wheel_radius=0.3 "
+    "steer_limit=35\n"
+)
+
+
+@pytest.fixture(scope="session")
+def car(tmp_path_factory):
+    """The car's dynamics, compiled from specs/figures/car.fig."""
+    path = tmp_path_factory.mktemp("dynamics") / "car.py"
+    compile_figure(SPECS / "figures" / "car.fig", path)
+    return load_dynamics(path)
+
+
+# --- figure spec --------------------------------------------------------------------------------
+
+
+def test_car_spec_parses_to_the_documented_geometry():
+    vehicle = parse_figure_text(CAR_LINE, "car.fig")
+    assert isinstance(vehicle, Vehicle)
+    assert vehicle.wheelbase == 2.5 and vehicle.wheel_radius == 0.3
+    assert vehicle.steer_limit == pytest.approx(math.radians(35))
+    assert vehicle.body_outline == ((0.8, -0.85), (0.8, 0.85), (-3.2, 0.85), (-3.2, -0.85))
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        (
+            "vehicle wheelbase=2.5 length=4.0 width=1.7 front_overhang=0.8 wheel_radius=0.3\n",
+            "car.fig:1:79: expected 'steer_limit=' (the largest steering angle of the road "
+            "wheels in degrees), found end of line",
+        ),
+        (
+            CAR_LINE.replace("length=4.0", "length=3.0"),
+            "car.fig:1:30: expected a length >= wheelbase + front_overhang (3.3 m: the rear "
+            "axle lies inside the body), found '3.0'",
+        ),
+        (
+            CAR_LINE.replace("width=1.7", "width=-1"),
+            "car.fig:1:40: expected a number > 0 for width, found '-1'",
+        ),
+        (
+            CAR_LINE + "gravity 9.81\n",
+            "car.fig:2:1: expected end of file (a vehicle spec has "
+            "one 'vehicle' line), found 'gravity'",
+        ),
+        (
+            "rod a length=1 mass=1\n" + CAR_LINE,
+            "car.fig:2:1: expected 'vehicle' as the first line of a spec of its own, "
+            "found 'vehicle'",
+        ),
+    ],
+)
+def test_bad_car_specs_name_the_place(text, message):
+    with pytest.raises(SpecError) as error:
+        parse_figure_text(text, "car.fig")
+    assert str(error.value) == message
+
+
+# --- kinematics -----------------------------------------------------------------------------------
+
+
+def simulate(car, state, inputs, seconds, dt=0.001):
+    state = np.array(state, dtype=float)
+    scratch = rk4_scratch(5)
+    for _ in range(round(seconds / dt)):
+        rk4_step(car.derivative_into, state, np.asarray(inputs, float), dt, scratch)
+    return state
+
+
+def test_fixed_steer_drives_the_front_wheels_round_a_circle(car):
+    """With steer δ and speed v held, the heading turns at v sin δ / L and the front-wheel
+    point runs on a circle of radius L / sin δ (a bicycle model)."""
+    steer, speed, seconds = math.radians(20), 1.5, 4.0
+    end = simulate(car, [0, 0, 0, steer, speed], [0, 0], seconds)
+    rate = speed * math.sin(steer) / 2.5
+    assert end[2] == pytest.approx(rate * seconds, rel=1e-9)
+    radius = 2.5 / math.sin(steer)
+    # the circle's centre lies a radius to the left of the front wheels' direction at the start
+    centre = np.array([-radius * math.sin(steer), radius * math.cos(steer)])
+    assert np.hypot(*(end[:2] - centre)) == pytest.approx(radius, rel=1e-9)
+
+
+def test_steering_stops_at_its_limit_and_wheel_accel_changes_speed(car):
+    end = simulate(car, [0, 0, 0, 0, 0], [math.radians(30), math.radians(100)], 2.0)
+    assert end[3] == pytest.approx(math.radians(35), abs=math.radians(0.05))
+    assert end[4] == pytest.approx(0.3 * math.radians(100) * 2.0, rel=1e-9)
+
+
+# --- geometry -------------------------------------------------------------------------------------
+
+
+def box(x0, y0, x1, y1):
+    return np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], dtype=float)
+
+
+coordinate = st.floats(-10, 10, allow_nan=False)
+
+
+@settings(deadline=None)  # the first example compiles the kernel
+@given(
+    coordinate,
+    coordinate,
+    st.floats(0.1, 5),
+    st.floats(0.1, 5),
+    coordinate,
+    coordinate,
+    st.floats(0.1, 5),
+    st.floats(0.1, 5),
+)
+def test_axis_aligned_boxes_overlap_exactly_when_their_intervals_do(x, y, w, h, u, v, a, b):
+    first, second = box(x, y, x + w, y + h), box(u, v, u + a, v + b)
+    expected = x <= u + a and u <= x + w and y <= v + b and v <= y + h
+    assert polygons_overlap(first, second) == expected
+    assert polygons_overlap(second, first) == expected
+
+
+def test_containment_and_an_l_shaped_obstacle():
+    assert polygons_overlap(box(0, 0, 10, 10), box(4, 4, 5, 5))  # one inside the other
+    ell = np.array([[0, 0], [4, 0], [4, 1], [1, 1], [1, 4], [0, 4]], dtype=float)
+    assert not polygons_overlap(ell, box(2, 2, 3, 3))  # in the notch
+    assert point_in_polygon(0.5, 3.0, ell) and not point_in_polygon(2.0, 2.0, ell)
+
+
+def test_first_collision_turns_the_body():
+    outline = box(-3.2, -0.85, 0.8, 0.85)
+    vertices, start = pack_polygons([box(-10, -1, 10, 0)])  # a curb below y = 0
+    body = np.empty_like(outline)
+    assert first_collision(outline, 0.0, 1.0, 0.0, vertices, start, body) == -1
+    # turned 30 degrees, the rear corner swings 3.2 sin 30 = 1.6 m down: into the curb
+    assert first_collision(outline, 0.0, 1.0, math.radians(30), vertices, start, body) == 0
+
+
+# --- controller spec lines ----------------------------------------------------------------------
+
+SMALL = """dyn car
+ssd x -2 2 9
+ssd y 1 2 5
+ssd heading -20 20 3
+ssd steer -30 30 3
+ssd speed -1 1 3
+torq steer_rate -30 30 3 0
+torq wheel_accel -200 200 3 0
+dest x=0 y=1 heading=0 speed=0
+tol 0.001
+dt 0.02
+obstacle curb -20,-1 20,-1 20,0 -20,0
+obstacle front 3.0,0.15 7,0.15 7,1.85 3.0,1.85
+domain -3,0.5 3,0.5 3,2.5 -3,2.5
+"""
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        (
+            "obstacle front 3.0,0.15 7,0.15 7,1.85 3.0,1.85",
+            "obstacle front 3,0 4,0",
+            "x.ssc:13:23: expected a vertex 'x,y' (a polygon has at least 3; 2 given), "
+            "found end of line",
+        ),
+        (
+            "obstacle front 3.0,0.15",
+            "obstacle curb 3.0,0.15",
+            "x.ssc:13:10: expected a name not used by another obstacle (line 12), found 'curb'",
+        ),
+        (
+            "3.0,1.85\ndomain",
+            "3.0;1.85\ndomain",
+            "x.ssc:13:39: expected a vertex 'x,y' in metres, found '3.0;1.85'",
+        ),
+        (
+            "domain -3,0.5 3,0.5 3,2.5 -3,2.5",
+            "domain 0,0 1,1 1,0 0,1",
+            "x.ssc:14:8: expected vertices enclosing a non-zero area, found '0,0'",
+        ),
+        (
+            "domain -3,0.5 3,0.5 3,2.5 -3,2.5",
+            "domain 0,0 2,0 2,2 1,-1 0,2",
+            "x.ssc:14:16: expected a simple polygon (its edges cross here), found '2,2'",
+        ),
+    ],
+)
+def test_bad_obstacle_lines_name_the_place(old, new, message):
+    with pytest.raises(SpecError) as error:
+        parse_controller_text(SMALL.replace(old, new), "x.ssc")
+    assert str(error.value) == message
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        (
+            "obstacle front 3.0,0.15 7,0.15 7,1.85 3.0,1.85",
+            "obstacle front 30,0.15 34,0.15 34,1.85 30,1.85",
+            "x.ssc:13:10: expected an obstacle within the car's reach (3.31 m) of the domain "
+            "(x -2..2 m, y 1..2 m), found 'front'",
+        ),
+        (
+            "obstacle front 3.0,0.15",
+            "obstacle front 0.5,0.15",
+            "x.ssc:9:6: expected a destination the car can occupy (the car's outline at (0, 1) "
+            "overlaps obstacle 'front' (line 13)), found 'x=0'",
+        ),
+        (
+            "ssd speed -1 1 3",
+            "ssd sped -1 1 3",
+            "x.ssc:6:5: expected a state variable of figure 'car' (one of 'x', 'y', 'heading', "
+            "'steer', 'speed'), found 'sped'",
+        ),
+        (
+            "torq wheel_accel -200 200 3 0",
+            "torq wheel_accel -200 200 0 0",
+            "x.ssc:8:27: expected a whole number >= 1 for samples, found '0'",
+        ),
+    ],
+)
+def test_specs_that_do_not_fit_the_car_name_the_line(car, old, new, message):
+    text = SMALL.replace(old, new)
+    if "dest" in new or "sped" in new:
+        text = text.replace("speed=0", "sped=0") if "sped" in new else text
+    with pytest.raises(SpecError) as error:
+        build_problem(parse_controller_text(text, "x.ssc"), car)
+    assert str(error.value) == message
+
+
+def test_obstacles_need_a_vehicle(link1):
+    spec = parse_controller_text(
+        "dyn link1\nssd angle -180 170 36 wrap\nssd omega -500 500 21\n"
+        "torq torque -10 10 11 0.1\ndest angle=0 omega=0\nobstacle wall 0,0 1,0 1,1\n",
+        "x.ssc",
+    )
+    with pytest.raises(SpecError) as error:
+        build_problem(spec, link1)
+    assert str(error.value) == (
+        "x.ssc:6:10: expected obstacle and domain lines only for a figure with a body outline "
+        "(a vehicle); figure 'link1' has none, found 'wall'"
+    )
+
+
+# --- generation ------------------------------------------------------------------------------------
+
+
+def brute_force_free(problem):
+    """Free nodes by an independent test: separating axes of two convex rectangles."""
+    grid = problem.grid
+    axes = np.meshgrid(*grid.axis_values(), indexing="ij")
+    x, y, heading = (axes[grid.names.index(n)].ravel() for n in ("x", "y", "heading"))
+    heading = np.radians(heading)
+    outline = problem.obstacles.outline
+    c, s = np.cos(heading)[:, None], np.sin(heading)[:, None]
+    body_x = x[:, None] + c * outline[:, 0] - s * outline[:, 1]
+    body_y = y[:, None] + s * outline[:, 0] + c * outline[:, 1]
+    free = np.ones(x.size, dtype=bool)
+    for polygon in problem.obstacles.polygons():
+        p = np.array(polygon)
+        separated = (body_x.max(1) < p[:, 0].min()) | (body_x.min(1) > p[:, 0].max())
+        separated |= (body_y.max(1) < p[:, 1].min()) | (body_y.min(1) > p[:, 1].max())
+        for ax, ay, low, high in ((c, s, -3.2, 0.8), (-s, c, -0.85, 0.85)):
+            projection = (p[None, :, 0] - x[:, None]) * ax + (p[None, :, 1] - y[:, None]) * ay
+            separated |= (projection.max(1) < low) | (projection.min(1) > high)
+        free &= separated
+    domain = np.array(problem.spec.domain.vertices)
+    inside = (x >= domain[:, 0].min()) & (x <= domain[:, 0].max())
+    inside &= (y >= domain[:, 1].min()) & (y <= domain[:, 1].max())
+    return free & inside
+
+
+def test_states_in_collision_are_removed_and_cost_inf(car, tmp_path):
+    spec = parse_controller_text(SMALL, "small.ssc")
+    problem = build_problem(spec, car)
+    expected = brute_force_free(problem)
+    assert 0 < expected.sum() < expected.size
+    np.testing.assert_array_equal(problem.node_valid, expected)
+    table = generate_controller(spec, car, tmp_path / "small.h5", quiet=True)
+    assert table.attrs["table_states"] == expected.sum()
+    assert table.attrs["removed_nodes"] == expected.size - expected.sum()
+    assert np.all(np.isinf(table.value.ravel()[~expected]))
+    assert np.isfinite(table.value).sum() > 0
+    for key in ("wheelbase", "wheel_radius", "body_outline", "obstacles"):
+        assert key in table.attrs
+
+
+# --- parking judgement ----------------------------------------------------------------------------
+
+
+def scene():
+    vertices, start = pack_polygons([box(-20, -1, 20, 0), box(3, 0.15, 7, 1.85)])
+    return Scene(
+        outline=box(-3.2, -0.85, 0.8, 0.85),
+        obstacle_vertices=vertices,
+        obstacle_start=start,
+        obstacle_names=("curb", "front"),
+        destination={"x": 0.0, "y": 1.0, "heading": 0.0},
+        wheelbase=2.5,
+    )
+
+
+ORDER = ("x", "y", "heading", "steer", "speed")
+
+
+def test_a_run_that_comes_to_rest_in_the_space_is_parked_from_its_arrival():
+    t = np.linspace(0, 10, 101)
+    x = np.clip(2.0 - 0.4 * t, 0.05, None)
+    speed = np.where(x > 0.05, -0.4, 0.0)
+    state = np.column_stack([x, np.ones_like(t), np.zeros_like(t), np.zeros_like(t), speed])
+    outcome = parking_outcome(t, state, ORDER, scene())
+    assert outcome.parked and outcome.collision_index == -1
+    assert outcome.parking_seconds == pytest.approx(t[np.argmax(x <= 0.05)])
+
+
+def test_a_run_that_touches_an_obstacle_is_a_failure_even_if_it_ends_parked():
+    t = np.linspace(0, 10, 101)
+    y = np.where(t < 5, 1.0 - 0.5 * np.sin(np.pi * t / 5), 1.0)  # dips into the curb
+    state = np.column_stack(
+        [np.zeros_like(t), y, np.zeros_like(t), np.zeros_like(t), np.zeros_like(t)]
+    )
+    outcome = parking_outcome(t, state, ORDER, scene())
+    assert not outcome.parked
+    assert outcome.collided_with == "curb"
+    assert 0 < outcome.collision_index < 50

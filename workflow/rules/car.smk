@@ -1,0 +1,94 @@
+# The self-parking car (1990 paper, section 6): its start grid, its plots and its table. The
+# controller and the Figure 19 trajectories come from the generic dp_controller and run_script.
+rule car_start_grid:
+    input:
+        table=car_table(),
+        dynamics=f"results/dynamics/{config['car']['figure']}.py",
+        code=package_sources("ssc", "scripts"),
+    output:
+        "results/car/start_grid.h5",
+    log:
+        "results/logs/car/start_grid.log",
+    benchmark:
+        "results/benchmarks/car/start_grid.tsv"
+    params:
+        x=" ".join(str(v) for v in config["car"]["start_grid"]["x"]),
+        y=" ".join(str(v) for v in config["car"]["start_grid"]["y"]),
+        heading=" ".join(str(v) for v in config["car"]["start_grid"]["heading"]),
+        steer=" ".join(str(v) for v in config["car"]["start_grid"]["steer"]),
+        seconds=config["car"]["start_grid"]["seconds"],
+        dt=config["car"]["start_grid"]["dt"],
+    threads: 1
+    shell:
+        "NUMBA_NUM_THREADS={threads} mosys starts {input.table} --dynamics {input.dynamics}"
+        " --x {params.x} --y {params.y} --heading {params.heading} --steer {params.steer}"
+        " --seconds {params.seconds} --dt {params.dt} -o {output} 2> {log}"
+        " || (cat {log} >&2; exit 1)"
+
+
+rule car_frames:
+    input:
+        trajectories=car_trajectories(),
+        code=package_sources("plots"),
+    output:
+        "results/plots/car/figure19_frames.png",
+    log:
+        "results/logs/plots/car/figure19_frames.log",
+    benchmark:
+        "results/benchmarks/plots/car/figure19_frames.tsv"
+    threads: 1
+    shell:
+        "mosys plot car {input.trajectories} --frames {output} 2> {log}"
+        " || (cat {log} >&2; exit 1)"
+
+
+rule car_gif:
+    input:
+        trajectory=f"results/trajectories/{config['car']['gif_script']}.h5",
+        code=package_sources("plots"),
+    output:
+        "results/plots/car/manoeuvre.gif",
+    log:
+        "results/logs/plots/car/manoeuvre.log",
+    benchmark:
+        "results/benchmarks/plots/car/manoeuvre.tsv"
+    threads: 1
+    shell:
+        "mosys plot car {input.trajectory} --gif {output} 2> {log} || (cat {log} >&2; exit 1)"
+
+
+rule car_start_map:
+    input:
+        grid="results/car/start_grid.h5",
+        code=package_sources("plots"),
+    output:
+        "results/plots/car/start_map.png",
+    log:
+        "results/logs/plots/car/start_map.log",
+    benchmark:
+        "results/benchmarks/plots/car/start_map.tsv"
+    threads: 1
+    shell:
+        "mosys plot car --map {input.grid} {output} 2> {log} || (cat {log} >&2; exit 1)"
+
+
+rule car_controller_table:
+    input:
+        table=car_table(),
+        grid="results/car/start_grid.h5",
+        trajectories=car_trajectories(),
+        code=package_sources("tables"),
+    output:
+        csv="results/tables/car_controller.csv",
+        md="results/tables/car_controller.md",
+    log:
+        "results/logs/tables/car_controller.log",
+    benchmark:
+        "results/benchmarks/tables/car_controller.tsv"
+    params:
+        budget=config["budget"],
+    threads: 1
+    shell:
+        "mosys car-table {input.table} --starts {input.grid} {input.trajectories}"
+        " --budget {params.budget} --csv {output.csv} --md {output.md} 2> {log}"
+        " || (cat {log} >&2; exit 1)"
