@@ -7,10 +7,10 @@ import math
 
 import numpy as np
 import pytest
+from conftest import SPECS
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from conftest import SPECS
 from mosys.dynamics.compile import compile_figure
 from mosys.dynamics.load import load_dynamics
 from mosys.kernels.geometry import (
@@ -41,7 +41,7 @@ def car(tmp_path_factory):
     return load_dynamics(path)
 
 
-# --- figure spec --------------------------------------------------------------------------------
+# --- figure spec
 
 
 def test_car_spec_parses_to_the_documented_geometry():
@@ -87,7 +87,7 @@ def test_bad_car_specs_name_the_place(text, message):
     assert str(error.value) == message
 
 
-# --- kinematics -----------------------------------------------------------------------------------
+# --- kinematics
 
 
 def simulate(car, state, inputs, seconds, dt=0.001):
@@ -117,7 +117,7 @@ def test_steering_stops_at_its_limit_and_wheel_accel_changes_speed(car):
     assert end[4] == pytest.approx(0.3 * math.radians(100) * 2.0, rel=1e-9)
 
 
-# --- geometry -------------------------------------------------------------------------------------
+# --- geometry
 
 
 def box(x0, y0, x1, y1):
@@ -161,7 +161,7 @@ def test_first_collision_turns_the_body():
     assert first_collision(outline, 0.0, 1.0, math.radians(30), vertices, start, body) == 0
 
 
-# --- controller spec lines ----------------------------------------------------------------------
+# --- controller spec lines
 
 SMALL = """dyn car
 ssd x -2 2 9
@@ -268,7 +268,7 @@ def test_obstacles_need_a_vehicle(link1):
     )
 
 
-# --- generation ------------------------------------------------------------------------------------
+# --- generation
 
 
 def brute_force_free(problem):
@@ -311,7 +311,7 @@ def test_states_in_collision_are_removed_and_cost_inf(car, tmp_path):
         assert key in table.attrs
 
 
-# --- parking judgement ----------------------------------------------------------------------------
+# --- parking judgement
 
 
 def scene():
