@@ -11,36 +11,18 @@ cache directory (NUMBA_CACHE_DIR), so they include JIT compilation, as a user's 
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import shutil
 import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 import pandas as pd
+from generation import generate
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER_SECONDS = {"A": 381.0, "B": 452.0, "C": 341.0, "D": 460.0, "E": 459.0, "F": 454.0}
-
-# Generation in a fresh process: the measured figure is the DP alone (generation_seconds); the
-# process time adds Python start-up, imports and, with a cold cache, JIT compilation.
-GENERATE = """
-import json, sys, time
-started = time.perf_counter()
-from mosys.dynamics.load import load_dynamics
-from mosys.parsing.controller import parse_controller_text
-from mosys.ssc.generate import generate_controller
-dynamics = load_dynamics(sys.argv[1])
-spec = parse_controller_text(open(sys.argv[2]).read(), sys.argv[2])
-table = generate_controller(spec, dynamics, sys.argv[3], quiet=True)
-print(json.dumps({"dp_seconds": table.attrs["generation_seconds"],
-                  "process_seconds": time.perf_counter() - started,
-                  "iterations": int(table.attrs["iterations"]),
-                  "nodes": int(table.value.size)}))
-"""
 
 
 def finer_spec(factor: int) -> str:
@@ -55,18 +37,6 @@ def finer_spec(factor: int) -> str:
         "dest angle=0 omega=0\n"
         f"dt {0.001 / factor:g}\n"
     )
-
-
-def generate(dynamics: Path, spec: Path, out: Path, cache: Path) -> dict:
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
-    done = subprocess.run(
-        [sys.executable, "-c", GENERATE, str(dynamics), str(spec), str(out)],
-        env=env,
-        check=True,
-        capture_output=True,
-        text=True,
-    )
-    return json.loads(done.stdout.strip().splitlines()[-1])
 
 
 def pipeline_seconds(cache: Path, work: Path) -> float:

@@ -1,0 +1,85 @@
+"""Car benchmark: generating the parking controller (the 1990 paper's §6) at the paper's size
+(about 13,250 states after removing collisions) and at about 8x as many states.
+
+    python benchmarks/car.py            # both sizes, warm numba cache (after one filling run)
+    python benchmarks/car.py --smoke    # CI: the paper's size only
+
+Writes results/benchmarks/car.{csv,md} (car_smoke.* with --smoke) and prints them. The 8x grid
+halves the step of x, y and heading over the same ranges (2n - 1 nodes on each of those axes).
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+import tempfile
+from pathlib import Path
+
+import pandas as pd
+from generation import generate
+
+ROOT = Path(__file__).resolve().parents[1]
+SPEC = ROOT / "specs/controllers/car/park.ssc"
+REFINED_AXES = ("x", "y", "heading")
+PAPER_STATES = 13250
+
+
+def refined_spec(text: str) -> str:
+    """The spec with the steps of x, y and heading halved: n nodes -> 2n - 1."""
+
+    def refine(match: re.Match) -> str:
+        name, low, high, count = match.groups()
+        return f"ssd {name} {low} {high} {2 * int(count) - 1}"
+
+    pattern = r"^ssd (" + "|".join(REFINED_AXES) + r") (\S+) (\S+) (\d+)"
+    return re.sub(pattern, refine, text, flags=re.M)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--smoke", action="store_true", help="the paper's size only, for CI")
+    args = parser.parse_args()
+    from mosys.dynamics.compile import compile_figure
+
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        cache = tmp / "cache"
+        dynamics = tmp / "car.py"
+        compile_figure(ROOT / "specs/figures/car.fig", dynamics)
+        cases = [("paper size", SPEC.read_text())]
+        if not args.smoke:
+            cases.append(("x, y, heading steps halved", refined_spec(SPEC.read_text())))
+        for label, text in cases:
+            spec = tmp / "park.ssc"
+            spec.write_text(text)
+            generate(dynamics, spec, tmp / "park.h5", cache)  # fill the numba cache
+            warm = generate(dynamics, spec, tmp / "park.h5", cache)
+            rows.append(
+                {
+                    "case": label,
+                    "grid_nodes": warm["nodes"],
+                    "table_states": warm["table_states"],
+                    "paper_states": PAPER_STATES,
+                    "iterations": warm["iterations"],
+                    "dp_s_warm": round(warm["dp_seconds"], 2),
+                    "process_s_warm": round(warm["process_seconds"], 2),
+                    "peak_rss_MiB": round(warm["peak_rss_bytes"] / 2**20, 1),
+                }
+            )
+    frame = pd.DataFrame(rows)
+    if len(frame) == 2:
+        base, big = frame.iloc[0], frame.iloc[1]
+        frame["states_ratio"] = [1.0, round(big.table_states / base.table_states, 2)]
+        frame["time_ratio"] = [1.0, round(big.dp_s_warm / base.dp_s_warm, 2)]
+        frame["memory_ratio"] = [1.0, round(big.peak_rss_MiB / base.peak_rss_MiB, 2)]
+    out = ROOT / "results" / "benchmarks"
+    out.mkdir(parents=True, exist_ok=True)
+    suffix = "_smoke" if args.smoke else ""
+    frame.to_csv(out / f"car{suffix}.csv", index=False)
+    (out / f"car{suffix}.md").write_text(frame.to_markdown(index=False) + "\n")
+    print(frame.to_markdown(index=False))
+
+
+if __name__ == "__main__":
+    main()
