@@ -199,7 +199,9 @@ def build_parser() -> argparse.ArgumentParser:
     car_table = verbs.add_parser("car-table", help="the car controller's table")
     car_table.add_argument("table", help="controller table (.h5)")
     car_table.add_argument("--starts", required=True, help="start grid (.h5, mosys starts)")
-    car_table.add_argument("trajectories", nargs="*", help="the Figure 19 trajectories")
+    car_table.add_argument(
+        "--trajectories", nargs="+", required=True, help="the Figure 19 trajectories (.h5)"
+    )
     car_table.add_argument("--csv", required=True)
     car_table.add_argument("--md", required=True)
     car_table.add_argument("--budget", default="paper", help="name of the config that built it")

@@ -89,6 +89,6 @@ rule car_controller_table:
         budget=config["budget"],
     threads: 1
     shell:
-        "mosys car-table {input.table} --starts {input.grid} {input.trajectories}"
+        "mosys car-table {input.table} --starts {input.grid} --trajectories {input.trajectories}"
         " --budget {params.budget} --csv {output.csv} --md {output.md} 2> {log}"
         " || (cat {log} >&2; exit 1)"

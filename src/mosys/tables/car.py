@@ -77,5 +77,5 @@ def write_car_table(
         f"(|speed| <= {tolerance['speed_m_s']} m/s) to the end of the run, with no collision "
         "at any instant.\n\n"
     )
-    write_text_atomically(md_path, caption + frame.T.to_markdown(header=False) + "\n")
+    write_text_atomically(md_path, caption + frame.T.to_markdown(headers=["", "value"]) + "\n")
     return frame

@@ -1,0 +1,1041 @@
+"""The self-parking car's plots (van de Panne, Fiume & Vranesic 1990, §6, Figure 19).
+
+- ``plot_parking_frames``: one panel per manoeuvre, to scale, the car's outline every
+  ``interval`` seconds over the obstacles and the destination (Figure 19).
+- ``write_parking_gif``: an animated GIF of one manoeuvre, wheels and all.
+- ``plot_success_map``: which start positions of a start grid park, collide or run out of time.
+
+Everything is drawn in metres in the world frame, equal aspect. Car states are in spec units and
+located by name through ``state_order``: x, y (m) of the reference point midway between the front
+wheels; heading (deg, 0 along +x, counter-clockwise); steer (deg, the road wheels' angle, positive
+left); speed (m/s). A trajectory that hits an obstacle is drawn only up to and including its first
+colliding sample, that outline in red, and its title says FAILED in red.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import h5py
+import matplotlib
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.collections import PolyCollection
+from matplotlib.colors import LinearSegmentedColormap, Normalize
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch, Polygon
+
+from mosys.io.atomic import write_atomically
+from mosys.io.attributes import string_tuple
+from mosys.io.trajectory import read_trajectory
+from mosys.plots.pendulum import GIF_DPI, PlotInputError, _shared_palette
+from mosys.plots.style import (
+    DESTINATION_COLOR,
+    LEGEND_ROW,
+    MARGIN_BOTTOM,
+    MARGIN_RIGHT,
+    SYMBOLS,
+    add_legend,
+    new_figure,
+    plot_style,
+    save_png,
+)
+
+FRAME_INTERVAL = 0.3  # s between the outlines drawn in a parking panel
+GIF_FPS = 20  # frames per second of motion time in a parking GIF
+GIF_HOLD_MS = 1500  # ms the last GIF frame stays up before the loop restarts
+COLUMNS = 3  # panels per row
+PANEL_WIDTH = 3.3  # inches of one panel's data area in a multi-panel figure
+SINGLE_PANEL_WIDTH = 6.0  # inches of the data area when there is one panel
+ASPECT_RANGE = (0.35, 1.25)  # height / width of a panel; the limits are widened to stay inside
+VIEW_MARGIN = 1.5  # m: obstacles are shown this far beyond the region the cars use
+EDGE_MARGIN = 0.4  # m: blank border around everything shown
+DEFAULT_WHEEL_RADIUS = 0.3  # m, when a trajectory records no wheel_radius
+TRACK_FRACTION = 0.82  # track / body width, when a trajectory records no track
+
+STATE_UNITS = {"x": "m", "y": "m", "heading": "deg", "steer": "deg", "speed": "m/s"}
+POSE_NAMES = ("x", "y", "heading", "steer")  # state variables every car file must carry
+SCENE_ATTRS = ("body_outline", "obstacles", "obstacle_names", "destination")
+RUN_ATTRS = (
+    *SCENE_ATTRS,
+    "wheelbase",
+    "collision_index",
+    "collided_with",
+    "parked",
+    "parking_seconds",
+    "simulated_seconds",
+)
+GRID_DATASETS = ("start", "parked", "collided", "parking_seconds")
+GRID_ATTRS = ("state_order", *SCENE_ATTRS, "controller", "simulated_seconds")
+
+OBSTACLE_FACE, OBSTACLE_EDGE = "0.72", "0.45"
+FAILURE_COLOR = "#d62728"  # the collision outline, the FAILED titles, the collision markers
+TIMEOUT_COLOR = "#ff7f0e"
+PATH_COLOR = "0.2"
+TIME_SHADES = matplotlib.colormaps["Blues"]  # outlines, light (start) to dark (end)
+SHADE_RANGE = (0.3, 0.95)  # the part of TIME_SHADES used
+PARKING_TIMES = LinearSegmentedColormap.from_list(
+    "parking_times", matplotlib.colormaps["Greens"](np.linspace(0.35, 1.0, 256))
+)
+TITLE_SIZE = 10.0  # pt, panel titles
+SUPTITLE_SIZE = 12.0  # pt
+OBSTACLE_LABEL_SIZE = 8.0  # pt
+
+
+# --------------------------------------------------------------------------- reading the inputs
+
+
+@dataclass(frozen=True)
+class Scene:
+    """The car's world: body_outline (V, 2) m in the car's frame (reference point at the origin,
+    heading along +x); obstacles: one (V_k, 2) m polygon each, named by obstacle_names;
+    destination: the goal pose, x and y (m), heading (deg)."""
+
+    body_outline: np.ndarray
+    obstacles: tuple[np.ndarray, ...]
+    obstacle_names: tuple[str, ...]
+    destination: dict[str, float]
+
+
+@dataclass(frozen=True)
+class CarTrajectory:
+    """One simulated manoeuvre. t: (N,) s; x, y: (N,) m; heading, steer: (N,) deg; speed: (N,)
+    m/s or None; collision_index: first sample whose outline meets an obstacle, -1 if none;
+    parking_seconds: s (NaN if not parked); simulated_seconds: s; wheelbase, track and
+    wheel_radius: m; name: the file's stem."""
+
+    name: str
+    t: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    heading: np.ndarray
+    steer: np.ndarray
+    speed: np.ndarray | None
+    scene: Scene
+    controllers: tuple[str, ...]
+    wheelbase: float
+    track: float
+    wheel_radius: float
+    collision_index: int
+    collided_with: str
+    parked: bool
+    parking_seconds: float
+    simulated_seconds: float
+
+    @property
+    def collided(self) -> bool:
+        return self.collision_index >= 0
+
+    @property
+    def failed(self) -> bool:
+        """True unless the car parked without touching anything."""
+        return self.collided or not self.parked
+
+    def start(self) -> dict[str, float]:
+        """The start state by name, spec units."""
+        start = {"x": self.x[0], "y": self.y[0], "heading": self.heading[0], "steer": self.steer[0]}
+        if self.speed is not None:
+            start["speed"] = self.speed[0]
+        return {name: float(value) for name, value in start.items()}
+
+
+@dataclass(frozen=True)
+class StartGrid:
+    """Outcomes from a grid of start states. start: (n, d) spec units in ``state_order``;
+    parked, collided: (n,) bool; parking_seconds: (n,) s (NaN where not parked)."""
+
+    start: np.ndarray
+    state_order: tuple[str, ...]
+    parked: np.ndarray
+    collided: np.ndarray
+    parking_seconds: np.ndarray
+    scene: Scene
+    controller: str
+    simulated_seconds: float
+
+    @property
+    def succeeded(self) -> np.ndarray:
+        """(n,) bool: parked without a collision (a collision never counts as parking)."""
+        return self.parked & ~self.collided
+
+
+def _text(value) -> str:
+    """A string attribute as read by h5py (str or bytes)."""
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def _missing(path, kind: str, names: Sequence[str], present) -> None:
+    absent = [name for name in names if name not in present]
+    if absent:
+        raise PlotInputError(f"{path}: not a {kind}: missing {', '.join(absent)}")
+
+
+def _json_attr(path, attrs, name: str):
+    text = attrs[name]
+    try:
+        return json.loads(_text(text))
+    except json.JSONDecodeError as error:
+        raise PlotInputError(f"{path}: root attribute {name} is not valid JSON ({error})") from None
+
+
+def _polygon(path, name: str, vertices) -> np.ndarray:
+    try:
+        polygon = np.asarray(vertices, dtype=np.float64)
+    except (TypeError, ValueError):
+        polygon = None
+    if polygon is None or polygon.ndim != 2 or polygon.shape[1] != 2 or len(polygon) < 3:
+        raise PlotInputError(
+            f"{path}: {name} must be a list of at least 3 [x, y] vertices, got {vertices!r}"
+        )
+    if not np.all(np.isfinite(polygon)):
+        raise PlotInputError(f"{path}: {name} has a non-finite vertex")
+    return polygon
+
+
+def _read_scene(path, attrs) -> Scene:
+    """The body outline, obstacles and destination from a file's root attributes."""
+    outline = _polygon(path, "body_outline", _json_attr(path, attrs, "body_outline"))
+    polygons = _json_attr(path, attrs, "obstacles")
+    if not isinstance(polygons, list):
+        raise PlotInputError(f"{path}: obstacles must be a list of polygons, got {polygons!r}")
+    names = string_tuple(attrs["obstacle_names"]) if len(polygons) else ()
+    if len(names) != len(polygons):
+        raise PlotInputError(
+            f"{path}: {len(polygons)} obstacles but {len(names)} obstacle_names {list(names)}"
+        )
+    obstacles = tuple(
+        _polygon(path, f"obstacle {name}", vertices)
+        for name, vertices in zip(names, polygons, strict=True)
+    )
+    destination = _json_attr(path, attrs, "destination")
+    try:
+        destination = {key: float(destination[key]) for key in ("x", "y", "heading")}
+    except (KeyError, TypeError, ValueError):
+        raise PlotInputError(
+            f'{path}: destination must be {{"x": m, "y": m, "heading": deg}}, got {destination!r}'
+        ) from None
+    return Scene(outline, obstacles, names, destination)
+
+
+def _columns(path, state_order: Sequence[str], required: Sequence[str]) -> dict[str, int]:
+    """Column index of each state variable by name; PlotInputError naming the absent ones."""
+    absent = [name for name in required if name not in state_order]
+    if absent:
+        raise PlotInputError(
+            f"{path}: state_order {list(state_order)} lacks {', '.join(absent)}: not a car state"
+        )
+    return {name: k for k, name in enumerate(state_order)}
+
+
+def read_car_trajectory(path: str | Path) -> CarTrajectory:
+    """Read a car trajectory (the trajectory contract plus the car's root attributes, see the
+    module docstring); PlotInputError naming the file and what is missing or malformed."""
+    try:
+        trajectory = read_trajectory(path)
+    except KeyError as error:  # h5py: a dataset or attribute the contract requires is absent
+        raise PlotInputError(f"{path}: not a trajectory file: {error}") from None
+    attrs = trajectory.attrs
+    _missing(path, "car trajectory (root attributes)", RUN_ATTRS, attrs)
+    column = _columns(path, trajectory.state_order, POSE_NAMES)
+    state, t = np.asarray(trajectory.state, dtype=np.float64), np.asarray(trajectory.t, np.float64)
+    if t.ndim != 1 or len(t) == 0:
+        raise PlotInputError(f"{path}: the trajectory has no samples")
+    if state.shape != (len(t), len(trajectory.state_order)):
+        raise PlotInputError(
+            f"{path}: /state has shape {state.shape}, expected ({len(t)}, "
+            f"{len(trajectory.state_order)}) for {len(t)} samples of {trajectory.state_order}"
+        )
+    for name in POSE_NAMES:
+        if not np.all(np.isfinite(state[:, column[name]])):
+            bad = int(np.flatnonzero(~np.isfinite(state[:, column[name]]))[0])
+            raise PlotInputError(f"{path}: {name} is {state[bad, column[name]]} at sample {bad}")
+    if not np.all(np.diff(t) >= 0):
+        raise PlotInputError(f"{path}: /t decreases at sample {int(np.argmin(np.diff(t))) + 1}")
+    scene = _read_scene(path, attrs)
+    collision_index = int(attrs["collision_index"])
+    if not -1 <= collision_index < len(t):
+        raise PlotInputError(
+            f"{path}: collision_index {collision_index} is outside the {len(t)} samples"
+        )
+    parked = bool(attrs["parked"])
+    parking_seconds = float(attrs["parking_seconds"])
+    if parked and not math.isfinite(parking_seconds):
+        raise PlotInputError(f"{path}: parked is true but parking_seconds is {parking_seconds}")
+    wheelbase = float(attrs["wheelbase"])
+    if not wheelbase > 0:
+        raise PlotInputError(f"{path}: wheelbase must be positive, got {wheelbase}")
+    half_width = float(np.abs(scene.body_outline[:, 1]).max())
+    return CarTrajectory(
+        name=Path(path).stem,
+        t=t,
+        x=state[:, column["x"]],
+        y=state[:, column["y"]],
+        heading=state[:, column["heading"]],
+        steer=state[:, column["steer"]],
+        speed=state[:, column["speed"]] if "speed" in column else None,
+        scene=scene,
+        controllers=trajectory.controllers,
+        wheelbase=wheelbase,
+        track=float(attrs.get("track", TRACK_FRACTION * 2 * half_width)),
+        wheel_radius=float(attrs.get("wheel_radius", DEFAULT_WHEEL_RADIUS)),
+        collision_index=collision_index,
+        collided_with=_text(attrs["collided_with"]),
+        parked=parked,
+        parking_seconds=parking_seconds,
+        simulated_seconds=float(attrs["simulated_seconds"]),
+    )
+
+
+def read_start_grid(path: str | Path) -> StartGrid:
+    """Read ``results/car/start_grid.h5`` (see ``plot_success_map``); PlotInputError naming the
+    file and what is missing or malformed."""
+    with h5py.File(path, "r") as h5:
+        _missing(path, "start grid (datasets)", GRID_DATASETS, h5)
+        _missing(path, "start grid (root attributes)", GRID_ATTRS, h5.attrs)
+        attrs = dict(h5.attrs)
+        start = np.asarray(h5["start"][()], dtype=np.float64)
+        flags = {name: np.asarray(h5[name][()]) for name in GRID_DATASETS[1:]}
+    state_order = string_tuple(attrs["state_order"])
+    _columns(path, state_order, ("x", "y"))
+    if start.ndim != 2 or start.shape[1] != len(state_order) or len(start) == 0:
+        raise PlotInputError(
+            f"{path}: /start has shape {start.shape}, expected (n > 0, {len(state_order)}) for "
+            f"state_order {list(state_order)}"
+        )
+    for name, values in flags.items():
+        if values.shape != (len(start),):
+            raise PlotInputError(
+                f"{path}: /{name} has shape {values.shape}, expected ({len(start)},)"
+            )
+    parked = flags["parked"].astype(bool) & ~flags["collided"].astype(bool)
+    if np.any(parked & ~np.isfinite(flags["parking_seconds"])):
+        first = int(np.flatnonzero(parked & ~np.isfinite(flags["parking_seconds"]))[0])
+        raise PlotInputError(
+            f"{path}: start {first} parked but its parking_seconds is "
+            f"{flags['parking_seconds'][first]}"
+        )
+    return StartGrid(
+        start=start,
+        state_order=state_order,
+        parked=flags["parked"].astype(bool),
+        collided=flags["collided"].astype(bool),
+        parking_seconds=flags["parking_seconds"].astype(np.float64),
+        scene=_read_scene(path, attrs),
+        controller=_text(attrs["controller"]),
+        simulated_seconds=float(attrs["simulated_seconds"]),
+    )
+
+
+# --------------------------------------------------------------------------- pure helpers
+
+
+def frame_indices(t: np.ndarray, interval: float) -> np.ndarray:
+    """Sample indices (int64, increasing, no repeats) of the first sample at or after each
+    time t[0] + k·interval (k = 0, 1, ...) up to t[-1]. t: (N,) s, non-decreasing; interval: s.
+    Times within 1e-9 s of a sample count as that sample."""
+    t = np.asarray(t, dtype=np.float64)
+    if t.ndim != 1:
+        raise ValueError(f"t must be 1-D, got shape {t.shape}")
+    if not interval > 0:
+        raise ValueError(f"interval must be positive, got {interval!r}")
+    if len(t) == 0:
+        return np.zeros(0, dtype=np.int64)
+    count = math.floor((t[-1] - t[0]) / interval + 1e-9) + 1
+    times = t[0] + interval * np.arange(count)
+    index = np.minimum(np.searchsorted(t, times - 1e-9), len(t) - 1)
+    return np.unique(index).astype(np.int64)
+
+
+def drawn_samples(t: np.ndarray, interval: float, collision_index: int = -1) -> np.ndarray:
+    """The samples whose outline a parking panel draws: every ``interval`` seconds (see
+    ``frame_indices``) and the last sample, but nothing after the first colliding sample
+    ``collision_index`` (-1: no collision), which is itself drawn (and is then the last)."""
+    index = frame_indices(t, interval)
+    last = len(t) - 1 if collision_index < 0 else int(collision_index)
+    if last < 0:
+        return index
+    return np.unique(np.append(index[index <= last], last)).astype(np.int64)
+
+
+def outcome_text(trajectory: CarTrajectory) -> str:
+    """The outcome line of a manoeuvre's title: ``parked in 12.3 s``, ``FAILED: hits
+    front_car at 4.2 s`` or ``FAILED: not parked in 20 s``. A collision is a failure even when
+    the file also says parked."""
+    if trajectory.collided:
+        where = trajectory.collided_with or "an obstacle"
+        return f"FAILED: hits {where} at {trajectory.t[trajectory.collision_index]:.1f} s"
+    if trajectory.parked:
+        return f"parked in {trajectory.parking_seconds:.1f} s"
+    return f"FAILED: not parked in {trajectory.simulated_seconds:g} s"
+
+
+def place_outline(outline: np.ndarray, x, y, heading) -> np.ndarray:
+    """An outline (V, 2) m in the car's frame placed at poses x, y (m), heading (deg), scalars
+    or (K,) arrays: (V, 2) or (K, V, 2) m in the world frame."""
+    x, y = np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64)
+    angle = np.radians(np.asarray(heading, dtype=np.float64))
+    c, s = np.cos(angle)[..., None], np.sin(angle)[..., None]
+    u, v = outline[:, 0], outline[:, 1]
+    return np.stack([x[..., None] + c * u - s * v, y[..., None] + s * u + c * v], axis=-1)
+
+
+def wheel_segments(trajectory: CarTrajectory, sample: int) -> np.ndarray:
+    """The four wheels at ``sample`` as (4, 2, 2) m segments (front left, front right, rear
+    left, rear right; each its two ends): centred on the axles, half a track out, one wheel
+    diameter long, the front pair turned by the steer angle."""
+    heading = math.radians(trajectory.heading[sample])
+    steer = math.radians(trajectory.steer[sample])
+    x, y = trajectory.x[sample], trajectory.y[sample]
+    forward = np.array([math.cos(heading), math.sin(heading)])
+    left = np.array([-forward[1], forward[0]])
+    half = trajectory.wheel_radius
+    segments = []
+    for axle, turn in ((0.0, steer), (-trajectory.wheelbase, 0.0)):
+        along = np.array([math.cos(heading + turn), math.sin(heading + turn)]) * half
+        for side in (1.0, -1.0):
+            centre = np.array([x, y]) + axle * forward + side * trajectory.track / 2 * left
+            segments.append([centre - along, centre + along])
+    return np.array(segments)
+
+
+def describe_value(name: str, value: float) -> str:
+    """A state value for a title: ``−30°``, ``3.5 m``, ``0.0 m/s`` (a true minus sign)."""
+    unit = STATE_UNITS.get(name, "")
+    whole = unit == "deg" and abs(value - round(value)) < 0.05
+    value = round(value, 0 if whole else 1) + 0.0  # + 0.0: no "-0"
+    text = f"{value:.0f}°" if whole else f"{value:.1f}°" if unit == "deg" else f"{value:.1f} {unit}"
+    return text.rstrip().replace("-", "−")
+
+
+def _start_summary(runs: Sequence[CarTrajectory]) -> list[list[str]]:
+    """Per run, its start state in brief, as parts to join with commas: the variables in which
+    the runs' starts differ (position, heading, steer, speed; position and heading when none
+    differ), e.g. ``["steer −30°"]`` or ``["from (7.9, 3.5) m", "heading 0°"]``."""
+    names = [n for n in STATE_UNITS if all(n in run.start() for run in runs)]
+    starts = np.array([[run.start()[n] for n in names] for run in runs])
+    varying = {n for k, n in enumerate(names) if np.ptp(starts[:, k]) > 1e-6}
+    if not varying:
+        varying = {"x", "heading"}
+    summaries = []
+    for run in runs:
+        start, parts = run.start(), []
+        if varying & {"x", "y"}:
+            position = f"from ({start['x']:.1f}, {start['y']:.1f}) m"
+            parts.append(position.replace("-", "−"))
+        for name in ("heading", "steer", "speed"):
+            if name in varying:
+                parts.append(f"{name} {describe_value(name, start[name])}")
+        summaries.append(parts)
+    return summaries
+
+
+def _wrap(head: str, parts: Sequence[str], width: int) -> str:
+    """``head`` then ``parts`` joined with commas, broken into lines of about ``width``
+    characters, only between parts."""
+    lines = [head]
+    for k, part in enumerate(parts):
+        piece = part + ("," if k < len(parts) - 1 else "")
+        if len(lines[-1]) + 1 + len(piece) > width and lines[-1] != head:
+            lines.append(piece)
+        else:
+            lines[-1] += " " + piece
+    return "\n".join(lines)
+
+
+def _title_chars(panel_width: float) -> int:
+    """About how many characters of a panel title fit across ``panel_width`` inches."""
+    return int(panel_width * 72 / (0.62 * TITLE_SIZE))
+
+
+# --------------------------------------------------------------------------- layout and drawing
+
+
+def _bounds(points: np.ndarray) -> np.ndarray:
+    """[[xmin, ymin], [xmax, ymax]] of points (..., 2)."""
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    return np.array([points.min(axis=0), points.max(axis=0)])
+
+
+def view_limits(car_points: np.ndarray, obstacles: Sequence[np.ndarray]) -> np.ndarray:
+    """[[xmin, ymin], [xmax, ymax]] m of the view: the region the cars use (``car_points``
+    (..., 2) m: outlines, path, destination) united with the obstacles' extents clipped to that
+    region widened by VIEW_MARGIN, plus EDGE_MARGIN all round, then widened in x or y to keep
+    the view's height / width within ASPECT_RANGE."""
+    cars = _bounds(car_points)
+    window = cars + [[-VIEW_MARGIN], [VIEW_MARGIN]]
+    limits = cars.copy()
+    for polygon in obstacles:
+        box = _bounds(polygon)
+        low, high = np.maximum(box[0], window[0]), np.minimum(box[1], window[1])
+        if np.all(high >= low):
+            limits = np.array([np.minimum(limits[0], low), np.maximum(limits[1], high)])
+    limits += [[-EDGE_MARGIN], [EDGE_MARGIN]]
+    width, height = limits[1] - limits[0]
+    low_aspect, high_aspect = ASPECT_RANGE
+    if height < low_aspect * width:
+        limits[:, 1] += np.array([-1, 1]) * (low_aspect * width - height) / 2
+    elif height > high_aspect * width:
+        limits[:, 0] += np.array([-1, 1]) * (height / high_aspect - width) / 2
+    return limits
+
+
+@dataclass(frozen=True)
+class _Layout:
+    figure: Figure
+    panels: list[Axes]
+    colorbar: Axes | None
+
+
+def _panel_figure(
+    count: int,
+    limits: np.ndarray,
+    suptitle_lines: int,
+    title_lines: int,
+    legend_rows: int,
+    colorbar: bool = False,
+    dpi: float | None = None,
+) -> _Layout:
+    """A figure of ``count`` equal-aspect panels on a grid of up to COLUMNS columns, sized in
+    inches so that each panel's box has the aspect of ``limits``: y tick labels on the left
+    column only (all panels share the limits), x labels under the lowest panel of each column,
+    room above for the figure's title and each panel's title, below for a legend, and on the
+    right for a colour bar."""
+    columns = min(COLUMNS, count)
+    rows = -(-count // columns)
+    (x0, y0), (x1, y1) = limits
+    width = SINGLE_PANEL_WIDTH if count == 1 else PANEL_WIDTH
+    height = width * (y1 - y0) / (x1 - x0)
+    title_space = title_lines * TITLE_SIZE * 1.45 / 72 + 0.1
+    left, gap_x, gap_y = 0.75, 0.22, title_space + 0.42
+    top = 0.12 + suptitle_lines * SUPTITLE_SIZE * 1.5 / 72 + title_space
+    bottom = MARGIN_BOTTOM + (LEGEND_ROW * (legend_rows + 1) if legend_rows else 0.0)
+    right = MARGIN_RIGHT + (1.05 if colorbar else 0.0)
+    fig_width = left + columns * width + (columns - 1) * gap_x + right
+    fig_height = top + rows * height + (rows - 1) * gap_y + bottom
+    figure = new_figure(fig_width, fig_height)
+    if dpi is not None:
+        figure.set_dpi(dpi)
+    panels = []
+    for k in range(count):
+        row, column = divmod(k, columns)
+        x = left + column * (width + gap_x)
+        y = fig_height - top - (row + 1) * height - row * gap_y
+        ax = figure.add_axes(
+            (x / fig_width, y / fig_height, width / fig_width, height / fig_height)
+        )
+        ax.set_xlim(x0, x1)
+        ax.set_ylim(y0, y1)
+        ax.set_aspect("equal", adjustable="box")
+        if column == 0:
+            ax.set_ylabel("y (m)")
+        else:
+            ax.tick_params(labelleft=False)
+        if k + columns >= count:
+            ax.set_xlabel("x (m)")
+        panels.append(ax)
+    bar = None
+    if colorbar:
+        x = left + columns * width + (columns - 1) * gap_x + 0.2
+        y = bottom
+        span = fig_height - top - bottom
+        bar = figure.add_axes((x / fig_width, y / fig_height, 0.16 / fig_width, span / fig_height))
+    return _Layout(figure, panels, bar)
+
+
+def _suptitle(figure: Figure, text: str) -> None:
+    height = figure.get_size_inches()[1]
+    figure.suptitle(text, y=1 - 0.08 / height, va="top", fontsize=SUPTITLE_SIZE)
+
+
+def _panel_title(ax: Axes, first_line: str, outcome: str | None = None, failed=False) -> None:
+    """A panel's title: ``first_line`` in black over an ``outcome`` line, red when ``failed``
+    (the outcome text carries the gid ``outcome``)."""
+    if outcome is None:
+        ax.set_title(first_line, fontsize=TITLE_SIZE)
+        return
+    ax.set_title(first_line, fontsize=TITLE_SIZE, pad=5 + 1.3 * TITLE_SIZE)
+    ax.annotate(
+        outcome,
+        xy=(0.5, 1.0),
+        xycoords="axes fraction",
+        xytext=(0, 4),
+        textcoords="offset points",
+        ha="center",
+        va="bottom",
+        fontsize=TITLE_SIZE,
+        color=FAILURE_COLOR if failed else "black",
+        fontweight="bold" if failed else "normal",
+        gid="outcome",
+    )
+
+
+def _draw_scene(ax: Axes, scene: Scene, limits: np.ndarray) -> None:
+    """Obstacles as grey polygons, each named where its name fits in the part in view, and the
+    destination as the car's outline, dotted, at the destination pose. Call once the axes are
+    placed: the name's size in metres comes from the axes' size in inches."""
+    axes_inches = ax.get_position().width * ax.figure.get_size_inches()[0]
+    metres_per_point = (limits[1, 0] - limits[0, 0]) / (axes_inches * 72)
+    for name, polygon in zip(scene.obstacle_names, scene.obstacles, strict=True):
+        ax.add_patch(
+            Polygon(
+                polygon,
+                closed=True,
+                facecolor=OBSTACLE_FACE,
+                edgecolor=OBSTACLE_EDGE,
+                linewidth=0.8,
+                zorder=1,
+            )
+        )
+        box = _bounds(polygon)
+        low, high = np.maximum(box[0], limits[0]), np.minimum(box[1], limits[1])
+        label = np.array([0.62 * len(name) + 1, 1.6]) * OBSTACLE_LABEL_SIZE * metres_per_point
+        if np.all(high - low > label):
+            centre = (low + high) / 2
+            ax.text(
+                *centre,
+                name,
+                ha="center",
+                va="center",
+                fontsize=OBSTACLE_LABEL_SIZE,
+                color="0.15",
+                clip_on=True,
+                zorder=1.5,
+            )
+    destination = scene.destination
+    goal = place_outline(
+        scene.body_outline, destination["x"], destination["y"], destination["heading"]
+    )
+    ax.add_patch(
+        Polygon(
+            goal,
+            closed=True,
+            fill=False,
+            edgecolor=DESTINATION_COLOR,
+            linestyle=":",
+            linewidth=1.4,
+            zorder=4,
+        )
+    )
+
+
+def _shade(fraction) -> np.ndarray:
+    low, high = SHADE_RANGE
+    return TIME_SHADES(low + (high - low) * np.asarray(fraction, dtype=np.float64))
+
+
+def _draw_manoeuvre(ax: Axes, run: CarTrajectory, samples: np.ndarray) -> None:
+    """The reference point's path and the car's outline at ``samples``, shaded light to dark
+    with time; the start and final outlines thick, a colliding final outline red."""
+    last = int(samples[-1])
+    ax.plot(run.x[: last + 1], run.y[: last + 1], color=PATH_COLOR, linewidth=0.8, zorder=3)
+    outlines = place_outline(
+        run.scene.body_outline, run.x[samples], run.y[samples], run.heading[samples]
+    )
+    span = run.t[last] - run.t[0]
+    colors = _shade((run.t[samples] - run.t[0]) / span if span > 0 else np.ones(len(samples)))
+    ax.add_collection(
+        PolyCollection(
+            outlines[1:-1],
+            closed=True,
+            facecolors="none",
+            edgecolors=colors[1:-1],
+            linewidths=0.7,
+            zorder=2,
+        )
+    )
+    ax.add_patch(
+        Polygon(outlines[0], closed=True, fill=False, edgecolor=colors[0], linewidth=2.0, zorder=3)
+    )
+    ax.plot(
+        run.x[0],
+        run.y[0],
+        "o",
+        color=colors[0],
+        markeredgecolor="black",
+        markeredgewidth=0.6,
+        markersize=4,
+        zorder=5,
+    )
+    if run.collided:
+        ax.add_patch(
+            Polygon(
+                outlines[-1],
+                closed=True,
+                facecolor=FAILURE_COLOR,
+                alpha=0.25,
+                edgecolor="none",
+                zorder=3,
+            )
+        )
+        ax.add_patch(
+            Polygon(
+                outlines[-1],
+                closed=True,
+                fill=False,
+                edgecolor=FAILURE_COLOR,
+                linewidth=2.0,
+                zorder=4,
+            )
+        )
+    else:
+        ax.add_patch(
+            Polygon(
+                outlines[-1], closed=True, fill=False, edgecolor=colors[-1], linewidth=2.0, zorder=3
+            )
+        )
+
+
+def _controller_names(runs: Sequence[CarTrajectory]) -> str:
+    names = list(dict.fromkeys(name for run in runs for name in run.controllers))
+    return ", ".join(names) if names else "?"
+
+
+def _scene_points(scene: Scene) -> np.ndarray:
+    d = scene.destination
+    return place_outline(scene.body_outline, d["x"], d["y"], d["heading"])
+
+
+# --------------------------------------------------------------------------- the plots
+
+
+def plot_parking_frames(
+    trajectory_paths: Sequence[str | Path],
+    out_path: str | Path,
+    interval: float = FRAME_INTERVAL,
+) -> None:
+    """Figure 19: one panel per car trajectory (2 rows × 3 columns for six; any count works),
+    each to scale in metres over the same x/y limits: the obstacles (grey), the destination
+    (the car's outline at the goal, dotted), the car's outline every ``interval`` seconds
+    (light to dark with time, the start and final outlines thick) and the reference point's path.
+    A run that hits an obstacle is drawn up to its first colliding sample, that outline red. Each
+    panel's title: the file stem, its start state, and the outcome (a failure in red). Writes a
+    PNG to ``out_path``."""
+    if not trajectory_paths:
+        raise PlotInputError("plot_parking_frames: no trajectories given")
+    runs = [read_car_trajectory(path) for path in trajectory_paths]
+    samples = [drawn_samples(run.t, interval, run.collision_index) for run in runs]
+    car_points = []
+    for run, drawn in zip(runs, samples, strict=True):
+        car_points.append(
+            place_outline(run.scene.body_outline, run.x[drawn], run.y[drawn], run.heading[drawn])
+        )
+        car_points.append(np.column_stack([run.x[: drawn[-1] + 1], run.y[: drawn[-1] + 1]]))
+        car_points.append(_scene_points(run.scene))
+    limits = view_limits(
+        np.concatenate([p.reshape(-1, 2) for p in car_points]),
+        [polygon for run in runs for polygon in run.scene.obstacles],
+    )
+    legend = [
+        (Patch(facecolor=OBSTACLE_FACE, edgecolor=OBSTACLE_EDGE), "obstacle"),
+        (
+            Line2D([], [], color=DESTINATION_COLOR, linestyle=":", linewidth=1.4),
+            "destination (car outline)",
+        ),
+        (
+            Line2D([], [], color=_shade(0.5), linewidth=0.7),
+            f"car every {interval:g} s, light → dark",
+        ),
+        (Line2D([], [], color=_shade(1.0), linewidth=2.0), "start and final outline"),
+        (Line2D([], [], color=PATH_COLOR, linewidth=0.8), "path of the front-axle midpoint"),
+        (
+            Patch(facecolor=(1, 0, 0, 0.25), edgecolor=FAILURE_COLOR, linewidth=2.0),
+            "first collision",
+        ),
+    ]
+    width = _title_chars(SINGLE_PANEL_WIDTH if len(runs) == 1 else PANEL_WIDTH)
+    summaries = _start_summary(runs)
+    heads = [
+        _wrap(f"{run.name}:", parts, width) for run, parts in zip(runs, summaries, strict=True)
+    ]
+    title_lines = 1 + max(head.count("\n") + 1 for head in heads)
+    with plot_style():
+        layout = _panel_figure(len(runs), limits, 1, title_lines, legend_rows=2)
+        for ax, run, drawn, head in zip(layout.panels, runs, samples, heads, strict=True):
+            _draw_scene(ax, run.scene, limits)
+            _draw_manoeuvre(ax, run, drawn)
+            _panel_title(ax, head, outcome_text(run), run.failed)
+        _suptitle(layout.figure, f"The car parking under controller {_controller_names(runs)}")
+        add_legend(layout.figure, legend, ncols=3)
+        save_png(layout.figure, out_path)
+
+
+def write_parking_gif(trajectory_path: str | Path, out_path: str | Path, fps: int = GIF_FPS):
+    """An animated GIF of one manoeuvre, to scale in metres: obstacles, the destination outline,
+    the car's outline with its four wheels (short thick segments, the front pair turned by the
+    steer angle), the path so far, the time and the speed. ``fps`` frames per second of motion time
+    (the sample at or after each frame time, see ``frame_indices``); a run that collides stops
+    at its first colliding sample, drawn red; the last frame is held GIF_HOLD_MS ms; loops.
+
+    Frames are blitted over the static background, and Pillow writes them with one shared
+    palette, as ``mosys.plots.pendulum.write_script_gif`` does."""
+    from PIL import Image
+
+    if not fps > 0:
+        raise ValueError(f"fps must be positive, got {fps!r}")
+    run = read_car_trajectory(trajectory_path)
+    last = len(run.t) - 1 if run.collision_index < 0 else run.collision_index
+    samples = frame_indices(run.t[: last + 1], 1.0 / fps)
+    if samples[-1] != last:
+        samples = np.append(samples, last)
+    every = np.arange(last + 1)
+    limits = view_limits(
+        np.concatenate(
+            [
+                place_outline(
+                    run.scene.body_outline, run.x[every], run.y[every], run.heading[every]
+                ).reshape(-1, 2),
+                _scene_points(run.scene),
+            ]
+        ),
+        run.scene.obstacles,
+    )
+    failed = run.failed
+    with plot_style():
+        head = _wrap(
+            f"{run.name}, controller {_controller_names([run])}:",
+            _start_summary([run])[0],
+            _title_chars(SINGLE_PANEL_WIDTH),
+        )
+        title_lines = head.count("\n") + 2
+        layout = _panel_figure(1, limits, 0, title_lines, legend_rows=0, dpi=GIF_DPI)
+        figure, ax = layout.figure, layout.panels[0]
+        _draw_scene(ax, run.scene, limits)
+        _panel_title(ax, head, outcome_text(run), failed)
+        body = Polygon(
+            run.scene.body_outline,
+            closed=True,
+            facecolor=_shade(0.15),
+            edgecolor=_shade(1.0),
+            linewidth=1.8,
+            zorder=5,
+        )
+        ax.add_patch(body)
+        wheels = [
+            ax.plot([], [], color="0.1", linewidth=4, solid_capstyle="butt", zorder=6)[0]
+            for _ in range(4)
+        ]
+        path = ax.plot([], [], color=PATH_COLOR, linewidth=1.0, zorder=4)[0]
+        caption = ax.text(
+            0.02,
+            0.97,
+            "",
+            transform=ax.transAxes,
+            family="monospace",
+            fontsize=9,
+            ha="left",
+            va="top",
+            zorder=7,
+            bbox={"facecolor": "white", "alpha": 0.85, "edgecolor": "0.6"},
+        )
+        moving = [path, body, *wheels, caption]  # in drawing (z) order
+        for artist in moving:
+            artist.set_animated(True)
+        canvas = figure.canvas
+        canvas.draw()
+        background = canvas.copy_from_bbox(figure.bbox)
+        frames = []
+        for s in samples:
+            s = int(s)
+            path.set_data(run.x[: s + 1], run.y[: s + 1])
+            body.set_xy(place_outline(run.scene.body_outline, run.x[s], run.y[s], run.heading[s]))
+            hit = run.collided and s == run.collision_index
+            body.set_edgecolor(FAILURE_COLOR if hit else _shade(1.0))
+            body.set_facecolor((1.0, 0.0, 0.0, 0.3) if hit else _shade(0.15))
+            for wheel, segment in zip(wheels, wheel_segments(run, s), strict=True):
+                wheel.set_data(segment[:, 0], segment[:, 1])
+            text = f"t = {run.t[s]:5.2f} s"  # short: text is most of a frame's drawing time
+            if run.speed is not None:
+                text += f"  v = {round(float(run.speed[s]), 1) + 0.0:+.1f} m/s"  # + 0.0: no -0
+            caption.set_text(text.replace("-", "−"))
+            canvas.restore_region(background)
+            for artist in moving:
+                figure.draw_artist(artist)
+            rgba = np.asarray(canvas.buffer_rgba())
+            frames.append(Image.fromarray(rgba[..., :3].copy()))
+
+    frames = _shared_palette(frames)
+    durations = [round(1000 / fps)] * (len(frames) - 1) + [GIF_HOLD_MS]
+
+    def write(partial: Path) -> None:
+        frames[0].save(
+            partial,
+            format="GIF",
+            save_all=True,
+            append_images=frames[1:],
+            duration=durations,
+            loop=0,
+        )
+
+    write_atomically(out_path, write)
+
+
+def _group_starts(grid: StartGrid) -> tuple[list[str], list[np.ndarray], list[str]]:
+    """The grid's starts grouped by every start variable other than x and y: (panel titles,
+    per panel the (n_k,) row indices, the variables common to all starts in brief)."""
+    others = [k for k, name in enumerate(grid.state_order) if name not in ("x", "y")]
+    values = np.round(grid.start[:, others], 6)
+    varying = [j for j in range(len(others)) if np.ptp(values[:, j]) > 0]
+    keys = values[:, varying]
+    distinct = np.unique(keys, axis=0) if varying else np.zeros((1, 0))
+    titles, groups = [], []
+    for key in distinct:
+        rows = np.flatnonzero(np.all(keys == key, axis=1)) if varying else np.arange(len(values))
+        groups.append(rows)
+        parts = []
+        for j, value in zip(varying, key, strict=True):
+            name = grid.state_order[others[j]]
+            symbol = SYMBOLS.get(name)
+            parts.append(
+                f"{name} {symbol} = {describe_value(name, value)}"
+                if symbol
+                else f"{name} = {describe_value(name, value)}"
+            )
+        titles.append(f"start {', '.join(parts)}" if parts else "")
+    common = [
+        f"{grid.state_order[others[j]]} {describe_value(grid.state_order[others[j]], values[0, j])}"
+        for j in range(len(others))
+        if j not in varying
+    ]
+    return titles, groups, common
+
+
+def plot_success_map(start_grid_path: str | Path, out_path: str | Path) -> None:
+    """Which start positions park: the start grid's obstacles and destination outline, and at
+    each start's reference point (x, y) a marker: a green disc where it parked (coloured by the
+    parking time, colour bar in s), a red × where it hit an obstacle, an orange square where it
+    did not park within the simulated time. Starts that differ in any other variable (heading,
+    steer, speed) get one panel per distinct combination. The title gives the success rate.
+
+    The start grid (``results/car/start_grid.h5``): datasets ``start`` (n, d) spec units in the
+    root attribute ``state_order``, ``parked`` and ``collided`` (n,) bool, ``parking_seconds``
+    (n,) s (NaN where not parked); root attributes ``body_outline``, ``obstacles``,
+    ``obstacle_names``, ``destination`` (JSON, as in a car trajectory), ``controller`` and
+    ``simulated_seconds`` (s). Writes a PNG to ``out_path``."""
+    grid = read_start_grid(start_grid_path)
+    column = {name: k for k, name in enumerate(grid.state_order)}
+    xy = grid.start[:, [column["x"], column["y"]]]
+    titles, groups, common = _group_starts(grid)
+    region = [xy, _scene_points(grid.scene)]
+    if "heading" in column:  # the cars' bodies at their starts
+        heading = grid.start[:, column["heading"]]
+        region.append(place_outline(grid.scene.body_outline, xy[:, 0], xy[:, 1], heading))
+    limits = view_limits(np.concatenate([r.reshape(-1, 2) for r in region]), grid.scene.obstacles)
+    parked = grid.succeeded
+    collided = grid.collided
+    timed_out = ~parked & ~collided
+    times = grid.parking_seconds[parked]
+    if len(times):
+        low, high = float(times.min()), float(times.max())
+        norm = Normalize(low - 0.5, high + 0.5) if high - low < 1e-9 else Normalize(low, high)
+    else:
+        norm = Normalize(0.0, 1.0)
+    count, total = int(parked.sum()), len(parked)
+    headline = (
+        f"Controller {grid.controller}: parks from {count} of {total} starts "
+        f"({100 * count / total:.0f} %)"
+    )
+    details = f"every start: {', '.join(common)}; " if common else ""
+    details += f"each run simulated for up to {grid.simulated_seconds:g} s"
+    legend = [
+        (
+            Line2D(
+                [],
+                [],
+                marker="o",
+                linestyle="none",
+                markerfacecolor=PARKING_TIMES(0.6),
+                markeredgecolor="black",
+                markeredgewidth=0.5,
+                markersize=7,
+            ),
+            "parked",
+        ),
+        (
+            Line2D(
+                [],
+                [],
+                marker="x",
+                linestyle="none",
+                color=FAILURE_COLOR,
+                markersize=7,
+                markeredgewidth=2,
+            ),
+            "collision",
+        ),
+        (
+            Line2D(
+                [],
+                [],
+                marker="s",
+                linestyle="none",
+                markerfacecolor=TIMEOUT_COLOR,
+                markeredgecolor="black",
+                markeredgewidth=0.5,
+                markersize=6,
+            ),
+            f"not parked in {grid.simulated_seconds:g} s",
+        ),
+        (
+            Line2D([], [], color=DESTINATION_COLOR, linestyle=":", linewidth=1.4),
+            "destination (car outline)",
+        ),
+    ]
+    with plot_style():
+        layout = _panel_figure(
+            len(groups),
+            limits,
+            suptitle_lines=2,
+            title_lines=1 if any(titles) else 0,
+            legend_rows=1,
+            colorbar=bool(len(times)),
+        )
+        mappable = None
+        for ax, title, rows in zip(layout.panels, titles, groups, strict=True):
+            _draw_scene(ax, grid.scene, limits)
+            good = rows[parked[rows]]
+            if len(good):
+                mappable = ax.scatter(
+                    xy[good, 0],
+                    xy[good, 1],
+                    c=grid.parking_seconds[good],
+                    cmap=PARKING_TIMES,
+                    norm=norm,
+                    marker="o",
+                    s=46,
+                    edgecolors="black",
+                    linewidths=0.5,
+                    zorder=6,
+                )
+            hit = rows[collided[rows]]
+            ax.scatter(
+                xy[hit, 0],
+                xy[hit, 1],
+                marker="x",
+                s=46,
+                color=FAILURE_COLOR,
+                linewidths=2.0,
+                zorder=6,
+            )
+            late = rows[timed_out[rows]]
+            ax.scatter(
+                xy[late, 0],
+                xy[late, 1],
+                marker="s",
+                s=36,
+                color=TIMEOUT_COLOR,
+                edgecolors="black",
+                linewidths=0.5,
+                zorder=6,
+            )
+            if title:
+                _panel_title(ax, title)
+        if layout.colorbar is not None and mappable is not None:
+            layout.figure.colorbar(mappable, cax=layout.colorbar, label="parking time (s)")
+        _suptitle(layout.figure, f"{headline}\n{details}")
+        add_legend(layout.figure, legend, ncols=4)
+        save_png(layout.figure, out_path)

@@ -1,0 +1,493 @@
+"""The car's plots (Figure 19, the parking GIF, the start-grid success map) from small car
+trajectories and a start grid built here: the car's own kinematics (mosys.dynamics.vehicle)
+integrated in numpy, collisions found by the real geometry kernel."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from matplotlib.colors import same_color
+from PIL import Image
+
+import mosys.plots.car as car
+from mosys.io.trajectory import Trajectory, write_trajectory
+from mosys.kernels.geometry import first_colliding_sample, pack_polygons
+from mosys.plots.car import (
+    FAILURE_COLOR,
+    PlotInputError,
+    drawn_samples,
+    frame_indices,
+    outcome_text,
+    plot_parking_frames,
+    plot_success_map,
+    read_car_trajectory,
+    view_limits,
+    wheel_segments,
+    write_parking_gif,
+)
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+WHEELBASE = 2.5  # m, as specs/figures/car.fig
+BODY = [[0.8, -0.85], [0.8, 0.85], [-3.2, 0.85], [-3.2, -0.85]]  # m, car frame
+OBSTACLES = {
+    "curb": [[-12.0, -1.0], [16.0, -1.0], [16.0, 0.0], [-12.0, 0.0]],
+    "rear_car": [[-8.0, 0.3], [-3.5, 0.3], [-3.5, 2.0], [-8.0, 2.0]],
+    "front_car": [[4.0, 0.3], [8.5, 0.3], [8.5, 2.0], [4.0, 2.0]],
+}
+DESTINATION = {"x": 2.6, "y": 1.15, "heading": 0.0}
+STATE_ORDER = ("x", "y", "heading", "steer", "speed")
+DT = 0.05  # s
+
+
+def drive(start, controls, dt=DT) -> np.ndarray:
+    """Euler steps of the car's kinematics (mosys.dynamics.vehicle) from ``start`` (x m, y m,
+    heading deg, steer deg) through ``controls``: (steer deg, speed m/s, seconds) legs, the
+    steer set at once. Returns the (N, 5) states in STATE_ORDER, spec units."""
+    x, y, heading, steer = start
+    rows = [[x, y, heading, steer, 0.0]]
+    for steer, speed, seconds in controls:
+        for _ in range(round(seconds / dt)):
+            h, d = math.radians(heading), math.radians(steer)
+            x += dt * speed * math.cos(h + d)
+            y += dt * speed * math.sin(h + d)
+            heading += math.degrees(dt * speed * math.sin(d) / WHEELBASE)
+            rows.append([x, y, heading, steer, speed])
+    return np.array(rows)
+
+
+def parking_states(first_steer: float) -> np.ndarray:
+    """A reverse parallel park into the destination: the destination pose driven out forwards
+    (left, then right), played backwards; starts with the steer at ``first_steer``."""
+    legs = [(0, -1.0, 1.2), (35, 1.2, 3.0), (-35, 1.2, 3.0), (0, 1.2, 1.0)]
+    out = drive((DESTINATION["x"], DESTINATION["y"], 0.0, 0.0), legs)
+    states = out[::-1].copy()
+    states[:, 4] *= -1  # driven backwards in time: the speeds reverse
+    states[0, 3] = first_steer
+    return states
+
+
+def car_attrs(states: np.ndarray, t: np.ndarray, seconds: float, **overrides) -> dict:
+    """The car runtime's root attributes for a run, its collision found by the real kernel."""
+    vertices, starts = pack_polygons([np.array(p) for p in OBSTACLES.values()])
+    poses = np.column_stack([states[:, 0], states[:, 1], np.radians(states[:, 2])])
+    sample, obstacle = first_colliding_sample(
+        np.ascontiguousarray(poses), np.array(BODY), vertices, starts
+    )
+    final = states[-1]
+    parked = bool(
+        sample < 0
+        and abs(final[0] - DESTINATION["x"]) < 0.2
+        and abs(final[1] - DESTINATION["y"]) < 0.2
+        and t[-1] <= seconds
+    )
+    attrs = {
+        "body_outline": json.dumps(BODY),
+        "obstacles": json.dumps(list(OBSTACLES.values())),
+        "obstacle_names": list(OBSTACLES),
+        "destination": json.dumps(DESTINATION),
+        "wheelbase": WHEELBASE,
+        "collision_index": int(sample),
+        "collided_with": list(OBSTACLES)[obstacle] if sample >= 0 else "",
+        "parked": parked,
+        "parking_seconds": float(t[-1]) if parked else math.nan,
+        "simulated_seconds": seconds,
+    }
+    attrs.update(overrides)
+    return {key: value for key, value in attrs.items() if value is not None}
+
+
+def write_car_trajectory(
+    path: Path, states: np.ndarray, seconds=20.0, state_order=STATE_ORDER, **overrides
+) -> Path:
+    """A car trajectory file: ``states`` (N, 5) in STATE_ORDER, written in ``state_order``."""
+    t = DT * np.arange(len(states))
+    attrs = car_attrs(states, t, seconds, **overrides)
+    columns = [STATE_ORDER.index(name) for name in state_order]
+    write_trajectory(
+        path,
+        Trajectory(
+            t=t,
+            state=states[:, columns],
+            control=np.zeros((len(t), 2)),
+            controller=np.zeros(len(t), dtype=np.int64),
+            state_order=tuple(state_order),
+            control_names=("steer_rate", "wheel_accel"),
+            controllers=("park",),
+            attrs=attrs,
+            motion=None,
+        ),
+    )
+    return path
+
+
+def crash_states() -> np.ndarray:
+    """Straight ahead, heading −15°, into the front car."""
+    return drive((-6.0, 4.5, -15.0, 0.0), [(0, 2.0, 6.0)])
+
+
+def lost_states() -> np.ndarray:
+    """A slow loop far from the gap: never parks, never touches anything."""
+    return drive((-2.0, 6.0, 0.0, 20.0), [(20, 0.8, 6.0)])
+
+
+@pytest.fixture
+def parks(tmp_path) -> Path:
+    return write_car_trajectory(tmp_path / "park_1.h5", parking_states(-30.0))
+
+
+@pytest.fixture
+def crashes(tmp_path) -> Path:
+    return write_car_trajectory(tmp_path / "park_2.h5", crash_states())
+
+
+@pytest.fixture
+def lost(tmp_path) -> Path:
+    return write_car_trajectory(tmp_path / "park_3.h5", lost_states(), seconds=6.0)
+
+
+def write_start_grid(path: Path, steers=(0.0,)) -> Path:
+    """A 2 × 3 grid of start positions (per steer value), outcomes by position: the lower row
+    parks (slower further right), the upper row's left start collides, the rest time out."""
+    rows, parked, collided, seconds = [], [], [], []
+    for steer in steers:
+        for j, y in enumerate((4.0, 6.0)):
+            for i, x in enumerate((0.0, 3.0, 6.0)):
+                rows.append([x, y, 0.0, steer, 0.0])
+                parked.append(j == 0 and steer == steers[0])
+                collided.append(j == 1 and i == 0)
+                seconds.append(8.0 + 2.0 * i if parked[-1] else math.nan)
+    with h5py.File(path, "w") as h5:
+        h5["start"] = np.array(rows)
+        h5["parked"] = np.array(parked)
+        h5["collided"] = np.array(collided)
+        h5["parking_seconds"] = np.array(seconds)
+        h5.attrs["state_order"] = list(STATE_ORDER)
+        h5.attrs["body_outline"] = json.dumps(BODY)
+        h5.attrs["obstacles"] = json.dumps(list(OBSTACLES.values()))
+        h5.attrs["obstacle_names"] = list(OBSTACLES)
+        h5.attrs["destination"] = json.dumps(DESTINATION)
+        h5.attrs["controller"] = "park"
+        h5.attrs["simulated_seconds"] = 20.0
+    return path
+
+
+@pytest.fixture
+def saved_figures(monkeypatch) -> list:
+    """The figures the car plots save, kept for inspection (the PNG is still written)."""
+    figures = []
+    save = car.save_png
+
+    def keep(figure, path):
+        figures.append(figure)
+        save(figure, path)
+
+    monkeypatch.setattr(car, "save_png", keep)
+    return figures
+
+
+def assert_image(path: Path, kind: str, min_size=(300, 200)) -> Image.Image:
+    with Image.open(path) as image:
+        assert image.format == kind
+        assert image.width >= min_size[0] and image.height >= min_size[1], image.size
+        colors = image.convert("RGB").getcolors(maxcolors=1 << 20)
+        assert len(colors) > 20, f"{path} looks blank"
+        return image.size
+
+
+def outcome_label(ax):
+    (label,) = [text for text in ax.texts if text.get_gid() == "outcome"]
+    return label
+
+
+# --------------------------------------------------------------------------- the synthetic runs
+
+
+def test_the_synthetic_runs_are_what_they_claim(parks, crashes, lost):
+    parked = read_car_trajectory(parks)
+    assert parked.parked and not parked.collided
+    assert abs(parked.x[-1] - DESTINATION["x"]) < 1e-9 and abs(parked.y[-1] - 1.15) < 1e-9
+    crashed = read_car_trajectory(crashes)
+    assert crashed.collided and crashed.collided_with == "front_car"
+    assert 0 < crashed.collision_index < len(crashed.t) - 1  # it drives on, into the car
+    wandered = read_car_trajectory(lost)
+    assert not wandered.parked and not wandered.collided
+
+
+# --------------------------------------------------------------------------- pure helpers
+
+
+def test_frame_indices_take_a_sample_every_interval():
+    t = np.arange(0.0, 2.0 + 1e-9, 0.05)  # 41 samples, 0.3 s is exactly six steps
+    np.testing.assert_array_equal(frame_indices(t, 0.3), [0, 6, 12, 18, 24, 30, 36])
+    np.testing.assert_array_equal(frame_indices(t, 0.5), [0, 10, 20, 30, 40])  # both ends
+    np.testing.assert_array_equal(frame_indices(t + 7.0, 0.5), [0, 10, 20, 30, 40])
+    np.testing.assert_array_equal(frame_indices(t, 0.01), np.arange(41))  # no repeats
+    np.testing.assert_array_equal(frame_indices(np.array([3.0]), 0.3), [0])
+    assert frame_indices(np.empty(0), 0.3).size == 0
+
+
+@given(
+    steps=st.lists(st.floats(0.0, 1.0), min_size=1, max_size=80),
+    interval=st.floats(0.01, 5.0),
+)
+@settings(max_examples=200, deadline=None)
+def test_frame_indices_are_the_first_samples_at_or_after_each_frame_time(steps, interval):
+    t = np.concatenate([[0.0], np.cumsum(steps)])
+    index = frame_indices(t, interval)
+    assert index[0] == 0 and np.all(np.diff(index) > 0) and index[-1] < len(t)
+    for k in range(math.floor(t[-1] / interval + 1e-9) + 1):
+        i = np.searchsorted(t, k * interval - 1e-9)
+        assert min(i, len(t) - 1) in index
+    assert len(index) <= math.floor(t[-1] / interval + 1e-9) + 1
+
+
+def test_frame_indices_reject_a_bad_interval():
+    with pytest.raises(ValueError, match="interval must be positive"):
+        frame_indices(np.arange(3.0), 0.0)
+
+
+def test_drawn_samples_stop_at_the_first_collision():
+    t = DT * np.arange(100)
+    np.testing.assert_array_equal(drawn_samples(t, 0.3, 17), [0, 6, 12, 17])
+    np.testing.assert_array_equal(drawn_samples(t, 0.3, 18), [0, 6, 12, 18])
+    free = drawn_samples(t, 0.3, -1)
+    assert free[-1] == 99 and np.all(np.isin(frame_indices(t, 0.3), free))
+    np.testing.assert_array_equal(drawn_samples(t, 0.3, 0), [0])
+
+
+def test_outcome_text(parks, crashes, lost):
+    parked = read_car_trajectory(parks)
+    assert outcome_text(parked) == f"parked in {parked.parking_seconds:.1f} s"
+    crashed = read_car_trajectory(crashes)
+    hit_time = crashed.t[crashed.collision_index]
+    assert outcome_text(crashed) == f"FAILED: hits front_car at {hit_time:.1f} s"
+    assert outcome_text(read_car_trajectory(lost)) == "FAILED: not parked in 6 s"
+
+
+def test_a_collision_is_a_failure_even_if_the_file_says_parked(tmp_path):
+    path = write_car_trajectory(
+        tmp_path / "both.h5", crash_states(), parked=True, parking_seconds=3.0
+    )
+    run = read_car_trajectory(path)
+    assert run.failed
+    assert outcome_text(run).startswith("FAILED: hits front_car at ")
+
+
+def test_columns_are_found_by_name(tmp_path, parks):
+    shuffled = write_car_trajectory(
+        tmp_path / "shuffled.h5",
+        parking_states(-30.0),
+        state_order=("speed", "steer", "heading", "y", "x"),
+    )
+    a, b = read_car_trajectory(parks), read_car_trajectory(shuffled)
+    for name in ("x", "y", "heading", "steer", "speed"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+
+
+def test_wheels_sit_on_the_axles_and_the_front_pair_steers(parks):
+    run = read_car_trajectory(parks)
+    wheels = wheel_segments(run, 0)  # steer -30 deg at the start
+    centres = wheels.mean(axis=1)
+    front = (centres[0] + centres[1]) / 2
+    rear = (centres[2] + centres[3]) / 2
+    np.testing.assert_allclose(front, [run.x[0], run.y[0]], atol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(front - rear), WHEELBASE)
+    angles = np.degrees(np.arctan2(*(wheels[:, 1] - wheels[:, 0]).T[::-1]))
+    np.testing.assert_allclose(angles[:2], run.heading[0] - 30.0, atol=1e-9)
+    np.testing.assert_allclose(angles[2:], run.heading[0], atol=1e-9)
+
+
+def test_view_limits_clip_long_obstacles_to_the_cars_region():
+    cars = np.array([[0.0, 1.0], [4.0, 3.0]])
+    wall = np.array([[-100.0, -1.0], [100.0, -1.0], [100.0, 0.0], [-100.0, 0.0]])
+    far = np.array([[50.0, 50.0], [51.0, 50.0], [51.0, 51.0]])
+    (x0, y0), (x1, y1) = view_limits(cars, [wall, far])
+    assert x0 == pytest.approx(-car.VIEW_MARGIN - car.EDGE_MARGIN)
+    assert x1 == pytest.approx(4.0 + car.VIEW_MARGIN + car.EDGE_MARGIN)
+    # the wall shows as far as VIEW_MARGIN below the cars; the far obstacle is left out
+    assert y0 == pytest.approx(1.0 - car.VIEW_MARGIN - car.EDGE_MARGIN)
+    assert y1 == pytest.approx(3.0 + car.EDGE_MARGIN)
+
+
+# --------------------------------------------------------------------------- the plots
+
+
+def test_parking_frames_png(tmp_path, parks, crashes, lost, saved_figures):
+    out = tmp_path / "frames.png"
+    plot_parking_frames([parks, crashes, lost], out, interval=0.3)
+    assert out.read_bytes()[:8] == PNG_MAGIC
+    assert_image(out, "PNG", min_size=(900, 300))
+    assert not [p for p in tmp_path.iterdir() if "partial" in p.name]
+    (figure,) = saved_figures
+    panels = [ax for ax in figure.axes if ax.get_title()]
+    assert [ax.get_title().split(":")[0] for ax in panels] == ["park_1", "park_2", "park_3"]
+    assert "controller park" in figure.get_suptitle()
+    assert all(ax.get_xlim() == panels[0].get_xlim() for ax in panels)
+    assert all(ax.get_ylim() == panels[0].get_ylim() for ax in panels)
+    assert all(ax.get_aspect() == 1.0 for ax in panels)
+    parked, crashed, wandered = (outcome_label(ax) for ax in panels)
+    assert parked.get_text().startswith("parked in") and parked.get_color() == "black"
+    assert crashed.get_text().startswith("FAILED: hits front_car")
+    assert crashed.get_color() == FAILURE_COLOR
+    assert wandered.get_text() == "FAILED: not parked in 6 s"
+    assert wandered.get_color() == FAILURE_COLOR
+    # the crash is drawn no further than its first colliding sample
+    run = read_car_trajectory(crashes)
+    (path,) = [line for line in panels[1].lines if len(line.get_xdata()) > 1]
+    assert len(path.get_xdata()) == run.collision_index + 1
+    assert path.get_xdata()[-1] == run.x[run.collision_index]
+    red = [p for p in panels[1].patches if same_color(p.get_edgecolor(), FAILURE_COLOR)]
+    assert red, "the colliding outline is drawn in red"
+
+
+def test_six_panels_are_two_rows_of_three(tmp_path, saved_figures):
+    paths = [
+        write_car_trajectory(tmp_path / f"park_{k}.h5", parking_states(steer))
+        for k, steer in enumerate((-30, -15, 0, 10, 20, 30), start=1)
+    ]
+    plot_parking_frames(paths, tmp_path / "six.png")
+    (figure,) = saved_figures
+    boxes = [ax.get_position() for ax in figure.axes if ax.get_title()]
+    assert len({round(b.y0, 6) for b in boxes}) == 2
+    assert len({round(b.x0, 6) for b in boxes}) == 3
+    assert [ax.get_title() for ax in figure.axes[:2]] == [
+        "park_1: steer −30°",
+        "park_2: steer −15°",
+    ]
+
+
+def test_parking_gif(tmp_path, crashes, parks):
+    out = tmp_path / "park.gif"
+    write_parking_gif(crashes, out, fps=10)
+    assert out.read_bytes()[:6] == b"GIF89a"
+    assert_image(out, "GIF")
+    run = read_car_trajectory(crashes)
+    hit = run.collision_index
+    with Image.open(out) as gif:
+        # every 0.1 s up to the collision, both ends included: no frame after it
+        expected = np.union1d(frame_indices(run.t[: run.collision_index + 1], 0.1), [hit])
+        assert gif.n_frames == len(expected)
+        first = np.asarray(gif.convert("RGB"))
+        gif.seek(gif.n_frames - 1)
+        last = np.asarray(gif.convert("RGB"))
+    assert np.any(first != last)
+    write_parking_gif(parks, tmp_path / "parks.gif", fps=4)
+    with Image.open(tmp_path / "parks.gif") as gif:
+        assert gif.n_frames > 1
+    assert not [p for p in tmp_path.iterdir() if "partial" in p.name]
+
+
+def test_success_map_one_panel(tmp_path, saved_figures):
+    out = tmp_path / "map.png"
+    plot_success_map(write_start_grid(tmp_path / "grid.h5"), out)
+    assert_image(out, "PNG")
+    (figure,) = saved_figures
+    assert figure.get_suptitle().startswith("Controller park: parks from 3 of 6 starts (50 %)")
+    (panel, colorbar) = figure.axes[:2]
+    assert colorbar.get_ylabel() == "parking time (s)"
+    assert panel.get_aspect() == 1.0
+
+
+def test_success_map_one_panel_per_steer(tmp_path, saved_figures):
+    out = tmp_path / "map.png"
+    plot_success_map(write_start_grid(tmp_path / "grid.h5", steers=(-30.0, 0.0)), out)
+    assert_image(out, "PNG")
+    (figure,) = saved_figures
+    titles = [ax.get_title() for ax in figure.axes if ax.get_title()]
+    assert titles == ["start steer δ = −30°", "start steer δ = 0°"]
+    assert "parks from 3 of 12 starts (25 %)" in figure.get_suptitle()
+
+
+# --------------------------------------------------------------------------- bad inputs
+
+
+def test_a_trajectory_without_body_outline(tmp_path):
+    path = write_car_trajectory(tmp_path / "bare.h5", crash_states(), body_outline=None)
+    with pytest.raises(PlotInputError) as error:
+        plot_parking_frames([path], tmp_path / "x.png")
+    assert str(error.value) == (
+        f"{path}: not a car trajectory (root attributes): missing body_outline"
+    )
+    assert not (tmp_path / "x.png").exists()
+
+
+@pytest.mark.parametrize(
+    "overrides, message",
+    [
+        (
+            {"body_outline": "[[0, 0], [1, 1]]"},
+            "body_outline must be a list of at least 3 [x, y] vertices, got [[0, 0], [1, 1]]",
+        ),
+        (
+            {"obstacles": "[[0, 0"},
+            "root attribute obstacles is not valid JSON (Expecting ',' delimiter: line 1 column 7"
+            " (char 6))",
+        ),
+        ({"obstacle_names": ["curb"]}, "3 obstacles but 1 obstacle_names ['curb']"),
+        (
+            {"destination": '{"x": 1}'},
+            'destination must be {"x": m, "y": m, "heading": deg}, got {\'x\': 1}',
+        ),
+        ({"collision_index": 10_000}, "collision_index 10000 is outside the 121 samples"),
+        ({"parked": True}, "parked is true but parking_seconds is nan"),
+    ],
+)
+def test_malformed_car_attributes(tmp_path, overrides, message):
+    path = write_car_trajectory(tmp_path / "bad.h5", crash_states(), **overrides)
+    with pytest.raises(PlotInputError) as error:
+        write_parking_gif(path, tmp_path / "x.gif")
+    assert str(error.value) == f"{path}: {message}"
+    assert not (tmp_path / "x.gif").exists()
+
+
+def test_a_trajectory_that_is_not_a_car(tmp_path):
+    path = write_car_trajectory(
+        tmp_path / "pendulum.h5",
+        crash_states(),
+        state_order=("x", "y", "heading", "steer", "speed"),
+    )
+    with h5py.File(path, "a") as h5:
+        h5.attrs["state_order"] = ["angle", "omega", "heading", "steer", "speed"]
+    with pytest.raises(PlotInputError) as error:
+        read_car_trajectory(path)
+    assert str(error.value) == (
+        f"{path}: state_order ['angle', 'omega', 'heading', 'steer', 'speed'] lacks x, y: "
+        "not a car state"
+    )
+    with h5py.File(path, "a") as h5:
+        del h5["t"]
+    with pytest.raises(PlotInputError, match=f"^{path}: not a trajectory file"):
+        read_car_trajectory(path)
+
+
+def test_a_start_grid_with_missing_parts(tmp_path):
+    path = write_start_grid(tmp_path / "grid.h5")
+    with h5py.File(path, "a") as h5:
+        del h5["collided"]
+        del h5.attrs["destination"]
+    with pytest.raises(PlotInputError) as error:
+        plot_success_map(path, tmp_path / "map.png")
+    assert str(error.value) == f"{path}: not a start grid (datasets): missing collided"
+    with h5py.File(path, "a") as h5:
+        h5["collided"] = np.zeros(4, dtype=bool)
+    with pytest.raises(PlotInputError) as error:
+        plot_success_map(path, tmp_path / "map.png")
+    assert str(error.value) == f"{path}: not a start grid (root attributes): missing destination"
+    with h5py.File(path, "a") as h5:
+        h5.attrs["destination"] = json.dumps(DESTINATION)
+    with pytest.raises(PlotInputError) as error:
+        plot_success_map(path, tmp_path / "map.png")
+    assert str(error.value) == f"{path}: /collided has shape (4,), expected (6,)"
+    assert not (tmp_path / "map.png").exists()
+
+
+def test_no_trajectories(tmp_path):
+    with pytest.raises(PlotInputError, match="no trajectories"):
+        plot_parking_frames([], tmp_path / "x.png")
