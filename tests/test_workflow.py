@@ -49,9 +49,9 @@ def snakemake(work: Path, *args: str) -> str:
     return done.stdout + done.stderr
 
 
-def planned_jobs(work: Path) -> dict[str, int]:
-    """Rule name -> job count of a dry run of results/pendulum_all ({} when nothing to do)."""
-    output = snakemake(work, "--dry-run", "results/pendulum_all")
+def planned_jobs(work: Path, target: str = "results/pendulum_all") -> dict[str, int]:
+    """Rule name -> job count of a dry run of ``target`` ({} when nothing to do)."""
+    output = snakemake(work, "--dry-run", target)
     if "Nothing to be done" in output:
         return {}
     stats = output.split("Job stats:", 1)[1]
@@ -144,3 +144,29 @@ def test_broken_spec_fails_with_its_location_and_leaves_no_output(workflow):
     )
     assert expected in done.stdout + done.stderr
     assert not (workflow / "results/controllers/pendulum/C.h5").exists()
+
+
+CAR_SCRIPTS = [f"park_{k}" for k in range(1, 7)]
+
+
+def test_editing_an_obstacle_rebuilds_the_car_and_nothing_else(workflow):
+    snakemake(workflow, "results/car_all")
+    index = (workflow / "results/car_all").read_text().split()
+    assert "results/plots/car/figure19_frames.png" in index
+    assert all(f"results/trajectories/{s}.h5" in index for s in CAR_SCRIPTS)
+    pendulum_plan = planned_jobs(workflow)  # earlier tests may have left edits behind
+    spec = workflow / "specs/controllers/car/park.ssc"
+    text = spec.read_text()
+    assert "obstacle front_car 2.3,0.15" in text
+    spec.write_text(text.replace("obstacle front_car 2.3,0.15", "obstacle front_car 2.4,0.15"))
+    assert planned_jobs(workflow, "results/car_all") == {
+        "dp_controller": 1,
+        "run_script": len(CAR_SCRIPTS),
+        "car_start_grid": 1,
+        "car_frames": 1,
+        "car_gif": 1,
+        "car_start_map": 1,
+        "car_controller_table": 1,
+        "car_all": 1,
+    }
+    assert planned_jobs(workflow) == pendulum_plan  # the pendulum does not depend on the car
