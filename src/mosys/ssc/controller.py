@@ -54,6 +54,10 @@ class Controller:
             [actuators.index(name) for name in table.control_names], dtype=np.int64
         )
         self.control_scale = np.array([control_scale(dynamics, n) for n in table.control_names])
+        # the simulator's SI copies of the table and the limits, made once per controller
+        self.torque_table_si = np.ascontiguousarray(self.torque_table * self.control_scale)
+        self.control_min_si = np.ascontiguousarray(table.control_min * self.control_scale)
+        self.control_max_si = np.ascontiguousarray(table.control_max * self.control_scale)
 
     @classmethod
     def load(cls, path: str | Path, dynamics: ModuleType) -> Controller:
@@ -117,10 +121,10 @@ class Controller:
             grid.axis_step,
             grid.axis_count,
             grid.wrap,
-            np.ascontiguousarray(self.torque_table * self.control_scale),
+            self.torque_table_si,
             self.known,
-            np.ascontiguousarray(self.table.control_min * self.control_scale),
-            np.ascontiguousarray(self.table.control_max * self.control_scale),
+            self.control_min_si,
+            self.control_max_si,
             grid.state_slot,
             self.control_slot,
             len(self.dynamics.INPUT_NAMES),
