@@ -11,6 +11,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from mosys.errors import InputError
 from mosys.io.atomic import write_atomically
 from mosys.io.attributes import string_tuple
 
@@ -47,9 +48,20 @@ def write_start_grid(path: str | Path, grid: StartGrid) -> None:
     write_atomically(path, write)
 
 
+DATASETS = ("start", "parked", "collided", "parking_seconds")
+
+
 def read_start_grid(path: str | Path) -> StartGrid:
-    """Read a start grid written by ``write_start_grid``."""
+    """Read a start grid written by ``write_start_grid``; InputError naming the file and the
+    datasets (or ``state_order``) it lacks."""
     with h5py.File(path, "r") as h5:
+        for kind, names, present in (
+            ("datasets", DATASETS, h5),
+            ("root attributes", ("state_order",), h5.attrs),
+        ):
+            absent = [name for name in names if name not in present]
+            if absent:
+                raise InputError(f"{path}: not a start grid ({kind}): missing {', '.join(absent)}")
         return StartGrid(
             start=h5["start"][()],
             state_order=string_tuple(h5.attrs["state_order"]),

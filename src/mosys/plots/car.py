@@ -20,7 +20,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-import h5py
 import matplotlib
 import numpy as np
 from matplotlib.axes import Axes
@@ -30,8 +29,11 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Polygon
 
+from mosys.errors import InputError
 from mosys.io.atomic import write_atomically
 from mosys.io.attributes import string_tuple
+from mosys.io.start_grid import DATASETS
+from mosys.io.start_grid import read_start_grid as read_start_grid_file
 from mosys.io.trajectory import read_trajectory
 from mosys.plots.pendulum import GIF_DPI, PlotInputError, _shared_palette
 from mosys.plots.style import (
@@ -70,8 +72,7 @@ RUN_ATTRS = (
     "parking_seconds",
     "simulated_seconds",
 )
-GRID_DATASETS = ("start", "parked", "collided", "parking_seconds")
-GRID_ATTRS = ("state_order", *SCENE_ATTRS, "controller", "simulated_seconds")
+GRID_ATTRS = (*SCENE_ATTRS, "controller", "simulated_seconds")  # beside io.start_grid's
 
 OBSTACLE_FACE, OBSTACLE_EDGE = "0.72", "0.45"
 FAILURE_COLOR = "#d62728"  # the collision outline, the FAILED titles, the collision markers
@@ -294,13 +295,15 @@ def read_car_trajectory(path: str | Path) -> CarTrajectory:
 def read_start_grid(path: str | Path) -> StartGrid:
     """Read ``results/car/start_grid.h5`` (see ``plot_success_map``); PlotInputError naming the
     file and what is missing or malformed."""
-    with h5py.File(path, "r") as h5:
-        _missing(path, "start grid (datasets)", GRID_DATASETS, h5)
-        _missing(path, "start grid (root attributes)", GRID_ATTRS, h5.attrs)
-        attrs = dict(h5.attrs)
-        start = np.asarray(h5["start"][()], dtype=np.float64)
-        flags = {name: np.asarray(h5[name][()]) for name in GRID_DATASETS[1:]}
-    state_order = string_tuple(attrs["state_order"])
+    try:
+        grid = read_start_grid_file(path)
+    except InputError as error:  # a dataset or state_order is missing
+        raise PlotInputError(str(error)) from None
+    attrs = grid.attrs
+    _missing(path, "start grid (root attributes)", GRID_ATTRS, attrs)
+    start = np.asarray(grid.start, dtype=np.float64)
+    flags = {name: np.asarray(getattr(grid, name)) for name in DATASETS[1:]}
+    state_order = grid.state_order
     _columns(path, state_order, ("x", "y"))
     if start.ndim != 2 or start.shape[1] != len(state_order) or len(start) == 0:
         raise PlotInputError(
