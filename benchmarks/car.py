@@ -16,7 +16,7 @@ import tempfile
 from pathlib import Path
 
 import pandas as pd
-from generation import generate
+from generation import generate, write_results
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = ROOT / "specs/controllers/car/park.ssc"
@@ -73,12 +73,7 @@ def main() -> None:
         frame["states_ratio"] = [1.0, round(big.table_states / base.table_states, 2)]
         frame["time_ratio"] = [1.0, round(big.dp_s_warm / base.dp_s_warm, 2)]
         frame["memory_ratio"] = [1.0, round(big.peak_rss_MiB / base.peak_rss_MiB, 2)]
-    out = ROOT / "results" / "benchmarks"
-    out.mkdir(parents=True, exist_ok=True)
-    suffix = "_smoke" if args.smoke else ""
-    frame.to_csv(out / f"car{suffix}.csv", index=False)
-    (out / f"car{suffix}.md").write_text(frame.to_markdown(index=False) + "\n")
-    print(frame.to_markdown(index=False))
+    write_results(frame, "car", args.smoke)
 
 
 if __name__ == "__main__":

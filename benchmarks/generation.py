@@ -1,6 +1,6 @@
-"""Controller generation in a fresh process, for the benchmarks: the measured figures are the DP
-alone (generation_seconds), the whole process (Python start-up, imports and, with a cold cache,
-JIT compilation) and the process's peak resident memory."""
+"""What the benchmarks share: controller generation in a fresh process (the measured figures are
+the DP alone (generation_seconds), the whole process (Python start-up, imports and, with a cold
+cache, JIT compilation) and the process's peak resident memory), and writing a result table."""
 
 from __future__ import annotations
 
@@ -9,6 +9,10 @@ import os
 import subprocess
 import sys
 from pathlib import Path
+
+import pandas as pd
+
+ROOT = Path(__file__).resolve().parents[1]
 
 GENERATE = """
 import json, sys, time
@@ -40,3 +44,13 @@ def generate(dynamics: Path, spec: Path, out: Path, cache: Path) -> dict:
         text=True,
     )
     return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def write_results(frame: pd.DataFrame, name: str, smoke: bool) -> None:
+    """Write results/benchmarks/NAME.{csv,md} (NAME_smoke.* for a smoke run) and print it."""
+    out = ROOT / "results" / "benchmarks"
+    out.mkdir(parents=True, exist_ok=True)
+    suffix = "_smoke" if smoke else ""
+    frame.to_csv(out / f"{name}{suffix}.csv", index=False)
+    (out / f"{name}{suffix}.md").write_text(frame.to_markdown(index=False) + "\n")
+    print(frame.to_markdown(index=False))

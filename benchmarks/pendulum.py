@@ -19,7 +19,7 @@ import time
 from pathlib import Path
 
 import pandas as pd
-from generation import generate
+from generation import generate, write_results
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER_SECONDS = {"A": 381.0, "B": 452.0, "C": 341.0, "D": 460.0, "E": 459.0, "F": 454.0}
@@ -120,12 +120,7 @@ def main() -> None:
                 }
             )
     frame = pd.DataFrame(rows)
-    out = ROOT / "results" / "benchmarks"
-    out.mkdir(parents=True, exist_ok=True)
-    suffix = "_smoke" if args.smoke else ""
-    frame.to_csv(out / f"pendulum{suffix}.csv", index=False)
-    (out / f"pendulum{suffix}.md").write_text(frame.to_markdown(index=False) + "\n")
-    print(frame.to_markdown(index=False))
+    write_results(frame, "pendulum", args.smoke)
 
 
 if __name__ == "__main__":
