@@ -10,12 +10,14 @@ include: "workflow/rules/scripts.smk"
 include: "workflow/rules/plots.smk"
 include: "workflow/rules/tables.smk"
 include: "workflow/rules/car.smk"
+include: "workflow/rules/luxo.smk"
 
 
 rule all:
     input:
         "results/pendulum_all",
         "results/car_all",
+        "results/luxo_all",
         "results/paper_tables",
 
 
@@ -37,6 +39,17 @@ rule car_all:
         "results/car_all",
     log:
         "results/logs/car_all.log",
+    shell:
+        "mosys index {input} -o {output} 2> {log}"
+
+
+rule luxo_all:
+    input:
+        luxo_targets(),
+    output:
+        "results/luxo_all",
+    log:
+        "results/logs/luxo_all.log",
     shell:
         "mosys index {input} -o {output} 2> {log}"
 

@@ -148,7 +148,7 @@ ERRORS = [
     ),
     (
         BASE.replace("sim 0.4", "sim 0.4 0.5"),
-        "x.anim:3:9: expected end of line, found '0.5'",
+        "x.anim:3:9: expected one of 'until=', found '0.5'",
     ),
     (
         BASE.replace("-135,350", "-135,,350"),
@@ -188,7 +188,8 @@ ERRORS = [
     ),
     (
         BASE + "simulate 0.4\n",
-        "x.anim:4:1: expected one of 'state', 'swapcon', 'sim', found 'simulate'",
+        "x.anim:4:1: expected one of 'object', 'state', 'swapcon', 'sim', 'motor', 'when', "
+        "found 'simulate'",
     ),
     ("", "x.anim:1:1: expected a 'state' line, found end of file"),
     ("# nothing\n\n", "x.anim:1:1: expected a 'state' line, found end of file"),

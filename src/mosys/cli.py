@@ -42,7 +42,9 @@ def _dp(args: argparse.Namespace) -> None:
 def _run(args: argparse.Namespace) -> None:
     from mosys.pipeline import run_animation_script
 
-    run_animation_script(args.script, args.controllers, args.dynamics_dir, args.output, args.dt)
+    run_animation_script(
+        args.script, args.controllers, args.dynamics_dir, args.output, args.dt, args.motor_dir
+    )
 
 
 def _plot_controller(args: argparse.Namespace) -> None:
@@ -111,6 +113,23 @@ def _car_table(args: argparse.Namespace) -> None:
     write_car_table(args.table, args.starts, args.trajectories, args.csv, args.md, args.budget)
 
 
+def _plot_luxo(args: argparse.Namespace) -> None:
+    from mosys.plots.luxo import plot_motion_strip, plot_torques_and_forces, write_show_gif
+
+    if args.strip:
+        plot_motion_strip(args.trajectory, args.strip, args.motion)
+    if args.forces:
+        plot_torques_and_forces(args.trajectory, args.forces)
+    if args.gif:
+        write_show_gif(args.trajectory, args.gif)
+
+
+def _luxo_table(args: argparse.Namespace) -> None:
+    from mosys.tables.luxo import write_luxo_table
+
+    write_luxo_table(args.trajectory, args.landing, args.csv, args.md, args.budget)
+
+
 def _index(args: argparse.Namespace) -> None:
     from mosys.io.atomic import write_text_atomically
 
@@ -142,6 +161,9 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("script")
     run.add_argument("--controllers", required=True, help="directory of controller tables")
     run.add_argument("--dynamics-dir", default="results/dynamics", help="generated dynamics")
+    run.add_argument(
+        "--motor-dir", default="specs/motor", help="motor programs: DIR/FIGURE/NAME.mot"
+    )
     run.add_argument("--dt", type=float, default=0.001, help="simulator step, s")
     run.add_argument("-o", "--output", required=True)
     run.set_defaults(handler=_run)
@@ -206,6 +228,24 @@ def build_parser() -> argparse.ArgumentParser:
     car_table.add_argument("--md", required=True)
     car_table.add_argument("--budget", default="paper", help="name of the config that built it")
     car_table.set_defaults(handler=_car_table)
+
+    luxo = plot.add_parser("luxo", help="Luxo: a motion's strip (Figure 22), forces, a GIF")
+    luxo.add_argument("trajectory", help="a trajectory of Luxo's figure (.h5)")
+    luxo.add_argument("--strip", help="PNG: the lamp every few frames of one motion")
+    luxo.add_argument("--motion", default="backflip", help="the motion the strip draws")
+    luxo.add_argument("--forces", help="PNG: joint torques and contact forces over time")
+    luxo.add_argument("--gif", help="animated GIF of the whole trajectory, terrain drawn")
+    luxo.set_defaults(handler=_plot_luxo)
+
+    luxo_table = verbs.add_parser("luxo-table", help="Luxo's motions table")
+    luxo_table.add_argument("trajectory", help="a trajectory of Luxo's show (.h5)")
+    luxo_table.add_argument(
+        "--landing", required=True, help="the landing controller's table (its dest: standing)"
+    )
+    luxo_table.add_argument("--csv", required=True)
+    luxo_table.add_argument("--md", required=True)
+    luxo_table.add_argument("--budget", default="paper", help="name of the config that built it")
+    luxo_table.set_defaults(handler=_luxo_table)
 
     index = verbs.add_parser("index", help="write an aggregate target: the list of its files")
     index.add_argument("inputs", nargs="*")

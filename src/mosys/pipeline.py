@@ -6,9 +6,15 @@ from __future__ import annotations
 from pathlib import Path
 
 from mosys import __version__
-from mosys.animation import controller_table_path, load_controllers, run_script
+from mosys.animation import (
+    ScriptSources,
+    controller_table_path,
+    load_controllers,
+    load_programs,
+    run_script,
+)
 from mosys.dynamics.load import figure_dynamics
-from mosys.dynamics.motion import figure_motion
+from mosys.dynamics.motion import figure_contacts, figure_motion
 from mosys.io.controller_table import read_controller_table
 from mosys.io.trajectory import Trajectory, write_trajectory
 from mosys.parsing.script import SwapController, parse_script
@@ -21,38 +27,53 @@ def run_animation_script(
     dynamics_dir: str | Path,
     out_path: str | Path,
     dt: float,
+    motor_dir: str | Path = "specs/motor",
 ) -> Trajectory:
-    """Run a ``.anim`` script with the tables in ``controller_dir`` (their figure's dynamics from
-    ``dynamics_dir``) and write its trajectory: with ``figure_motion`` for an articulated figure,
-    with the scene and the parking outcome (``ssc.parking``) for a vehicle."""
+    """Run a ``.anim`` script with the tables in ``controller_dir`` and the motor programs in
+    ``motor_dir/FIGURE/`` (the object's figure's dynamics from ``dynamics_dir``) and write its
+    trajectory: with ``figure_motion`` (and ``contacts`` where the figure has contact points) for
+    an articulated figure, with the scene and the parking outcome (``ssc.parking``) for a
+    vehicle."""
     script = parse_script(script_path)
-    first = next(c for c in script.commands if isinstance(c, SwapController))
-    figure = read_controller_table(controller_table_path(script, first, controller_dir)).figure
-    dynamics = figure_dynamics(figure, dynamics_dir, script.error, first.table_token)
-    controllers = load_controllers(script, controller_dir, dynamics)
-    run = run_script(script, controllers, dt)
-    first_table = next(iter(controllers.values())).table
+    declared = script.declared_figure
+    if declared is not None:
+        figure, token = declared.figure, declared.figure_token
+    else:
+        first = next(c for c in script.commands if isinstance(c, SwapController))
+        figure = read_controller_table(controller_table_path(script, first, controller_dir)).figure
+        token = first.table_token
+    dynamics = figure_dynamics(figure, dynamics_dir, script.error, token)
+    sources = ScriptSources(
+        dynamics,
+        load_controllers(script, controller_dir, dynamics),
+        load_programs(script, motor_dir, figure, dynamics),
+    )
+    run = run_script(script, sources, dt)
+    contacts = None
     if getattr(dynamics, "MODEL_KIND", "figure") == "vehicle":
         motion = None  # not an articulated figure: no figure_motion (DESIGN.md)
+        first_table = next(iter(sources.controllers.values())).table
         scene = Scene.from_table(first_table)
         outcome = parking_outcome(run.t, run.state, run.state_order, scene)
         extra = scene.attributes() | outcome.attributes()
     else:
         motion = figure_motion(dynamics, run.t, run.figure_states)
+        contacts = figure_contacts(dynamics, run.figure_states)
         extra = {}
     trajectory = Trajectory(
         t=run.t,
         state=run.state,
         control=run.control,
-        controller=run.controller,
+        controller=run.source,
         state_order=run.state_order,
         control_names=run.control_names,
-        controllers=run.controllers,
+        controllers=run.sources,
         attrs={
             "script": str(script_path),
             "spec_sha256": script.spec_sha256,
-            "figure": first_table.figure,
+            "figure": figure,
             "dt": dt,
+            "controller_kinds": list(run.source_kinds),
             "switch_times": [time for time, _ in run.switches],
             "switch_controllers": [name for _, name in run.switches],
             "samples_outside_domain": int(run.outside.sum()),
@@ -61,6 +82,7 @@ def run_animation_script(
             **extra,
         },
         motion=motion,
+        contacts=contacts,
     )
     write_trajectory(out_path, trajectory)
     return trajectory

@@ -16,8 +16,9 @@ STAGE_MODULES = {
             "kernels/figure_state.py", "kernels/interpolate.py", "kernels/geometry.py",
             "ssc/generate.py", "ssc/grid.py", "ssc/obstacles.py", "io/controller_table.py",
             "dynamics/load.py"],
-    "scripts": ["parsing/script.py", "animation.py", "pipeline.py", "ssc/controller.py",
-                "ssc/parking.py", "kernels/simulate.py", "kernels/motion.py",
+    "scripts": ["parsing/script.py", "parsing/motor.py", "animation.py", "motor.py",
+                "pipeline.py", "ssc/controller.py", "ssc/regions.py", "ssc/parking.py",
+                "kernels/simulate.py", "kernels/motor.py", "kernels/motion.py",
                 "io/trajectory.py", "io/start_grid.py", "dynamics/motion.py"],
     "plots": ["plots"],
     "tables": ["tables", "ssc/quality.py"],
@@ -58,21 +59,43 @@ def table_controller(reference):
     return match.group(1) if match else reference
 
 
+def script_figure(script):
+    """The figure a script's 'object' line names (figure=NAME), or None."""
+    for words in spec_words(f"specs/scripts/{script}.anim", "object")[:1]:
+        for word in words[2:]:
+            if word.startswith("figure=") and re.fullmatch(r"\w+", word[len("figure="):]):
+                return word[len("figure="):]
+    return None
+
+
 def script_group(script):
-    """The controller directory a script draws on: the configured one for the pendulum script
-    and the car's scripts, else the script's own name."""
+    """The controller directory a script draws on: the configured one for the pendulum script,
+    the car's scripts and every script of Luxo's figure, else the script's own name."""
     if script == config["pendulum"]["script"]:
         return config["pendulum"]["group"]
     if script in config["car"]["scripts"]:
         return config["car"]["group"]
+    if script_figure(script) == config["luxo"]["figure"]:
+        return config["luxo"]["group"]
     return script
 
 
+def script_dt(script):
+    """The simulator step of a script, s: Luxo's own (stiff contacts), else the default."""
+    if script_figure(script) == config["luxo"]["figure"]:
+        return config["luxo"]["dt"]
+    return config["simulation"]["dt"]
+
+
 def script_inputs(wildcards):
-    """The tables and dynamics a script needs (from its 'swapcon' lines)."""
+    """The tables, dynamics and motor programs a script needs (from its 'swapcon', 'when',
+    'object' and 'motor' lines)."""
+    script = f"specs/scripts/{wildcards.script}.anim"
     group = script_group(wildcards.script)
-    words = spec_words(f"specs/scripts/{wildcards.script}.anim", "swapcon")
-    names = dict.fromkeys(table_controller(w[2]) for w in words if len(w) > 2)
+    words = spec_words(script, "swapcon")
+    for line in spec_words(script, "when"):
+        words += [line[line.index("swapcon"):]] if "swapcon" in line else []
+    names = dict.fromkeys(table_controller(w[-1]) for w in words if len(w) > 1)
     tables = [f"results/controllers/{group}/{name}.h5" for name in names
               if re.fullmatch(r"\w+", name)]
     figures = set()
@@ -80,7 +103,13 @@ def script_inputs(wildcards):
         for words in spec_words(f"specs/controllers/{group}/{name}.ssc", "dyn")[:1]:
             if len(words) > 1:
                 figures.add(f"results/dynamics/{words[1]}.py")
-    return tables + sorted(figures)
+    figure = script_figure(wildcards.script)
+    programs = []
+    if figure is not None:
+        figures.add(f"results/dynamics/{figure}.py")
+        programs = [f"specs/motor/{figure}/{w[2]}.mot" for w in spec_words(script, "motor")
+                    if len(w) > 2 and re.fullmatch(r"\w+", w[2])]
+    return tables + sorted(figures) + list(dict.fromkeys(programs))
 
 
 def pendulum_controller_tables():
@@ -125,4 +154,25 @@ def car_targets():
         + ["results/plots/car/figure19_frames.png", "results/plots/car/manoeuvre.gif",
            "results/plots/car/start_map.png"]
         + car_table_targets()
+    )
+
+
+def luxo_script():
+    return config["luxo"]["script"]
+
+
+def luxo_table_targets():
+    return ["results/tables/luxo_motions.csv", "results/tables/luxo_motions.md"]
+
+
+def luxo_targets():
+    group = config["luxo"]["group"]
+    script = luxo_script()
+    return (
+        [f"results/controllers/{group}/{config['luxo']['controller']}.h5",
+         f"results/trajectories/{script}.h5",
+         f"results/plots/luxo/{script}_strip.png",
+         f"results/plots/luxo/{script}.gif",
+         f"results/plots/luxo/{script}_forces.png"]
+        + luxo_table_targets()
     )

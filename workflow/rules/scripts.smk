@@ -11,7 +11,7 @@ rule run_script:
         "results/benchmarks/scripts/{script}.tsv"
     params:
         controllers=lambda wildcards: f"results/controllers/{script_group(wildcards.script)}",
-        dt=config["simulation"]["dt"],
+        dt=lambda wildcards: script_dt(wildcards.script),
     threads: 1
     priority: 2  # on the path to the script's plots: schedule first
     shell:

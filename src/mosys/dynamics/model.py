@@ -158,7 +158,7 @@ def build_model(figure: Figure) -> KinematicModel:
         if joint.kind == "pin":
             base = (constant("pivot_x", joint.pivot[0]), constant("pivot_y", joint.pivot[1]))
             proximal[i] = PlanarPoint(base, ())
-            angles[i] = angle_q
+            angles[i] = constant(constant_name("offset", name), joint.offset) + angle_q
         elif joint.kind == "free":
             x, y = joint.coordinates[0].name, joint.coordinates[1].name
             proximal[i] = PlanarPoint((q[index[x]], q[index[y]]), ())

@@ -8,7 +8,7 @@ from types import ModuleType
 
 import numpy as np
 
-from mosys.io.trajectory import FigureMotion
+from mosys.io.trajectory import Contacts, FigureMotion
 from mosys.kernels.motion import endpoints_over_time
 
 
@@ -37,3 +37,21 @@ def figure_motion(dynamics: ModuleType, t: np.ndarray, figure_states: np.ndarray
         terrain=json.loads(dynamics.TERRAIN_JSON),
         contact=str(dynamics.CONTACT_MODEL),
     )
+
+
+def figure_contacts(dynamics: ModuleType, figure_states: np.ndarray) -> Contacts | None:
+    """The figure's contact points and the ground's forces on them for each state (N, 2n) SI,
+    or None for a figure without contact points. (A Python loop over samples: this runs once per
+    trajectory written, after the simulation.)"""
+    count = len(getattr(dynamics, "CONTACT_ROD", ()))
+    if count == 0:
+        return None
+    n = dynamics.COORDINATE_COUNT
+    position = np.empty((len(figure_states), count, 2))
+    force = np.empty((len(figure_states), count, 2))
+    for sample, state in enumerate(figure_states):
+        q, qd = np.ascontiguousarray(state[:n]), np.ascontiguousarray(state[n:])
+        position[sample] = dynamics.contact_points(q)
+        force[sample] = dynamics.contact_forces(q, qd)
+    rods = tuple(dynamics.ROD_NAMES[rod] for rod in dynamics.CONTACT_ROD)
+    return Contacts(position, force, rods, np.asarray(dynamics.CONTACT_FRACTION, np.float64))

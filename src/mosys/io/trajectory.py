@@ -69,10 +69,23 @@ def read_figure_motion(group: h5py.Group) -> FigureMotion:
 
 
 @dataclass(frozen=True)
+class Contacts:
+    """A figure's contact points over a trajectory (group ``contacts``): position (N, C, 2) m
+    and the ground's force on each, force (N, C, 2) N, sampled at ``/t``; ``rods`` the rod of
+    each point and ``fraction`` where along it (0 proximal, 1 distal)."""
+
+    position: np.ndarray
+    force: np.ndarray
+    rods: tuple[str, ...]
+    fraction: np.ndarray
+
+
+@dataclass(frozen=True)
 class Trajectory:
     """A script's trajectory. t: (N,) s; state: (N, d) spec units in ``state_order``; control:
     (N, m); controller: (N,) int64 index into ``controllers`` (table file stems); attrs: extra
-    root attributes; motion: the figure's ``figure_motion`` (None for non-articulated figures)."""
+    root attributes; motion: the figure's ``figure_motion`` (None for non-articulated figures);
+    contacts: its contact points (None for a figure without them)."""
 
     t: np.ndarray
     state: np.ndarray
@@ -83,6 +96,7 @@ class Trajectory:
     controllers: tuple[str, ...]
     attrs: dict
     motion: FigureMotion | None
+    contacts: Contacts | None = None
 
 
 def write_trajectory(path: str | Path, trajectory: Trajectory) -> None:
@@ -102,6 +116,13 @@ def write_trajectory(path: str | Path, trajectory: Trajectory) -> None:
                 h5.attrs[key] = value
             if trajectory.motion is not None:
                 write_figure_motion(h5.create_group("figure_motion"), trajectory.motion)
+            if trajectory.contacts is not None:
+                group = h5.create_group("contacts")
+                contacts = trajectory.contacts
+                group.create_dataset("position", data=np.asarray(contacts.position, np.float64))
+                group.create_dataset("force", data=np.asarray(contacts.force, np.float64))
+                group.attrs["rods"] = list(contacts.rods)
+                group.attrs["fraction"] = np.asarray(contacts.fraction, np.float64)
 
     write_atomically(path, write)
 
@@ -120,4 +141,14 @@ def read_trajectory(path: str | Path) -> Trajectory:
             controllers=string_tuple(h5.attrs["controllers"]),
             attrs={k: h5.attrs[k] for k in h5.attrs if k not in known},
             motion=read_figure_motion(h5["figure_motion"]) if "figure_motion" in h5 else None,
+            contacts=_read_contacts(h5["contacts"]) if "contacts" in h5 else None,
         )
+
+
+def _read_contacts(group: h5py.Group) -> Contacts:
+    return Contacts(
+        position=group["position"][()],
+        force=group["force"][()],
+        rods=string_tuple(group.attrs["rods"]),
+        fraction=np.atleast_1d(group.attrs["fraction"]),
+    )

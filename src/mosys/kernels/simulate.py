@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit, types
 
@@ -21,7 +23,7 @@ from mosys.kernels.interpolate import (
     interpolation_scratch,
 )
 
-SIMULATE_SIGNATURE = types.void(
+SIMULATE_SIGNATURE = types.int64(
     DERIVATIVE_INTO,  # derivative_into
     VECTOR,  # axis_min
     VECTOR,  # axis_step
@@ -39,7 +41,30 @@ SIMULATE_SIGNATURE = types.void(
     types.float64[:, ::1],  # record_state
     types.float64[:, ::1],  # record_control
     FLAGS,  # record_outside
+    types.float64[:, ::1],  # region_lower
+    types.float64[:, ::1],  # region_upper
+    VECTOR,  # region_period
 )
+
+
+@njit(cache=True)
+def inside_region(state, lower, upper, period):
+    """True when every entry of ``state`` (S,) lies in [lower, upper] ((S,) each). An entry with
+    a period (> 0: an angle, 2π) and finite bounds is compared modulo its period."""
+    for i in range(state.shape[0]):
+        value = state[i]
+        if period[i] > 0.0 and math.isfinite(lower[i]) and math.isfinite(upper[i]):
+            value = lower[i] + (value - lower[i]) % period[i]
+        if not lower[i] <= value <= upper[i]:
+            return False
+    return True
+
+
+@njit(cache=True)
+def region_membership(state, region_lower, region_upper, period, out):
+    """out (K,) bool: whether ``state`` (S,) lies in each of the K boxes (K, S)."""
+    for k in range(region_lower.shape[0]):
+        out[k] = inside_region(state, region_lower[k], region_upper[k], period)
 
 
 @njit(SIMULATE_SIGNATURE, cache=True)
@@ -61,8 +86,19 @@ def simulate_controlled(
     record_state,
     record_control,
     record_outside,
+    region_lower,
+    region_upper,
+    region_period,
 ):
-    """Simulate ``record_state.shape[0]`` RK4 steps of dt seconds under a controller.
+    """Simulate up to ``record_state.shape[0]`` RK4 steps of dt seconds under a controller;
+    return how many were taken.
+
+    Regions (state-space breakpoints and arrival boxes): boxes ``[region_lower[k],
+    region_upper[k]]`` ((K, S) SI, ±inf for unbounded entries) over the model's full state,
+    angles compared modulo ``region_period`` ((S,): 2π for an angle, else 0; ``inside_region``).
+    The run stops before the first step whose starting state lies in a different set of boxes
+    than the run's first state (K = 0: never), so the caller can hand over to another
+    controller there.
 
     At every step the controller's state is read from the model's state, clamped into the
     table's domain (non-wrap axes; ``record_outside`` marks the steps where it had to be), the
@@ -85,7 +121,15 @@ def simulate_controlled(
     strides = np.empty(d, np.int64)
     grid_strides(axis_count, strides)
     interpolation = interpolation_scratch(d)
+    regions = region_lower.shape[0]
+    start_membership = np.empty(regions, np.bool_)
+    membership = np.empty(regions, np.bool_)
+    region_membership(state, region_lower, region_upper, region_period, start_membership)
     for step in range(record_state.shape[0]):
+        region_membership(state, region_lower, region_upper, region_period, membership)
+        for k in range(regions):
+            if membership[k] != start_membership[k]:
+                return step
         for i in range(size):
             record_state[step, i] = state[i]
         read_state(state, state_slot, controller_state)
@@ -110,3 +154,4 @@ def simulate_controlled(
             record_control[step, j] = value
             inputs[control_slot[j]] += value
         rk4_step(derivative_into, state, inputs, dt, scratch)
+    return record_state.shape[0]

@@ -12,9 +12,12 @@
     dt 0.001                           # optional: DP integration step, s (default 0.001)
     obstacle curb -20,-1 20,-1 20,0 -20,0   # optional: a polygon the body must not overlap, m
     domain -4,0.5 8,0.5 8,4 -4,4       # optional: a polygon the reference point stays in, m
+    hold                               # optional: the destination nodes hold the figure at rest
 
 ``obstacle`` and ``domain`` are for figures with a body outline (the car): their vertices are in
-metres in the frame of the figure's ``x``/``y`` state variables.
+metres in the frame of the figure's ``x``/``y`` state variables. ``hold`` is for a destination at
+rest: its nodes store the torques that keep the figure still there (``ssc.generate``), instead of
+the DP's best control sample.
 
 Values are in spec units: degrees for angles, deg/s for angular rates, metres and m/s otherwise
 (the figure says which). The full grammar is in ``docs/controller-spec.md``.
@@ -41,7 +44,7 @@ from mosys.parsing.tokens import (
     value_token,
 )
 
-KEYWORDS = ("dyn", "ssd", "torq", "dest", "tol", "maxiter", "dt", "obstacle", "domain")
+KEYWORDS = ("dyn", "ssd", "torq", "dest", "tol", "maxiter", "dt", "obstacle", "domain", "hold")
 DEFAULT_TOLERANCE = (
     1e-6  # s: largest change of the cost-to-go in one sweep that counts as converged
 )
@@ -153,7 +156,8 @@ class ControllerSpec:
     ``dt`` (s) is the integration step of the DP's simulations. ``spec_sha256`` is the hex
     SHA-256 of the file's bytes. ``obstacles`` and ``domain`` (None: no such line) restrict a
     figure with a body outline: states whose body overlaps an obstacle or whose reference point
-    lies outside the domain are removed from the table.
+    lies outside the domain are removed from the table. ``hold`` (the keyword's token, None
+    without a ``hold`` line) asks for holding torques at the destination nodes.
     """
 
     path: str
@@ -168,6 +172,7 @@ class ControllerSpec:
     spec_sha256: str
     obstacles: tuple[Polygon, ...] = ()
     domain: Polygon | None = None
+    hold: Token | None = None
 
     @property
     def name(self) -> str:
@@ -239,6 +244,7 @@ class _Parser:
         self.names: dict[str, int] = {}  # ssd/torq name -> its line number
         self.obstacles: list[Polygon] = []
         self.domain: Polygon | None = None
+        self.hold: Token | None = None
 
     def error(self, token: Token, expected: str, found: str | None) -> SpecError:
         return SpecError(self.path, token.line, token.column, expected, found)
@@ -248,7 +254,7 @@ class _Parser:
             keyword = line.keyword.text
             if keyword not in KEYWORDS:
                 raise unknown_keyword(line, KEYWORDS)
-            if keyword in ("dyn", "dest", "tol", "maxiter", "dt", "domain"):
+            if keyword in ("dyn", "dest", "tol", "maxiter", "dt", "domain", "hold"):
                 self.once(line)
             getattr(self, f"line_{keyword}")(line)
         for keyword, given in (
@@ -273,6 +279,7 @@ class _Parser:
             spec_sha256=spec_sha256,
             obstacles=tuple(self.obstacles),
             domain=self.domain,
+            hold=self.hold,
         )
 
     def once(self, line: Line) -> None:
@@ -476,6 +483,10 @@ class _Parser:
     def line_dt(self, line: Line) -> None:
         self.options["dt"] = self.positive(line, "dt (s)")
 
+    def line_hold(self, line: Line) -> None:
+        line.reader().end()
+        self.hold = line.keyword
+
     def line_maxiter(self, line: Line) -> None:
         reader = line.reader()
         self.options["maxiter"] = reader.integer("maxiter", minimum=1)
@@ -557,4 +568,6 @@ def render_controller_spec(spec: ControllerSpec) -> str:
         lines.append(f"obstacle {obstacle.name} {vertices(obstacle)}")
     if spec.domain is not None:
         lines.append(f"domain {vertices(spec.domain)}")
+    if spec.hold is not None:
+        lines.append("hold")
     return "\n".join(lines) + "\n"

@@ -78,10 +78,11 @@ class Coordinate:
 
 @dataclass(frozen=True)
 class Joint:
-    """How one rod hangs in the tree: a ``pin`` (root hinged to a fixed ``pivot`` (x, y), m),
-    a ``free`` root (floating base: coordinates x, y, angle) or a ``hinge`` on ``parent`` at
-    ``position`` metres along the parent from its proximal end, with a fixed ``offset`` (rad):
-    child absolute angle = parent absolute angle + offset + coordinate."""
+    """How one rod hangs in the tree: a ``pin`` (root hinged to a fixed ``pivot`` (x, y), m;
+    absolute angle = ``offset`` + coordinate), a ``free`` root (floating base: coordinates x,
+    y, angle) or a ``hinge`` on ``parent`` at ``position`` metres along the parent from its
+    proximal end, with a fixed ``offset`` (rad): child absolute angle = parent absolute angle +
+    offset + coordinate."""
 
     kind: str
     rod: str
@@ -269,7 +270,8 @@ def render_figure_spec(figure: Figure) -> str:
         actuator = f" actuator={angle.actuator}" if angle.actuator else ""
         if joint.kind == "pin":
             at = f"{_fmt(joint.pivot[0])},{_fmt(joint.pivot[1])}"
-            out.append(f"pin {joint.rod} at={at} {names}{actuator}")
+            offset = f" offset={_fmt(math.degrees(joint.offset))}" if joint.offset else ""
+            out.append(f"pin {joint.rod} at={at}{offset} {names}{actuator}")
         elif joint.kind == "free":
             x, y = joint.coordinates[0], joint.coordinates[1]
             out.append(
@@ -496,14 +498,18 @@ class _Parser:
             reader,
             {
                 "at": "the pivot 'x,y' in metres",
+                "offset": "the fixed angle offset in degrees",
                 "angle": "a name for the angle coordinate",
                 "rate": "a name for the angle's rate",
                 "actuator": "a name for the hinge's actuator",
             },
         )
         pivot = self.point(found["at"], "at", "at") if "at" in found else (0.0, 0.0)
+        offset = self.offset(found)
         angle, names = self.angle_coordinate(found, rod)
-        self.joints.append(_RawJoint("pin", line.keyword, rod, [angle], names, pivot=pivot))
+        self.joints.append(
+            _RawJoint("pin", line.keyword, rod, [angle], names, pivot=pivot, offset=offset)
+        )
 
     def line_free(self, line: Line) -> None:
         reader = line.reader()
@@ -567,9 +573,7 @@ class _Parser:
         if "at" in found:
             at = found["at"]
             position = (self.number(at, "at", "at (m along the parent)"), value_token(at, "at"))
-        offset = 0.0
-        if "offset" in found:
-            offset = math.radians(self.number(found["offset"], "offset", "offset (degrees)"))
+        offset = self.offset(found)
         angle, names = self.angle_coordinate(found, rod)
         self.joints.append(
             _RawJoint(
@@ -583,6 +587,12 @@ class _Parser:
                 offset=offset,
             )
         )
+
+    def offset(self, found: dict[str, Token]) -> float:
+        """A joint line's ``offset=`` in radians (0 without one)."""
+        if "offset" not in found:
+            return 0.0
+        return math.radians(self.number(found["offset"], "offset", "offset (degrees)"))
 
     def line_limit(self, line: Line) -> None:
         reader = line.reader()

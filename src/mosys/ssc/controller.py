@@ -16,7 +16,8 @@ import numpy as np
 from mosys.io.controller_table import ControllerTable, read_controller_table
 from mosys.kernels.interpolate import clamp_to_domain, interpolate_into
 from mosys.kernels.simulate import simulate_controlled
-from mosys.ssc.grid import FigureGrid, control_scale, figure_grid
+from mosys.ssc.grid import FigureGrid, control_scale, figure_grid, figure_state_names, state_unit
+from mosys.ssc.regions import ARRIVAL_STEPS, REST_RATE, Bounds, Regions, state_periods
 
 
 @dataclass(frozen=True)
@@ -105,17 +106,44 @@ class Controller:
             states[:, k] = first + np.mod(states[:, k] - first, period)
         return states
 
-    def simulate(self, figure_state: np.ndarray, seconds: float, dt: float) -> ClosedLoopRun:
+    def arrival_box(self) -> Bounds:
+        """The box, spec units, in which the figure counts as back at the destination: each
+        dimension ``dest`` names within ARRIVAL_STEPS grid steps of it, and every rate of the
+        figure that the controller does not see below REST_RATE (SI) in size."""
+        grid = self.grid
+        box: dict[str, tuple[float, float]] = {}
+        for k, name in enumerate(grid.names):
+            if name in self.table.dest:
+                reach = ARRIVAL_STEPS * grid.axis_step[k] / grid.scale[k]
+                box[name] = (self.table.dest[name] - reach, self.table.dest[name] + reach)
+        coordinates = len(getattr(self.dynamics, "Q_NAMES", ()))
+        for name in figure_state_names(self.dynamics)[coordinates:]:
+            if name not in grid.names:
+                rest = REST_RATE / state_unit(self.dynamics, name)[1]
+                box[name] = (-rest, rest)
+        return box
+
+    def simulate(
+        self,
+        figure_state: np.ndarray,
+        seconds: float,
+        dt: float,
+        regions: Regions | None = None,
+    ) -> ClosedLoopRun:
         """Run the model from ``figure_state`` (S,) SI under this controller for ``seconds``
-        (rounded to whole steps of ``dt``). The run's controls are in spec units."""
+        (rounded to whole steps of ``dt``), or until the state enters or leaves one of
+        ``regions`` (``kernels.simulate.simulate_controlled``). The run's controls are in spec
+        units."""
         steps = int(round(seconds / dt))
         n2 = len(figure_state)
+        if regions is None:
+            regions = Regions(np.empty((0, n2)), np.empty((0, n2)), state_periods(self.dynamics))
         state = np.ascontiguousarray(figure_state, dtype=np.float64).copy()
         states = np.empty((steps + 1, n2))
         controls = np.empty((steps, len(self.table.control_names)))
         outside = np.empty(steps, dtype=np.bool_)
         grid = self.grid
-        simulate_controlled(
+        taken = simulate_controlled(
             self.dynamics.derivative_into,
             grid.axis_min,
             grid.axis_step,
@@ -133,6 +161,11 @@ class Controller:
             states[:-1],
             controls,
             outside,
+            regions.lower,
+            regions.upper,
+            regions.period,
         )
-        states[-1] = state
-        return ClosedLoopRun(states, controls / self.control_scale, outside)
+        states[taken] = state
+        return ClosedLoopRun(
+            states[: taken + 1], controls[:taken] / self.control_scale, outside[:taken]
+        )

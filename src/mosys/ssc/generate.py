@@ -247,6 +247,54 @@ def solve(
     )
 
 
+def holding_torques(problem: Problem, dynamics: ModuleType) -> np.ndarray:
+    """(D, m) controls, spec units, that hold the figure at rest at each of the D destination
+    nodes (``hold``): with every rate 0, the actuators cancel the generalised forces of gravity,
+    joint stops and contacts, ``-forcing(q, 0, 0)``. SpecError at the ``hold`` line when the
+    figure has no equations of motion (a vehicle), the destination is not at rest, a coordinate
+    without an actuator would need a force, or a torque lies outside its ``torq`` range."""
+    spec, grid = problem.spec, problem.grid
+    assert spec.hold is not None
+    if not hasattr(dynamics, "forcing"):
+        raise spec.error(spec.hold, "no 'hold' line: a vehicle is held by braking, not torques")
+    n = dynamics.COORDINATE_COUNT
+    coordinates = grid.state_slot < n
+    rates_named = {entry.name for entry in spec.destination}
+    for k, name in enumerate(grid.names):
+        if not coordinates[k] and name not in rates_named:
+            raise spec.error(spec.hold, f"a 'dest' that names the rate '{name}' (= 0) for 'hold'")
+    lower = np.array([c.minimum for c in spec.controls])
+    upper = np.array([c.maximum for c in spec.controls])
+    nodes = np.flatnonzero(problem.is_destination)
+    held = np.empty((len(nodes), len(spec.controls)))
+    state = np.empty(len(problem.base_state))
+    center = np.empty(len(grid.names))
+    for row, node in enumerate(nodes):
+        node_coordinates(grid.axis_min, grid.axis_step, grid.axis_count, node, center)
+        state[:] = problem.base_state
+        state[grid.state_slot] = center
+        if np.any(state[n:] != 0.0):
+            raise spec.error(spec.hold, "a destination at rest (every rate 0) for 'hold'")
+        force = -np.asarray(dynamics.forcing(state[:n], state[n:], np.zeros(n)))
+        unheld = np.ones(n, dtype=bool)
+        unheld[problem.control_slot] = False
+        if np.any(np.abs(force[unheld]) > 1e-9):
+            name = dynamics.Q_NAMES[int(np.flatnonzero(unheld & (np.abs(force) > 1e-9))[0])]
+            raise spec.error(
+                spec.hold, f"a destination where '{name}', which has no actuator, is at rest"
+            )
+        held[row] = force[problem.control_slot] / problem.control_scale
+        outside = np.flatnonzero((held[row] < lower) | (held[row] > upper))
+        if outside.size:
+            control = spec.controls[int(outside[0])]
+            raise spec.error(
+                spec.hold,
+                f"holding torques within the torq range of '{control.name}' "
+                f"(it needs {held[row, outside[0]]:.4g})",
+            )
+    return held
+
+
 def peak_rss_bytes() -> int:
     """This process's peak resident set size so far, bytes (Linux reports KiB)."""
     return int(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss) * 1024
@@ -296,6 +344,8 @@ def generate_controller(
     torque = problem.control_samples[solution.best_control]
     unreachable = ~np.isfinite(solution.value)
     torque[unreachable] = np.clip(0.0, lower, upper)
+    if spec.hold is not None:
+        torque[problem.is_destination] = holding_torques(problem, dynamics)
     table = ControllerTable(
         state_order=grid.names,
         control_names=tuple(c.name for c in spec.controls),
@@ -326,6 +376,7 @@ def generate_controller(
             "removed_nodes": int((~problem.node_valid).sum()),
             "table_states": int(problem.node_valid.sum()),
             "peak_rss_bytes": peak_rss_bytes(),
+            "hold": spec.hold is not None,
             "mosys_version": __version__,
             **figure_attributes(problem, dynamics),
         },

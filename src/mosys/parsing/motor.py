@@ -1,0 +1,463 @@
+"""The motor program (``.mot``): a procedural function of joint torques over time, as van de
+Panne, Fiume & Vranesic (1990) drive Luxo the lamp through its airborne motions.
+
+::
+
+    # hop: a short hop forward
+    figure luxo                               # the figure it drives: specs/figures/luxo.fig
+    limit hip_torque=5 elbow_torque=5         # optional: |torque| cap per actuator, N m
+    gains kp=6 kd=0.25                        # optional: servo gains, N m/rad and N m s/rad
+    phase 0.35 hip=10 elbow=150               # 0.35 s: servo 'hip' towards 10 deg, 'elbow' 150
+    phase 0.12 hip=-30 elbow=40 kp=40 kd=0.3  # gains for this phase only
+    phase 0.30 hip_torque=-2 elbow_torque=1.5 # constant torques, N m
+    phase 0.2 hip=0 elbow_torque=0.5          # mixed: hip servoed, elbow a constant torque
+
+Grammar (one line each; ``#`` comments and blank lines are ignored)::
+
+    figure NAME                     exactly once, before the first phase
+    limit ACTUATOR=N_M ...          at most once, before the first phase; each value > 0
+                                    (default: no cap)
+    gains [kp=KP] [kd=KD]           at most once, before the first phase; at least one of the
+                                    two, each >= 0, N m/rad and N m s/rad (default: 0 and 0)
+    phase SECONDS [NAME=VALUE ...]  at least one; SECONDS > 0. kp= and kd= (>= 0) override the
+                                    gains for this phase; any other NAME is a joint coordinate
+                                    (VALUE: its target angle, degrees) or an actuator (VALUE: a
+                                    constant torque, N m), each NAME once per phase
+
+The phases run one after another from time 0; an actuator that a phase does not mention is limp
+(zero torque) for that phase. The parser does not know the figure, so it keeps each phase's
+settings as written; ``bind_motor_program`` classifies them against the figure's coordinates
+and actuators and lays the program out as arrays for a numeric kernel.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from mosys.parsing.tokens import (
+    NAME,
+    Line,
+    SpecError,
+    Token,
+    missing_line,
+    parse_number,
+    read_spec_text,
+    tokenize,
+    unknown_keyword,
+    value_token,
+)
+
+KEYWORDS = ("figure", "limit", "gains", "phase")
+GAINS = ("kp", "kd")
+DEFAULT_KP = 0.0  # N·m/rad
+DEFAULT_KD = 0.0  # N·m·s/rad
+
+LIMP = 0  # BoundProgram.mode: zero torque
+TORQUE = 1  # a constant torque, N·m
+SERVO = 2  # PD servo towards a target angle, rad
+
+
+@dataclass(frozen=True)
+class Limit:
+    """One ``ACTUATOR=VALUE`` of the ``limit`` line: the actuator's torque is clipped to
+    ``[-value, value]`` (N·m, > 0). ``token`` is the whole ``name=value`` token."""
+
+    name: str
+    value: float
+    token: Token
+
+    @property
+    def name_token(self) -> Token:
+        """The name part of ``token``."""
+        return Token(self.name, self.token.line, self.token.column)
+
+    @property
+    def value_token(self) -> Token:
+        """The value part of ``token``."""
+        return value_token(self.token, self.name)
+
+
+@dataclass(frozen=True)
+class PhaseSetting:
+    """One ``NAME=VALUE`` of a ``phase`` line other than ``kp=``/``kd=``: a joint coordinate's
+    target angle (degrees) or an actuator's constant torque (N·m); which of the two is settled
+    by ``bind_motor_program``. ``token`` is the whole ``name=value`` token."""
+
+    name: str
+    value: float
+    token: Token
+
+    @property
+    def name_token(self) -> Token:
+        """The name part of ``token``."""
+        return Token(self.name, self.token.line, self.token.column)
+
+    @property
+    def value_token(self) -> Token:
+        """The value part of ``token``."""
+        return value_token(self.token, self.name)
+
+
+@dataclass(frozen=True)
+class Phase:
+    """One ``phase`` line: for ``seconds`` (> 0, s) apply ``settings`` (file order). ``kp``
+    (N·m/rad) and ``kd`` (N·m·s/rad) override the program's gains for this phase (None: not
+    given). ``token`` is the keyword; ``seconds_token`` the duration."""
+
+    seconds: float
+    settings: tuple[PhaseSetting, ...]
+    kp: float | None
+    kd: float | None
+    token: Token
+    seconds_token: Token
+
+
+@dataclass(frozen=True)
+class MotorProgram:
+    """A parsed ``.mot`` file.
+
+    ``figure`` names the figure it drives. ``limits`` (file order) cap actuators' torques, N·m.
+    ``kp`` (N·m/rad) and ``kd`` (N·m·s/rad) are the default servo gains (0 unless a ``gains``
+    line sets them). ``phases`` run in file order from time 0. ``spec_sha256`` is the hex
+    SHA-256 of the file's bytes.
+    """
+
+    path: str
+    figure: str
+    figure_token: Token
+    limits: tuple[Limit, ...]
+    kp: float
+    kd: float
+    phases: tuple[Phase, ...]
+    spec_sha256: str
+
+    @property
+    def name(self) -> str:
+        """The program's name: the file's stem (``hop`` for ``hop.mot``)."""
+        return Path(self.path).stem
+
+    def duration(self) -> float:
+        """Total time of all phases, s."""
+        return sum(phase.seconds for phase in self.phases)
+
+    def error(self, token: Token, expected: str) -> SpecError:
+        """A SpecError at ``token`` of this program, found its text: for checks made after
+        parsing (against the figure, say)."""
+        return SpecError.at(self.path, token, expected)
+
+
+@dataclass(frozen=True, eq=False)
+class BoundProgram:
+    """A motor program laid out against a figure, for a numeric kernel. With P phases and A
+    actuators (the figure's actuated coordinates, in coordinate order):
+
+    ``durations``: (P,) float64, s. ``mode``: (P, A) int64, ``LIMP`` (0: zero torque),
+    ``TORQUE`` (1: constant torque) or ``SERVO`` (2: PD servo). ``value``: (P, A) float64, the
+    torque (N·m) for ``TORQUE``, the target angle (rad) for ``SERVO``, 0 for ``LIMP``.
+    ``kp``: (P, A) float64, N·m/rad and ``kd``: (P, A) float64, N·m·s/rad, the phase's gains
+    (else the program's). ``limit``: (A,) float64, the torque cap, N·m (inf: none).
+    ``coordinate``: (A,) int64, the index of each actuator's coordinate among the figure's.
+    ``actuator_names``: (A,) the actuators' names.
+    """
+
+    durations: np.ndarray
+    mode: np.ndarray
+    value: np.ndarray
+    kp: np.ndarray
+    kd: np.ndarray
+    limit: np.ndarray
+    coordinate: np.ndarray
+    actuator_names: tuple[str, ...]
+
+
+def parse_motor_program(path: str | Path) -> MotorProgram:
+    """Parse a ``.mot`` file; any problem raises SpecError naming file, line and column."""
+    text, digest = read_spec_text(path)
+    return parse_motor_program_text(text, str(path), digest)
+
+
+def parse_motor_program_text(
+    text: str, path: str = "<text>", spec_sha256: str | None = None
+) -> MotorProgram:
+    """Parse ``.mot`` text; ``path`` names it in errors. ``spec_sha256`` defaults to the SHA-256
+    of the text's UTF-8 encoding."""
+    if spec_sha256 is None:
+        spec_sha256 = hashlib.sha256(text.encode("utf-8")).hexdigest()
+    return _Parser(path).parse(tokenize(text, path), spec_sha256)
+
+
+class _Parser:
+    def __init__(self, path: str):
+        self.path = path
+        self.figure: Token | None = None
+        self.limits: tuple[Limit, ...] = ()
+        self.gains: dict[str, float] = {}
+        self.phases: list[Phase] = []
+        self.first_line: dict[str, int] = {}  # once-only keyword -> its line number
+        self.total = 0.0  # s, the phases so far
+
+    def error(self, token: Token, expected: str, found: str | None) -> SpecError:
+        return SpecError(self.path, token.line, token.column, expected, found)
+
+    def parse(self, lines: list[Line], spec_sha256: str) -> MotorProgram:
+        for line in lines:
+            keyword = line.keyword
+            if keyword.text not in KEYWORDS:
+                raise unknown_keyword(line, KEYWORDS)
+            if keyword.text == "phase":
+                if self.figure is None:
+                    raise self.error(
+                        keyword, "a 'figure' line before the first 'phase'", keyword.text
+                    )
+            else:
+                self.once(line)
+                if self.phases:
+                    raise self.error(
+                        keyword,
+                        f"a 'phase' line ('{keyword.text}' goes before the first 'phase', "
+                        f"line {self.phases[0].token.line})",
+                        keyword.text,
+                    )
+            getattr(self, f"line_{keyword.text}")(line)
+        if not self.phases:
+            raise missing_line(self.path, lines, "figure" if self.figure is None else "phase")
+        assert self.figure is not None
+        return MotorProgram(
+            path=self.path,
+            figure=self.figure.text,
+            figure_token=self.figure,
+            limits=self.limits,
+            kp=self.gains.get("kp", DEFAULT_KP),
+            kd=self.gains.get("kd", DEFAULT_KD),
+            phases=tuple(self.phases),
+            spec_sha256=spec_sha256,
+        )
+
+    def once(self, line: Line) -> None:
+        keyword = line.keyword
+        if keyword.text in self.first_line:
+            first = self.first_line[keyword.text]
+            raise self.error(
+                keyword, f"one '{keyword.text}' line only (the first is line {first})", keyword.text
+            )
+        self.first_line[keyword.text] = line.number
+
+    def assignment(self, token: Token, expected: str) -> tuple[str, Token]:
+        """A ``name=value`` token: the name and the value part (its own column)."""
+        name, sep, _ = token.text.partition("=")
+        if not sep:
+            raise self.error(token, expected, token.text)
+        if NAME.fullmatch(name) is None:
+            raise self.error(token, "a name before '='", name)
+        return name, value_token(token, name)
+
+    def number_at_least(self, token: Token, what: str, minimum: float, strict: bool) -> float:
+        value = parse_number(token, self.path, what)
+        if value < minimum or (strict and value == minimum):
+            relation = ">" if strict else ">="
+            raise self.error(token, f"a number {relation} {minimum:g} for {what}", token.text)
+        return value
+
+    def line_figure(self, line: Line) -> None:
+        reader = line.reader()
+        token = reader.peek()
+        reader.name("the figure")
+        reader.end()
+        self.figure = token
+
+    def line_limit(self, line: Line) -> None:
+        expected = "a torque limit 'actuator=value' (N m)"
+        if len(line.tokens) == 1:
+            raise SpecError(self.path, line.number, line.end_column, expected, None)
+        limits: dict[str, Limit] = {}
+        for token in line.tokens[1:]:
+            name, part = self.assignment(token, expected)
+            if name in limits:
+                raise self.error(token, f"'{name}=' only once", token.text)
+            value = self.number_at_least(part, f"limit {name}", 0.0, strict=True)
+            limits[name] = Limit(name, value, token)
+        self.limits = tuple(limits.values())
+
+    def line_gains(self, line: Line) -> None:
+        expected = "one of 'kp=', 'kd='"
+        if len(line.tokens) == 1:
+            raise SpecError(self.path, line.number, line.end_column, expected, None)
+        for token in line.tokens[1:]:
+            self.gain(token, expected, self.gains)
+
+    def gain(self, token: Token, expected: str, gains: dict[str, float]) -> None:
+        """A ``kp=`` or ``kd=`` token (value >= 0) into ``gains``."""
+        name, part = self.assignment(token, expected)
+        if name not in GAINS:
+            raise self.error(token, expected, token.text)
+        if name in gains:
+            raise self.error(token, f"'{name}=' only once", token.text)
+        gains[name] = self.number_at_least(part, name, 0.0, strict=False)
+
+    def line_phase(self, line: Line) -> None:
+        reader = line.reader()
+        seconds_token = reader.peek()
+        seconds = reader.number("seconds")
+        assert seconds_token is not None
+        if not seconds > 0:
+            raise self.error(seconds_token, "a number > 0 for seconds", seconds_token.text)
+        if not math.isfinite(self.total + seconds):
+            raise self.error(
+                seconds_token, "seconds with a finite total duration", seconds_token.text
+            )
+        self.total += seconds
+        expected = "a setting 'name=value' (joint=degrees, actuator=N m, kp= or kd=)"
+        gains: dict[str, float] = {}
+        settings: dict[str, PhaseSetting] = {}
+        for token in reader.remaining():
+            name, part = self.assignment(token, expected)
+            if name in GAINS:
+                self.gain(token, expected, gains)
+                continue
+            if name in settings:
+                raise self.error(token, f"'{name}=' only once", token.text)
+            value = parse_number(part, self.path, name)
+            settings[name] = PhaseSetting(name, value, token)
+        self.phases.append(
+            Phase(
+                seconds,
+                tuple(settings.values()),
+                gains.get("kp"),
+                gains.get("kd"),
+                line.keyword,
+                seconds_token,
+            )
+        )
+
+
+def render_motor_program(program: MotorProgram) -> str:
+    """The ``.mot`` text of ``program`` (parsing it gives back the same values). ``limit`` and
+    ``gains`` are written only when they say something."""
+
+    def number(value: float) -> str:
+        return repr(float(value))
+
+    lines = [f"figure {program.figure}"]
+    if program.limits:
+        lines.append(
+            "limit " + " ".join(f"{limit.name}={number(limit.value)}" for limit in program.limits)
+        )
+    if program.kp != DEFAULT_KP or program.kd != DEFAULT_KD:
+        lines.append(f"gains kp={number(program.kp)} kd={number(program.kd)}")
+    for phase in program.phases:
+        words = [f"phase {number(phase.seconds)}"]
+        words += [f"{setting.name}={number(setting.value)}" for setting in phase.settings]
+        words += [
+            f"{name}={number(gain)}"
+            for name, gain in (("kp", phase.kp), ("kd", phase.kd))
+            if gain is not None
+        ]
+        lines.append(" ".join(words))
+    return "\n".join(lines) + "\n"
+
+
+def _choices(names: Sequence[str]) -> str:
+    """``one of: 'a', 'b'`` for an error message."""
+    if not names:
+        return "the figure has none"
+    return "one of: " + ", ".join(f"'{name}'" for name in names)
+
+
+def bind_motor_program(
+    program: MotorProgram,
+    coordinate_names: Sequence[str],
+    actuator_names: Sequence[str],
+) -> BoundProgram:
+    """Classify each phase setting against a figure and lay the program out as arrays.
+
+    ``coordinate_names``: (n,) the figure's coordinates (``Figure.q_names``);
+    ``actuator_names``: (n,) aligned with them, the actuator of each, ``""`` where unactuated
+    (``Figure.tau_names``). Luxo: ``('x', 'y', 'base', 'hip', 'elbow')`` and
+    ``('', '', '', 'hip_torque', 'elbow_torque')``. A setting named after an actuated coordinate
+    servos it (target degrees -> radians); one named after an actuator sets a constant torque.
+
+    A setting or ``limit`` naming nothing the figure can drive, a phase that drives one actuator
+    twice (its joint's target and its torque), and a servo with kp = kd = 0 raise SpecError at
+    the offending token. Mismatched argument lengths raise ValueError.
+    """
+    if len(coordinate_names) != len(actuator_names):
+        raise ValueError(
+            f"{len(coordinate_names)} coordinate names but {len(actuator_names)} actuator names"
+        )
+    actuated = [index for index, actuator in enumerate(actuator_names) if actuator]
+    names = tuple(actuator_names[index] for index in actuated)
+    joints = {coordinate_names[index]: a for a, index in enumerate(actuated)}
+    actuators = {name: a for a, name in enumerate(names)}
+    unactuated = {
+        coordinate
+        for coordinate, actuator in zip(coordinate_names, actuator_names, strict=True)
+        if not actuator
+    }
+    figure = program.figure
+    drivable = _choices([coordinate_names[index] for index in actuated] + list(names))
+
+    limit = np.full(len(names), np.inf)
+    for entry in program.limits:
+        if entry.name not in actuators:
+            raise program.error(
+                entry.name_token, f"an actuator of figure '{figure}' ({_choices(names)})"
+            )
+        limit[actuators[entry.name]] = entry.value
+
+    shape = (len(program.phases), len(names))
+    mode = np.full(shape, LIMP, dtype=np.int64)
+    value = np.zeros(shape)
+    kp = np.zeros(shape)
+    kd = np.zeros(shape)
+    for p, phase in enumerate(program.phases):
+        kp[p] = program.kp if phase.kp is None else phase.kp
+        kd[p] = program.kd if phase.kd is None else phase.kd
+        driven: dict[int, PhaseSetting] = {}  # actuator -> the setting that drives it
+        for setting in phase.settings:
+            if setting.name in joints:
+                a, kind, amount = joints[setting.name], SERVO, math.radians(setting.value)
+            elif setting.name in actuators:
+                a, kind, amount = actuators[setting.name], TORQUE, setting.value
+            elif setting.name in unactuated:
+                raise program.error(
+                    setting.name_token,
+                    f"an actuated joint angle or an actuator of figure '{figure}' "
+                    f"(coordinate '{setting.name}' has no actuator; {drivable})",
+                )
+            else:
+                raise program.error(
+                    setting.name_token,
+                    f"a joint angle or an actuator of figure '{figure}' ({drivable})",
+                )
+            if a in driven:
+                earlier = driven[a].token
+                raise program.error(
+                    setting.name_token,
+                    f"one setting per actuator ('{earlier.text}' at column {earlier.column} "
+                    f"already drives '{names[a]}' in this phase)",
+                )
+            if kind == SERVO and kp[p, a] == 0 and kd[p, a] == 0:
+                raise program.error(
+                    setting.token,
+                    f"servo gains kp > 0 or kd > 0 to servo '{setting.name}' "
+                    "(set 'gains' or kp= on the phase)",
+                )
+            driven[a] = setting
+            mode[p, a] = kind
+            value[p, a] = amount
+    return BoundProgram(
+        durations=np.array([phase.seconds for phase in program.phases], dtype=np.float64),
+        mode=mode,
+        value=value,
+        kp=kp,
+        kd=kd,
+        limit=limit,
+        coordinate=np.array(actuated, dtype=np.int64),
+        actuator_names=names,
+    )

@@ -1,0 +1,638 @@
+"""Luxo the lamp's plots (van de Panne, Fiume & Vranesic 1990, §7), drawn from a script's
+trajectory with ``figure_motion`` and ``contacts`` (``mosys.io.trajectory``):
+
+- ``plot_motion_strip``: Figure 22, one motion (a backflip, say) as a strip of the lamp's poses
+  every few hundredths of a second over the terrain.
+- ``write_show_gif``: an animated GIF of the whole trajectory, the motion and what drives it named.
+- ``plot_torques_and_forces``: the joint torques and the ground's forces over time, the motions
+  marked.
+
+The lamp is drawn from ``figure_motion``: the base (rod 0) thick, the arms thinner, and the head
+a lamp shade whose mouth is at the far end of the rod named ``upper`` (the last rod if none is),
+where the head's contact point is; the terrain polyline filled grey below. Metres in the world
+frame, y up, equal aspect. Luxo faces -x, so the base's proximal end (fraction 0) is its front
+edge. A motion is one of ``mosys.motions.motions``: from a motor program's start to the next
+one's, the landing included.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import matplotlib
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.cm import ScalarMappable
+from matplotlib.collections import LineCollection
+from matplotlib.colors import LinearSegmentedColormap, Normalize, to_rgba
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch, Polygon
+from matplotlib.transforms import blended_transform_factory
+
+from mosys.io.trajectory import Trajectory, read_trajectory
+from mosys.motions import Motion, motions
+from mosys.plots.car import frame_indices
+from mosys.plots.pendulum import PlotInputError
+from mosys.plots.style import (
+    GIF_DPI,
+    LEGEND_ROW,
+    MARGIN_BOTTOM,
+    MARGIN_LEFT,
+    MARGIN_RIGHT,
+    MARGIN_TOP,
+    TITLE_LINE,
+    add_legend,
+    animation_frames,
+    arrange,
+    controller_colors,
+    new_figure,
+    plot_style,
+    save_png,
+    write_gif,
+)
+
+HEAD_ROD = "upper"  # the rod whose far end carries the head
+BASE_WIDTH = 6.0  # pt, the base's line
+ARM_WIDTH = 2.6  # pt, the arms' lines
+HEAD_LENGTH = 0.06  # m, the lamp shade from its neck to its mouth, along the upper rod
+HEAD_MOUTH = 0.032  # m, half the shade's mouth
+HEAD_NECK = 0.008  # m, half the shade's neck
+TERRAIN_FACE, TERRAIN_EDGE = "0.8", "0.35"
+COM_COLOR = "#d62728"  # the centre of mass's path in the strip
+POSE_TIMES = LinearSegmentedColormap.from_list(  # poses, light (start) to dark (end)
+    "luxo_times", matplotlib.colormaps["YlGnBu"](np.linspace(0.3, 1.0, 256))
+)
+VIEW_MARGIN = 0.08  # m of blank around the lamp
+GROUND_MARGIN = 0.04  # m of ground shown below the lowest ground in view
+ASPECT_RANGE = (0.3, 0.85)  # height / width of a scene; its x or y limits widen to stay inside
+STRIP_EVERY = 0.05  # s between the poses of a strip
+STILL_DISTANCE = 0.005  # m: a strip leaves out a pose no end of which moved this far
+STRIP_WIDTH = 7.5  # inches, the strip's data area
+GIF_WIDTH = 6.0  # inches, the animation's data area
+GIF_FPS = 25  # frames per second of motion time
+GIF_MAX_FRAMES = 600
+GIF_HOLD_MS = 1500  # ms the last frame stays up before the loop restarts
+FOLLOW_WIDTH = 3.0  # m: a lamp ranging wider in x is followed by a view this wide
+COLORBAR_SPACE = 1.05  # inches right of a scene for its colour bar and label
+SERIES_WIDTH = 7.2  # inches, the data area of the time series
+SIDE_LEGEND = 2.0  # inches right of the time series for their legends
+WEIGHT_COLOR = "0.35"
+# line colours of the time series, apart from the motions' colours (tab10) of the timeline
+TORQUE_COLORS = ("black", "#7570b3", "#66a61e")
+CONTACT_COLORS = ("#1b9e77", "#e7298a", "#a6761d", "#e6ab02", "#666666")
+KIND_TEXT = {"motor": "motor program", "controller": "controller"}
+
+
+# --------------------------------------------------------------------------- reading the inputs
+
+
+def read_luxo_trajectory(path: str | Path, contacts: bool = False) -> Trajectory:
+    """Read a trajectory with a ``figure_motion`` group sampled at ``/t`` (and a ``contacts``
+    group if ``contacts``); PlotInputError naming the file and what is missing or malformed."""
+    try:
+        trajectory = read_trajectory(path)
+    except KeyError as error:  # h5py: a dataset or attribute the contract requires is absent
+        raise PlotInputError(f"{path}: not a trajectory file: {error}") from None
+    samples = len(trajectory.t)
+    if samples == 0:
+        raise PlotInputError(f"{path}: the trajectory has no samples")
+    figure = trajectory.motion
+    if figure is None:
+        raise PlotInputError(f"{path}: no figure_motion group: not an articulated figure")
+    if figure.endpoints.ndim != 4 or figure.endpoints.shape[0] != samples:
+        raise PlotInputError(
+            f"{path}: figure_motion/endpoints has shape {figure.endpoints.shape}, expected "
+            f"({samples}, rods, 2, 2): one row per sample of /t"
+        )
+    if contacts:
+        if trajectory.contacts is None:
+            raise PlotInputError(f"{path}: no contacts group: the figure has no contact points")
+        if trajectory.contacts.force.shape[0] != samples:
+            raise PlotInputError(
+                f"{path}: contacts/force has {trajectory.contacts.force.shape[0]} rows, "
+                f"/t {samples}"
+            )
+    if trajectory.control.shape != (samples, len(trajectory.control_names)):
+        raise PlotInputError(
+            f"{path}: /control has shape {trajectory.control.shape}, expected ({samples}, "
+            f"{len(trajectory.control_names)}) for {list(trajectory.control_names)}"
+        )
+    return trajectory
+
+
+def find_motion(trajectory: Trajectory, name: str, path: str | Path = "") -> Motion:
+    """The first motion called ``name``; ValueError (a PlotInputError) listing the motions there
+    are when there is none."""
+    found = motions(trajectory)
+    for motion in found:
+        if motion.name == name:
+            return motion
+    there = ", ".join(dict.fromkeys(m.name for m in found)) or "none: it runs no motor program"
+    raise PlotInputError(f"{path}: no motion called {name!r}; its motions: {there}")
+
+
+def head_rod(names: Sequence[str]) -> int:
+    """The index of the rod carrying the head: ``upper``, else the last rod."""
+    return names.index(HEAD_ROD) if HEAD_ROD in names else len(names) - 1
+
+
+def net_rotation(trajectory: Trajectory, motion: Motion) -> float:
+    """The base's net rotation over ``motion``, deg, counter-clockwise positive (a backflip:
+    about -360): the state column ``base`` at the motion's last sample minus its first, else
+    the base rod's angle, unwrapped."""
+    first, last = motion.start, motion.end - 1
+    if "base" in trajectory.state_order:
+        base = trajectory.state[:, trajectory.state_order.index("base")]
+        return float(base[last] - base[first])
+    ends = trajectory.motion.endpoints[first : last + 1, 0]
+    along = ends[:, 1] - ends[:, 0]
+    angle = np.unwrap(np.arctan2(along[:, 1], along[:, 0]))
+    return float(np.degrees(angle[-1] - angle[0]))
+
+
+def contact_labels(
+    rods: Sequence[str], fraction: Sequence[float], base: str = "base", head: str = HEAD_ROD
+) -> list[str]:
+    """A label per contact point from its rod and where along it (0 proximal, 1 distal). Luxo
+    faces -x: the ``base`` rod's proximal end is its front edge, its distal end its back edge;
+    the ``head`` rod's distal end is the head."""
+    labels = []
+    for rod, where in zip(rods, fraction, strict=True):
+        if rod == base and where in (0.0, 1.0):
+            labels.append(f"{rod} {'front' if where == 0.0 else 'back'} edge")
+        elif rod == head and where == 1.0:
+            labels.append("head")
+        else:
+            labels.append(f"{rod} at {where:g} of its length")
+    return labels
+
+
+def strip_samples(
+    t: np.ndarray, endpoints: np.ndarray, first: int, last: int, every: float
+) -> np.ndarray:
+    """The samples a strip draws between ``first`` and ``last`` (both drawn): one every
+    ``every`` seconds (see ``mosys.plots.car.frame_indices``), leaving out each pose none of
+    whose rod ends moved STILL_DISTANCE m or more from the last pose kept (a lamp at rest is
+    drawn once). t: (N,) s; endpoints: (N, rods, 2, 2) m."""
+    candidates = np.append(frame_indices(t[first : last + 1], every) + first, last)
+    kept = [int(candidates[0])]
+    for sample in candidates[1:-1]:
+        moved = np.abs(endpoints[sample] - endpoints[kept[-1]]).max()
+        if moved >= STILL_DISTANCE:
+            kept.append(int(sample))
+    if last != kept[-1]:
+        kept.append(last)
+    return np.asarray(kept, dtype=np.int64)
+
+
+def _script_name(trajectory: Trajectory, path: str | Path) -> str:
+    return Path(str(trajectory.attrs.get("script", path))).name
+
+
+def _minus(text: str) -> str:
+    """A true minus sign for hyphens in numbers."""
+    return text.replace("-", "−")
+
+
+# --------------------------------------------------------------------------- drawing the lamp
+
+
+def head_outline(proximal: np.ndarray, distal: np.ndarray) -> np.ndarray:
+    """The lamp shade of a pose: a trapezoid from a narrow neck HEAD_LENGTH back along the
+    upper rod to its mouth, centred on the rod's distal end. proximal, distal: (..., 2) m, the
+    upper rod's ends; returns (..., 4, 2) m."""
+    proximal = np.asarray(proximal, dtype=np.float64)
+    distal = np.asarray(distal, dtype=np.float64)
+    along = distal - proximal
+    length = np.linalg.norm(along, axis=-1, keepdims=True)
+    unit = along / np.where(length > 0, length, 1.0)
+    normal = np.stack([-unit[..., 1], unit[..., 0]], axis=-1)
+    neck = distal - HEAD_LENGTH * unit
+    corners = (
+        neck + HEAD_NECK * normal,
+        distal + HEAD_MOUTH * normal,
+        distal - HEAD_MOUTH * normal,
+        neck - HEAD_NECK * normal,
+    )
+    return np.stack(corners, axis=-2)
+
+
+class _Lamp:
+    """The lamp's artists: its rods (a line collection, the base thick) and its head."""
+
+    def __init__(self, ax: Axes, rods: int, head: int, color, zorder: float):
+        self.head_index = head
+        self.rods = LineCollection(
+            np.zeros((rods, 2, 2)),
+            linewidths=[BASE_WIDTH] + [ARM_WIDTH] * (rods - 1),
+            colors=[color],
+            capstyle="round",
+            zorder=zorder,
+        )
+        ax.add_collection(self.rods, autolim=False)
+        self.head = Polygon(
+            np.zeros((4, 2)),
+            closed=True,
+            facecolor=color,
+            edgecolor="0.15",
+            linewidth=0.5,
+            zorder=zorder + 0.01,
+        )
+        ax.add_patch(self.head)
+
+    @property
+    def artists(self) -> list:
+        return [self.rods, self.head]
+
+    def place(self, endpoints: np.ndarray) -> None:
+        """Put the lamp at one pose, endpoints (rods, 2, 2) m."""
+        self.rods.set_segments(endpoints)
+        upper = endpoints[self.head_index]
+        self.head.set_xy(head_outline(upper[0], upper[1]))
+
+    def paint(self, color) -> None:
+        self.rods.set_color(color)
+        self.head.set_facecolor(color)
+
+
+def _draw_terrain(ax: Axes, terrain: list, bottom: float) -> None:
+    """The terrain polyline, the ground below it filled grey down to ``bottom`` (m)."""
+    if not terrain:
+        return
+    ground = np.asarray(terrain, dtype=np.float64)
+    below = [[ground[-1, 0], bottom], [ground[0, 0], bottom]]
+    ax.add_patch(
+        Polygon(np.vstack([ground, below]), closed=True, facecolor=TERRAIN_FACE, edgecolor="none")
+    )
+    ax.plot(ground[:, 0], ground[:, 1], color=TERRAIN_EDGE, linewidth=1.2, zorder=1.5)
+
+
+def _ground_range(terrain: list, x0: float, x1: float) -> tuple[float, float] | None:
+    """The lowest and highest ground between x0 and x1 (m), None without terrain."""
+    if not terrain:
+        return None
+    ground = np.asarray(terrain, dtype=np.float64)
+    inside = ground[(ground[:, 0] >= x0) & (ground[:, 0] <= x1), 1]
+    ends = np.interp([x0, x1], ground[:, 0], ground[:, 1])
+    heights = np.concatenate([inside, ends])
+    return float(heights.min()), float(heights.max())
+
+
+def scene_limits(points: np.ndarray, terrain: list) -> np.ndarray:
+    """[[xmin, ymin], [xmax, ymax]] m of a view of the lamp: its ``points`` (..., 2) m with
+    VIEW_MARGIN all round and the ground in that range of x with GROUND_MARGIN below, widened
+    by ``fit_aspect``."""
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    low, high = points.min(axis=0) - VIEW_MARGIN, points.max(axis=0) + VIEW_MARGIN
+    limits = np.array([low, high])
+    for _ in range(2):  # once more after a widening in x, which may show deeper ground
+        ground = _ground_range(terrain, limits[0, 0], limits[1, 0])
+        if ground is not None:
+            limits[0, 1] = min(limits[0, 1], ground[0] - GROUND_MARGIN)
+            limits[1, 1] = max(limits[1, 1], ground[1] + VIEW_MARGIN)
+        limits = fit_aspect(limits)
+    return limits
+
+
+def fit_aspect(limits: np.ndarray, widen_x: bool = True) -> np.ndarray:
+    """``limits`` [[xmin, ymin], [xmax, ymax]] (m) widened about their centre to a height /
+    width within ASPECT_RANGE: in y if too flat, in x if too tall (unless not ``widen_x``)."""
+    limits = np.array(limits, dtype=np.float64)
+    width, height = limits[1] - limits[0]
+    least, most = ASPECT_RANGE
+    if height < least * width:
+        limits[:, 1] += np.array([-1, 1]) * (least * width - height) / 2
+    elif height > most * width and widen_x:
+        limits[:, 0] += np.array([-1, 1]) * (height / most - width) / 2
+    return limits
+
+
+def _scene_figure(
+    limits: np.ndarray,
+    width: float,
+    header_lines: int,
+    legend_rows: int,
+    colorbar: bool = False,
+    dpi: float | None = None,
+) -> tuple[Figure, Axes, Axes | None]:
+    """A figure with one equal-aspect panel ``width`` inches wide showing ``limits``, sized in
+    inches so that its box has their aspect: room above for ``header_lines`` lines of title,
+    below for the axis label and a legend of ``legend_rows`` rows, on the right for a colour
+    bar."""
+    (x0, y0), (x1, y1) = limits
+    height = width * (y1 - y0) / (x1 - x0)
+    top = MARGIN_TOP + TITLE_LINE * header_lines + 0.1
+    bottom = MARGIN_BOTTOM + (LEGEND_ROW * (legend_rows + 1) if legend_rows else 0.0)
+    right = MARGIN_RIGHT + (COLORBAR_SPACE if colorbar else 0.0)
+    fig_width = MARGIN_LEFT + width + right
+    fig_height = top + height + bottom
+    figure = new_figure(fig_width, fig_height)
+    if dpi is not None:
+        figure.set_dpi(dpi)
+    ax = figure.add_axes(
+        (MARGIN_LEFT / fig_width, bottom / fig_height, width / fig_width, height / fig_height)
+    )
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    bar = None
+    if colorbar:
+        left = (MARGIN_LEFT + width + 0.2) / fig_width
+        bar = figure.add_axes((left, bottom / fig_height, 0.16 / fig_width, height / fig_height))
+    return figure, ax, bar
+
+
+# --------------------------------------------------------------------------- the plots
+
+
+def plot_motion_strip(
+    trajectory_path: str | Path,
+    out_path: str | Path,
+    motion: str,
+    every: float = STRIP_EVERY,
+) -> None:
+    """Figure 22 ("A Luxo back-flip"): the first motion called ``motion`` in one panel, to
+    scale in metres: the terrain (filled grey), the lamp every ``every`` seconds from the
+    motion's start to its last sample (the landing included; a pose that hardly moved from the
+    last one drawn is left out, see ``strip_samples``), light to dark with the time since the
+    motion began (colour bar, s), and the path of its centre of mass. The title gives the
+    base's net rotation (deg, from the state column ``base``). Writes a PNG to ``out_path``;
+    ValueError (PlotInputError) if the trajectory has no such motion."""
+    if not every > 0:
+        raise ValueError(f"every must be a positive number of seconds, got {every!r}")
+    trajectory = read_luxo_trajectory(trajectory_path)
+    chosen = find_motion(trajectory, motion, trajectory_path)
+    figure_motion = trajectory.motion
+    t, endpoints = trajectory.t, figure_motion.endpoints
+    first, last = chosen.start, chosen.end - 1
+    samples = strip_samples(t, endpoints, first, last, every)
+    elapsed = t[samples] - t[first]
+    span = float(t[last] - t[first])
+    norm = Normalize(0.0, span if span > 0 else 1.0)
+    head = head_rod(figure_motion.rod_names)
+    shades = head_outline(endpoints[samples, head, 0], endpoints[samples, head, 1])
+    com = figure_motion.com[first : last + 1]
+    limits = scene_limits(
+        np.concatenate([endpoints[samples].reshape(-1, 2), shades.reshape(-1, 2), com]),
+        figure_motion.terrain,
+    )
+    rotation = _minus(f"{net_rotation(trajectory, chosen):.0f}")
+    title = (
+        f"Luxo: {chosen.name} (net base rotation {rotation}°)\n"
+        f"poses every {every:g} s from t = {t[first]:.2f} s to {t[last]:.2f} s, "
+        "the landing included"
+    )
+    legend = [
+        (Patch(facecolor=TERRAIN_FACE, edgecolor=TERRAIN_EDGE), "ground"),
+        (
+            Line2D([], [], color=POSE_TIMES(0.6), linewidth=ARM_WIDTH),
+            f"Luxo every {every:g} s (once when still), light → dark",
+        ),
+        (Line2D([], [], color=COM_COLOR, linestyle=":", linewidth=1.2), "centre of mass"),
+    ]
+    with plot_style():
+        figure, ax, bar = _scene_figure(limits, STRIP_WIDTH, 2, legend_rows=1, colorbar=True)
+        _draw_terrain(ax, figure_motion.terrain, limits[0, 1] - 1.0)
+        ax.plot(com[:, 0], com[:, 1], color=COM_COLOR, linestyle=":", linewidth=1.2, zorder=2.5)
+        rods = endpoints.shape[1]
+        for k, sample in enumerate(samples):
+            lamp = _Lamp(ax, rods, head, POSE_TIMES(norm(elapsed[k])), 3 + k / len(samples))
+            lamp.place(endpoints[sample])
+        figure.colorbar(
+            ScalarMappable(norm, POSE_TIMES), cax=bar, label="time since the motion began (s)"
+        )
+        ax.set_title(title)
+        add_legend(figure, legend, ncols=3)
+        save_png(figure, out_path)
+
+
+def _frame_samples(t: np.ndarray, fps: int, max_frames: int) -> tuple[np.ndarray, float]:
+    """The samples a GIF shows, one per 1/fps s of motion time (the step widened to keep to
+    ``max_frames``), the last sample always included; and the step, s."""
+    span = float(t[-1] - t[0])
+    step = max(1.0 / fps, span / (max_frames - 1)) if span > 0 else 1.0 / fps
+    samples = frame_indices(t, step)
+    if samples[-1] != len(t) - 1:
+        samples = np.append(samples[: max_frames - 1], len(t) - 1)
+    return samples, step
+
+
+def _motion_at(found: Sequence[Motion], samples: np.ndarray) -> np.ndarray:
+    """(K,) the index into ``found`` of the motion each sample belongs to, -1 for none."""
+    index = np.full(len(samples), -1, dtype=np.int64)
+    for k, motion in enumerate(found):
+        index[(samples >= motion.start) & (samples < motion.end)] = k
+    return index
+
+
+def write_show_gif(
+    trajectory_path: str | Path,
+    out_path: str | Path,
+    fps: int = GIF_FPS,
+    max_frames: int = GIF_MAX_FRAMES,
+) -> None:
+    """An animated GIF of the whole trajectory, to scale in metres: the terrain, the lamp
+    coloured by what drives it (legend), and in the title the time, the motion (``k of n``) and
+    the motor program or controller driving. One frame per 1/``fps`` s of motion time, played
+    in real time; a longer trajectory gets a wider step to keep to ``max_frames`` frames. The
+    view shows all the x the lamp covers, or, when that is wider than FOLLOW_WIDTH m, a window
+    that wide which pans to keep the lamp in its middle half. The last frame is held GIF_HOLD_MS
+    ms; loops. Written atomically."""
+    if not (isinstance(fps, int | np.integer) and fps > 0):
+        raise ValueError(f"fps must be a positive whole number, got {fps!r}")
+    if not (isinstance(max_frames, int | np.integer) and max_frames >= 2):
+        raise ValueError(f"max_frames must be a whole number of at least 2, got {max_frames!r}")
+    trajectory = read_luxo_trajectory(trajectory_path)
+    figure_motion = trajectory.motion
+    t, endpoints = trajectory.t, figure_motion.endpoints
+    samples, step = _frame_samples(t, int(fps), int(max_frames))
+    head = head_rod(figure_motion.rod_names)
+    kinds = [str(kind) for kind in trajectory.attrs.get("controller_kinds", [])]
+    kinds += ["controller"] * (len(trajectory.controllers) - len(kinds))
+    colors = controller_colors(trajectory.controllers)
+    found = motions(trajectory)
+    motion_index = _motion_at(found, samples)
+    drivers = trajectory.controller[samples]
+    shades = head_outline(endpoints[samples, head, 0], endpoints[samples, head, 1])
+    limits = scene_limits(
+        np.concatenate([endpoints[samples].reshape(-1, 2), shades.reshape(-1, 2)]),
+        figure_motion.terrain,
+    )
+    ends = endpoints[samples, :, :, 0].reshape(len(samples), -1)
+    centre = (ends.min(axis=1) + ends.max(axis=1)) / 2  # the middle of the lamp's x, m
+    follow = limits[1, 0] - limits[0, 0] > FOLLOW_WIDTH
+    if follow:
+        limits[:, 0] = centre[0] + np.array([-0.5, 0.5]) * FOLLOW_WIDTH
+        limits = fit_aspect(limits, widen_x=False)
+    shown = list(dict.fromkeys(int(d) for d in drivers))
+    legend = [
+        (
+            Line2D([], [], color=colors[trajectory.controllers[d]], linewidth=ARM_WIDTH + 1),
+            f"{trajectory.controllers[d]} ({KIND_TEXT.get(kinds[d], kinds[d])})",
+        )
+        for d in shown
+    ]
+    ncols = min(2, len(legend))
+    with plot_style():
+        figure, ax, _ = _scene_figure(
+            limits, GIF_WIDTH, 3, legend_rows=-(-len(legend) // ncols), dpi=GIF_DPI
+        )
+        _draw_terrain(ax, figure_motion.terrain, limits[0, 1] - 1.0)
+        figure.suptitle(
+            f"Luxo: {_script_name(trajectory, trajectory_path)}",
+            y=1 - 0.08 / figure.get_size_inches()[1],
+            va="top",
+        )
+        title = ax.set_title(" \n ", fontsize=10)
+        lamp = _Lamp(ax, endpoints.shape[1], head, "black", 3)
+        add_legend(figure, legend, ncols=ncols)
+
+        def update(frame: int) -> bool:
+            sample = int(samples[frame])
+            lamp.place(endpoints[sample])
+            driver = int(drivers[frame])
+            name = trajectory.controllers[driver]
+            lamp.paint(colors[name])
+            k = int(motion_index[frame])
+            what = f"motion {k + 1} of {len(found)}: {found[k].name}" if k >= 0 else "no motion"
+            title.set_text(
+                f"t = {t[sample]:5.2f} s   {what}\n"
+                f"driven by the {KIND_TEXT.get(kinds[driver], kinds[driver])} {name}"
+            )
+            if not follow:
+                return False
+            x0, x1 = ax.get_xlim()
+            quarter = (x1 - x0) / 4
+            if x0 + quarter <= centre[frame] <= x1 - quarter:
+                return False
+            ax.set_xlim(centre[frame] - 2 * quarter, centre[frame] + 2 * quarter)
+            return True
+
+        frames = animation_frames(figure, [*lamp.artists, title], range(len(samples)), update)
+    frame_ms = max(20, round(1000 * step))
+    write_gif(frames, out_path, [frame_ms] * (len(frames) - 1) + [GIF_HOLD_MS])
+
+
+def _program_end(trajectory: Trajectory, motion: Motion) -> int:
+    """The sample where the motion's own program stops driving (its end if it never does)."""
+    driver = trajectory.controller[motion.start : motion.end]
+    changes = np.flatnonzero(driver != driver[0])
+    return motion.start + (int(changes[0]) if changes.size else len(driver))
+
+
+def _mark_motions(
+    axes: Sequence[Axes], timeline: Axes, trajectory: Trajectory, found: Sequence[Motion]
+) -> list[tuple[object, str]]:
+    """Shade each motion's span on ``axes`` (alternate motions a light grey, a dashed line at
+    each start) and on ``timeline`` a bar per motion in its program's colour, solid while the
+    program drives and faded while a controller lands the figure, named in the middle.
+    Returns legend entries for the timeline."""
+    t = trajectory.t
+    colors = controller_colors(trajectory.controllers)
+    final = len(t) - 1
+    landing = []
+    for k, motion in enumerate(found):
+        start, stop = t[motion.start], t[min(motion.end, final)]
+        switch = t[min(_program_end(trajectory, motion), final)]
+        for ax in axes:
+            if k % 2 == 0:
+                ax.axvspan(start, stop, color="0.93", zorder=0, linewidth=0)
+            ax.axvline(start, color="0.55", linestyle="--", linewidth=0.8, zorder=0.5)
+        color = colors[motion.name]
+        timeline.axvspan(start, switch, color=color, linewidth=0)
+        timeline.axvspan(switch, stop, color=to_rgba(color, 0.3), linewidth=0)
+        timeline.axvline(start, color="white", linewidth=1.5)
+        timeline.text(
+            (start + stop) / 2,
+            0.5,
+            motion.name,
+            transform=blended_transform_factory(timeline.transData, timeline.transAxes),
+            ha="center",
+            va="center",
+            fontsize=8.5,
+            clip_on=True,
+            bbox={"boxstyle": "round,pad=0.15", "facecolor": "white", "alpha": 0.8, "lw": 0},
+        )
+        driven = trajectory.controller[motion.start : motion.end]
+        landing += [trajectory.controllers[d] for d in np.unique(driven) if d != driven[0]]
+    grey = "0.45"
+    entries: list[tuple[object, str]] = [(Patch(color=grey), "motor program driving")]
+    if landing:
+        names = ", ".join(dict.fromkeys(landing))
+        noun = "controller" if len(set(landing)) == 1 else "controllers"
+        entries.append((Patch(color=to_rgba(grey, 0.3)), f"then {noun} {names}"))
+    return entries
+
+
+def plot_torques_and_forces(trajectory_path: str | Path, out_path: str | Path) -> None:
+    """The lamp's actuation and ground contact over the whole trajectory, three panels on one
+    time axis (s): a timeline of the motions (a bar each, named, solid while its motor
+    program drives, faded while the landing controller does); the joint torques (each
+    ``/control`` column, N·m); and the magnitude of the ground's force on each contact point
+    (N, on a scale linear to 10 N and logarithmic above, with the lamp's weight for
+    reference), labelled base front edge, base back edge and head. The motions' spans are
+    shaded on both data panels. Writes a PNG to ``out_path``."""
+    trajectory = read_luxo_trajectory(trajectory_path, contacts=True)
+    t = trajectory.t
+    contacts = trajectory.contacts
+    figure_motion = trajectory.motion
+    found = motions(trajectory)
+    force = np.linalg.norm(contacts.force, axis=2)
+    labels = contact_labels(
+        contacts.rods,
+        contacts.fraction,
+        figure_motion.rod_names[0],
+        figure_motion.rod_names[head_rod(figure_motion.rod_names)],
+    )
+    weight = float(np.sum(figure_motion.rod_mass) * figure_motion.gravity)
+    with plot_style():
+        figure = new_figure(MARGIN_LEFT + SERIES_WIDTH + SIDE_LEGEND, 7.0)
+        timeline, torques, forces = figure.subplots(
+            3, 1, sharex=True, gridspec_kw={"height_ratios": [0.1, 1, 1], "hspace": 0.12}
+        )
+        entries = _mark_motions([torques, forces], timeline, trajectory, found)
+        timeline.set_ylim(0, 1)
+        timeline.set_yticks([])
+        timeline.grid(False)
+        timeline.set_ylabel("motion", rotation=0, ha="right", va="center")
+        timeline.set_title(
+            f"Luxo's joint torques and ground forces: {_script_name(trajectory, trajectory_path)}"
+        )
+        timeline.legend(
+            *zip(*[(h, lab) for h, lab in entries], strict=True),
+            loc="center left",
+            bbox_to_anchor=(1.01, 0.5),
+            frameon=False,
+        )
+        for j, name in enumerate(trajectory.control_names):
+            color = TORQUE_COLORS[j % len(TORQUE_COLORS)]
+            torques.plot(t, trajectory.control[:, j], color=color, linewidth=1.0, label=name)
+        torques.axhline(0.0, color="0.3", linewidth=0.6, zorder=1)
+        torques.set_ylabel("joint torque (N·m)")
+        torques.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), title="actuator")
+        for c, label in enumerate(labels):
+            color = CONTACT_COLORS[c % len(CONTACT_COLORS)]
+            forces.plot(t, force[:, c], color=color, linewidth=1.0, label=label)
+        forces.axhline(
+            weight,
+            color=WEIGHT_COLOR,
+            linestyle=":",
+            linewidth=1.2,
+            label=f"Luxo's weight, {weight:.1f} N",
+        )
+        forces.set_yscale("symlog", linthresh=10.0, linscale=1.0)
+        forces.set_ylim(bottom=0.0)
+        forces.set_ylabel("ground force |F| (N)\nlinear to 10, log above")
+        forces.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), title="contact point")
+        forces.set_xlabel("time t (s)")
+        forces.set_xlim(t[0], t[-1] if t[-1] > t[0] else t[0] + 1.0)
+        arrange(figure)
+        width, height = figure.get_size_inches()
+        figure.subplots_adjust(
+            left=(MARGIN_LEFT + 0.3) / width, right=1 - SIDE_LEGEND / width, top=1 - 0.45 / height
+        )
+        save_png(figure, out_path)

@@ -1,0 +1,41 @@
+# Luxo the lamp (1990 paper, section 7): the plots and the motions table of its show. Its
+# dynamics, its landing controller and its trajectories come from the generic compile_dynamics,
+# dp_controller and run_script rules (a script of Luxo's figure draws on the luxo group).
+rule luxo_plots:
+    input:
+        trajectory="results/trajectories/{script}.h5",
+        code=package_sources("plots"),
+    output:
+        strip="results/plots/luxo/{script}_strip.png",
+        gif="results/plots/luxo/{script}.gif",
+        forces="results/plots/luxo/{script}_forces.png",
+    log:
+        "results/logs/plots/luxo/{script}.log",
+    benchmark:
+        "results/benchmarks/plots/luxo/{script}.tsv"
+    params:
+        motion=config["luxo"]["strip_motion"],
+    threads: 1
+    shell:
+        "mosys plot luxo {input.trajectory} --strip {output.strip} --motion {params.motion}"
+        " --gif {output.gif} --forces {output.forces} 2> {log} || (cat {log} >&2; exit 1)"
+
+
+rule luxo_motions_table:
+    input:
+        trajectory=f"results/trajectories/{luxo_script()}.h5",
+        landing=f"results/controllers/{config['luxo']['group']}/{config['luxo']['controller']}.h5",
+        code=package_sources("tables"),
+    output:
+        csv="results/tables/luxo_motions.csv",
+        md="results/tables/luxo_motions.md",
+    log:
+        "results/logs/tables/luxo_motions.log",
+    benchmark:
+        "results/benchmarks/tables/luxo_motions.tsv"
+    params:
+        budget=config["budget"],
+    threads: 1
+    shell:
+        "mosys luxo-table {input.trajectory} --landing {input.landing} --budget {params.budget}"
+        " --csv {output.csv} --md {output.md} 2> {log} || (cat {log} >&2; exit 1)"
