@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import math
 from pathlib import Path
 
 import pytest
@@ -307,3 +308,83 @@ def test_render_then_parse_round_trips(script):
     assert values(parsed) == values(script)
     assert parsed.spec_sha256 == hashlib.sha256(text.encode()).hexdigest()
     assert render_script(parsed) == text
+
+
+# --- Luxo's additions: object, named state, motor, sim until=dest, when ---------------------
+
+LUXO = """object luxo figure=luxo
+state luxo x=0.5 hip=0 elbow=120
+swapcon luxo conland.ctab
+motor luxo hop
+sim 3 until=dest
+when luxo hip>-20 hip<20 elbow_rate<100 swapcon conland.ctab
+sim 1
+"""
+
+
+def test_luxo_commands_parse_to_values():
+    script = parse_script_text(LUXO, "s.anim")
+    declare, state, _, motor, until, when, sim = script.commands
+    assert (declare.object, declare.figure) == ("luxo", "luxo")
+    assert script.declared_figure is declare and script.object == "luxo"
+    assert state.names == ("x", "hip", "elbow") and state.values == (0.5, 0.0, 120.0)
+    assert motor.program == "hop" and script.motor_programs() == ("hop",)
+    assert until.until_dest and not sim.until_dest
+    assert when.box() == {"hip": (-20.0, 20.0), "elbow_rate": (-math.inf, 100.0)}
+    assert script.controllers() == ("land",)
+    rendered = render_script(script)
+    assert render_script(parse_script_text(rendered)) == rendered
+
+
+LUXO_ERRORS = [
+    (LUXO.replace("until=dest", "until=now"), "s.anim:5:13: expected 'dest', found 'now'"),
+    (
+        LUXO.replace("hip>-20 hip<20 elbow_rate<100 ", ""),
+        "s.anim:6:11: expected at least one condition 'NAME<VALUE' or 'NAME>VALUE' before "
+        "'swapcon', found 'swapcon'",
+    ),
+    (
+        LUXO.replace("hip<20", "hip=20"),
+        "s.anim:6:19: expected a condition 'NAME<VALUE' or 'NAME>VALUE', or 'swapcon', "
+        "found 'hip=20'",
+    ),
+    (
+        LUXO.replace("hip<20", "hip<-30"),
+        "s.anim:6:11: expected bounds on 'hip' that leave room (low -20 < high -30), "
+        "found 'hip>-20'",
+    ),
+    (
+        LUXO.replace("hip<20", "hip>3"),
+        "s.anim:6:19: expected one 'hip>' bound (the first is column 11), found 'hip>3'",
+    ),
+    (
+        LUXO.replace(" swapcon conland.ctab\nsim 1", "\nsim 1"),
+        "s.anim:6:40: expected a condition 'NAME<VALUE' or 'NAME>VALUE', or 'swapcon', "
+        "found end of line",
+    ),
+    (
+        "object luxo figure=luxo\nmotor luxo hop\n",
+        "s.anim:2:1: expected a 'state' line before the first 'motor', found 'motor'",
+    ),
+    (
+        LUXO.replace("state luxo", "object luxo figure=luxo\nstate luxo"),
+        "s.anim:2:1: expected one 'object' line, before the object's other lines (line 1 "
+        "names it), found 'object'",
+    ),
+    (
+        LUXO.replace("elbow=120", "hip=120"),
+        "s.anim:2:24: expected 'hip=' only once, found 'hip=120'",
+    ),
+    (LUXO.replace("figure=luxo", ""), "s.anim:1:12: expected 'figure=NAME', found end of line"),
+    (
+        LUXO.replace("motor luxo hop", "motor luxo 2hop"),
+        "s.anim:4:12: expected a name for the motor program, found '2hop'",
+    ),
+]
+
+
+@pytest.mark.parametrize(("text", "message"), LUXO_ERRORS)
+def test_luxo_command_errors(text, message):
+    with pytest.raises(SpecError) as error:
+        parse_script_text(text, "s.anim")
+    assert str(error.value) == message

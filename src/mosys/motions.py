@@ -61,6 +61,20 @@ def ground_height(terrain: list[list[float]], x: np.ndarray) -> np.ndarray:
     return height
 
 
+def longest_flight(touching: np.ndarray) -> tuple[int | None, int | None]:
+    """(take-off, touch-down) sample indices of the longest stretch without contact in
+    ``touching`` (N,) bool: its first airborne sample and the first touching one after it
+    (None when it never leaves the ground, or never comes back)."""
+    flying = np.concatenate([[False], ~touching, [False]]).astype(np.int8)
+    edges = np.flatnonzero(np.diff(flying))
+    if edges.size == 0:
+        return None, None
+    starts, ends = edges[::2], edges[1::2]
+    longest = int(np.argmax(ends - starts))
+    touchdown = int(ends[longest])
+    return int(starts[longest]), touchdown if touchdown < len(touching) else None
+
+
 @dataclass(frozen=True)
 class MotionMeasures:
     """What the motions table reports for one motion (SI, angles in degrees)."""
@@ -70,8 +84,8 @@ class MotionMeasures:
     distance_m: float  # the base's x displacement, end - start
     peak_height_m: float  # the base centre's highest point above its start
     rotation_deg: float  # the base's net rotation, end - start (a backflip: about -360)
-    airborne_s: float  # from take-off (no contact force) to touch-down
-    touchdown_s: float  # when it touched down, since the motion began (nan: it never left)
+    airborne_s: float  # its longest flight: from take-off (no contact force) to touch-down
+    touchdown_s: float  # end of its longest flight, since the motion began (nan: no flight)
     settle_s: float  # from touch-down until it stayed settled to the end (nan: never)
     landed: bool  # touched down and settled within SETTLE_WITHIN s
     start_ground_m: float  # the ground's height under the base's centre, at the start
@@ -116,12 +130,7 @@ def measure(trajectory: Trajectory, motion: Motion, standing: dict[str, float]) 
     centre = base.mean(axis=1)
     rotation = _column(trajectory, trajectory.state_order[2])[span]
     touching = np.linalg.norm(contacts.force[span], axis=2).max(axis=1) > 0.0
-    airborne = np.flatnonzero(~touching)
-    takeoff = airborne[0] if airborne.size else None
-    touchdown = None
-    if takeoff is not None:
-        after = np.flatnonzero(touching[takeoff:])
-        touchdown = takeoff + after[0] if after.size else None
+    takeoff, touchdown = longest_flight(touching)
     good = settled(trajectory, standing)[span]
     settle = np.nan
     landed = False

@@ -1,6 +1,9 @@
 # Luxo the lamp (1990 paper, section 7): the plots and the motions table of its show. Its
 # dynamics, its landing controller and its trajectories come from the generic compile_dynamics,
 # dp_controller and run_script rules (a script of Luxo's figure draws on the luxo group).
+ruleorder: luxo_plots > script_plots
+
+
 rule luxo_plots:
     input:
         trajectory="results/trajectories/{script}.h5",

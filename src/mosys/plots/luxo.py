@@ -74,7 +74,7 @@ GIF_WIDTH = 6.0  # inches, the animation's data area
 GIF_FPS = 25  # frames per second of motion time
 GIF_MAX_FRAMES = 600
 GIF_HOLD_MS = 1500  # ms the last frame stays up before the loop restarts
-FOLLOW_WIDTH = 3.0  # m: a lamp ranging wider in x is followed by a view this wide
+FOLLOW_WIDTH = 3.0  # m: a lamp ranging wider in x is followed by a view this wide (at least)
 COLORBAR_SPACE = 1.05  # inches right of a scene for its colour bar and label
 SERIES_WIDTH = 7.2  # inches, the data area of the time series
 SIDE_LEGEND = 2.0  # inches right of the time series for their legends
@@ -129,7 +129,9 @@ def find_motion(trajectory: Trajectory, name: str, path: str | Path = "") -> Mot
     for motion in found:
         if motion.name == name:
             return motion
-    there = ", ".join(dict.fromkeys(m.name for m in found)) or "none: it runs no motor program"
+    if not found:
+        raise PlotInputError(f"{path}: no motion called {name!r}: it runs no motor program")
+    there = ", ".join(dict.fromkeys(m.name for m in found))
     raise PlotInputError(f"{path}: no motion called {name!r}; its motions: {there}")
 
 
@@ -296,15 +298,15 @@ def scene_limits(points: np.ndarray, terrain: list) -> np.ndarray:
     return limits
 
 
-def fit_aspect(limits: np.ndarray, widen_x: bool = True) -> np.ndarray:
+def fit_aspect(limits: np.ndarray) -> np.ndarray:
     """``limits`` [[xmin, ymin], [xmax, ymax]] (m) widened about their centre to a height /
-    width within ASPECT_RANGE: in y if too flat, in x if too tall (unless not ``widen_x``)."""
+    width within ASPECT_RANGE: in y if too flat, in x if too tall."""
     limits = np.array(limits, dtype=np.float64)
     width, height = limits[1] - limits[0]
     least, most = ASPECT_RANGE
     if height < least * width:
         limits[:, 1] += np.array([-1, 1]) * (least * width - height) / 2
-    elif height > most * width and widen_x:
+    elif height > most * width:
         limits[:, 0] += np.array([-1, 1]) * (height / most - width) / 2
     return limits
 
@@ -429,6 +431,16 @@ def _motion_at(found: Sequence[Motion], samples: np.ndarray) -> np.ndarray:
     return index
 
 
+def pan(view: tuple[float, float], x: float) -> tuple[float, float] | None:
+    """A view (xmin, xmax) m that follows a lamp whose middle is at ``x`` m: None (stay) while
+    ``x`` is in the view's middle half, else the view of the same width centred on ``x``."""
+    x0, x1 = view
+    quarter = (x1 - x0) / 4
+    if x0 + quarter <= x <= x1 - quarter:
+        return None
+    return (x - 2 * quarter, x + 2 * quarter)
+
+
 def write_show_gif(
     trajectory_path: str | Path,
     out_path: str | Path,
@@ -439,8 +451,9 @@ def write_show_gif(
     coloured by what drives it (legend), and in the title the time, the motion (``k of n``) and
     the motor program or controller driving. One frame per 1/``fps`` s of motion time, played
     in real time; a longer trajectory gets a wider step to keep to ``max_frames`` frames. The
-    view shows all the x the lamp covers, or, when that is wider than FOLLOW_WIDTH m, a window
-    that wide which pans to keep the lamp in its middle half. The last frame is held GIF_HOLD_MS
+    view shows all the x the lamp covers, or, when that is wider than FOLLOW_WIDTH m (or the
+    view's height over ASPECT_RANGE's largest, if more), a window that wide which pans to keep
+    the lamp in its middle half (``pan``). The last frame is held GIF_HOLD_MS
     ms; loops. Written atomically."""
     if not (isinstance(fps, int | np.integer) and fps > 0):
         raise ValueError(f"fps must be a positive whole number, got {fps!r}")
@@ -464,10 +477,11 @@ def write_show_gif(
     )
     ends = endpoints[samples, :, :, 0].reshape(len(samples), -1)
     centre = (ends.min(axis=1) + ends.max(axis=1)) / 2  # the middle of the lamp's x, m
-    follow = limits[1, 0] - limits[0, 0] > FOLLOW_WIDTH
+    window = max(FOLLOW_WIDTH, (limits[1, 1] - limits[0, 1]) / ASPECT_RANGE[1])  # m
+    follow = limits[1, 0] - limits[0, 0] > window
     if follow:
-        limits[:, 0] = centre[0] + np.array([-0.5, 0.5]) * FOLLOW_WIDTH
-        limits = fit_aspect(limits, widen_x=False)
+        limits[:, 0] = centre[0] + np.array([-0.5, 0.5]) * window
+        limits = fit_aspect(limits)
     shown = list(dict.fromkeys(int(d) for d in drivers))
     legend = [
         (
@@ -503,13 +517,10 @@ def write_show_gif(
                 f"t = {t[sample]:5.2f} s   {what}\n"
                 f"driven by the {KIND_TEXT.get(kinds[driver], kinds[driver])} {name}"
             )
-            if not follow:
+            view = pan(ax.get_xlim(), centre[frame]) if follow else None
+            if view is None:
                 return False
-            x0, x1 = ax.get_xlim()
-            quarter = (x1 - x0) / 4
-            if x0 + quarter <= centre[frame] <= x1 - quarter:
-                return False
-            ax.set_xlim(centre[frame] - 2 * quarter, centre[frame] + 2 * quarter)
+            ax.set_xlim(*view)
             return True
 
         frames = animation_frames(figure, [*lamp.artists, title], range(len(samples)), update)
@@ -559,6 +570,8 @@ def _mark_motions(
         )
         driven = trajectory.controller[motion.start : motion.end]
         landing += [trajectory.controllers[d] for d in np.unique(driven) if d != driven[0]]
+    if not found:
+        return []
     grey = "0.45"
     entries: list[tuple[object, str]] = [(Patch(color=grey), "motor program driving")]
     if landing:
@@ -602,12 +615,23 @@ def plot_torques_and_forces(trajectory_path: str | Path, out_path: str | Path) -
         timeline.set_title(
             f"Luxo's joint torques and ground forces: {_script_name(trajectory, trajectory_path)}"
         )
-        timeline.legend(
-            *zip(*[(h, lab) for h, lab in entries], strict=True),
-            loc="center left",
-            bbox_to_anchor=(1.01, 0.5),
-            frameon=False,
-        )
+        if entries:
+            timeline.legend(
+                *zip(*entries, strict=True),
+                loc="center left",
+                bbox_to_anchor=(1.01, 0.5),
+                frameon=False,
+            )
+        else:
+            timeline.text(
+                0.5,
+                0.5,
+                "no motor program runs",
+                transform=timeline.transAxes,
+                ha="center",
+                va="center",
+                fontsize=8.5,
+            )
         for j, name in enumerate(trajectory.control_names):
             color = TORQUE_COLORS[j % len(TORQUE_COLORS)]
             torques.plot(t, trajectory.control[:, j], color=color, linewidth=1.0, label=name)
