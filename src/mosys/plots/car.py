@@ -35,9 +35,10 @@ from mosys.io.attributes import string_tuple
 from mosys.io.start_grid import DATASETS
 from mosys.io.start_grid import read_start_grid as read_start_grid_file
 from mosys.io.trajectory import read_trajectory
-from mosys.plots.pendulum import GIF_DPI, PlotInputError, _shared_palette
+from mosys.plots.pendulum import PlotInputError
 from mosys.plots.style import (
     DESTINATION_COLOR,
+    GIF_DPI,
     LEGEND_ROW,
     MARGIN_BOTTOM,
     MARGIN_RIGHT,
@@ -46,6 +47,7 @@ from mosys.plots.style import (
     new_figure,
     plot_style,
     save_png,
+    shared_palette,
 )
 
 FRAME_INTERVAL = 0.3  # s between the outlines drawn in a parking panel
@@ -861,7 +863,7 @@ def write_parking_gif(trajectory_path: str | Path, out_path: str | Path, fps: in
             rgba = np.asarray(canvas.buffer_rgba())
             frames.append(Image.fromarray(rgba[..., :3].copy()))
 
-    frames = _shared_palette(frames)
+    frames = shared_palette(frames)
     durations = [round(1000 / fps)] * (len(frames) - 1) + [GIF_HOLD_MS]
 
     def write(partial: Path) -> None:

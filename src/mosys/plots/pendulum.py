@@ -33,6 +33,7 @@ from mosys.io.controller_table import ControllerTable, read_controller_table
 from mosys.io.trajectory import Trajectory, read_trajectory
 from mosys.plots.style import (
     DESTINATION_COLOR,
+    GIF_DPI,
     SYMBOLS,
     add_legend,
     axis_label,
@@ -43,6 +44,7 @@ from mosys.plots.style import (
     new_figure,
     plot_style,
     save_png,
+    shared_palette,
     start_style,
 )
 
@@ -50,7 +52,6 @@ PORTRAIT_STARTS = 8  # start states per portrait
 PORTRAIT_SECONDS = 3.0  # s simulated from each start
 CYCLE_SECONDS = (3.0, 5.0)  # s: a periodic destination's cycle is drawn over this window
 GIF_FPS = 25  # frames per second of the animations
-GIF_DPI = 80  # dots per inch of the animation frames
 DEFAULT_DT = 0.001  # s: simulator step when a table does not record its own
 
 
@@ -668,7 +669,7 @@ def write_script_gif(trajectory_path: str | Path, out_path: str | Path, fps: int
             rgba = np.asarray(canvas.buffer_rgba())
             frames.append(Image.fromarray(rgba[..., :3].copy()))
 
-    frames = _shared_palette(frames)
+    frames = shared_palette(frames)
 
     def write(partial: Path) -> None:
         frames[0].save(
@@ -681,21 +682,6 @@ def write_script_gif(trajectory_path: str | Path, out_path: str | Path, fps: int
         )
 
     write_atomically(out_path, write)
-
-
-def _shared_palette(frames: list, samples: int = 8) -> list:
-    """The RGB ``frames`` as palette images sharing one 256-colour palette, made from a montage
-    of a few evenly spaced frames: no colour flicker between frames, and far quicker than a
-    palette per frame."""
-    from PIL import Image
-
-    picks = frames[:: max(1, len(frames) // samples)][:samples]
-    width, height = frames[0].size
-    montage = Image.new("RGB", (width, height * len(picks)))
-    for k, frame in enumerate(picks):
-        montage.paste(frame, (0, height * k))
-    palette = montage.quantize(256)
-    return [frame.quantize(palette=palette, dither=Image.Dither.NONE) for frame in frames]
 
 
 # --------------------------------------------------------------------------- the CLI verb
