@@ -22,12 +22,6 @@ from mosys.ssc.generate import generate_controller
 SPECS = Path(__file__).resolve().parents[1] / "specs"
 DT = 0.0005  # s: config/config.yaml's luxo dt
 PENETRATION_TOLERANCE = 0.01  # m: the deepest a contact point may go on landing (README)
-# The motor programs are not yet robust to the state the previous landing leaves (session 4): the
-# second hop tips Luxo into the ditch, and the rest of the show fails after it. These are the
-# issue's targets; they are expected to fail until the programs are retuned (see the README).
-NOT_YET = pytest.mark.xfail(
-    reason="motor programs not robust to the landing's end state yet (issue 5 open)", strict=True
-)
 SHOW = ("hop", "hop", "hop", "long_jump", "backflip", "double_backflip", "backflip_down_step")
 
 
@@ -80,7 +74,6 @@ def test_show_runs_the_motions_in_order(show) -> None:
     assert trajectory.state_order[:5] == ("x", "y", "base", "hip", "elbow")
 
 
-@NOT_YET
 def test_every_motion_lands_and_settles_within_two_seconds(show) -> None:
     _, measured = show
     for name, m in measured.items():
@@ -88,9 +81,9 @@ def test_every_motion_lands_and_settles_within_two_seconds(show) -> None:
         assert m.airborne_s > 0.05, (name, m)  # it really left the ground
         assert m.settle_s <= SETTLE_WITHIN, (name, m)
         assert m.max_penetration_m < PENETRATION_TOLERANCE, (name, m)
+        assert not m.limb_touched, (name, m)  # it lands on its base, not on its head
 
 
-@NOT_YET
 def test_rotations_of_the_flips(show) -> None:
     _, measured = show
     turns = {name.rstrip("0123456789"): m.rotation_deg for name, m in measured.items()}
@@ -100,7 +93,6 @@ def test_rotations_of_the_flips(show) -> None:
     assert abs(turns["backflip_down_step"] + 360) <= 30
 
 
-@NOT_YET
 def test_long_jump_clears_the_ditch_and_the_step_variant_ends_lower(show) -> None:
     trajectory, measured = show
     terrain = np.array(trajectory.motion.terrain)

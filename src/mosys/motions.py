@@ -92,6 +92,7 @@ class MotionMeasures:
     end_ground_m: float  # and at the end
     lowest_ground_touched_m: float  # the lowest ground a contact point touched
     max_penetration_m: float  # the deepest any contact point went below the ground
+    limb_touched: bool  # a contact point off the root rod (Luxo: the head) touched the ground
 
 
 def _column(trajectory: Trajectory, name: str) -> np.ndarray:
@@ -144,6 +145,7 @@ def measure(trajectory: Trajectory, motion: Motion, standing: dict[str, float]) 
     depth = np.where(np.isfinite(surface), surface - points[..., 1], 0.0)
     in_contact = np.linalg.norm(contacts.force[span], axis=2) > 0.0
     touched = surface[in_contact]
+    off_root = np.array([rod != figure.rod_names[0] for rod in contacts.rods], dtype=bool)
     return MotionMeasures(
         motion=motion.name,
         start_s=float(trajectory.t[motion.start]),
@@ -158,4 +160,5 @@ def measure(trajectory: Trajectory, motion: Motion, standing: dict[str, float]) 
         end_ground_m=float(ground_height(terrain, centre[-1:, 0])[0]),
         lowest_ground_touched_m=float(touched.min()) if touched.size else np.nan,
         max_penetration_m=float(max(0.0, depth.max())),
+        limb_touched=bool(in_contact[:, off_root].any()),
     )

@@ -109,7 +109,8 @@ class Controller:
     def arrival_box(self) -> Bounds:
         """The box, spec units, in which the figure counts as back at the destination: each
         dimension ``dest`` names within ARRIVAL_STEPS grid steps of it, and every rate of the
-        figure that the controller does not see below REST_RATE (SI) in size."""
+        figure, whether the controller sees it or not, below REST_RATE (SI) in size as well:
+        at rest, so that what follows starts from (nearly) the same state every time."""
         grid = self.grid
         box: dict[str, tuple[float, float]] = {}
         for k, name in enumerate(grid.names):
@@ -118,9 +119,9 @@ class Controller:
                 box[name] = (self.table.dest[name] - reach, self.table.dest[name] + reach)
         coordinates = len(getattr(self.dynamics, "Q_NAMES", ()))
         for name in figure_state_names(self.dynamics)[coordinates:]:
-            if name not in grid.names:
-                rest = REST_RATE / state_unit(self.dynamics, name)[1]
-                box[name] = (-rest, rest)
+            rest = REST_RATE / state_unit(self.dynamics, name)[1]
+            low, high = box.get(name, (-rest, rest))
+            box[name] = (max(low, -rest), min(high, rest))
         return box
 
     def simulate(

@@ -16,7 +16,7 @@ from mosys.ssc.grid import figure_state_names, state_unit
 # a figure at rest: every rate a controller does not see below this, SI (m/s, rad/s)
 REST_RATE = 0.01
 # arrival: each controller dimension within this fraction of its grid step of the destination
-ARRIVAL_STEPS = 0.1
+ARRIVAL_STEPS = 0.02
 
 Bounds = Mapping[str, tuple[float, float]]  # state variable -> (low, high), spec units
 

@@ -55,7 +55,8 @@ def write_luxo_table(
         f"{BASE_FLAT_DEG:g}°, joints within {JOINT_DEG:g}° of standing, |vx|, |vy| <= "
         f"{REST_SPEED:g} m/s and angular rates <= {REST_RATE:g} deg/s, to the motion's end; "
         f"landed: touched down and settled within {SETTLE_WITHIN:g} s. Penetration: the "
-        "deepest a contact point went below the ground (vertically).\n\n"
+        "deepest a contact point went below the ground (vertically). limb_touched: a contact "
+        "point off the base (the head) touched the ground during the motion.\n\n"
     )
     write_text_atomically(md_path, caption + frame.to_markdown(index=False) + "\n")
     return frame

@@ -1,0 +1,76 @@
+"""State-space breakpoints at run time (paper §3.1, the script's ``when``): while the state lies
+in a breakpoint's box its controller drives, elsewhere the last ``swapcon``'s; and ``sim ...
+until=dest`` stops in the active controller's arrival box. On the real pendulum and its
+controllers A (to angle 0) and B (to angle 120)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mosys.dynamics.compile import compile_figure
+from mosys.dynamics.load import load_dynamics
+from mosys.io.trajectory import read_trajectory
+from mosys.parsing.controller import parse_controller_spec
+from mosys.pipeline import run_animation_script
+from mosys.ssc.generate import generate_controller
+
+SPECS = Path(__file__).resolve().parents[1] / "specs"
+DT = 0.001
+
+
+@pytest.fixture(scope="module")
+def dynamics_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    directory = tmp_path_factory.mktemp("dynamics")
+    compile_figure(SPECS / "figures" / "link1.fig", directory / "link1.py")
+    return directory
+
+
+def run(tmp_path: Path, dynamics_dir: Path, pendulum_tables: Path, text: str):
+    script = tmp_path / "breakpoint.anim"
+    script.write_text(text)
+    out = tmp_path / "breakpoint.h5"
+    run_animation_script(script, pendulum_tables, dynamics_dir, out, DT, SPECS / "motor")
+    return read_trajectory(out)
+
+
+def test_the_breakpoint_controller_drives_exactly_while_the_state_is_in_its_box(
+    tmp_path, dynamics_dir, pendulum_tables
+):
+    trajectory = run(
+        tmp_path,
+        dynamics_dir,
+        pendulum_tables,
+        "state link -135,350\n"
+        "swapcon link conA.ctab\n"
+        "when link angle>-60 angle<-20 swapcon conB.ctab\n"
+        "sim 2\n",
+    )
+    angle = trajectory.state[:, trajectory.state_order.index("angle")]
+    driver = np.array(trajectory.controllers)[trajectory.controller]
+    inside = (angle > -60) & (angle < -20)
+    # each sample's driver is chosen from the state at that sample (the last holds the final state)
+    expected = np.where(inside, "B", "A")[:-1]
+    assert inside.any() and (~inside).any()  # the swing passes through the box and leaves it
+    np.testing.assert_array_equal(driver[:-1], expected)
+
+
+def test_sim_until_dest_stops_at_rest_in_the_destination(tmp_path, dynamics_dir):
+    """Controller A with 'hold' (without it, A's interpolated torques balance gravity 7 degrees
+    short of its destination, and 'until=dest' would run the whole time)."""
+    spec_path = tmp_path / "H.ssc"
+    spec_path.write_text((SPECS / "controllers" / "pendulum" / "A.ssc").read_text() + "hold\n")
+    link1 = load_dynamics(dynamics_dir / "link1.py")
+    generate_controller(parse_controller_spec(spec_path), link1, tmp_path / "H.h5", quiet=True)
+    trajectory = run(
+        tmp_path,
+        dynamics_dir,
+        tmp_path,
+        "state link -135,350\nswapcon link conH.ctab\nsim 5 until=dest\n",
+    )
+    end = dict(zip(trajectory.state_order, trajectory.state[-1], strict=True))
+    assert trajectory.t[-1] < 4.0  # stopped early
+    assert abs(end["angle"]) <= 0.02 * 10.0  # ARRIVAL_STEPS grid steps of 10 deg
+    assert abs(end["omega"]) <= np.degrees(0.01)  # at rest: REST_RATE
