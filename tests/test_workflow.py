@@ -170,3 +170,32 @@ def test_editing_an_obstacle_rebuilds_the_car_and_nothing_else(workflow):
         "car_all": 1,
     }
     assert planned_jobs(workflow) == pendulum_plan  # the pendulum does not depend on the car
+
+
+def test_a_new_luxo_script_reuses_the_controller_and_motor_programs(workflow):
+    """Issue 5: a user's own order of Luxo's motions needs only its own run and plots; editing a
+    motor program reruns the shows that use it, never the dynamics or the landing controller."""
+    snakemake(workflow, "results/luxo_all")
+    index = (workflow / "results/luxo_all").read_text().split()
+    assert "results/tables/luxo_motions.md" in index
+    assert "results/plots/luxo/luxo_show_strip.png" in index
+    script = workflow / "specs/scripts/my_show.anim"
+    script.write_text(
+        "object luxo figure=luxo\nstate luxo x=1 hip=0 elbow=120\nswapcon luxo conland.ctab\n"
+        "motor luxo backflip\nsim 3 until=dest\nmotor luxo hop\nsim 3 until=dest\n"
+    )
+    try:
+        assert planned_jobs(workflow, "results/plots/luxo/my_show.gif") == {
+            "run_script": 1,
+            "luxo_plots": 1,
+        }
+        hop = workflow / "specs/motor/luxo/hop.mot"
+        hop.write_text(hop.read_text() + "# edited\n")
+        assert planned_jobs(workflow, "results/luxo_all") == {
+            "run_script": 1,
+            "luxo_plots": 1,
+            "luxo_motions_table": 1,
+            "luxo_all": 1,
+        }
+    finally:
+        script.unlink()
