@@ -13,6 +13,10 @@ from spec_fuzz import token_mutations
 
 from mosys.parsing.script import (
     AnimationScript,
+    Breakpoint,
+    Condition,
+    DeclareObject,
+    RunMotorProgram,
     SetState,
     Simulate,
     SwapController,
@@ -36,12 +40,20 @@ def values(script: AnimationScript) -> tuple:
     """The commands without tokens."""
     out = []
     for command in script.commands:
-        if isinstance(command, SetState):
-            out.append(("state", command.object, command.values))
+        if isinstance(command, DeclareObject):
+            out.append(("object", command.object, command.figure))
+        elif isinstance(command, SetState):
+            named = (command.names,) if command.names else ()
+            out.append(("state", command.object, command.values, *named))
         elif isinstance(command, SwapController):
             out.append(("swapcon", command.object, command.table, command.controller))
+        elif isinstance(command, RunMotorProgram):
+            out.append(("motor", command.object, command.program))
+        elif isinstance(command, Breakpoint):
+            bounds = tuple((c.name, c.operator, c.value) for c in command.conditions)
+            out.append(("when", command.object, bounds, command.table, command.controller))
         else:
-            out.append(("sim", command.seconds))
+            out.append(("sim", command.seconds, *(("until=dest",) if command.until_dest else ())))
     return tuple(out)
 
 
@@ -279,9 +291,12 @@ def scripts(draw) -> AnimationScript:
     target = draw(NAMES)
 
     def state():
-        return SetState(
-            target, tuple(draw(st.lists(NUMBERS, min_size=1, max_size=5))), token, token, ()
-        )
+        numbers = tuple(draw(st.lists(NUMBERS, min_size=1, max_size=5)))
+        if not draw(st.booleans()):
+            return SetState(target, numbers, token, token, ())
+        count = len(numbers)
+        names = tuple(draw(st.lists(NAMES, min_size=count, max_size=count, unique=True)))
+        return SetState(target, numbers, token, token, (), names, (token,) * len(names))
 
     def swap():
         controller = draw(NAMES)
@@ -290,13 +305,26 @@ def scripts(draw) -> AnimationScript:
 
     def sim():
         seconds = draw(st.floats(min_value=1e-6, max_value=1e6, allow_nan=False))
-        return Simulate(seconds, token, token)
+        return Simulate(seconds, token, token, draw(st.booleans()))
+
+    def motor():
+        return RunMotorProgram(target, draw(NAMES), token, token, token)
+
+    def when():
+        controller = draw(NAMES)
+        bounds = st.tuples(NAMES, st.sampled_from("<>"), NUMBERS)
+        drawn = draw(st.lists(bounds, min_size=1, max_size=3, unique_by=lambda b: b[:2]))
+        conditions = tuple(Condition(name, op, value, token) for name, op, value in drawn)
+        return Breakpoint(
+            target, conditions, f"con{controller}.ctab", controller, token, token, token
+        )
 
     commands = [state(), swap(), sim()]
     for _ in range(draw(st.integers(0, 8))):
-        commands.insert(
-            draw(st.integers(3, len(commands))), draw(st.sampled_from([state, swap, sim]))()
-        )
+        command = draw(st.sampled_from([state, swap, sim, motor, when]))
+        commands.insert(draw(st.integers(3, len(commands))), command())
+    if draw(st.booleans()):
+        commands.insert(0, DeclareObject(target, draw(NAMES), token, token, token))
     return AnimationScript("generated.anim", tuple(commands), "")
 
 

@@ -27,6 +27,7 @@ from where the previous ones leave Luxo (``--starts``, the front edge's x).
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import shlex
 import sys
@@ -88,10 +89,7 @@ class Evaluator:
     def __init__(self, dynamics_path: str, controller_path: str):
         self.dynamics = load_dynamics(dynamics_path)
         self.controller = Controller.load(controller_path, self.dynamics)
-        self.terrain = [
-            list(point)
-            for point in zip(self.dynamics._TERRAIN_X, self.dynamics._TERRAIN_Y, strict=True)
-        ]
+        self.terrain = json.loads(self.dynamics.TERRAIN_JSON)
         self.names = self.dynamics.Q_NAMES
         self.workdir = Path(tempfile.mkdtemp(prefix="tune_luxo_"))
 

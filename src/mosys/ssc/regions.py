@@ -13,7 +13,7 @@ import numpy as np
 from mosys.kernels.simulate import region_membership
 from mosys.ssc.grid import figure_state_names, state_unit
 
-# a figure at rest: every rate a controller does not see below this, SI (m/s, rad/s)
+# a figure at rest: every rate of the figure below this, SI (m/s, rad/s)
 REST_RATE = 0.01
 # arrival: each controller dimension within this fraction of its grid step of the destination
 ARRIVAL_STEPS = 0.02
