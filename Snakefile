@@ -56,7 +56,7 @@ rule luxo_all:
 
 rule paper_tables:
     input:
-        paper_table_targets() + car_table_targets(),
+        paper_table_targets() + car_table_targets() + luxo_table_targets(),
     output:
         "results/paper_tables",
     log:
