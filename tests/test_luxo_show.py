@@ -5,6 +5,7 @@ the trajectory file, as a user would."""
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +16,7 @@ from mosys.dynamics.load import load_dynamics
 from mosys.io.controller_table import read_controller_table
 from mosys.io.trajectory import read_trajectory
 from mosys.motions import SETTLE_WITHIN, measure, motions
+from mosys.motor import load_motor_program
 from mosys.parsing.controller import parse_controller_spec
 from mosys.pipeline import run_animation_script
 from mosys.ssc.generate import generate_controller
@@ -123,3 +125,28 @@ def test_motions_reuse_in_a_new_script_without_a_new_controller(luxo_results: Pa
     assert [m.motion for m in measured] == ["backflip", "hop"]
     assert all(m.landed for m in measured)
     assert math.isclose(measured[0].rotation_deg, -360, abs_tol=30)
+
+
+def test_the_tuning_tool_writes_a_program_that_runs(
+    luxo_results: Path, tmp_path, capsys, monkeypatch
+):
+    """tools/tune_luxo_motion.py (how the programs were made), at a tiny budget: the program it
+    writes parses, binds to Luxo, and its parameters read back as written."""
+    import importlib.util
+
+    path = Path(__file__).resolve().parents[1] / "tools" / "tune_luxo_motion.py"
+    spec = importlib.util.spec_from_file_location("tune_luxo_motion", path)
+    tool = importlib.util.module_from_spec(spec)
+    monkeypatch.setitem(sys.modules, spec.name, tool)  # its dataclass looks itself up there
+    spec.loader.exec_module(tool)
+    out = tmp_path / "hop.mot"
+    argv = ["hop", "--distance=-0.2", "--samples", "4", "--local", "2", "--write", str(out)]
+    argv += ["--dynamics", str(luxo_results / "dynamics" / "luxo.py")]
+    argv += ["--controller", str(luxo_results / "controllers" / "land.h5")]
+    assert tool.main(argv) == 0
+    assert "cost " in capsys.readouterr().out
+    parameters = tool.program_parameters(str(out))
+    assert np.all(parameters >= tool.LOW - 1e-3) and np.all(parameters <= tool.HIGH + 1e-3)
+    lamp = load_dynamics(luxo_results / "dynamics" / "luxo.py")
+    program = load_motor_program(out, "luxo", lamp)
+    assert program.duration() == pytest.approx(parameters[[0, 3, 7]].sum(), abs=1e-3)
