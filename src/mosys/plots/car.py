@@ -30,7 +30,6 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Polygon
 
 from mosys.errors import InputError
-from mosys.io.atomic import write_atomically
 from mosys.io.attributes import string_tuple
 from mosys.io.start_grid import DATASETS
 from mosys.io.start_grid import read_start_grid as read_start_grid_file
@@ -47,7 +46,7 @@ from mosys.plots.style import (
     new_figure,
     plot_style,
     save_png,
-    shared_palette,
+    write_gif,
 )
 
 FRAME_INTERVAL = 0.3  # s between the outlines drawn in a parking panel
@@ -863,20 +862,7 @@ def write_parking_gif(trajectory_path: str | Path, out_path: str | Path, fps: in
             rgba = np.asarray(canvas.buffer_rgba())
             frames.append(Image.fromarray(rgba[..., :3].copy()))
 
-    frames = shared_palette(frames)
-    durations = [round(1000 / fps)] * (len(frames) - 1) + [GIF_HOLD_MS]
-
-    def write(partial: Path) -> None:
-        frames[0].save(
-            partial,
-            format="GIF",
-            save_all=True,
-            append_images=frames[1:],
-            duration=durations,
-            loop=0,
-        )
-
-    write_atomically(out_path, write)
+    write_gif(frames, out_path, [round(1000 / fps)] * (len(frames) - 1) + [GIF_HOLD_MS])
 
 
 def _group_starts(grid: StartGrid) -> tuple[list[str], list[np.ndarray], list[str]]:
