@@ -11,6 +11,7 @@ include: "workflow/rules/plots.smk"
 include: "workflow/rules/tables.smk"
 include: "workflow/rules/car.smk"
 include: "workflow/rules/luxo.smk"
+include: "workflow/rules/bsr.smk"
 
 
 rule all:
@@ -18,6 +19,7 @@ rule all:
         "results/pendulum_all",
         "results/car_all",
         "results/luxo_all",
+        "results/bsr_all",
         "results/paper_tables",
 
 
@@ -54,9 +56,20 @@ rule luxo_all:
         "mosys index {input} -o {output} 2> {log}"
 
 
+rule bsr_all:
+    input:
+        bsr_targets(),
+    output:
+        "results/bsr_all",
+    log:
+        "results/logs/bsr_all.log",
+    shell:
+        "mosys index {input} -o {output} 2> {log}"
+
+
 rule paper_tables:
     input:
-        paper_table_targets() + car_table_targets() + luxo_table_targets(),
+        paper_table_targets() + car_table_targets() + luxo_table_targets() + bsr_table_targets(),
     output:
         "results/paper_tables",
     log:

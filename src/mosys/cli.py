@@ -124,6 +124,49 @@ def _plot_luxo(args: argparse.Namespace) -> None:
         write_show_gif(args.trajectory, args.gif)
 
 
+def _plot_bsr(args: argparse.Namespace) -> None:
+    from mosys.plots import bsr
+
+    if args.learning:
+        bsr.plot_learning(args.results, args.learning)
+    if args.filmstrip or args.gif:
+        best = bsr.best_result_path(args.results)  # highest best_fitness, ties to lowest seed
+        if args.filmstrip:
+            bsr.plot_filmstrip(best, args.filmstrip)
+        if args.gif:
+            bsr.write_motion_gif(best, args.gif)
+
+
+def _plot_bsr_learning(args: argparse.Namespace) -> None:
+    from mosys.plots import bsr
+
+    bsr.plot_learning_comparison(bsr.group_by_search(args.results), args.output)
+
+
+def _bsr_search(args: argparse.Namespace) -> None:
+    from mosys.bsr.run import search_to_file
+
+    outcome = search_to_file(
+        args.spec,
+        args.figures,
+        args.seed,
+        args.output,
+        args.generations,
+        args.budget,
+        args.threads,
+    )
+    print(
+        f"{args.output}: best fitness {outcome.fitness:.3f} after {outcome.evaluations[-1]} "
+        f"evaluations in {outcome.wall_seconds:.1f} s ({outcome.steps_per_second:.3g} steps/s)"
+    )
+
+
+def _bsr_table(args: argparse.Namespace) -> None:
+    from mosys.tables.bsr import write_bsr_table
+
+    write_bsr_table(args.results, args.csv, args.md)
+
+
 def _luxo_table(args: argparse.Namespace) -> None:
     from mosys.tables.luxo import write_luxo_table
 
@@ -237,6 +280,37 @@ def build_parser() -> argparse.ArgumentParser:
     luxo.add_argument("--gif", help="animated GIF of the whole trajectory, terrain drawn")
     luxo.set_defaults(handler=_plot_luxo)
 
+    bsr_plot = plot.add_parser("bsr", help="a BSR search: learning curves, filmstrip, GIF")
+    bsr_plot.add_argument("results", nargs="+", help="all seed files of one search (.h5)")
+    bsr_plot.add_argument("--learning", help="PNG: best fitness per seed (Figure 8 style)")
+    bsr_plot.add_argument("--filmstrip", help="PNG: the best seed's motion (Figures 9-12 style)")
+    bsr_plot.add_argument("--gif", help="animated GIF of the best seed's motion")
+    bsr_plot.set_defaults(handler=_plot_bsr)
+    bsr_learning = plot.add_parser(
+        "bsr-learning", help="learning curves of BSR searches compared (Figure 7 style)"
+    )
+    bsr_learning.add_argument(
+        "results", nargs="+", help="seed files (.h5) of one or more searches, grouped by name"
+    )
+    bsr_learning.add_argument("-o", "--output", required=True, help="PNG")
+    bsr_learning.set_defaults(handler=_plot_bsr_learning)
+
+    search = verbs.add_parser("bsr-search", help="BSR search spec (.bsr) -> result (.h5)")
+    search.add_argument("spec", help="the search spec (.bsr)")
+    search.add_argument("--seed", type=int, required=True, help="one of the spec's seeds")
+    search.add_argument("--figures", default="specs/figures", help="where NAME.fig lives")
+    search.add_argument("--generations", type=int, help="override the spec's G (a budget)")
+    search.add_argument("--budget", default="paper", help="name of the config that built it")
+    search.add_argument("--threads", type=int, help="threads that run the population")
+    search.add_argument("-o", "--output", required=True)
+    search.set_defaults(handler=_bsr_search)
+
+    bsr_table = verbs.add_parser("bsr-table", help="the BSR runs table")
+    bsr_table.add_argument("results", nargs="+", help="seed files (.h5) of the searches")
+    bsr_table.add_argument("--csv", required=True)
+    bsr_table.add_argument("--md", required=True)
+    bsr_table.set_defaults(handler=_bsr_table)
+
     luxo_table = verbs.add_parser("luxo-table", help="Luxo's motions table")
     luxo_table.add_argument("trajectory", help="a trajectory of Luxo's show (.h5)")
     luxo_table.add_argument(
@@ -269,6 +343,12 @@ def main(argv: list[str] | None = None) -> int:
             parser.error("plot car: give --frames, --gif and/or --map")
         if (args.frames or args.gif) and not args.trajectories:
             parser.error("plot car: --frames and --gif need trajectories")
+    if (
+        args.verb == "plot"
+        and args.kind == "bsr"
+        and not (args.learning or args.filmstrip or args.gif)
+    ):
+        parser.error("plot bsr: give --learning, --filmstrip and/or --gif")
     from mosys.errors import InputError
     from mosys.parsing.tokens import SpecError
 

@@ -20,6 +20,8 @@ STAGE_MODULES = {
                 "pipeline.py", "ssc/controller.py", "ssc/regions.py", "ssc/parking.py",
                 "kernels/simulate.py", "kernels/motor.py", "kernels/motion.py",
                 "io/trajectory.py", "io/start_grid.py", "dynamics/motion.py"],
+    "bsr": ["parsing/bsr.py", "parsing/figure.py", "bsr", "kernels/bsr_simulate.py",
+            "kernels/bsr_run.py", "io/bsr_result.py", "io/trajectory.py", "progress.py"],
     "plots": ["plots"],
     "tables": ["tables", "ssc/quality.py"],
 }
@@ -176,3 +178,44 @@ def luxo_targets():
          f"results/plots/luxo/{script}_forces.png"]
         + luxo_table_targets()
     )
+
+
+def bsr_seeds(name):
+    """The seeds of a search: its spec's 'seeds' line, the first config bsr.seeds of them if
+    that is set (a reduced budget)."""
+    seeds = [word for words in spec_words(f"specs/bsr/{name}.bsr", "seeds")[:1]
+             for word in words[1:] if re.fullmatch(r"\d+", word)]
+    limit = config["bsr"]["seeds"]
+    return seeds if limit is None else seeds[:limit]
+
+
+def bsr_seed_results(wildcards):
+    return [f"results/bsr/{wildcards.name}/seed{seed}.h5" for seed in bsr_seeds(wildcards.name)]
+
+
+def bsr_all_results():
+    return [f"results/bsr/{name}/seed{seed}.h5"
+            for name in config["bsr"]["searches"] for seed in bsr_seeds(name)]
+
+
+def bsr_figure_spec(wildcards):
+    """The figure spec a search names in its 'figure' line."""
+    return [f"specs/figures/{words[1]}.fig"
+            for words in spec_words(f"specs/bsr/{wildcards.name}.bsr", "figure")[:1]
+            if len(words) > 1 and re.fullmatch(r"\w+", words[1])]
+
+
+def bsr_generations_option(wildcards):
+    """'--generations G' when the config caps the searches' generations, else nothing."""
+    generations = config["bsr"]["generations"]
+    return "" if generations is None else f"--generations {generations}"
+
+
+def bsr_table_targets():
+    return ["results/tables/bsr_runs.csv", "results/tables/bsr_runs.md"]
+
+
+def bsr_targets():
+    plots = [f"results/plots/bsr/{name}/{plot}" for name in config["bsr"]["searches"]
+             for plot in ("learning.png", "filmstrip.png", "motion.gif")]
+    return bsr_all_results() + plots + ["results/plots/bsr/learning_curves.png"] + bsr_table_targets()

@@ -20,13 +20,11 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
-import matplotlib
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.cm import ScalarMappable
 from matplotlib.collections import LineCollection
-from matplotlib.colors import LinearSegmentedColormap, Normalize, to_rgba
-from matplotlib.figure import Figure
+from matplotlib.colors import Normalize, to_rgba
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Polygon
 from matplotlib.transforms import blended_transform_factory
@@ -37,19 +35,20 @@ from mosys.plots.car import frame_indices
 from mosys.plots.pendulum import PlotInputError
 from mosys.plots.style import (
     GIF_DPI,
-    LEGEND_ROW,
-    MARGIN_BOTTOM,
     MARGIN_LEFT,
-    MARGIN_RIGHT,
-    MARGIN_TOP,
-    TITLE_LINE,
+    POSE_TIMES,
+    TERRAIN_EDGE,
+    TERRAIN_FACE,
     add_legend,
     animation_frames,
     arrange,
     controller_colors,
+    draw_terrain,
+    frame_samples,
     new_figure,
     plot_style,
     save_png,
+    scene_figure,
     write_gif,
 )
 
@@ -59,11 +58,7 @@ ARM_WIDTH = 2.6  # pt, the arms' lines
 HEAD_LENGTH = 0.06  # m, the lamp shade from its neck to its mouth, along the upper rod
 HEAD_MOUTH = 0.032  # m, half the shade's mouth
 HEAD_NECK = 0.008  # m, half the shade's neck
-TERRAIN_FACE, TERRAIN_EDGE = "0.8", "0.35"
 COM_COLOR = "#d62728"  # the centre of mass's path in the strip
-POSE_TIMES = LinearSegmentedColormap.from_list(  # poses, light (start) to dark (end)
-    "luxo_times", matplotlib.colormaps["YlGnBu"](np.linspace(0.3, 1.0, 256))
-)
 VIEW_MARGIN = 0.08  # m of blank around the lamp
 GROUND_MARGIN = 0.04  # m of ground shown below the lowest ground in view
 ASPECT_RANGE = (0.3, 0.85)  # height / width of a scene; its x or y limits widen to stay inside
@@ -75,7 +70,6 @@ GIF_FPS = 25  # frames per second of motion time
 GIF_MAX_FRAMES = 600
 GIF_HOLD_MS = 1500  # ms the last frame stays up before the loop restarts
 FOLLOW_WIDTH = 3.0  # m: a lamp ranging wider in x is followed by a view this wide (at least)
-COLORBAR_SPACE = 1.05  # inches right of a scene for its colour bar and label
 SERIES_WIDTH = 7.2  # inches, the data area of the time series
 SIDE_LEGEND = 2.0  # inches right of the time series for their legends
 WEIGHT_COLOR = "0.35"
@@ -259,18 +253,6 @@ class _Lamp:
         self.head.set_facecolor(color)
 
 
-def _draw_terrain(ax: Axes, terrain: list, bottom: float) -> None:
-    """The terrain polyline, the ground below it filled grey down to ``bottom`` (m)."""
-    if not terrain:
-        return
-    ground = np.asarray(terrain, dtype=np.float64)
-    below = [[ground[-1, 0], bottom], [ground[0, 0], bottom]]
-    ax.add_patch(
-        Polygon(np.vstack([ground, below]), closed=True, facecolor=TERRAIN_FACE, edgecolor="none")
-    )
-    ax.plot(ground[:, 0], ground[:, 1], color=TERRAIN_EDGE, linewidth=1.2, zorder=1.5)
-
-
 def _ground_range(terrain: list, x0: float, x1: float) -> tuple[float, float] | None:
     """The lowest and highest ground between x0 and x1 (m), None without terrain."""
     if not terrain:
@@ -309,43 +291,6 @@ def fit_aspect(limits: np.ndarray) -> np.ndarray:
     elif height > most * width:
         limits[:, 0] += np.array([-1, 1]) * (height / most - width) / 2
     return limits
-
-
-def _scene_figure(
-    limits: np.ndarray,
-    width: float,
-    header_lines: int,
-    legend_rows: int,
-    colorbar: bool = False,
-    dpi: float | None = None,
-) -> tuple[Figure, Axes, Axes | None]:
-    """A figure with one equal-aspect panel ``width`` inches wide showing ``limits``, sized in
-    inches so that its box has their aspect: room above for ``header_lines`` lines of title,
-    below for the axis label and a legend of ``legend_rows`` rows, on the right for a colour
-    bar."""
-    (x0, y0), (x1, y1) = limits
-    height = width * (y1 - y0) / (x1 - x0)
-    top = MARGIN_TOP + TITLE_LINE * header_lines + 0.1
-    bottom = MARGIN_BOTTOM + (LEGEND_ROW * (legend_rows + 1) if legend_rows else 0.0)
-    right = MARGIN_RIGHT + (COLORBAR_SPACE if colorbar else 0.0)
-    fig_width = MARGIN_LEFT + width + right
-    fig_height = top + height + bottom
-    figure = new_figure(fig_width, fig_height)
-    if dpi is not None:
-        figure.set_dpi(dpi)
-    ax = figure.add_axes(
-        (MARGIN_LEFT / fig_width, bottom / fig_height, width / fig_width, height / fig_height)
-    )
-    ax.set_xlim(x0, x1)
-    ax.set_ylim(y0, y1)
-    ax.set_aspect("equal", adjustable="box")
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    bar = None
-    if colorbar:
-        left = (MARGIN_LEFT + width + 0.2) / fig_width
-        bar = figure.add_axes((left, bottom / fig_height, 0.16 / fig_width, height / fig_height))
-    return figure, ax, bar
 
 
 # --------------------------------------------------------------------------- the plots
@@ -397,8 +342,8 @@ def plot_motion_strip(
         (Line2D([], [], color=COM_COLOR, linestyle=":", linewidth=1.2), "centre of mass"),
     ]
     with plot_style():
-        figure, ax, bar = _scene_figure(limits, STRIP_WIDTH, 2, legend_rows=1, colorbar=True)
-        _draw_terrain(ax, figure_motion.terrain, limits[0, 1] - 1.0)
+        figure, ax, bar = scene_figure(limits, STRIP_WIDTH, 2, legend_rows=1, colorbar=True)
+        draw_terrain(ax, figure_motion.terrain, limits[0, 1] - 1.0)
         ax.plot(com[:, 0], com[:, 1], color=COM_COLOR, linestyle=":", linewidth=1.2, zorder=2.5)
         rods = endpoints.shape[1]
         for k, sample in enumerate(samples):
@@ -410,17 +355,6 @@ def plot_motion_strip(
         ax.set_title(title)
         add_legend(figure, legend, ncols=3)
         save_png(figure, out_path)
-
-
-def _frame_samples(t: np.ndarray, fps: int, max_frames: int) -> tuple[np.ndarray, float]:
-    """The samples a GIF shows, one per 1/fps s of motion time (the step widened to keep to
-    ``max_frames``), the last sample always included; and the step, s."""
-    span = float(t[-1] - t[0])
-    step = max(1.0 / fps, span / (max_frames - 1)) if span > 0 else 1.0 / fps
-    samples = frame_indices(t, step)
-    if samples[-1] != len(t) - 1:
-        samples = np.append(samples[: max_frames - 1], len(t) - 1)
-    return samples, step
 
 
 def _motion_at(found: Sequence[Motion], samples: np.ndarray) -> np.ndarray:
@@ -462,7 +396,7 @@ def write_show_gif(
     trajectory = read_luxo_trajectory(trajectory_path)
     figure_motion = trajectory.motion
     t, endpoints = trajectory.t, figure_motion.endpoints
-    samples, step = _frame_samples(t, int(fps), int(max_frames))
+    samples, step = frame_samples(t, int(fps), int(max_frames))
     head = head_rod(figure_motion.rod_names)
     kinds = [str(kind) for kind in trajectory.attrs.get("controller_kinds", [])]
     kinds += ["controller"] * (len(trajectory.controllers) - len(kinds))
@@ -492,10 +426,10 @@ def write_show_gif(
     ]
     ncols = min(2, len(legend))
     with plot_style():
-        figure, ax, _ = _scene_figure(
+        figure, ax, _ = scene_figure(
             limits, GIF_WIDTH, 3, legend_rows=-(-len(legend) // ncols), dpi=GIF_DPI
         )
-        _draw_terrain(ax, figure_motion.terrain, limits[0, 1] - 1.0)
+        draw_terrain(ax, figure_motion.terrain, limits[0, 1] - 1.0)
         figure.suptitle(
             f"Luxo: {_script_name(trajectory, trajectory_path)}",
             y=1 - 0.08 / figure.get_size_inches()[1],

@@ -16,9 +16,11 @@ import numpy as np
 from matplotlib.artist import Artist
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.colors import LinearSegmentedColormap
 from matplotlib.figure import Figure
 from matplotlib.legend_handler import HandlerTuple
 from matplotlib.lines import Line2D
+from matplotlib.patches import Polygon
 
 from mosys.io.atomic import write_atomically
 
@@ -178,9 +180,83 @@ def add_legend(
     arrange(figure, legend_rows=-(-len(entries) // ncols))
 
 
+# --------------------------------------------------------------------------- scenes
+
+# Scenes draw an articulated figure (``figure_motion``) to scale in metres, y up, over its terrain.
+TERRAIN_FACE, TERRAIN_EDGE = "0.8", "0.35"
+POSE_TIMES = LinearSegmentedColormap.from_list(  # poses, light (start) to dark (end)
+    "pose_times", matplotlib.colormaps["YlGnBu"](np.linspace(0.3, 1.0, 256))
+)
+COLORBAR_SPACE = 1.05  # inches right of a scene for its colour bar and label
+
+
+def draw_terrain(ax: Axes, terrain: list, bottom: float) -> None:
+    """The terrain polyline (``figure_motion``'s ``terrain``: [x, y] vertices, m), the ground
+    below it filled grey down to ``bottom`` (m). Nothing for an empty terrain."""
+    if not terrain:
+        return
+    ground = np.asarray(terrain, dtype=np.float64)
+    below = [[ground[-1, 0], bottom], [ground[0, 0], bottom]]
+    ax.add_patch(
+        Polygon(np.vstack([ground, below]), closed=True, facecolor=TERRAIN_FACE, edgecolor="none")
+    )
+    ax.plot(ground[:, 0], ground[:, 1], color=TERRAIN_EDGE, linewidth=1.2, zorder=1.5)
+
+
+def scene_figure(
+    limits: np.ndarray,
+    width: float,
+    header_lines: int,
+    legend_rows: int,
+    colorbar: bool = False,
+    dpi: float | None = None,
+) -> tuple[Figure, Axes, Axes | None]:
+    """A figure with one equal-aspect panel ``width`` inches wide showing ``limits``
+    [[xmin, ymin], [xmax, ymax]] (m), sized in inches so that its box has their aspect: room
+    above for ``header_lines`` lines of title, below for the axis label and a legend of
+    ``legend_rows`` rows, on the right for a colour bar (the returned third axes, else None)."""
+    (x0, y0), (x1, y1) = limits
+    height = width * (y1 - y0) / (x1 - x0)
+    top = MARGIN_TOP + TITLE_LINE * header_lines + 0.1
+    bottom = MARGIN_BOTTOM + (LEGEND_ROW * (legend_rows + 1) if legend_rows else 0.0)
+    right = MARGIN_RIGHT + (COLORBAR_SPACE if colorbar else 0.0)
+    fig_width = MARGIN_LEFT + width + right
+    fig_height = top + height + bottom
+    figure = new_figure(fig_width, fig_height)
+    if dpi is not None:
+        figure.set_dpi(dpi)
+    ax = figure.add_axes(
+        (MARGIN_LEFT / fig_width, bottom / fig_height, width / fig_width, height / fig_height)
+    )
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    bar = None
+    if colorbar:
+        left = (MARGIN_LEFT + width + 0.2) / fig_width
+        bar = figure.add_axes((left, bottom / fig_height, 0.16 / fig_width, height / fig_height))
+    return figure, ax, bar
+
+
 # --------------------------------------------------------------------------- animations
 
 GIF_DPI = 80  # dots per inch of animation frames
+
+
+def frame_samples(t: np.ndarray, fps: int, max_frames: int) -> tuple[np.ndarray, float]:
+    """The samples of ``t`` (s, non-decreasing) an animation shows, one per 1/fps s of motion
+    time (the step widened to keep to ``max_frames``), the last sample always included; and
+    the step, s."""
+    from mosys.plots.car import frame_indices  # here: car imports this module
+
+    span = float(t[-1] - t[0])
+    step = max(1.0 / fps, span / (max_frames - 1)) if span > 0 else 1.0 / fps
+    samples = frame_indices(t, step)
+    if samples[-1] != len(t) - 1:
+        samples = np.append(samples[: max_frames - 1], len(t) - 1)
+    return samples, step
 
 
 def animation_frames(

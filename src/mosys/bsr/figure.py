@@ -1,0 +1,169 @@
+"""A ``.fig`` figure laid out for the BSR simulator (``kernels.bsr_simulate``).
+
+A BSR figure is a tree of rods with a ``free`` root and ``hinge`` joints, every hinge with a
+``limit`` line giving its range (the target poses of Table 2 are drawn in it; the simulator's joints
+are kinematic, so the limit's stiffness and damping are not used), on a flat ``terrain floor`` (or
+no terrain). Its contact points are its rod endpoints: where a child hangs on an end of its parent
+the two ends are one endpoint, so a tree of N rods hinged end to end has N + 1.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from mosys.parsing.figure import Figure
+from mosys.parsing.tokens import SpecError
+
+_SAME_POINT = 1e-12  # m: a hinge this close to an end of its parent sits on that endpoint
+
+
+@dataclass(frozen=True)
+class BsrFigure:
+    """Arrays of ``kernels.bsr_simulate`` (rods in file order, which the binding checks puts
+    every parent first). ``joint_names``: the hinges' angle coordinates (J), in θ order;
+    ``joint_min``/``joint_max``: (J,) rad; ``endpoints``: (E, 2) int64 rod and end (0 proximal,
+    1 distal) of each distinct endpoint; ``endpoint_names``: ``ROD.proximal``/``ROD.distal``;
+    ``floor``: the floor's height, m (nan: none); ``root_angle``, ``root_x``: the free root's
+    angle and x coordinate names."""
+
+    figure: Figure
+    parent: np.ndarray
+    hinge: np.ndarray
+    offset: np.ndarray
+    length: np.ndarray
+    mass: np.ndarray
+    com: np.ndarray
+    inertia: np.ndarray
+    joint: np.ndarray
+    joint_names: tuple[str, ...]
+    joint_min: np.ndarray
+    joint_max: np.ndarray
+    endpoints: np.ndarray
+    endpoint_names: tuple[str, ...]
+    floor: float
+    gravity: float
+    root_angle: str
+    root_x: str
+
+    @property
+    def total_mass(self) -> float:
+        return float(self.mass.sum())
+
+    @property
+    def reach(self) -> float:
+        """The sum of the rods' lengths, m: the scale of the height sense variable."""
+        return float(self.length.sum())
+
+    @property
+    def sense_names(self) -> tuple[str, ...]:
+        """Table 1's sense variables: joint angles, endpoint contact forces, y_cm, y_cm rate."""
+        return (
+            self.joint_names
+            + tuple(f"force_{name}" for name in self.endpoint_names)
+            + ("y_cm", "vy_cm")
+        )
+
+    @property
+    def kernel_arrays(self) -> tuple:
+        """The figure's arrays in the order the kernels take them."""
+        return (
+            self.parent,
+            self.hinge,
+            self.offset,
+            self.length,
+            self.mass,
+            self.com,
+            self.inertia,
+            self.joint,
+            self.endpoints,
+            self.joint_min,
+            self.joint_max,
+        )
+
+
+def bsr_figure(figure: Figure) -> BsrFigure:
+    """Lay out ``figure`` for the BSR simulator; a figure it cannot simulate raises SpecError
+    at the offending line (a pinned root, a hinge out of order or without a limit, terrain that
+    is not a flat floor)."""
+    root = figure.root
+    if root.kind != "free":
+        raise SpecError.at(figure.path, root.token, "a 'free' root (BSR figures fly and fall)")
+    names = [rod.name for rod in figure.rods]
+    if names[0] != root.rod:
+        raise SpecError.at(figure.path, figure.rods[0].token, f"the root rod '{root.rod}' first")
+    index = {name: i for i, name in enumerate(names)}
+    limits = {limit.rod: limit for limit in figure.limits}
+    n = len(names)
+    parent = np.full(n, -1, np.int64)
+    hinge = np.zeros(n)
+    offset = np.zeros(n)
+    joint = np.full(n, -1, np.int64)
+    joint_names: list[str] = []
+    joint_min: list[float] = []
+    joint_max: list[float] = []
+    for i, rod in enumerate(figure.rods):
+        spec = figure.joint(rod.name)
+        if spec.kind != "hinge":
+            continue
+        assert spec.parent is not None
+        if index[spec.parent] >= i:
+            raise SpecError.at(figure.path, rod.token, f"rod '{spec.parent}' before its child")
+        limit = limits.get(rod.name)
+        if limit is None or not (math.isfinite(limit.lower) and math.isfinite(limit.upper)):
+            raise SpecError.at(
+                figure.path, spec.token, f"a 'limit {rod.name} lower=... upper=...' line"
+            )
+        parent[i] = index[spec.parent]
+        hinge[i] = spec.position
+        offset[i] = spec.offset
+        joint[i] = len(joint_names)
+        joint_names.append(spec.coordinates[-1].name)
+        joint_min.append(limit.lower)
+        joint_max.append(limit.upper)
+    terrain = figure.terrain
+    if terrain.kind not in ("none", "floor"):
+        raise SpecError(figure.path, 1, 1, "a flat 'terrain floor' for a BSR figure", None)
+    length = np.array([rod.length for rod in figure.rods])
+    return BsrFigure(
+        figure=figure,
+        parent=parent,
+        hinge=hinge,
+        offset=offset,
+        length=length,
+        mass=np.array([rod.mass for rod in figure.rods]),
+        com=np.array([rod.com for rod in figure.rods]),
+        inertia=np.array([rod.inertia for rod in figure.rods]),
+        joint=joint,
+        joint_names=tuple(joint_names),
+        joint_min=np.array(joint_min),
+        joint_max=np.array(joint_max),
+        endpoints=_distinct_endpoints(parent, hinge, length),
+        endpoint_names=tuple(
+            f"{names[rod]}.{('proximal', 'distal')[end]}"
+            for rod, end in _distinct_endpoints(parent, hinge, length)
+        ),
+        floor=terrain.height if terrain.kind == "floor" else math.nan,
+        gravity=figure.gravity,
+        root_angle=root.coordinates[2].name,
+        root_x=root.coordinates[0].name,
+    )
+
+
+def _distinct_endpoints(parent: np.ndarray, hinge: np.ndarray, length: np.ndarray) -> np.ndarray:
+    """(E, 2) rod and end of every distinct endpoint: a child's proximal end that sits on an
+    end of its parent is that end, not a new point."""
+    owner: dict[tuple[int, int], tuple[int, int]] = {}
+    for k in range(parent.shape[0]):
+        owner[(k, 1)] = (k, 1)
+        p = parent[k]
+        if p >= 0 and abs(hinge[k]) <= _SAME_POINT:
+            owner[(k, 0)] = owner[(p, 0)]
+        elif p >= 0 and abs(hinge[k] - length[p]) <= _SAME_POINT:
+            owner[(k, 0)] = owner[(p, 1)]
+        else:
+            owner[(k, 0)] = (k, 0)
+    distinct = sorted(set(owner.values()))
+    return np.array(distinct, np.int64).reshape(-1, 2)

@@ -1,0 +1,368 @@
+"""The serial search of the 1995 paper's Figure 3 for a BSR controller.
+
+C controllers are drawn from Table 2's distributions and evaluated; then, for G generations, each
+is mutated (one rule re-initialised with probability ``reinitialize``, else one rule crept) and
+the mutant replaces it if it is fitter; every ``reseed`` generations the worse half of the set is
+replaced by copies of the better half. All random numbers come, in a fixed order, from one
+generator seeded with the search's seed, and each generation's C simulations are independent, so
+a seed gives the same result whatever the number of threads that run them.
+
+Choices where the paper is silent (documented in the README): creep perturbs every parameter of
+the rule (target angles by N(0, 0.1 range), tau by a factor exp N(0, 0.2), centres by N(0, 0.1),
+sides by a factor exp N(0, 0.1), a time segment's weight by exp N(0, 0.2)), each clipped to Table
+2's range; a re-initialised sense rule puts one corner of its new hyper-rectangle (sides drawn as
+Table 2) on the sense vector at a random step of the parent's run; a time-based rule's segment
+length is its weight over the sum of weights times t_per, weights drawn uniformly in [0.2, 1].
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from mosys.bsr.controller import CENTER_MAX, CENTER_MIN, SIDE_MAX, SIDE_MIN, BsrController
+from mosys.bsr.figure import BsrFigure
+from mosys.bsr.spec import BsrSpec
+from mosys.bsr.start import perturbed_state, standing_state
+from mosys.kernels.bsr_run import TERMS, run_controller, run_population
+from mosys.parsing.tokens import SpecError
+from mosys.progress import Progress
+
+SEGMENT_WEIGHT_MIN = 0.2
+SEGMENT_WEIGHT_MAX = 1.0
+CREEP_TARGET = 0.1  # of the joint's range
+CREEP_LOG_TAU = 0.2
+CREEP_CENTER = 0.1
+CREEP_LOG_SIDE = 0.1
+CREEP_LOG_SEGMENT = 0.2
+
+
+@dataclass(frozen=True)
+class SearchSetup:
+    """A spec bound to its figure: the nominal start pose (root angle rad, joints (J,) rad, x
+    m), the fall endpoints' indices, the term weights in ``TERMS`` order, and the budget."""
+
+    spec: BsrSpec
+    figure: BsrFigure
+    root_angle: float
+    joints: np.ndarray
+    x: float
+    fall_endpoints: np.ndarray
+    weights: np.ndarray
+    generations: int
+
+    @property
+    def tau_range(self) -> tuple[float, float]:
+        """Table 2: tau in [2 dt, T / 4], s (from tau_min if the spec raises the floor)."""
+        low = 2.0 * self.spec.dt if self.spec.tau_min is None else self.spec.tau_min
+        return low, self.spec.duration / 4.0
+
+    @property
+    def period(self) -> float:
+        return self.spec.duration if self.spec.period is None else self.spec.period
+
+
+@dataclass(frozen=True)
+class SearchOutcome:
+    """What a search found: the learning curve (evaluations (M,), best fitness (M,)), the best
+    controller, its fitness during the search, and its run from the nominal start (terms as
+    ``TERMS``, the active rule (steps + 1,), rod ends (steps + 1, N, 2, 2) m, com
+    (steps + 1, 2) m), the wall time s and the simulated steps per second."""
+
+    evaluations: np.ndarray
+    best_fitness: np.ndarray
+    controller: BsrController
+    fitness: float
+    nominal_fitness: float
+    terms: np.ndarray
+    active_rule: np.ndarray
+    rod_ends: np.ndarray
+    com: np.ndarray
+    wall_seconds: float
+    steps_per_second: float
+
+    def terms_json(self) -> str:
+        return json.dumps({name: float(value) for name, value in zip(TERMS, self.terms)})
+
+
+def bind_search(spec: BsrSpec, figure: BsrFigure, generations: int | None = None) -> SearchSetup:
+    """Check the spec's names against the figure (start coordinates, fall endpoints) and lay
+    out its numbers; a name the figure lacks raises SpecError at its word. ``generations``
+    overrides the spec's G (a reduced budget)."""
+    known = {figure.root_angle: "angle", figure.root_x: "x"}
+    known.update({name: "joint" for name in figure.joint_names})
+    joints = np.zeros(len(figure.joint_names))
+    root_angle = 0.0
+    x = 0.0
+    for name, value in spec.start.items():
+        kind = known.get(name)
+        if kind is None:
+            raise SpecError.at(
+                spec.path,
+                spec.tokens[f"start.{name}"],
+                f"a coordinate of figure '{figure.figure.name}' ({', '.join(known)})",
+            )
+        if kind == "x":
+            x = value
+        elif kind == "angle":
+            root_angle = math.radians(value)
+        else:
+            joints[figure.joint_names.index(name)] = math.radians(value)
+    fall = []
+    for i, endpoint in enumerate(spec.fall):
+        name = f"{endpoint.rod}.{endpoint.end}"
+        if name not in figure.endpoint_names:
+            raise SpecError.at(
+                spec.path,
+                spec.tokens[f"fall.{i}"],
+                f"an endpoint of figure '{figure.figure.name}' ({', '.join(figure.endpoint_names)})",
+            )
+        fall.append(figure.endpoint_names.index(name))
+    return SearchSetup(
+        spec=spec,
+        figure=figure,
+        root_angle=root_angle,
+        joints=joints,
+        x=x,
+        fall_endpoints=np.array(fall, np.int64),
+        weights=np.array([spec.weights.get(term, 0.0) for term in TERMS]),
+        generations=spec.generations if generations is None else generations,
+    )
+
+
+class _Population:
+    """C controllers as stacked arrays (what ``run_population`` takes), their fitness and the
+    sense trajectory of each one's last run (for the relevance heuristic)."""
+
+    def __init__(self, setup: SearchSetup, rng: np.random.Generator):
+        spec, figure = setup.spec, setup.figure
+        c, r, j, v = spec.controllers, spec.rules, len(figure.joint_names), 0
+        if spec.kind == "sense":
+            v = len(figure.sense_names)
+        self.setup = setup
+        self.target = np.empty((c, r, j))
+        self.tau = np.empty((c, r))
+        self.center = np.empty((c, r, v))
+        self.side = np.empty((c, r, v))
+        self.segment = np.ones((c, r))
+        for k in range(c):
+            for i in range(r):
+                self.draw_rule(k, i, rng, None)
+        self.fitness = np.full(c, -np.inf)
+        self.senses = np.zeros((c, spec.steps + 1, len(figure.sense_names)))
+
+    def draw_rule(self, k: int, i: int, rng: np.random.Generator, senses: np.ndarray | None):
+        """Rule i of controller k from Table 2; with senses (steps + 1, V), a corner of its
+        hyper-rectangle on a random one of them (the relevance heuristic)."""
+        figure = self.setup.figure
+        low, high = self.setup.tau_range
+        self.target[k, i] = rng.uniform(figure.joint_min, figure.joint_max)
+        self.tau[k, i] = math.exp(rng.uniform(math.log(low), math.log(high)))
+        v = self.center.shape[2]
+        if v:
+            self.side[k, i] = np.exp(rng.uniform(math.log(SIDE_MIN), math.log(SIDE_MAX), v))
+            if senses is None:
+                self.center[k, i] = rng.uniform(CENTER_MIN, CENTER_MAX, v)
+            else:
+                corner = senses[rng.integers(senses.shape[0])]
+                sign = rng.choice(np.array([-1.0, 1.0]), v)
+                self.center[k, i] = corner + sign * self.side[k, i] / 2.0
+        else:
+            self.segment[k, i] = rng.uniform(SEGMENT_WEIGHT_MIN, SEGMENT_WEIGHT_MAX)
+
+    def creep_rule(self, k: int, i: int, rng: np.random.Generator):
+        """Perturb every parameter of rule i of controller k slightly, within Table 2's ranges."""
+        figure = self.setup.figure
+        low, high = self.setup.tau_range
+        span = figure.joint_max - figure.joint_min
+        self.target[k, i] = np.clip(
+            self.target[k, i] + rng.normal(0.0, CREEP_TARGET, span.shape) * span,
+            figure.joint_min,
+            figure.joint_max,
+        )
+        self.tau[k, i] = np.clip(self.tau[k, i] * math.exp(rng.normal(0.0, CREEP_LOG_TAU)), low, high)
+        v = self.center.shape[2]
+        if v:
+            self.center[k, i] = np.clip(
+                self.center[k, i] + rng.normal(0.0, CREEP_CENTER, v), CENTER_MIN, CENTER_MAX
+            )
+            self.side[k, i] = np.clip(
+                self.side[k, i] * np.exp(rng.normal(0.0, CREEP_LOG_SIDE, v)), SIDE_MIN, SIDE_MAX
+            )
+        else:
+            self.segment[k, i] = np.clip(
+                self.segment[k, i] * math.exp(rng.normal(0.0, CREEP_LOG_SEGMENT)),
+                SEGMENT_WEIGHT_MIN,
+                SEGMENT_WEIGHT_MAX,
+            )
+
+    def copy_from(self, other: _Population, k_to: int, k_from: int) -> None:
+        for name in ("target", "tau", "center", "side", "segment", "senses", "fitness"):
+            getattr(self, name)[k_to] = getattr(other, name)[k_from]
+
+    def segment_end(self) -> np.ndarray:
+        """(C, R) cumulative segment ends, s (time-based)."""
+        weights = self.segment / self.segment.sum(axis=1, keepdims=True)
+        ends = np.cumsum(weights, axis=1) * self.setup.period
+        ends[:, -1] = self.setup.period
+        return ends
+
+    def controller(self, k: int) -> BsrController:
+        spec = self.setup.spec
+        segment = np.diff(self.segment_end()[k], prepend=0.0) if spec.kind == "time" else None
+        return BsrController(
+            kind=spec.kind,
+            target=self.target[k].copy(),
+            tau=self.tau[k].copy(),
+            center=self.center[k].copy(),
+            side=self.side[k].copy(),
+            segment=np.zeros(0) if segment is None else segment,
+            period=self.setup.period if spec.kind == "time" else math.nan,
+        )
+
+
+def _evaluate(setup: SearchSetup, population: _Population, rng: np.random.Generator):
+    """Run every controller of the population once (from the nominal start, or a perturbed
+    one per controller); returns the fitness (C,), and fills population.senses."""
+    spec, figure = setup.spec, setup.figure
+    c = spec.controllers
+    if spec.perturbation.any:
+        starts = np.stack(
+            [
+                perturbed_state(
+                    figure, setup.root_angle, setup.joints, setup.x, spec.perturbation, rng
+                )
+                for _ in range(c)
+            ]
+        )
+    else:
+        start = standing_state(figure, setup.root_angle, setup.joints, setup.x)
+        starts = np.repeat(start[None, :], c, axis=0)
+    rules = np.zeros((c, spec.steps + 1), np.int64)
+    terms = np.zeros((c, len(TERMS)))
+    run_population(
+        *figure.kernel_arrays,
+        figure.gravity,
+        figure.floor,
+        figure.reach,
+        spec.kind == "time",
+        population.target,
+        population.tau,
+        population.center,
+        population.side,
+        population.segment_end(),
+        setup.period,
+        starts,
+        spec.steps,
+        spec.dt,
+        setup.fall_endpoints,
+        population.senses,
+        rules,
+        terms,
+    )
+    return terms @ setup.weights
+
+
+def run_search(setup: SearchSetup, seed: int, label: str = "search") -> SearchOutcome:
+    """Figure 3 with the setup's C, G and reseed period, seeded with ``seed``; reports
+    progress (generations, rate, ETA, best fitness) on stderr."""
+    spec = setup.spec
+    c = spec.controllers
+    rng = np.random.default_rng(seed)
+    began = time.perf_counter()
+    current = _Population(setup, rng)
+    current.fitness[:] = _evaluate(setup, current, rng)
+    mutant = _Population.__new__(_Population)
+    mutant.__dict__.update({name: np.copy(value) for name, value in vars(current).items()})
+    mutant.setup = setup
+    best_k = int(np.argmax(current.fitness))
+    best = current.controller(best_k)
+    best_fitness = float(current.fitness[best_k])
+    evaluations = [c]
+    curve = [best_fitness]
+    progress = Progress(label, setup.generations, "generations")
+    for generation in range(1, setup.generations + 1):
+        for k in range(c):
+            mutant.copy_from(current, k, k)
+            i = int(rng.integers(spec.rules))
+            if rng.random() < spec.reinitialize:
+                mutant.draw_rule(k, i, rng, current.senses[k] if spec.kind == "sense" else None)
+            else:
+                mutant.creep_rule(k, i, rng)
+        fitness = _evaluate(setup, mutant, rng)
+        for k in range(c):
+            if fitness[k] > current.fitness[k]:
+                current.copy_from(mutant, k, k)
+                current.fitness[k] = fitness[k]
+        k = int(np.argmax(current.fitness))
+        if current.fitness[k] > best_fitness:
+            best_fitness = float(current.fitness[k])
+            best = current.controller(k)
+        if generation % spec.reseed == 0:
+            order = np.argsort(-current.fitness, kind="stable")
+            half = c // 2
+            for worse, better in zip(order[c - half :], order[:half]):
+                current.copy_from(current, int(worse), int(better))
+        evaluations.append(c * (generation + 1))
+        curve.append(best_fitness)
+        progress.update(generation, f"best fitness {best_fitness:.3f}")
+    progress.finish(f"best fitness {best_fitness:.3f}")
+    wall = time.perf_counter() - began
+    run = nominal_run(setup, best)
+    return SearchOutcome(
+        evaluations=np.array(evaluations, np.int64),
+        best_fitness=np.array(curve),
+        controller=best,
+        fitness=best_fitness,
+        nominal_fitness=float(run[0] @ setup.weights),
+        terms=run[0],
+        active_rule=run[1],
+        rod_ends=run[2],
+        com=run[3],
+        wall_seconds=wall,
+        steps_per_second=evaluations[-1] * spec.steps / wall,
+    )
+
+
+def nominal_run(setup: SearchSetup, controller: BsrController):
+    """Run one controller from the nominal start, recording everything: returns terms
+    (len(TERMS),), active rule (steps + 1,), rod ends (steps + 1, N, 2, 2) m, com
+    (steps + 1, 2) m."""
+    spec, figure = setup.spec, setup.figure
+    steps = spec.steps
+    n_rods = figure.parent.shape[0]
+    senses = np.zeros((steps + 1, len(figure.sense_names)))
+    rules = np.zeros(steps + 1, np.int64)
+    terms = np.zeros(len(TERMS))
+    ends = np.zeros((steps + 1, n_rods, 2, 2))
+    com = np.zeros((steps + 1, 2))
+    segment_end = np.cumsum(controller.segment) if controller.kind == "time" else np.zeros(0)
+    if controller.kind == "time":
+        segment_end[-1] = controller.period
+    run_controller(
+        *figure.kernel_arrays,
+        figure.gravity,
+        figure.floor,
+        figure.reach,
+        controller.kind == "time",
+        controller.target,
+        controller.tau,
+        controller.center,
+        controller.side,
+        segment_end if controller.kind == "time" else np.zeros(controller.rules),
+        controller.period if controller.kind == "time" else 1.0,
+        standing_state(figure, setup.root_angle, setup.joints, setup.x),
+        steps,
+        spec.dt,
+        setup.fall_endpoints,
+        senses,
+        rules,
+        terms,
+        ends,
+        com,
+    )
+    return terms, rules, ends, com

@@ -1,0 +1,113 @@
+"""The BSR search result contract (DESIGN.md, ``results/bsr/NAME/seedK.h5``).
+
+Layout of ``best/controller`` (ours; documented in the README): datasets ``target`` (R, J) deg,
+``tau`` (R,) s; sense-based also ``center`` and ``side`` (R, V) in normalised sense units (the
+hyper-rectangle of rule i spans ``center ± side/2``); time-based also ``segment`` (R,) s. Group
+attrs ``kind``, ``period`` (s, time-based; NaN otherwise), ``joint_names``, ``sense_names``.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from mosys.bsr.controller import BsrController
+from mosys.io.atomic import write_atomically
+from mosys.io.attributes import string_tuple
+from mosys.io.trajectory import FigureMotion, read_figure_motion, write_figure_motion
+
+FORMAT_VERSION = 1
+
+
+@dataclass(frozen=True)
+class BsrResult:
+    """One search's result. ``evaluations``/``best_fitness``: (M,) the learning curve;
+    ``controller``: the best controller; ``motion``: its motion from the nominal start;
+    ``active_rule``: (N,) int64, the rule active at each sample of ``motion.t`` (-1: none);
+    ``joint_names`` (J) and ``sense_names`` (V, empty for time-based); ``attrs``: the root
+    attributes of the contract plus ours (``name``, ``budget``, ``generations``,
+    ``controllers``, ``reseed``, ``rules``, ``period``, ``steps_per_second``, ...)."""
+
+    evaluations: np.ndarray
+    best_fitness: np.ndarray
+    controller: BsrController
+    motion: FigureMotion
+    active_rule: np.ndarray
+    joint_names: tuple[str, ...]
+    sense_names: tuple[str, ...]
+    attrs: dict = field(default_factory=dict)
+
+    @property
+    def fitness_terms(self) -> dict[str, float]:
+        return json.loads(self.attrs["fitness_terms"])
+
+    @property
+    def fitness_weights(self) -> dict[str, float]:
+        return json.loads(self.attrs["fitness_weights"])
+
+
+def write_bsr_result(path: str | Path, result: BsrResult) -> None:
+    """Write a result file atomically."""
+
+    def write(partial: Path) -> None:
+        with h5py.File(partial, "w") as h5:
+            curve = h5.create_group("learning_curve")
+            curve.create_dataset("evaluations", data=np.asarray(result.evaluations, np.int64))
+            curve.create_dataset("best_fitness", data=np.asarray(result.best_fitness, np.float64))
+            best = h5.create_group("best")
+            controller = best.create_group("controller")
+            _write_controller(controller, result.controller)
+            controller.attrs["joint_names"] = list(result.joint_names)
+            controller.attrs["sense_names"] = list(result.sense_names)
+            write_figure_motion(best.create_group("figure_motion"), result.motion)
+            best.create_dataset("active_rule", data=np.asarray(result.active_rule, np.int64))
+            h5.attrs["format_version"] = FORMAT_VERSION
+            for key, value in result.attrs.items():
+                h5.attrs[key] = value
+
+    write_atomically(path, write)
+
+
+def _write_controller(group: h5py.Group, controller: BsrController) -> None:
+    group.attrs["kind"] = controller.kind
+    group.create_dataset("target", data=np.degrees(controller.target))
+    group.create_dataset("tau", data=np.asarray(controller.tau, np.float64))
+    if controller.kind == "sense":
+        group.create_dataset("center", data=np.asarray(controller.center, np.float64))
+        group.create_dataset("side", data=np.asarray(controller.side, np.float64))
+        group.attrs["period"] = float("nan")
+    else:
+        group.create_dataset("segment", data=np.asarray(controller.segment, np.float64))
+        group.attrs["period"] = float(controller.period)
+
+
+def read_bsr_result(path: str | Path) -> BsrResult:
+    """Read a result file."""
+    with h5py.File(path, "r") as h5:
+        group = h5["best/controller"]
+        kind = str(group.attrs["kind"])
+        rules = group["tau"].shape[0]
+        empty = np.zeros((rules, 0))
+        controller = BsrController(
+            kind=kind,
+            target=np.radians(group["target"][()]),
+            tau=group["tau"][()],
+            center=group["center"][()] if kind == "sense" else empty,
+            side=group["side"][()] if kind == "sense" else empty,
+            segment=group["segment"][()] if kind == "time" else np.zeros(0),
+            period=float(group.attrs["period"]),
+        )
+        return BsrResult(
+            evaluations=h5["learning_curve/evaluations"][()],
+            best_fitness=h5["learning_curve/best_fitness"][()],
+            controller=controller,
+            motion=read_figure_motion(h5["best/figure_motion"]),
+            active_rule=h5["best/active_rule"][()],
+            joint_names=string_tuple(group.attrs["joint_names"]),
+            sense_names=string_tuple(group.attrs["sense_names"]),
+            attrs={key: h5.attrs[key] for key in h5.attrs},
+        )

@@ -1,0 +1,217 @@
+"""Running a BSR controller (the 1995 paper's Figure 2): the simulator steps, the sense variables
+of Table 1, rule selection, and the fitness terms of the run; a population at once in parallel.
+
+Sense variables (V = J + E + 2, each normalised to [0, 1] and clipped): joint angle j as
+``(θ_j - min_j) / (max_j - min_j)``; the ground's normal force on endpoint e over the figure's
+weight ``f_e / (M g)``; the centre of mass's height over the floor over the figure's reach
+``y_cm / reach``; its vertical velocity ``0.5 + vy / (2 sqrt(2 g reach))``.
+
+Fitness terms (TERMS order): ``distance`` com x at the end minus at the start, m;
+``max_height`` the largest com y, m; ``contact_distance`` the horizontal distance travelled by
+endpoints while they touch the floor (within ``CONTACT_TOLERANCE``) at both ends of a step, m;
+``rotations`` |net rotation of the root rod| / 360°; ``fall`` the fraction of steps that end with
+one of the ``fall`` endpoints touching the floor.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from mosys.kernels.bsr_simulate import (
+    CONTACT_TOLERANCE,
+    CX,
+    CY,
+    JOINTS,
+    PHI,
+    VY,
+    body_frame,
+    step,
+)
+
+TERMS = ("distance", "max_height", "contact_distance", "rotations", "fall")
+SIDE_MAX = 4.0  # the largest hyper-rectangle side (Table 2): lambda_min = 2 / SIDE_MAX
+
+
+@njit(cache=True)
+def measure_senses(state, joint_min, joint_max, end_force, weight, floor, reach, gravity, out):
+    """Fill out (V,) with the normalised sense variables of the state (S,) and the endpoint
+    forces (E,) N; weight = M g, N; reach m."""
+    n_joints = joint_min.shape[0]
+    for j in range(n_joints):
+        value = (state[JOINTS + j] - joint_min[j]) / (joint_max[j] - joint_min[j])
+        out[j] = min(max(value, 0.0), 1.0)
+    for e in range(end_force.shape[0]):
+        out[n_joints + e] = min(max(end_force[e] / weight, 0.0), 1.0)
+    base = 0.0 if math.isnan(floor) else floor
+    out[n_joints + end_force.shape[0]] = min(max((state[CY] - base) / reach, 0.0), 1.0)
+    speed_scale = 2.0 * math.sqrt(2.0 * gravity * reach)
+    out[n_joints + end_force.shape[0] + 1] = min(max(0.5 + state[VY] / speed_scale, 0.0), 1.0)
+
+
+@njit(cache=True)
+def rule_weights(side):
+    """W_i = sum_j log(lambda_ij / lambda_min) of every rule: side (R, V) -> (R,)."""
+    weights = np.zeros(side.shape[0])
+    for i in range(side.shape[0]):
+        for j in range(side.shape[1]):
+            weights[i] += math.log(SIDE_MAX / side[i, j])
+    return weights
+
+
+@njit(cache=True)
+def active_rule(senses, center, side, weights, previous):
+    """The rule with the highest positive score W (1 - max_j [lambda_j (S_j - mu_j)]²), or
+    ``previous`` if no score is positive. senses (V,); center, side (R, V); weights (R,)."""
+    best = previous
+    best_score = 0.0
+    for i in range(center.shape[0]):
+        worst = 0.0
+        for j in range(senses.shape[0]):
+            reach = 2.0 * (senses[j] - center[i, j]) / side[i, j]
+            worst = max(worst, reach * reach)
+            if worst >= 1.0:
+                break
+        score = weights[i] * (1.0 - worst)
+        if score > best_score:
+            best_score = score
+            best = i
+    return best
+
+
+@njit(cache=True)
+def segment_rule(time, segment_end, period):
+    """The rule of a time-based controller at ``time`` s: the segment of ``time mod period``
+    (segment_end (R,): cumulative ends, s, the last equal to period)."""
+    phase = time - period * math.floor(time / period)
+    for i in range(segment_end.shape[0]):
+        if phase < segment_end[i]:
+            return i
+    return segment_end.shape[0] - 1
+
+
+@njit(cache=True)
+def run_controller(
+    parent, hinge, offset, length, mass, com, inertia, joint, endpoints, joint_min, joint_max,
+    gravity, floor, reach, time_based, target, tau, center, side, segment_end, period, start,
+    steps, dt, fall_endpoints, senses_out, rule_out, terms_out, ends_out, com_out,
+):
+    """Run a controller for ``steps`` steps of dt seconds from the state ``start`` (S,).
+
+    Sense-based (time_based False): center, side (R, V) select the rule; time-based:
+    segment_end (R,) and period s do. target (R, J) rad, tau (R,) s. fall_endpoints (F,) int64.
+    Fills senses_out (steps + 1, V) and rule_out (steps + 1,) (sample 0: the start, with rule 0
+    active as Figure 2 begins), terms_out (len(TERMS),), and, if ends_out has steps + 1 rows,
+    ends_out (steps + 1, N, 2, 2) and com_out (steps + 1, 2), world metres.
+    """
+    state = start.copy()
+    n_rods = parent.shape[0]
+    n_ends = endpoints.shape[0]
+    rod_ends = np.empty((n_rods, 2, 2))
+    end_offset = np.empty((n_ends, 2))
+    end_velocity = np.empty((n_ends, 2))
+    end_force = np.zeros(n_ends)
+    end_x = np.empty(n_ends)
+    touching = np.zeros(n_ends, np.bool_)
+    previous = np.zeros(1)
+    scratch = np.empty((n_rods, 8))
+    contact = np.empty((3, 2, 2))
+    entry_x = np.empty(n_ends)
+    weight = mass.sum() * gravity
+    record = ends_out.shape[0] == steps + 1
+    weights = rule_weights(side)
+    # the start: its pose, no forces yet
+    n_joints = joint_min.shape[0]
+    theta = state[JOINTS : JOINTS + n_joints]
+    theta_rate = state[JOINTS + n_joints : JOINTS + 2 * n_joints]
+    _, total_inertia, deformation_momentum = body_frame(
+        parent, hinge, offset, length, mass, com, inertia, joint, endpoints, theta, theta_rate,
+        rod_ends, end_offset, end_velocity, scratch,
+    )
+    previous[0] = deformation_momentum / total_inertia
+    cos_phi = math.cos(state[PHI])
+    sin_phi = math.sin(state[PHI])
+    for e in range(n_ends):
+        end_x[e] = state[CX] + cos_phi * end_offset[e, 0] - sin_phi * end_offset[e, 1]
+        y = state[CY] + sin_phi * end_offset[e, 0] + cos_phi * end_offset[e, 1]
+        touching[e] = not math.isnan(floor) and y <= floor + CONTACT_TOLERANCE
+    if record:
+        for k in range(n_rods):
+            for end in range(2):
+                bx = rod_ends[k, end, 0]
+                by = rod_ends[k, end, 1]
+                ends_out[0, k, end, 0] = state[CX] + cos_phi * bx - sin_phi * by
+                ends_out[0, k, end, 1] = state[CY] + sin_phi * bx + cos_phi * by
+        com_out[0, 0] = state[CX]
+        com_out[0, 1] = state[CY]
+    measure_senses(state, joint_min, joint_max, end_force, weight, floor, reach, gravity,
+                   senses_out[0])
+    rule = 0
+    rule_out[0] = rule
+    start_x = state[CX]
+    start_phi = state[PHI]
+    max_height = state[CY]
+    contact_distance = 0.0
+    fallen_steps = 0
+    for n in range(steps):
+        step(
+            parent, hinge, offset, length, mass, com, inertia, joint, endpoints, joint_min,
+            joint_max, gravity, floor, state, target[rule], tau[rule], dt, previous, rod_ends,
+            end_offset, end_velocity, end_force, scratch, contact, entry_x,
+        )
+        cos_phi = math.cos(state[PHI])
+        sin_phi = math.sin(state[PHI])
+        fallen = False
+        for e in range(n_ends):
+            x = state[CX] + cos_phi * end_offset[e, 0] - sin_phi * end_offset[e, 1]
+            y = state[CY] + sin_phi * end_offset[e, 0] + cos_phi * end_offset[e, 1]
+            now_touching = not math.isnan(floor) and y <= floor + CONTACT_TOLERANCE
+            if now_touching and touching[e]:
+                contact_distance += abs(x - end_x[e])
+            end_x[e] = x
+            touching[e] = now_touching
+        for f in range(fall_endpoints.shape[0]):
+            if touching[fall_endpoints[f]]:
+                fallen = True
+        if fallen:
+            fallen_steps += 1
+        max_height = max(max_height, state[CY])
+        measure_senses(state, joint_min, joint_max, end_force, weight, floor, reach, gravity,
+                       senses_out[n + 1])
+        if time_based:
+            rule = segment_rule((n + 1) * dt, segment_end, period)
+        else:
+            rule = active_rule(senses_out[n + 1], center, side, weights, rule)
+        rule_out[n + 1] = rule
+        if record:
+            ends_out[n + 1] = rod_ends
+            com_out[n + 1, 0] = state[CX]
+            com_out[n + 1, 1] = state[CY]
+    terms_out[0] = state[CX] - start_x
+    terms_out[1] = max_height
+    terms_out[2] = contact_distance
+    terms_out[3] = abs(state[PHI] - start_phi) / (2.0 * math.pi)
+    terms_out[4] = fallen_steps / steps
+
+
+@njit(cache=True, parallel=True)
+def run_population(
+    parent, hinge, offset, length, mass, com, inertia, joint, endpoints, joint_min, joint_max,
+    gravity, floor, reach, time_based, target, tau, center, side, segment_end, period, start,
+    steps, dt, fall_endpoints, senses_out, rule_out, terms_out,
+):
+    """``run_controller`` for C controllers at once, in parallel (each run is independent, so
+    the results do not depend on the number of threads). target (C, R, J), tau (C, R),
+    center/side (C, R, V), segment_end (C, R), start (C, S); fills senses_out
+    (C, steps + 1, V), rule_out (C, steps + 1), terms_out (C, len(TERMS))."""
+    no_ends = np.empty((0, parent.shape[0], 2, 2))
+    no_com = np.empty((0, 2))
+    for c in prange(target.shape[0]):
+        run_controller(
+            parent, hinge, offset, length, mass, com, inertia, joint, endpoints, joint_min,
+            joint_max, gravity, floor, reach, time_based, target[c], tau[c], center[c],
+            side[c], segment_end[c], period, start[c], steps, dt, fall_endpoints,
+            senses_out[c], rule_out[c], terms_out[c], no_ends, no_com,
+        )

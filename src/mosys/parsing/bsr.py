@@ -1,0 +1,435 @@
+"""The BSR search spec (``.bsr``): what a search for banked stimulus-response controllers runs
+on (Auslander et al. 1995): the figure, the kind and size of controller, the simulation, the
+genetic search's sizes, the random seeds, the start pose and its perturbation, and the fitness.
+
+::
+
+    # luxo_hop: a sense-based controller that carries Luxo as far as it can
+    figure luxo                                  # the figure: specs/figures/luxo.fig
+    controller sense rules=8                     # R = 8 stimulus-response rules
+    simulate duration=4 dt=0.001                 # T = 4 s in steps of 1 ms (4000 steps)
+    search controllers=40 generations=200 reseed=25 reinitialize=0.25
+    seeds 1 2 3                                  # three independent searches
+    start x=0 base=0 hip=0 elbow=120             # the nominal start pose: m, degrees
+    perturb angle=2 joints=5 speed=0.05 spin=10  # half-widths: deg, deg, m/s, deg/s
+    fitness distance=1 max_height=0.5 fall=-10   # fitness term -> weight
+    fall upper.distal lower.distal               # the endpoints that must not touch the ground
+
+Grammar (one line each; ``#`` comments and blank lines are ignored; every line at most once)::
+
+    figure NAME                             required: the figure spec specs/figures/NAME.fig
+    controller KIND rules=R [period=S]      required. KIND: 'sense' or 'time'; R: whole >= 1.
+                                            period= (s, > 0) only for 'time'; omitted: the
+                                            duration T (an aperiodic sequence of rules)
+    simulate duration=T dt=DT [tau_min=S]   required. T and DT in s, > 0; T / DT a whole number
+                                            (within 1e-9 relative) and 2 DT < T / 4, so that
+                                            Table 2's time-constant range [2 DT, T / 4] is not
+                                            empty. tau_min: the smallest time constant, s, from
+                                            2 DT to below T / 4 (default 2 DT): the paper's
+                                            footnote 2 (a fast deformation needs a huge torque)
+    search controllers=C generations=G reseed=RS [reinitialize=P]
+                                            required. C whole >= 2, G and RS whole >= 1; P the
+                                            probability that a mutation re-initialises a rule
+                                            rather than creeping it, 0 to 1 (default 0.5)
+    seeds K [K ...]                         required: whole numbers >= 0, distinct; one search
+                                            per seed
+    start NAME=VALUE ...                    optional: the nominal start pose, a figure coordinate
+                                            per NAME (m for x and y, degrees for angles), each
+                                            NAME once (default: none)
+    perturb [angle=D] [joints=D] [speed=V] [spin=W]
+                                            optional, at least one key, each >= 0: half-widths of
+                                            the uniform random perturbation of the start state, on
+                                            the root angle (deg), each joint angle (deg), each
+                                            component of the centre of mass's velocity (m/s) and
+                                            the angular velocity (deg/s) (default: all 0)
+    fitness TERM=WEIGHT ...                 required: TERM one of distance, max_height,
+                                            contact_distance, rotations, fall, each once; WEIGHT
+                                            any number
+    fall ROD.END ...                        the endpoints (END: proximal or distal) whose ground
+                                            contact the 'fall' term measures, each once; required
+                                            if fitness names fall=
+
+The parser does not know the figure: start names and fall rods are checked when the spec is bound
+to it, at the tokens kept in ``BsrSpec.tokens``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from pathlib import Path
+
+from mosys.bsr.spec import (
+    CONTROLLER_KINDS,
+    ENDPOINT_ENDS,
+    FITNESS_TERMS,
+    BsrSpec,
+    Endpoint,
+    Perturbation,
+)
+
+# the figure spec's number format (shortest repr, no trailing '.0'); private there, reused here
+from mosys.parsing.figure import _fmt as format_number
+from mosys.parsing.tokens import (
+    NAME,
+    Line,
+    LineReader,
+    SpecError,
+    Token,
+    missing_line,
+    parse_int,
+    parse_number,
+    read_spec_text,
+    tokenize,
+    unknown_keyword,
+    value_token,
+)
+
+KEYWORDS = (
+    *("figure", "controller", "simulate", "search", "seeds"),
+    *("start", "perturb", "fitness", "fall"),
+)
+REQUIRED = ("figure", "controller", "simulate", "search", "seeds", "fitness")
+DEFAULT_REINITIALIZE = 0.5
+# rounding allowed in duration / dt being a whole number of steps, relative
+STEPS_TOLERANCE = 1e-9
+
+# key -> (minimum, what) for whole numbers; (check, what) for numbers, check one of
+# '>0', '>=0', '0..1', None
+_CONTROLLER_KEYS = {"rules": (1, "rules="), "period": (">0", "period= (s)")}
+_SIMULATE_KEYS = {
+    "duration": (">0", "duration= (s)"),
+    "dt": (">0", "dt= (s)"),
+    "tau_min": (">0", "tau_min= (s)"),
+}
+_SEARCH_KEYS = {
+    "controllers": (2, "controllers="),
+    "generations": (1, "generations="),
+    "reseed": (1, "reseed="),
+    "reinitialize": ("0..1", "reinitialize="),
+}
+_PERTURB_KEYS = {
+    "angle": (">=0", "angle= (deg)"),
+    "joints": (">=0", "joints= (deg)"),
+    "speed": (">=0", "speed= (m/s)"),
+    "spin": (">=0", "spin= (deg/s)"),
+}
+_FITNESS_KEYS = {term: (None, f"{term}= (weight)") for term in FITNESS_TERMS}
+
+
+def _expected(check: int | str | None, what: str) -> str:
+    """What a value of ``check`` (a minimum whole number or a number check) is, for errors."""
+    if isinstance(check, int):
+        return f"a whole number >= {check} for {what}"
+    return {
+        ">0": f"a number > 0 for {what}",
+        ">=0": f"a number >= 0 for {what}",
+        "0..1": f"a number from 0 to 1 for {what}",
+        None: f"a number for {what}",
+    }[check]
+
+
+def parse_bsr_spec(path: str | Path) -> BsrSpec:
+    """Parse a ``.bsr`` file; any problem (a missing or unreadable file too, at 1:1) raises
+    SpecError naming file, line and column. ``spec_sha256`` is the SHA-256 of the file's bytes."""
+    text, digest = read_spec_text(path)
+    return parse_bsr_text(text, str(path), digest)
+
+
+def parse_bsr_text(text: str, path: str = "<text>", spec_sha256: str | None = None) -> BsrSpec:
+    """Parse ``.bsr`` text; ``path`` names it in errors and becomes ``BsrSpec.path``.
+    ``spec_sha256`` defaults to the SHA-256 of the text's UTF-8 encoding."""
+    if spec_sha256 is None:
+        spec_sha256 = hashlib.sha256(text.encode("utf-8")).hexdigest()
+    return _Parser(str(path)).parse(tokenize(text, str(path)), spec_sha256)
+
+
+class _Parser:
+    def __init__(self, path: str):
+        self.path = path
+        self.first_line: dict[str, int] = {}  # keyword -> the line number of its line
+        self.tokens: dict[str, Token] = {}
+        self.figure = ""
+        self.kind = ""
+        self.rules = 0
+        self.period: float | None = None
+        self.duration = 0.0
+        self.dt = 0.0
+        self.tau_min: float | None = None
+        self.search: dict[str, int | float] = {}
+        self.seeds: tuple[int, ...] = ()
+        self.start: dict[str, float] = {}
+        self.perturbation = Perturbation()
+        self.weights: dict[str, float] = {}
+        self.fall: tuple[Endpoint, ...] = ()
+        self.fall_weight: Token | None = None  # the fitness line's 'fall=' token
+
+    def error(self, token: Token, expected: str) -> SpecError:
+        return SpecError.at(self.path, token, expected)
+
+    def parse(self, lines: list[Line], spec_sha256: str) -> BsrSpec:
+        for line in lines:
+            keyword = line.keyword
+            if keyword.text not in KEYWORDS:
+                raise unknown_keyword(line, KEYWORDS)
+            if keyword.text in self.first_line:
+                first = self.first_line[keyword.text]
+                raise self.error(
+                    keyword, f"one '{keyword.text}' line only (the first is line {first})"
+                )
+            self.first_line[keyword.text] = line.number
+            getattr(self, f"line_{keyword.text}")(line)
+        for keyword in REQUIRED:
+            if keyword not in self.first_line:
+                raise missing_line(self.path, lines, keyword)
+        if self.fall_weight is not None and "fall" not in self.first_line:
+            raise self.error(
+                self.fall_weight,
+                "a 'fall' line naming the endpoints whose ground contact the fall term "
+                "measures (e.g. 'fall upper.distal')",
+            )
+        return BsrSpec(
+            path=self.path,
+            figure=self.figure,
+            kind=self.kind,
+            rules=self.rules,
+            period=self.period,
+            duration=self.duration,
+            dt=self.dt,
+            controllers=int(self.search["controllers"]),
+            generations=int(self.search["generations"]),
+            reseed=int(self.search["reseed"]),
+            reinitialize=float(self.search.get("reinitialize", DEFAULT_REINITIALIZE)),
+            seeds=self.seeds,
+            start=self.start,
+            perturbation=self.perturbation,
+            weights=self.weights,
+            fall=self.fall,
+            tau_min=self.tau_min,
+            spec_sha256=spec_sha256,
+            tokens=self.tokens,
+        )
+
+    # --- values ---------------------------------------------------------------------------
+
+    def settings(
+        self, line: Line, reader: LineReader, keys: dict[str, tuple], required: tuple[str, ...]
+    ) -> dict[str, Token]:
+        """The ``key=value`` tokens of the rest of the line (``keys`` as ``_SEARCH_KEYS``),
+        key -> the whole token. Unknown or repeated keys, an empty value and a missing
+        ``required`` key are errors."""
+        allowed = {key: _expected(check, what) for key, (check, what) in keys.items()}
+        found = {key: token for key, (token, _) in reader.key_values(allowed).items()}
+        for key in required:
+            if key not in found:
+                raise SpecError(
+                    self.path, line.number, line.end_column, f"'{key}=' ({allowed[key]})", None
+                )
+        return found
+
+    def value(self, token: Token, key: str, check: int | str | None, what: str) -> int | float:
+        """The value of a ``key=value`` token: a whole number (``check`` an int: the minimum)
+        or a number passing ``check``; errors point at the value."""
+        part = value_token(token, key)
+        if isinstance(check, int):
+            return parse_int(part, self.path, what, check)
+        value = parse_number(part, self.path, what)
+        bad = {
+            ">0": value <= 0,
+            ">=0": value < 0,
+            "0..1": not 0 <= value <= 1,
+            None: False,
+        }[check]
+        if bad:
+            raise self.error(part, _expected(check, what))
+        return value
+
+    def values(self, found: dict[str, Token], keys: dict[str, tuple]) -> dict[str, int | float]:
+        """Each found key's value, checked in the order of ``keys``."""
+        return {key: self.value(found[key], key, *keys[key]) for key in keys if key in found}
+
+    def at_least_one(self, line: Line, keys: dict[str, tuple]) -> None:
+        """Fail on a line with nothing after its keyword, expecting one of ``keys``."""
+        if len(line.tokens) == 1:
+            choices = ", ".join(f"'{key}='" for key in keys)
+            raise SpecError(self.path, line.number, line.end_column, f"one of {choices}", None)
+
+    # --- lines ----------------------------------------------------------------------------
+
+    def line_figure(self, line: Line) -> None:
+        reader = line.reader()
+        token = reader.peek()
+        self.figure = reader.name("the figure")
+        reader.end()
+        assert token is not None
+        self.tokens["figure"] = token
+
+    def line_controller(self, line: Line) -> None:
+        reader = line.reader()
+        expected = "a controller kind 'sense' or 'time'"
+        kind = reader.word(expected)
+        if kind.text not in CONTROLLER_KINDS:
+            raise self.error(kind, expected)
+        found = self.settings(line, reader, _CONTROLLER_KEYS, ("rules",))
+        if kind.text == "sense" and "period" in found:
+            raise self.error(
+                found["period"], "end of line (period= is for a 'time' controller only)"
+            )
+        values = self.values(found, _CONTROLLER_KEYS)
+        self.kind = kind.text
+        self.rules = int(values["rules"])
+        self.period = float(values["period"]) if "period" in values else None
+
+    def line_simulate(self, line: Line) -> None:
+        found = self.settings(line, line.reader(), _SIMULATE_KEYS, ("duration", "dt"))
+        values = self.values(found, _SIMULATE_KEYS)
+        duration, dt = float(values["duration"]), float(values["dt"])
+        part = value_token(found["dt"], "dt")
+        steps = duration / dt
+        if not math.isfinite(steps) or abs(steps - round(steps)) > STEPS_TOLERANCE * steps:
+            shown = f"{steps:.6g}" if math.isfinite(steps) else "not finite"
+            raise self.error(
+                part,
+                f"a dt= (s) that divides duration={format_number(duration)} into whole steps "
+                f"({format_number(duration)} / {part.text} = {shown})",
+            )
+        if not 2 * dt < duration / 4:
+            raise self.error(
+                part,
+                f"a number < {format_number(duration / 8)} for dt= (s), so that Table 2's "
+                "time-constant range [2 dt, T/4] is not empty",
+            )
+        self.duration, self.dt = duration, dt
+        if "tau_min" in values:
+            tau_min = float(values["tau_min"])
+            if not 2 * dt <= tau_min < duration / 4:
+                raise self.error(
+                    value_token(found["tau_min"], "tau_min"),
+                    f"a number from 2 dt ({format_number(2 * dt)}) to below T/4 "
+                    f"({format_number(duration / 4)}) for tau_min= (s)",
+                )
+            self.tau_min = tau_min
+
+    def line_search(self, line: Line) -> None:
+        required = ("controllers", "generations", "reseed")
+        found = self.settings(line, line.reader(), _SEARCH_KEYS, required)
+        self.search = self.values(found, _SEARCH_KEYS)
+
+    def line_seeds(self, line: Line) -> None:
+        reader = line.reader()
+        what = "a seed"
+        seeds: dict[int, Token] = {}
+        while True:
+            token = reader.word(f"a whole number >= 0 for {what}")
+            seed = parse_int(token, self.path, what, 0)
+            if seed in seeds:
+                raise self.error(
+                    token, f"distinct seeds ({seed} is already at column {seeds[seed].column})"
+                )
+            seeds[seed] = token
+            if reader.at_end():
+                break
+        self.seeds = tuple(seeds)
+
+    def line_start(self, line: Line) -> None:
+        expected = "a start coordinate 'name=value' (m for x and y, degrees for angles)"
+        if len(line.tokens) == 1:
+            raise SpecError(self.path, line.number, line.end_column, expected, None)
+        for token in line.tokens[1:]:
+            name, sep, _ = token.text.partition("=")
+            if not sep:
+                raise self.error(token, expected)
+            if NAME.fullmatch(name) is None:
+                raise SpecError(
+                    self.path, token.line, token.column, "a coordinate name before '='", name
+                )
+            if name in self.start:
+                raise self.error(token, f"'{name}=' only once")
+            self.start[name] = float(self.value(token, name, None, f"start {name}="))
+            self.tokens[f"start.{name}"] = token
+
+    def line_perturb(self, line: Line) -> None:
+        self.at_least_one(line, _PERTURB_KEYS)
+        found = self.settings(line, line.reader(), _PERTURB_KEYS, ())
+        values = self.values(found, _PERTURB_KEYS)
+        self.perturbation = Perturbation(**{key: float(value) for key, value in values.items()})
+
+    def line_fitness(self, line: Line) -> None:
+        self.at_least_one(line, _FITNESS_KEYS)
+        found = self.settings(line, line.reader(), _FITNESS_KEYS, ())
+        for term, token in found.items():  # file order
+            self.weights[term] = float(self.value(token, term, *_FITNESS_KEYS[term]))
+            self.tokens[f"fitness.{term}"] = token
+        self.fall_weight = found.get("fall")
+
+    def line_fall(self, line: Line) -> None:
+        expected = "an endpoint 'rod.proximal' or 'rod.distal'"
+        if len(line.tokens) == 1:
+            raise SpecError(self.path, line.number, line.end_column, expected, None)
+        endpoints: list[Endpoint] = []
+        for token in line.tokens[1:]:
+            rod, sep, end = token.text.partition(".")
+            if not sep:
+                raise self.error(token, expected)
+            if NAME.fullmatch(rod) is None:
+                raise SpecError(self.path, token.line, token.column, "a rod name before '.'", rod)
+            if end not in ENDPOINT_ENDS:
+                raise SpecError(
+                    self.path,
+                    token.line,
+                    token.column + len(rod) + 1,
+                    f"'proximal' or 'distal' after '{rod}.'",
+                    end,
+                )
+            endpoint = Endpoint(rod, end, token)
+            if endpoint in endpoints:
+                first = endpoints[endpoints.index(endpoint)].token
+                raise self.error(
+                    token, f"each endpoint once ('{first.text}' is at column {first.column})"
+                )
+            self.tokens[f"fall.{len(endpoints)}"] = token
+            endpoints.append(endpoint)
+        self.fall = tuple(endpoints)
+
+
+def render_bsr_spec(spec: BsrSpec) -> str:
+    """The ``.bsr`` text of ``spec``: parsing it gives back an equal BsrSpec (numbers in their
+    shortest form). Optional lines and ``reinitialize=`` are written only when they say
+    something."""
+    number = format_number
+    controller = f"controller {spec.kind} rules={spec.rules}"
+    if spec.period is not None:
+        controller += f" period={number(spec.period)}"
+    search = (
+        f"search controllers={spec.controllers} generations={spec.generations} reseed={spec.reseed}"
+    )
+    if spec.reinitialize != DEFAULT_REINITIALIZE:
+        search += f" reinitialize={number(spec.reinitialize)}"
+    simulate = f"simulate duration={number(spec.duration)} dt={number(spec.dt)}"
+    if spec.tau_min is not None:
+        simulate += f" tau_min={number(spec.tau_min)}"
+    lines = [
+        f"figure {spec.figure}",
+        controller,
+        simulate,
+        search,
+        "seeds " + " ".join(str(seed) for seed in spec.seeds),
+    ]
+    if spec.start:
+        lines.append(
+            "start " + " ".join(f"{name}={number(value)}" for name, value in spec.start.items())
+        )
+    perturbation = spec.perturbation
+    perturb = [
+        f"{key}={number(getattr(perturbation, key))}"
+        for key in _PERTURB_KEYS
+        if getattr(perturbation, key) != 0.0
+    ]
+    if perturb:
+        lines.append("perturb " + " ".join(perturb))
+    lines.append(
+        "fitness " + " ".join(f"{term}={number(weight)}" for term, weight in spec.weights.items())
+    )
+    if spec.fall:
+        lines.append("fall " + " ".join(f"{point.rod}.{point.end}" for point in spec.fall))
+    return "\n".join(lines) + "\n"

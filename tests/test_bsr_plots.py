@@ -1,0 +1,338 @@
+"""The BSR plots (learning curves of Figures 7 and 8, the filmstrip of Figures 9-12, the motion
+GIF) from small synthetic search results: a five-rod star (a torso, two arms at its top, two legs
+at its bottom) turning as it moves, written with ``write_bsr_result`` for a sense-based and a
+time-based search of a few seeds each, with made-up non-decreasing learning curves."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+import mosys.plots.bsr as bsr
+from mosys.bsr.controller import BsrController
+from mosys.cli import main
+from mosys.io.bsr_result import BsrResult, write_bsr_result
+from mosys.io.trajectory import FigureMotion
+from mosys.plots.bsr import (
+    best_result_path,
+    choose_interval,
+    curves_on_grid,
+    fitness_formula,
+    group_by_search,
+    letter_levels,
+    plot_filmstrip,
+    plot_learning,
+    plot_learning_comparison,
+    pose_offsets,
+    read_result,
+    rule_letter,
+    spread_labels,
+    write_motion_gif,
+)
+from mosys.plots.pendulum import PlotInputError
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+DT = 0.01  # s between the samples of the motions
+ROD_NAMES = ("torso", "arm_left", "arm_right", "leg_left", "leg_right")
+# the star in its own frame, m: per rod its proximal then distal end; the torso hip to neck
+STAR = np.array(
+    [
+        [[0.0, -0.35], [0.0, 0.35]],
+        [[0.0, 0.35], [-0.45, 0.75]],
+        [[0.0, 0.35], [0.45, 0.75]],
+        [[0.0, -0.35], [-0.3, -0.95]],
+        [[0.0, -0.35], [0.3, -0.95]],
+    ]
+)
+RULES = 4
+JOINTS = 4
+SENSES = 3
+
+
+def star_motion(duration: float, travel: float, turns: float) -> FigureMotion:
+    """The star over ``duration`` s: its middle moving ``travel`` m along x at 1.05 m up, the
+    whole turning ``turns`` times clockwise, the arms waving."""
+    t = np.arange(0.0, duration + DT / 2, DT)
+    angle = -2 * math.pi * turns * t / duration
+    wave = 0.25 * np.sin(2 * math.pi * t / 0.8)
+    body = np.broadcast_to(STAR, (len(t), *STAR.shape)).copy()
+    for rod, sign in ((1, -1.0), (2, 1.0)):  # the arms about the neck
+        c, s = np.cos(sign * wave), np.sin(sign * wave)
+        arm = body[:, rod, 1] - body[:, rod, 0]
+        body[:, rod, 1, 0] = body[:, rod, 0, 0] + c * arm[:, 0] - s * arm[:, 1]
+        body[:, rod, 1, 1] = body[:, rod, 0, 1] + s * arm[:, 0] + c * arm[:, 1]
+    c, s = np.cos(angle)[:, None, None], np.sin(angle)[:, None, None]
+    x = c * body[..., 0] - s * body[..., 1]
+    y = s * body[..., 0] + c * body[..., 1]
+    com = np.stack([travel * t / duration, np.full_like(t, 1.05)], axis=1)
+    endpoints = np.stack([x, y], axis=-1) + com[:, None, None, :]
+    rods = len(ROD_NAMES)
+    return FigureMotion(
+        t=t,
+        endpoints=endpoints,
+        com=com,
+        rod_names=ROD_NAMES,
+        rod_mass=np.ones(rods),
+        rod_length=np.linalg.norm(STAR[:, 1] - STAR[:, 0], axis=1),
+        rod_com=np.full(rods, 0.5),
+        rod_inertia=np.full(rods, 0.05),
+        gravity=9.81,
+        terrain=[[-1000.0, 0.0], [1000.0, 0.0]],
+        contact="penalty",
+    )
+
+
+def controller(kind: str, period: float) -> BsrController:
+    rng = np.random.default_rng(7)
+    target = rng.uniform(-1.0, 1.0, (RULES, JOINTS))
+    tau = rng.uniform(0.05, 0.3, RULES)
+    if kind == "sense":
+        return BsrController(
+            "sense",
+            target,
+            tau,
+            rng.uniform(-0.5, 1.5, (RULES, SENSES)),
+            rng.uniform(0.4, 4.0, (RULES, SENSES)),
+            np.zeros(0),
+            float("nan"),
+        )
+    segment = np.array([0.3, 0.2, 0.4, 0.1]) * period
+    empty = np.zeros((RULES, 0))
+    return BsrController("time", target, tau, empty, empty, segment, period)
+
+
+def active_rules(kind: str, t: np.ndarray, period: float) -> np.ndarray:
+    """Sense-based: none for the first 0.15 s, then B, C, D, B, ... every 0.35 s; time-based:
+    the segment of the period each sample is in."""
+    if kind == "sense":
+        rules = 1 + (np.floor((t - 0.15) / 0.35).astype(np.int64) % 3)
+        return np.where(t < 0.15, -1, rules)
+    bounds = np.cumsum([0.3, 0.2, 0.4, 0.1])[:-1] * period
+    return np.searchsorted(bounds, np.mod(t, period), side="right").astype(np.int64)
+
+
+def write_search(
+    directory: Path,
+    name: str,
+    kind: str,
+    finals: dict[int, float],
+    travel: float = 0.4,
+    turns: float = 0.5,
+    duration: float = 4.0,
+    budget: int = 5000,
+) -> list[Path]:
+    """One search's result files ``directory/name/seedK.h5``, seed K's best fitness ending at
+    ``finals[K]``; all seeds share the one motion."""
+    period = 1.2
+    motion = star_motion(duration, travel, turns)
+    paths = []
+    for seed, final in finals.items():
+        rng = np.random.default_rng(seed)
+        evaluations = np.arange(100, budget + 1, 100, dtype=np.int64)
+        steps = rng.exponential(1.0, len(evaluations)) * rng.integers(0, 2, len(evaluations))
+        best = np.cumsum(steps / np.arange(1, len(evaluations) + 1))
+        best = 0.15 * final + 0.85 * final * best / best[-1]  # non-decreasing, ending at final
+        terms = {"distance": travel, "rotations": turns, "contact_distance": 0.8, "max_height": 2}
+        result = BsrResult(
+            evaluations=evaluations,
+            best_fitness=best,
+            controller=controller(kind, period),
+            motion=motion,
+            active_rule=active_rules(kind, motion.t, period),
+            joint_names=("shoulder_left", "shoulder_right", "hip_left", "hip_right"),
+            sense_names=("height", "angle", "contact") if kind == "sense" else (),
+            attrs={
+                "name": name,
+                "controller_kind": kind,
+                "seed": seed,
+                "evaluations": budget,
+                "best_fitness": final,
+                "fitness_terms": json.dumps(terms),
+                "fitness_weights": json.dumps(
+                    {"distance": 1.0, "rotations": -0.5, "contact_distance": 0.0}
+                ),
+                "duration": duration,
+                "dt": 0.001,
+                "figure": "starman",
+            },
+        )
+        path = directory / name / f"seed{seed}.h5"
+        path.parent.mkdir(parents=True, exist_ok=True)
+        write_bsr_result(path, result)
+        paths.append(path)
+    return paths
+
+
+@pytest.fixture(scope="module")
+def searches(tmp_path_factory: pytest.TempPathFactory) -> dict[str, list[Path]]:
+    """Two searches: 'star_sense' (3 seeds; seeds 2 and 3 tie for the best) and 'star_time'
+    (2 seeds, a larger fitness scale, a budget of 4000 evaluations)."""
+    root = tmp_path_factory.mktemp("bsr")
+    return {
+        "star_sense": write_search(root, "star_sense", "sense", {3: 2.5, 1: 1.1, 2: 2.5}),
+        "star_time": write_search(
+            root, "star_time", "time", {1: 7.0, 2: 4.0}, travel=2.5, turns=1.0, budget=4000
+        ),
+    }
+
+
+def assert_png(path: Path) -> tuple[int, int]:
+    data = path.read_bytes()
+    assert data.startswith(PNG_MAGIC)
+    assert 10_000 < len(data) < 2_000_000
+    with Image.open(path) as image:
+        width, height = image.size
+    assert 600 < width < 2500 and 300 < height < 2500
+    assert not list(path.parent.glob(".*.partial"))  # written atomically
+    return width, height
+
+
+def test_the_fixture_writes_readable_results(searches: dict[str, list[Path]]) -> None:
+    result = read_result(searches["star_time"][0])
+    assert result.motion.endpoints.shape == (401, 5, 2, 2)
+    assert np.all(np.diff(result.best_fitness) >= 0)
+    assert result.best_fitness[-1] == pytest.approx(7.0)
+    assert set(result.active_rule) == {0, 1, 2, 3}
+    # the legs' ends touch the ground (y 0) when the star is upright
+    assert result.motion.endpoints[0, 3:, 1, 1].min() == pytest.approx(0.1, abs=1e-9)
+
+
+def test_rule_letters() -> None:
+    assert [rule_letter(k) for k in (0, 1, 25, 26, 27)] == ["A", "B", "Z", "AA", "AB"]
+    assert rule_letter(-1) == bsr.NO_RULE
+
+
+def test_best_result_is_the_highest_fitness_ties_to_the_lowest_seed(
+    searches: dict[str, list[Path]],
+) -> None:
+    assert best_result_path(searches["star_sense"]).name == "seed2.h5"  # 2 and 3 tie at 2.5
+    assert best_result_path(searches["star_time"]).name == "seed1.h5"
+
+
+def test_group_by_search_reads_the_name_attribute(searches: dict[str, list[Path]]) -> None:
+    mixed = [searches["star_time"][0], *searches["star_sense"], searches["star_time"][1]]
+    assert group_by_search(mixed) == {
+        "star_time": searches["star_time"],
+        "star_sense": searches["star_sense"],
+    }
+
+
+def test_curves_on_grid_hold_each_best_until_the_next_record(
+    searches: dict[str, list[Path]],
+) -> None:
+    results = [read_result(p) for p in searches["star_sense"]]
+    grid, values = curves_on_grid(results)
+    assert grid[0] == 100 and grid[-1] == 5000
+    np.testing.assert_allclose(values[0], results[0].best_fitness)
+    later = [read_result(p) for p in searches["star_time"]]
+    grid, values = curves_on_grid(later + results[:1])  # to the fewest evaluations, 4000
+    assert grid[-1] == 4000 and values.shape == (3, 40)
+
+
+def test_helpers() -> None:
+    assert choose_interval(4.0) == 0.25  # 17 poses
+    for duration in (0.7, 3.0, 10.0, 37.0, 123.0):
+        count = math.floor(duration / choose_interval(duration) + 1e-9) + 1
+        assert 12 <= count <= 20
+    assert fitness_formula({"distance": 1.0, "rotations": -0.5, "fall": 0.0}) == (
+        "fitness = 1·distance − 0.5·rotations"
+    )
+    np.testing.assert_array_equal(letter_levels(np.array([0.0, 0.1, 0.5, 0.55]), 0.3), [0, 1, 0, 1])
+    labels = spread_labels(np.array([1.0, 1.01, 5.0]), 0.2, 0.0, 5.05)
+    assert labels[1] - labels[0] == pytest.approx(0.2) and labels[2] <= 5.05
+
+
+def test_poses_are_shifted_apart_only_when_the_figure_hardly_travels() -> None:
+    still = star_motion(4.0, 0.2, 0.5).endpoints[::25]
+    offsets, spacing, travel = pose_offsets(still)
+    assert spacing > 0 and travel == pytest.approx(0.2, abs=0.2)
+    np.testing.assert_allclose(np.diff(offsets), spacing)
+    running = star_motion(4.0, 40.0, 0.0).endpoints[::25]
+    offsets, spacing, _ = pose_offsets(running)
+    assert spacing == 0 and not offsets.any()
+
+
+def test_learning_plot(searches: dict[str, list[Path]], tmp_path: Path) -> None:
+    out = tmp_path / "learning.png"
+    plot_learning(searches["star_sense"], out)
+    width, height = assert_png(out)
+    assert width > height
+    with pytest.raises(PlotInputError, match="more than one search"):
+        plot_learning([*searches["star_sense"], *searches["star_time"]], tmp_path / "x.png")
+
+
+def test_learning_comparison_plot(searches: dict[str, list[Path]], tmp_path: Path) -> None:
+    out = tmp_path / "comparison.png"
+    plot_learning_comparison(searches, out)
+    width, height = assert_png(out)
+    assert width > 1.5 * height
+
+
+@pytest.mark.parametrize("search", ["star_sense", "star_time"])
+def test_filmstrip(searches: dict[str, list[Path]], tmp_path: Path, search: str) -> None:
+    out = tmp_path / f"{search}.png"
+    plot_filmstrip(searches[search][0], out)
+    assert_png(out)
+
+
+def test_motion_gif_is_small_and_real_time(searches: dict[str, list[Path]], tmp_path: Path) -> None:
+    out = tmp_path / "motion.gif"
+    write_motion_gif(searches["star_time"][0], out)
+    assert 10_000 < out.stat().st_size < 2_000_000
+    with Image.open(out) as gif:
+        assert gif.n_frames == 101  # 4 s, a frame every 40 ms, both ends
+        assert gif.info["duration"] == 40
+        assert 400 < gif.size[0] < 800
+    assert not list(tmp_path.glob(".*.partial"))
+    short = tmp_path / "short.gif"
+    write_motion_gif(searches["star_time"][0], short, max_frames=9)
+    with Image.open(short) as gif:
+        assert gif.n_frames == 9 and gif.info["duration"] == 500
+
+
+def test_cli_draws_the_best_seed(
+    searches: dict[str, list[Path]], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    drawn = []
+    real = bsr.plot_filmstrip
+
+    def recorded(result_path, path, *args, **kwargs):
+        drawn.append(Path(result_path).name)
+        return real(result_path, path, *args, **kwargs)
+
+    monkeypatch.setattr(bsr, "plot_filmstrip", recorded)
+    learning, strip, gif = tmp_path / "l.png", tmp_path / "f.png", tmp_path / "m.gif"
+    files = [str(p) for p in searches["star_sense"]]
+    code = main(
+        ["plot", "bsr", *files, "--learning", str(learning), "--filmstrip", str(strip)]
+        + ["--gif", str(gif)]
+    )
+    assert code == 0
+    assert drawn == ["seed2.h5"]
+    assert_png(learning)
+    assert_png(strip)
+    assert gif.stat().st_size > 10_000
+
+
+def test_cli_comparison_groups_files_by_search(
+    searches: dict[str, list[Path]], tmp_path: Path
+) -> None:
+    out = tmp_path / "compare.png"
+    files = [str(p) for paths in searches.values() for p in paths]
+    assert main(["plot", "bsr-learning", *files, "-o", str(out)]) == 0
+    assert_png(out)
+
+
+def test_cli_rejects_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    bogus = tmp_path / "bogus.h5"
+    bogus.write_text("not hdf5")
+    assert main(["plot", "bsr", str(bogus), "--learning", str(tmp_path / "l.png")]) == 2
+    assert "bogus.h5" in capsys.readouterr().err
+    assert not (tmp_path / "l.png").exists()
+    with pytest.raises(SystemExit):
+        main(["plot", "bsr", str(bogus)])  # no output asked for

@@ -1,0 +1,146 @@
+"""The BSR simulator of §2.1.1: deformation keeps momentum, contacts hold the figure up without
+sinking, one contact does not slide, two share friction in the ratio of their normal forces; the
+sense-based scoring of §2.1.2 and the time-based segments of §2.3."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mosys.bsr.figure import bsr_figure
+from mosys.bsr.start import standing_state
+from mosys.kernels.bsr_run import active_rule, rule_weights, run_controller, segment_rule
+from mosys.kernels.bsr_simulate import contact_impulses
+from mosys.parsing.figure import parse_figure_spec, parse_figure_text
+
+ROOT = Path(__file__).resolve().parents[1]
+STARMAN = bsr_figure(parse_figure_spec(ROOT / "specs/figures/starman.fig"))
+STAR_POSE = np.radians([45.0, -45.0, 20.0, -20.0])
+
+
+def run(figure, start, target, tau, steps, dt=0.01):
+    """One rule held for the whole run; returns rod ends (steps+1, N, 2, 2), com (steps+1, 2)
+    and the terms."""
+    j = len(figure.joint_names)
+    v = len(figure.sense_names)
+    ends = np.zeros((steps + 1, figure.parent.shape[0], 2, 2))
+    com = np.zeros((steps + 1, 2))
+    terms = np.zeros(5)
+    run_controller(
+        *figure.kernel_arrays, figure.gravity, figure.floor, figure.reach, True,
+        np.asarray(target, np.float64).reshape(1, j), np.array([tau]), np.zeros((1, 0)),
+        np.zeros((1, 0)), np.array([1e9]), 1e9, start, steps, dt, np.zeros(0, np.int64),
+        np.zeros((steps + 1, v)), np.zeros(steps + 1, np.int64), terms, ends, com,
+    )
+    return ends, com, terms
+
+
+def rod_motion(figure, ends, dt):
+    """Each rod's centre of mass (steps+1, N, 2), its velocity and its angular velocity, from
+    the recorded ends alone (central differences)."""
+    fraction = figure.com[None, :, None]
+    centres = ends[:, :, 0, :] + fraction * (ends[:, :, 1, :] - ends[:, :, 0, :])
+    delta = ends[:, :, 1, :] - ends[:, :, 0, :]
+    angles = np.unwrap(np.arctan2(delta[..., 1], delta[..., 0]), axis=0)
+    return centres, np.gradient(centres, dt, axis=0), np.gradient(angles, dt, axis=0)
+
+
+def floating(figure):
+    """The figure with no floor (free flight)."""
+    text = Path(figure.figure.path).read_text().replace("terrain floor", "")
+    return bsr_figure(parse_figure_text(text, figure.figure.path))
+
+
+def test_a_deformation_in_the_air_leaves_momentum_unchanged():
+    figure = floating(STARMAN)
+    start = standing_state(figure, math.pi / 2, STAR_POSE, velocity=(0.7, 2.0), spin=1.5)
+    dt, steps = 0.001, 600
+    target = np.radians([-120.0, 150.0, -90.0, 80.0])
+    ends, com, _ = run(figure, start, target, 0.1, steps, dt)
+    centres, velocity, spin = rod_motion(figure, ends, dt)
+    mass = figure.mass
+    # the centre of mass of the recorded rods is the state's, and it flies a parabola
+    recorded_com = (mass[None, :, None] * centres).sum(axis=1) / mass.sum()
+    np.testing.assert_allclose(recorded_com, com, atol=1e-9)
+    t = np.arange(steps + 1) * dt
+    np.testing.assert_allclose(com[:, 0], 0.7 * t, atol=1e-9)
+    y0 = com[0, 1]
+    np.testing.assert_allclose(com[:, 1], y0 + 2.0 * t - 0.5 * 9.81 * t * (t + dt), atol=1e-9)
+    # angular momentum about the centre of mass, from the rods' own motion, stays put while
+    # the figure changes shape (it starts at I0 * 1.5 rad/s)
+    r = centres - com[:, None, :]
+    v = velocity - np.gradient(com, dt, axis=0)[:, None, :]
+    momentum = (mass * (r[..., 0] * v[..., 1] - r[..., 1] * v[..., 0])).sum(axis=1)
+    momentum += (figure.inertia[None, :] * spin).sum(axis=1)
+    inner = momentum[2:-2]
+    assert np.ptp(inner) < 2e-3 * abs(inner.mean())
+    assert abs(inner.mean() - start[5]) < 2e-3 * abs(start[5])
+    # the shape did change a lot
+    assert np.degrees(abs(np.unwrap(spin * dt).sum())) > 10.0
+
+
+def test_a_dropped_rigid_figure_comes_to_rest_without_sinking():
+    start = standing_state(STARMAN, math.pi / 2 + 0.05, STAR_POSE)
+    start[1] += 0.5  # dropped from half a metre above its feet
+    ends, com, _ = run(STARMAN, start, STAR_POSE, 0.1, 400)
+    assert ends[..., 1].min() >= -1e-9  # never below the floor
+    tail = com[-50:]
+    assert np.ptp(tail[:, 0]) < 1e-6 and np.ptp(tail[:, 1]) < 1e-6  # at rest
+    assert ends[-1, :, :, 1].min() == pytest.approx(0.0, abs=1e-9)  # on the floor, not above
+
+
+def test_a_single_contact_does_not_slide():
+    # legs together: the feet are one point; leaning, the figure topples about it
+    pose = np.radians([45.0, -45.0, 0.0, 0.0])
+    start = standing_state(STARMAN, math.pi / 2 + 0.2, pose)
+    ends, _, _ = run(STARMAN, start, pose, 0.1, 60)
+    feet = ends[:, 3, 1, :]
+    assert np.ptp(feet[:, 0]) < 1e-9  # the foot stays where it stood
+    np.testing.assert_allclose(feet[:, 1], 0.0, atol=1e-9)
+    torso = ends[:, 0, 1, :] - ends[:, 0, 0, :]
+    assert abs(math.degrees(math.atan2(torso[-1, 1], torso[-1, 0])) - 90.0) > 20.0  # it fell
+
+
+def test_two_contacts_share_friction_in_the_ratio_of_their_normal_impulses():
+    u = np.array([[0.05, -0.5], [-0.1, -0.4]])  # sinking, sliding towards each other
+    r = np.array([[-0.4, -0.9], [0.5, -0.9]])
+    impulse = np.zeros((2, 2))
+    inverse_mass, inverse_inertia = 1 / 60.0, 1 / 8.0
+    contact_impulses(u, r, 2, inverse_mass, inverse_inertia, impulse)
+    assert impulse[0, 1] > 0 and impulse[1, 1] > 0
+    assert impulse[0, 0] / impulse[1, 0] == pytest.approx(impulse[0, 1] / impulse[1, 1], 1e-9)
+    # velocities after: no sinking, and the normal-weighted sliding vanishes
+    linear = impulse.sum(axis=0) * inverse_mass
+    angular = (r[:, 0] * impulse[:, 1] - r[:, 1] * impulse[:, 0]).sum() * inverse_inertia
+    after = u + linear + angular * np.stack([-r[:, 1], r[:, 0]], axis=1)
+    np.testing.assert_allclose(after[:, 1], 0.0, atol=1e-12)
+    weights = impulse[:, 1] / impulse[:, 1].sum()
+    assert abs(weights @ after[:, 0]) < 1e-9
+
+
+def test_a_contact_that_is_leaving_gets_no_impulse():
+    impulse = np.ones((2, 2))
+    contact_impulses(np.array([[0.2, 0.4], [0, 0]]), np.array([[0.1, -0.5], [0, 0]]), 1,
+                     1.0, 1.0, impulse)
+    assert not impulse.any()
+
+
+def test_the_smallest_box_that_holds_the_senses_is_active_and_none_keeps_the_last():
+    senses = np.array([0.5, 0.5])
+    center = np.array([[0.5, 0.5], [0.45, 0.55], [3.0, 3.0]])
+    side = np.array([[2.0, 2.0], [0.4, 0.4], [0.4, 0.4]])
+    weights = rule_weights(side)
+    np.testing.assert_allclose(weights, [2 * math.log(2.0), 2 * math.log(10.0), 2 * math.log(10)])
+    # scores: W (1 - max_j (2 (S_j - mu_j) / side_j)^2): rule 0 1.386, rule 1 4.6 * 0.9375
+    assert active_rule(senses, center, side, weights, 2) == 1
+    far = np.array([-3.0, -3.0])
+    assert active_rule(far, center, side, weights, 2) == 2  # no positive score: keep the last
+
+
+def test_time_segments_repeat_every_period():
+    ends = np.array([0.1, 0.4, 0.6])
+    rules = [segment_rule(t, ends, 0.6) for t in (0.0, 0.15, 0.45, 0.59, 0.61, 1.25, 1.95)]
+    assert rules == [0, 1, 2, 2, 0, 0, 1]
