@@ -30,10 +30,26 @@ def run(figure, start, target, tau, steps, dt=0.01):
     com = np.zeros((steps + 1, 2))
     terms = np.zeros(5)
     run_controller(
-        *figure.kernel_arrays, figure.gravity, figure.floor, figure.reach, True,
-        np.asarray(target, np.float64).reshape(1, j), np.array([tau]), np.zeros((1, 0)),
-        np.zeros((1, 0)), np.array([1e9]), 1e9, start, steps, dt, np.zeros(0, np.int64),
-        np.zeros((steps + 1, v)), np.zeros(steps + 1, np.int64), terms, ends, com,
+        *figure.kernel_arrays,
+        figure.gravity,
+        figure.floor,
+        figure.reach,
+        True,
+        np.asarray(target, np.float64).reshape(1, j),
+        np.array([tau]),
+        np.zeros((1, 0)),
+        np.zeros((1, 0)),
+        np.array([1e9]),
+        1e9,
+        start,
+        steps,
+        dt,
+        np.zeros(0, np.int64),
+        np.zeros((steps + 1, v)),
+        np.zeros(steps + 1, np.int64),
+        terms,
+        ends,
+        com,
     )
     return ends, com, terms
 
@@ -123,8 +139,9 @@ def test_two_contacts_share_friction_in_the_ratio_of_their_normal_impulses():
 
 def test_a_contact_that_is_leaving_gets_no_impulse():
     impulse = np.ones((2, 2))
-    contact_impulses(np.array([[0.2, 0.4], [0, 0]]), np.array([[0.1, -0.5], [0, 0]]), 1,
-                     1.0, 1.0, impulse)
+    contact_impulses(
+        np.array([[0.2, 0.4], [0, 0]]), np.array([[0.1, -0.5], [0, 0]]), 1, 1.0, 1.0, impulse
+    )
     assert not impulse.any()
 
 

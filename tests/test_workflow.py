@@ -10,6 +10,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -49,9 +50,9 @@ def snakemake(work: Path, *args: str) -> str:
     return done.stdout + done.stderr
 
 
-def planned_jobs(work: Path, target: str = "results/pendulum_all") -> dict[str, int]:
+def planned_jobs(work: Path, target: str = "results/pendulum_all", *options: str) -> dict[str, int]:
     """Rule name -> job count of a dry run of ``target`` ({} when nothing to do)."""
-    output = snakemake(work, "--dry-run", target)
+    output = snakemake(work, "--dry-run", target, *options)
     if "Nothing to be done" in output:
         return {}
     stats = output.split("Job stats:", 1)[1]
@@ -199,3 +200,55 @@ def test_a_new_luxo_script_reuses_the_controller_and_motor_programs(workflow):
         }
     finally:
         script.unlink()
+
+
+@pytest.fixture(scope="module")
+def bsr_built(workflow) -> Path:
+    """results/bsr_all at CI's reduced budget (config/ci.yaml: G = 300, five seeds)."""
+    snakemake(workflow, "results/bsr_all", "--configfile", "config/ci.yaml")
+    return workflow
+
+
+def median_terms(work: Path, name: str) -> dict[str, float]:
+    """The median over a search's seeds of each measured term of its best motion, and the
+    rotations of each seed."""
+    from mosys.io.bsr_result import read_bsr_result
+
+    results = [read_bsr_result(path) for path in sorted((work / "results/bsr" / name).glob("*.h5"))]
+    assert len(results) == 5
+    terms = {key: [r.fitness_terms[key] for r in results] for key in results[0].fitness_terms}
+    medians = {key: float(np.median(values)) for key, values in terms.items()}
+    medians["rotations_each"] = terms["rotations"]
+    return medians
+
+
+def test_the_secondary_terms_steer_star_mans_style(bsr_built):
+    shuffle = median_terms(bsr_built, "starman_shuffle")
+    cartwheel = median_terms(bsr_built, "starman_cartwheel")
+    jump = median_terms(bsr_built, "starman_jump")
+    # the cartwheel turns over in most seeds, and more than the shuffle
+    assert sum(turns >= 1.0 for turns in cartwheel["rotations_each"]) >= 3
+    assert cartwheel["rotations"] > shuffle["rotations"]
+    # the shuffle slides its feet further than the cartwheel
+    assert shuffle["contact_distance"] > cartwheel["contact_distance"]
+    # the jump goes higher than both
+    assert jump["max_height"] > max(shuffle["max_height"], cartwheel["max_height"])
+    table = (bsr_built / "results/tables/bsr_runs.csv").read_text()
+    assert table.count(",ci,") == 5  # every row says which budget made it
+
+
+def test_editing_one_weight_reruns_only_that_search_and_its_plots(bsr_built):
+    spec = bsr_built / "specs/bsr/starman_jump.bsr"
+    spec.write_text(spec.read_text().replace("max_height=4", "max_height=5"))
+    jobs = planned_jobs(bsr_built, "results/bsr_all", "--configfile", "config/ci.yaml")
+    assert jobs == {
+        "bsr_search": 5,
+        "bsr_plots": 1,
+        "bsr_learning_curves": 1,
+        "bsr_runs_table": 1,
+        "bsr_all": 1,
+        "total": 9,
+    }
+    output = snakemake(bsr_built, "--dry-run", "results/bsr_all", "--configfile", "config/ci.yaml")
+    assert "results/bsr/starman_jump/seed1.h5" in output
+    assert "results/bsr/starman_shuffle/seed1.h5" not in output

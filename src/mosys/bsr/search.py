@@ -86,7 +86,8 @@ class SearchOutcome:
     steps_per_second: float
 
     def terms_json(self) -> str:
-        return json.dumps({name: float(value) for name, value in zip(TERMS, self.terms)})
+        terms = zip(TERMS, self.terms, strict=True)
+        return json.dumps({name: float(value) for name, value in terms})
 
 
 def bind_search(spec: BsrSpec, figure: BsrFigure, generations: int | None = None) -> SearchSetup:
@@ -119,7 +120,8 @@ def bind_search(spec: BsrSpec, figure: BsrFigure, generations: int | None = None
             raise SpecError.at(
                 spec.path,
                 spec.tokens[f"fall.{i}"],
-                f"an endpoint of figure '{figure.figure.name}' ({', '.join(figure.endpoint_names)})",
+                f"an endpoint of figure '{figure.figure.name}' "
+                f"({', '.join(figure.endpoint_names)})",
             )
         fall.append(figure.endpoint_names.index(name))
     return SearchSetup(
@@ -184,7 +186,8 @@ class _Population:
             figure.joint_min,
             figure.joint_max,
         )
-        self.tau[k, i] = np.clip(self.tau[k, i] * math.exp(rng.normal(0.0, CREEP_LOG_TAU)), low, high)
+        creep = math.exp(rng.normal(0.0, CREEP_LOG_TAU))
+        self.tau[k, i] = np.clip(self.tau[k, i] * creep, low, high)
         v = self.center.shape[2]
         if v:
             self.center[k, i] = np.clip(
@@ -305,7 +308,7 @@ def run_search(setup: SearchSetup, seed: int, label: str = "search") -> SearchOu
         if generation % spec.reseed == 0:
             order = np.argsort(-current.fitness, kind="stable")
             half = c // 2
-            for worse, better in zip(order[c - half :], order[:half]):
+            for worse, better in zip(order[c - half :], order[:half], strict=True):
                 current.copy_from(current, int(worse), int(better))
         evaluations.append(c * (generation + 1))
         curve.append(best_fitness)

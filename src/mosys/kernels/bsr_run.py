@@ -94,9 +94,36 @@ def segment_rule(time, segment_end, period):
 
 @njit(cache=True)
 def run_controller(
-    parent, hinge, offset, length, mass, com, inertia, joint, endpoints, joint_min, joint_max,
-    gravity, floor, reach, time_based, target, tau, center, side, segment_end, period, start,
-    steps, dt, fall_endpoints, senses_out, rule_out, terms_out, ends_out, com_out,
+    parent,
+    hinge,
+    offset,
+    length,
+    mass,
+    com,
+    inertia,
+    joint,
+    endpoints,
+    joint_min,
+    joint_max,
+    gravity,
+    floor,
+    reach,
+    time_based,
+    target,
+    tau,
+    center,
+    side,
+    segment_end,
+    period,
+    start,
+    steps,
+    dt,
+    fall_endpoints,
+    senses_out,
+    rule_out,
+    terms_out,
+    ends_out,
+    com_out,
 ):
     """Run a controller for ``steps`` steps of dt seconds from the state ``start`` (S,).
 
@@ -127,8 +154,21 @@ def run_controller(
     theta = state[JOINTS : JOINTS + n_joints]
     theta_rate = state[JOINTS + n_joints : JOINTS + 2 * n_joints]
     _, total_inertia, deformation_momentum = body_frame(
-        parent, hinge, offset, length, mass, com, inertia, joint, endpoints, theta, theta_rate,
-        rod_ends, end_offset, end_velocity, scratch,
+        parent,
+        hinge,
+        offset,
+        length,
+        mass,
+        com,
+        inertia,
+        joint,
+        endpoints,
+        theta,
+        theta_rate,
+        rod_ends,
+        end_offset,
+        end_velocity,
+        scratch,
     )
     previous[0] = deformation_momentum / total_inertia
     cos_phi = math.cos(state[PHI])
@@ -146,8 +186,9 @@ def run_controller(
                 ends_out[0, k, end, 1] = state[CY] + sin_phi * bx + cos_phi * by
         com_out[0, 0] = state[CX]
         com_out[0, 1] = state[CY]
-    measure_senses(state, joint_min, joint_max, end_force, weight, floor, reach, gravity,
-                   senses_out[0])
+    measure_senses(
+        state, joint_min, joint_max, end_force, weight, floor, reach, gravity, senses_out[0]
+    )
     rule = 0
     rule_out[0] = rule
     start_x = state[CX]
@@ -157,9 +198,31 @@ def run_controller(
     fallen_steps = 0
     for n in range(steps):
         step(
-            parent, hinge, offset, length, mass, com, inertia, joint, endpoints, joint_min,
-            joint_max, gravity, floor, state, target[rule], tau[rule], dt, previous, rod_ends,
-            end_offset, end_velocity, end_force, scratch, contact, entry_x,
+            parent,
+            hinge,
+            offset,
+            length,
+            mass,
+            com,
+            inertia,
+            joint,
+            endpoints,
+            joint_min,
+            joint_max,
+            gravity,
+            floor,
+            state,
+            target[rule],
+            tau[rule],
+            dt,
+            previous,
+            rod_ends,
+            end_offset,
+            end_velocity,
+            end_force,
+            scratch,
+            contact,
+            entry_x,
         )
         cos_phi = math.cos(state[PHI])
         sin_phi = math.sin(state[PHI])
@@ -178,8 +241,9 @@ def run_controller(
         if fallen:
             fallen_steps += 1
         max_height = max(max_height, state[CY])
-        measure_senses(state, joint_min, joint_max, end_force, weight, floor, reach, gravity,
-                       senses_out[n + 1])
+        measure_senses(
+            state, joint_min, joint_max, end_force, weight, floor, reach, gravity, senses_out[n + 1]
+        )
         if time_based:
             rule = segment_rule((n + 1) * dt, segment_end, period)
         else:
@@ -198,9 +262,34 @@ def run_controller(
 
 @njit(cache=True, parallel=True)
 def run_population(
-    parent, hinge, offset, length, mass, com, inertia, joint, endpoints, joint_min, joint_max,
-    gravity, floor, reach, time_based, target, tau, center, side, segment_end, period, start,
-    steps, dt, fall_endpoints, senses_out, rule_out, terms_out,
+    parent,
+    hinge,
+    offset,
+    length,
+    mass,
+    com,
+    inertia,
+    joint,
+    endpoints,
+    joint_min,
+    joint_max,
+    gravity,
+    floor,
+    reach,
+    time_based,
+    target,
+    tau,
+    center,
+    side,
+    segment_end,
+    period,
+    start,
+    steps,
+    dt,
+    fall_endpoints,
+    senses_out,
+    rule_out,
+    terms_out,
 ):
     """``run_controller`` for C controllers at once, in parallel (each run is independent, so
     the results do not depend on the number of threads). target (C, R, J), tau (C, R),
@@ -210,8 +299,34 @@ def run_population(
     no_com = np.empty((0, 2))
     for c in prange(target.shape[0]):
         run_controller(
-            parent, hinge, offset, length, mass, com, inertia, joint, endpoints, joint_min,
-            joint_max, gravity, floor, reach, time_based, target[c], tau[c], center[c],
-            side[c], segment_end[c], period, start[c], steps, dt, fall_endpoints,
-            senses_out[c], rule_out[c], terms_out[c], no_ends, no_com,
+            parent,
+            hinge,
+            offset,
+            length,
+            mass,
+            com,
+            inertia,
+            joint,
+            endpoints,
+            joint_min,
+            joint_max,
+            gravity,
+            floor,
+            reach,
+            time_based,
+            target[c],
+            tau[c],
+            center[c],
+            side[c],
+            segment_end[c],
+            period,
+            start[c],
+            steps,
+            dt,
+            fall_endpoints,
+            senses_out[c],
+            rule_out[c],
+            terms_out[c],
+            no_ends,
+            no_com,
         )

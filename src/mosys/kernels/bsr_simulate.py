@@ -37,8 +37,21 @@ MAX_CONTACTS = 2
 
 @njit(cache=True)
 def body_frame(
-    parent, hinge, offset, length, mass, com, inertia, joint, endpoints, theta, theta_rate,
-    rod_ends, end_offset, end_velocity, scratch,
+    parent,
+    hinge,
+    offset,
+    length,
+    mass,
+    com,
+    inertia,
+    joint,
+    endpoints,
+    theta,
+    theta_rate,
+    rod_ends,
+    end_offset,
+    end_velocity,
+    scratch,
 ):
     """The deformed figure in its body frame (root angle 0), about its centre of mass.
 
@@ -241,14 +254,14 @@ def contact_impulses(u, r, count, inverse_mass, inverse_inertia, impulse):
         i = first if attempt == 0 else 1 - first
         if u[i, 1] >= 0.0:
             continue
-        px, py = _single_contact(u[i, 0], u[i, 1], r[i, 0], r[i, 1], inverse_mass,
-                                 inverse_inertia)
+        px, py = _single_contact(u[i, 0], u[i, 1], r[i, 0], r[i, 1], inverse_mass, inverse_inertia)
         if py <= 0.0:
             continue
         if count == 2:
             other = 1 - i
-            _, _, kyx, kyy = _response(r[other, 0], r[other, 1], r[i, 0], r[i, 1],
-                                       inverse_mass, inverse_inertia)
+            _, _, kyx, kyy = _response(
+                r[other, 0], r[other, 1], r[i, 0], r[i, 1], inverse_mass, inverse_inertia
+            )
             if u[other, 1] + kyx * px + kyy * py < -1e-9:
                 continue
         impulse[i, 0] = px
@@ -258,9 +271,31 @@ def contact_impulses(u, r, count, inverse_mass, inverse_inertia, impulse):
 
 @njit(cache=True)
 def step(
-    parent, hinge, offset, length, mass, com, inertia, joint, endpoints, joint_min, joint_max,
-    gravity, floor, state, target, tau, dt, previous, rod_ends, end_offset, end_velocity,
-    end_force, scratch, contact, entry_x,
+    parent,
+    hinge,
+    offset,
+    length,
+    mass,
+    com,
+    inertia,
+    joint,
+    endpoints,
+    joint_min,
+    joint_max,
+    gravity,
+    floor,
+    state,
+    target,
+    tau,
+    dt,
+    previous,
+    rod_ends,
+    end_offset,
+    end_velocity,
+    end_force,
+    scratch,
+    contact,
+    entry_x,
 ):
     """Advance the state (S,) by dt seconds toward the target pose (J,) rad with time constant
     tau s. ``previous`` (2,): h / I of the figure before the step (rad/s), updated to the
@@ -279,8 +314,21 @@ def step(
     theta_rate = state[JOINTS + n_joints : JOINTS + 2 * n_joints]
     deform_joints(theta, theta_rate, target, tau, joint_min, joint_max, dt)
     total_mass, total_inertia, deformation_momentum = body_frame(
-        parent, hinge, offset, length, mass, com, inertia, joint, endpoints, theta, theta_rate,
-        rod_ends, end_offset, end_velocity, scratch,
+        parent,
+        hinge,
+        offset,
+        length,
+        mass,
+        com,
+        inertia,
+        joint,
+        endpoints,
+        theta,
+        theta_rate,
+        rod_ends,
+        end_offset,
+        end_velocity,
+        scratch,
     )
     spin_of_deformation = deformation_momentum / total_inertia
     # orientation correction: the deformation leaves the angular momentum unchanged
@@ -306,8 +354,10 @@ def step(
             rx = cos_phi * end_offset[e, 0] - sin_phi * end_offset[e, 1]
             ry = sin_phi * end_offset[e, 0] + cos_phi * end_offset[e, 1]
             uy = (
-                state[VY] + body_rate * rx
-                + sin_phi * end_velocity[e, 0] + cos_phi * end_velocity[e, 1]
+                state[VY]
+                + body_rate * rx
+                + sin_phi * end_velocity[e, 0]
+                + cos_phi * end_velocity[e, 1]
             )
             predicted = state[CY] + ry - floor + min(uy, 0.0) * dt
             if predicted <= CONTACT_TOLERANCE:
@@ -331,14 +381,18 @@ def step(
             r[count, 0] = rx
             r[count, 1] = ry
             u[count, 0] = (
-                state[VX] - body_rate * ry
-                + cos_phi * end_velocity[e, 0] - sin_phi * end_velocity[e, 1]
+                state[VX]
+                - body_rate * ry
+                + cos_phi * end_velocity[e, 0]
+                - sin_phi * end_velocity[e, 1]
             )
             # the velocity that would take the point exactly to the floor counts as zero
             gap = max(state[CY] + ry - floor, 0.0)
             u[count, 1] = (
-                state[VY] + body_rate * rx
-                + sin_phi * end_velocity[e, 0] + cos_phi * end_velocity[e, 1]
+                state[VY]
+                + body_rate * rx
+                + sin_phi * end_velocity[e, 0]
+                + cos_phi * end_velocity[e, 1]
                 + gap / dt
             )
             count += 1

@@ -1,0 +1,164 @@
+"""The serial search of Figure 3: Table 2's initial values, the relevance heuristic, creep inside
+the ranges, reseeding, determinism whatever the number of threads, the result file contract, and
+binding errors that name the spec's word."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import h5py
+import numba
+import numpy as np
+import pytest
+
+from mosys.bsr.controller import SIDE_MAX, SIDE_MIN
+from mosys.bsr.figure import bsr_figure
+from mosys.bsr.run import search_to_file
+from mosys.bsr.search import _Population, bind_search, run_search
+from mosys.bsr.start import perturbed_state
+from mosys.io.bsr_result import read_bsr_result
+from mosys.parsing.bsr import parse_bsr_text
+from mosys.parsing.figure import parse_figure_spec
+from mosys.parsing.tokens import SpecError
+
+ROOT = Path(__file__).resolve().parents[1]
+STARMAN = bsr_figure(parse_figure_spec(ROOT / "specs/figures/starman.fig"))
+SPEC = """\
+figure starman
+controller sense rules=6
+simulate duration=2 dt=0.01 tau_min=0.15
+search controllers=6 generations=30 reseed=10
+seeds 7 8
+start torso=90 arm_a=45 arm_b=-45 leg_a=20 leg_b=-20
+fitness distance=1 contact_distance=1
+"""
+
+
+def setup(text: str = SPEC, generations: int | None = None):
+    return bind_search(parse_bsr_text(text, "test.bsr"), STARMAN, generations)
+
+
+def test_initial_rules_follow_table_2():
+    population = _Population(setup(), np.random.default_rng(0))
+    figure = STARMAN
+    assert np.all(population.target >= figure.joint_min) and np.all(
+        population.target <= figure.joint_max
+    )
+    assert np.all(population.tau >= 0.15) and np.all(population.tau <= 2 / 4)
+    assert np.all(population.side >= SIDE_MIN) and np.all(population.side <= SIDE_MAX)
+    assert np.all(population.center >= -0.5) and np.all(population.center <= 1.5)
+    # log-uniform sides: about half of them below the geometric mean of the range
+    below = np.mean(population.side < math.sqrt(SIDE_MIN * SIDE_MAX))
+    assert 0.4 < below < 0.6
+
+
+def test_a_reinitialised_rule_has_a_corner_on_the_sense_trajectory():
+    population = _Population(setup(), np.random.default_rng(1))
+    senses = np.random.default_rng(2).uniform(0, 1, (201, len(STARMAN.sense_names)))
+    population.draw_rule(3, 2, np.random.default_rng(3), senses)
+    low = population.center[3, 2] - population.side[3, 2] / 2
+    high = population.center[3, 2] + population.side[3, 2] / 2
+    on_corner = [np.allclose(np.where(np.isclose(low, row), low, high), row) for row in senses]
+    assert any(on_corner)
+
+
+def test_creep_stays_inside_the_ranges():
+    bound = setup()
+    population = _Population(bound, np.random.default_rng(4))
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        population.creep_rule(0, 0, rng)
+    assert np.all(population.target[0, 0] >= STARMAN.joint_min)
+    assert np.all(population.target[0, 0] <= STARMAN.joint_max)
+    assert bound.tau_range[0] <= population.tau[0, 0] <= bound.tau_range[1]
+    assert np.all((population.side[0, 0] >= SIDE_MIN) & (population.side[0, 0] <= SIDE_MAX))
+
+
+def test_the_learning_curve_climbs_and_the_best_is_rerun_from_the_nominal_start():
+    outcome = run_search(setup(generations=150), 7)
+    assert outcome.evaluations[0] == 6 and outcome.evaluations[-1] == 6 * 151
+    assert np.all(np.diff(outcome.best_fitness) >= 0)
+    assert outcome.best_fitness[-1] > outcome.best_fitness[0]
+    # no perturbation: the best's fitness is the fitness of its nominal run
+    assert outcome.nominal_fitness == pytest.approx(outcome.fitness, abs=1e-12)
+
+
+def test_a_seed_gives_the_same_result_with_one_thread_or_two():
+    threads = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = run_search(setup(), 8)
+        numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
+        two = run_search(setup(), 8)
+    finally:
+        numba.set_num_threads(threads)
+    np.testing.assert_array_equal(one.best_fitness, two.best_fitness)
+    np.testing.assert_array_equal(one.controller.center, two.controller.center)
+    np.testing.assert_array_equal(one.rod_ends, two.rod_ends)
+    other = run_search(setup(), 7)
+    assert not np.array_equal(other.best_fitness, one.best_fitness)
+
+
+def test_perturbed_starts_differ_and_stand_on_the_floor():
+    spec = setup(SPEC.replace("fitness", "perturb angle=5 joints=10 speed=0.2 spin=20\nfitness"))
+    rng = np.random.default_rng(0)
+    starts = [
+        perturbed_state(STARMAN, spec.root_angle, spec.joints, 0.0, spec.spec.perturbation, rng)
+        for _ in range(20)
+    ]
+    assert len({tuple(start) for start in starts}) == 20
+    outcome = run_search(bind_search(spec.spec, STARMAN, 5), 7)
+    assert outcome.rod_ends[0, :, :, 1].min() == pytest.approx(0.0, abs=1e-12)
+
+
+def test_the_result_file_keeps_the_contract(tmp_path):
+    spec_path = tmp_path / "tiny.bsr"
+    spec_path.write_text(SPEC)
+    output = tmp_path / "tiny" / "seed7.h5"
+    search_to_file(spec_path, ROOT / "specs/figures", 7, output, generations=3, budget="test")
+    with h5py.File(output) as h5:
+        curve = h5["learning_curve"]
+        assert curve["evaluations"].dtype == np.int64 and curve["evaluations"][-1] == 24
+        motion = h5["best/figure_motion"]
+        n = motion["t"].shape[0]
+        assert n == 201 and motion["endpoints"].shape == (n, 5, 2, 2)
+        assert h5["best/active_rule"].shape == (n,)
+        assert json.loads(motion.attrs["terrain"]) == [[-1000.0, 0.0], [1000.0, 0.0]]
+        for key in (
+            "format_version",
+            "figure",
+            "controller_kind",
+            "seed",
+            "evaluations",
+            "duration",
+            "dt",
+            "best_fitness",
+            "fitness_weights",
+            "fitness_terms",
+            "spec_sha256",
+            "wall_seconds",
+        ):
+            assert key in h5.attrs
+        terms = json.loads(h5.attrs["fitness_terms"])
+        assert {"distance", "max_height", "contact_distance", "rotations"} <= set(terms)
+    result = read_bsr_result(output)
+    assert result.attrs["budget"] == "test" and result.controller.kind == "sense"
+    com = result.motion.com
+    assert terms["distance"] == pytest.approx(com[-1, 0] - com[0, 0])
+    assert terms["max_height"] == pytest.approx(com[:, 1].max())
+
+
+def test_a_start_name_the_figure_lacks_is_an_error_at_its_word():
+    text = SPEC.replace("leg_b=-20", "knee=-20")
+    with pytest.raises(SpecError) as error:
+        setup(text)
+    assert str(error.value) == (
+        "test.bsr:6:44: expected a coordinate of figure 'starman' (torso, x, arm_a, arm_b, "
+        "leg_a, leg_b), found 'knee=-20'"
+    )
+    text = SPEC + "fall torso.distal arm_c.distal\n"
+    with pytest.raises(SpecError) as error:
+        setup(text)
+    assert str(error.value).startswith("test.bsr:8:19: expected an endpoint of figure 'starman'")
