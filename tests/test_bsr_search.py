@@ -16,9 +16,10 @@ import pytest
 from mosys.bsr.controller import SIDE_MAX, SIDE_MIN
 from mosys.bsr.figure import bsr_figure
 from mosys.bsr.run import search_to_file
-from mosys.bsr.search import _Population, bind_search, run_search
+from mosys.bsr.search import CORNER_INSIDE, _Population, bind_search, run_search
 from mosys.bsr.start import perturbed_state
 from mosys.io.bsr_result import read_bsr_result
+from mosys.kernels.bsr_run import active_rule, rule_weights
 from mosys.parsing.bsr import parse_bsr_text
 from mosys.parsing.figure import parse_figure_spec
 from mosys.parsing.tokens import SpecError
@@ -54,14 +55,18 @@ def test_initial_rules_follow_table_2():
     assert 0.4 < below < 0.6
 
 
-def test_a_reinitialised_rule_has_a_corner_on_the_sense_trajectory():
+def test_a_reinitialised_rule_fires_at_a_corner_on_the_sense_trajectory():
     population = _Population(setup(), np.random.default_rng(1))
     senses = np.random.default_rng(2).uniform(0, 1, (201, len(STARMAN.sense_names)))
     population.draw_rule(3, 2, np.random.default_rng(3), senses)
-    low = population.center[3, 2] - population.side[3, 2] / 2
-    high = population.center[3, 2] + population.side[3, 2] / 2
+    half = population.side[3, 2] / 2 * CORNER_INSIDE
+    low = population.center[3, 2] - half
+    high = population.center[3, 2] + half
     on_corner = [np.allclose(np.where(np.isclose(low, row), low, high), row) for row in senses]
     assert any(on_corner)
+    row = senses[on_corner.index(True)]
+    weights = rule_weights(population.side[3])
+    assert active_rule(row, population.center[3], population.side[3], weights, -1) == 2
 
 
 def test_creep_stays_inside_the_ranges():

@@ -11,7 +11,8 @@ Choices where the paper is silent (documented in the README): creep perturbs eve
 the rule (target angles by N(0, 0.1 range), tau by a factor exp N(0, 0.2), centres by N(0, 0.1),
 sides by a factor exp N(0, 0.1), a time segment's weight by exp N(0, 0.2)), each clipped to Table
 2's range; a re-initialised sense rule puts one corner of its new hyper-rectangle (sides drawn as
-Table 2) on the sense vector at a random step of the parent's run; a time-based rule's segment
+Table 2) on the sense vector at a random step of the parent's run (just outside it, at 0.98 of
+the half-side from the centre, so that the rule fires there); a time-based rule's segment
 length is its weight over the sum of weights times t_per, weights drawn uniformly in [0.2, 1].
 """
 
@@ -32,6 +33,7 @@ from mosys.kernels.bsr_run import TERMS, run_controller, run_population
 from mosys.parsing.tokens import SpecError
 from mosys.progress import Progress
 
+CORNER_INSIDE = 0.98  # a re-initialised box's corner: this fraction of the half-side out
 SEGMENT_WEIGHT_MIN = 0.2
 SEGMENT_WEIGHT_MAX = 1.0
 CREEP_TARGET = 0.1  # of the joint's range
@@ -172,7 +174,9 @@ class _Population:
             else:
                 corner = senses[rng.integers(senses.shape[0])]
                 sign = rng.choice(np.array([-1.0, 1.0]), v)
-                self.center[k, i] = corner + sign * self.side[k, i] / 2.0
+                # the sense point sits just inside that corner, so that the rule fires there
+                # (exactly on it, its score would be 0: never positive, never active)
+                self.center[k, i] = corner + sign * self.side[k, i] / 2.0 * CORNER_INSIDE
         else:
             self.segment[k, i] = rng.uniform(SEGMENT_WEIGHT_MIN, SEGMENT_WEIGHT_MAX)
 
