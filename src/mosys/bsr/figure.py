@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mosys.bsr.spec import ENDPOINT_ENDS
 from mosys.parsing.figure import Figure
 from mosys.parsing.tokens import SpecError
 
@@ -127,6 +128,7 @@ def bsr_figure(figure: Figure) -> BsrFigure:
     if terrain.kind not in ("none", "floor"):
         raise SpecError(figure.path, 1, 1, "a flat 'terrain floor' for a BSR figure", None)
     length = np.array([rod.length for rod in figure.rods])
+    endpoints = _distinct_endpoints(parent, hinge, length)
     return BsrFigure(
         figure=figure,
         parent=parent,
@@ -140,11 +142,8 @@ def bsr_figure(figure: Figure) -> BsrFigure:
         joint_names=tuple(joint_names),
         joint_min=np.array(joint_min),
         joint_max=np.array(joint_max),
-        endpoints=_distinct_endpoints(parent, hinge, length),
-        endpoint_names=tuple(
-            f"{names[rod]}.{('proximal', 'distal')[end]}"
-            for rod, end in _distinct_endpoints(parent, hinge, length)
-        ),
+        endpoints=endpoints,
+        endpoint_names=tuple(f"{names[rod]}.{ENDPOINT_ENDS[end]}" for rod, end in endpoints),
         floor=terrain.height if terrain.kind == "floor" else math.nan,
         gravity=figure.gravity,
         root_angle=root.coordinates[2].name,

@@ -69,13 +69,13 @@ from mosys.bsr.spec import (
 )
 
 # the figure spec's number format (shortest repr, no trailing '.0'); private there, reused here
-from mosys.parsing.figure import _fmt as format_number
 from mosys.parsing.tokens import (
     NAME,
     Line,
     LineReader,
     SpecError,
     Token,
+    format_number,
     missing_line,
     parse_int,
     parse_number,

@@ -25,6 +25,7 @@ from mosys.parsing.tokens import (
     LineReader,
     SpecError,
     Token,
+    format_number,
     parse_name,
     parse_number,
     read_spec,
@@ -250,27 +251,21 @@ def parse_figure_text(
     return _Parser(path).parse(lines, spec_sha256)
 
 
-def _fmt(value: float) -> str:
-    """A number in spec text: the shortest repr that reads back to the same float."""
-    text = repr(float(value))
-    return text[:-2] if text.endswith(".0") else text
-
-
 def render_figure_spec(figure: Figure) -> str:
     """Spec text that parses back to ``figure`` (angles round-trip through degrees)."""
-    out = [f"gravity {_fmt(figure.gravity)}"]
+    out = [f"gravity {format_number(figure.gravity)}"]
     for rod in figure.rods:
         out.append(
-            f"rod {rod.name} length={_fmt(rod.length)} mass={_fmt(rod.mass)} "
-            f"com={_fmt(rod.com)} inertia={_fmt(rod.inertia)}"
+            f"rod {rod.name} length={format_number(rod.length)} mass={format_number(rod.mass)} "
+            f"com={format_number(rod.com)} inertia={format_number(rod.inertia)}"
         )
     for joint in figure.joints:
         angle = joint.coordinates[-1]
         names = f"angle={angle.name} rate={angle.rate}"
         actuator = f" actuator={angle.actuator}" if angle.actuator else ""
         if joint.kind == "pin":
-            at = f"{_fmt(joint.pivot[0])},{_fmt(joint.pivot[1])}"
-            offset = f" offset={_fmt(math.degrees(joint.offset))}" if joint.offset else ""
+            at = f"{format_number(joint.pivot[0])},{format_number(joint.pivot[1])}"
+            offset = f" offset={format_number(math.degrees(joint.offset))}" if joint.offset else ""
             out.append(f"pin {joint.rod} at={at}{offset} {names}{actuator}")
         elif joint.kind == "free":
             x, y = joint.coordinates[0], joint.coordinates[1]
@@ -279,31 +274,32 @@ def render_figure_spec(figure: Figure) -> str:
             )
         else:
             out.append(
-                f"hinge {joint.rod} on={joint.parent} at={_fmt(joint.position)} "
-                f"offset={_fmt(math.degrees(joint.offset))} {names}{actuator}"
+                f"hinge {joint.rod} on={joint.parent} at={format_number(joint.position)} "
+                f"offset={format_number(math.degrees(joint.offset))} {names}{actuator}"
             )
     for limit in figure.limits:
         bounds = "".join(
-            f" {key}={_fmt(math.degrees(value))}"
+            f" {key}={format_number(math.degrees(value))}"
             for key, value in (("lower", limit.lower), ("upper", limit.upper))
             if math.isfinite(value)
         )
         out.append(
-            f"limit {limit.rod}{bounds} stiffness={_fmt(limit.stiffness)} "
-            f"damping={_fmt(limit.damping)}"
+            f"limit {limit.rod}{bounds} stiffness={format_number(limit.stiffness)} "
+            f"damping={format_number(limit.damping)}"
         )
     for contact in figure.contacts:
         out.append(
-            f"contact {contact.rod} fraction={_fmt(contact.fraction)} "
-            f"stiffness={_fmt(contact.stiffness)} damping={_fmt(contact.damping)} "
-            f"friction={_fmt(contact.friction)} slip={_fmt(contact.slip)}"
+            f"contact {contact.rod} fraction={format_number(contact.fraction)} "
+            f"stiffness={format_number(contact.stiffness)} "
+            f"damping={format_number(contact.damping)} "
+            f"friction={format_number(contact.friction)} slip={format_number(contact.slip)}"
         )
     terrain = figure.terrain
-    points = " ".join(f"{_fmt(x)},{_fmt(y)}" for x, y in terrain.points)
+    points = " ".join(f"{format_number(x)},{format_number(y)}" for x, y in terrain.points)
     if terrain.kind == "floor":
-        out.append(f"terrain floor height={_fmt(terrain.height)}")
+        out.append(f"terrain floor height={format_number(terrain.height)}")
     elif terrain.kind == "steps":
-        out.append(f"terrain steps {points} height={_fmt(terrain.height)}")
+        out.append(f"terrain steps {points} height={format_number(terrain.height)}")
     elif terrain.kind == "polyline":
         out.append(f"terrain polyline {points}")
     return "\n".join(out) + "\n"

@@ -105,6 +105,13 @@ def read_spec(path: str | Path) -> list[Line]:
     return tokenize(read_spec_text(path)[0], str(path))
 
 
+def format_number(value: float) -> str:
+    """A number in spec text: the shortest repr that reads back to the same float (``2``,
+    ``0.1``, ``1e-06``)."""
+    text = repr(float(value))
+    return text[:-2] if text.endswith(".0") else text
+
+
 def parse_number(token: Token, path: str, what: str, text: str | None = None) -> float:
     """A finite decimal number (``1``, ``-2.5``, ``1e-3``); ``what`` names it in the error.
     ``text`` overrides the token's text (for parts of a token such as ``-135`` in ``-135,350``)."""
