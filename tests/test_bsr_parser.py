@@ -498,3 +498,10 @@ def test_render_then_parse_round_trips(spec):
     for i, endpoint in enumerate(parsed.fall):
         assert parsed.tokens[f"fall.{i}"] == endpoint.token
         assert endpoint.token.text == f"{endpoint.rod}.{endpoint.end}"
+
+
+def test_a_seed_of_thousands_of_digits_is_a_spec_error():
+    text = EXAMPLE.replace("seeds 1 2 3", "seeds " + "9" * 5000)
+    with pytest.raises(SpecError) as error:
+        parse_bsr_text(text, "x.bsr")
+    assert "expected a whole number of fewer digits for" in str(error.value)

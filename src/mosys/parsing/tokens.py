@@ -128,7 +128,12 @@ def parse_int(token: Token, path: str, what: str, minimum: int | None = None) ->
     """A whole number (no sign, point or exponent), at least ``minimum`` if given."""
     if re.fullmatch(r"[+-]?\d+", token.text) is None:
         raise SpecError(path, token.line, token.column, f"a whole number for {what}", token.text)
-    value = int(token.text)
+    try:
+        value = int(token.text)
+    except ValueError:  # more digits than Python converts (sys.get_int_max_str_digits)
+        raise SpecError(
+            path, token.line, token.column, f"a whole number of fewer digits for {what}", token.text
+        ) from None
     if minimum is not None and value < minimum:
         raise SpecError(
             path, token.line, token.column, f"a whole number >= {minimum} for {what}", token.text
