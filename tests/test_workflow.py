@@ -252,5 +252,6 @@ def test_editing_one_weight_reruns_only_that_search_and_its_plots(bsr_built):
         "bsr_all": 1,
     }
     output = snakemake(bsr_built, "--dry-run", "results/bsr_all", "--configfile", "config/ci.yaml")
-    assert "results/bsr/starman_jump/seed1.h5" in output
-    assert "results/bsr/starman_shuffle/seed1.h5" not in output
+    searched = re.findall(r"wildcards: name=(\w+), seed=(\d+)", output)
+    assert sorted(searched) == [("starman_jump", str(seed)) for seed in range(1, 6)]
+    assert set(re.findall(r"wildcards: name=(\w+)$", output, re.M)) == {"starman_jump"}
