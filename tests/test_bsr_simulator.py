@@ -10,9 +10,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from mosys.bsr.controller import BsrController
 from mosys.bsr.figure import bsr_figure
+from mosys.bsr.search import record_run
 from mosys.bsr.start import standing_state
-from mosys.kernels.bsr_run import active_rule, rule_weights, run_controller, segment_rule
+from mosys.kernels.bsr_run import active_rule, rule_weights, segment_rule
 from mosys.kernels.bsr_simulate import contact_impulses
 from mosys.parsing.figure import parse_figure_spec, parse_figure_text
 
@@ -25,33 +27,17 @@ def run(figure, start, target, tau, steps, dt=0.01):
     """One rule held for the whole run; returns rod ends (steps+1, N, 2, 2), com (steps+1, 2)
     and the terms."""
     j = len(figure.joint_names)
-    v = len(figure.sense_names)
-    ends = np.zeros((steps + 1, figure.parent.shape[0], 2, 2))
-    com = np.zeros((steps + 1, 2))
-    terms = np.zeros(5)
-    run_controller(
-        *figure.kernel_arrays,
-        figure.gravity,
-        figure.floor,
-        figure.reach,
-        True,
-        np.asarray(target, np.float64).reshape(1, j),
-        np.array([tau]),
-        np.zeros((1, 0)),
-        np.zeros((1, 0)),
-        np.array([1e9]),
-        1e9,
-        start,
-        steps,
-        dt,
-        np.zeros(0, np.int64),
-        np.zeros((steps + 1, v)),
-        np.zeros(steps + 1, np.int64),
-        terms,
-        ends,
-        com,
+    held = BsrController(
+        kind="time",
+        target=np.asarray(target, np.float64).reshape(1, j),
+        tau=np.array([tau]),
+        center=np.zeros((1, 0)),
+        side=np.zeros((1, 0)),
+        segment=np.array([1e9]),
+        period=1e9,
     )
-    return ends, com, terms
+    recorded = record_run(figure, held, start, steps, dt)
+    return recorded.rod_ends, recorded.com, recorded.terms
 
 
 def rod_motion(figure, ends, dt):

@@ -339,37 +339,82 @@ def nominal_run(setup: SearchSetup, controller: BsrController):
     """Run one controller from the nominal start, recording everything: returns terms
     (len(TERMS),), active rule (steps + 1,), rod ends (steps + 1, N, 2, 2) m, com
     (steps + 1, 2) m."""
-    spec, figure = setup.spec, setup.figure
-    steps = spec.steps
-    n_rods = figure.parent.shape[0]
-    senses = np.zeros((steps + 1, len(figure.sense_names)))
-    rules = np.zeros(steps + 1, np.int64)
-    terms = np.zeros(len(TERMS))
-    ends = np.zeros((steps + 1, n_rods, 2, 2))
-    com = np.zeros((steps + 1, 2))
-    segment_end = np.cumsum(controller.segment) if controller.kind == "time" else np.zeros(0)
-    if controller.kind == "time":
+    run = record_run(
+        setup.figure,
+        controller,
+        standing_state(setup.figure, setup.root_angle, setup.joints, setup.x),
+        setup.spec.steps,
+        setup.spec.dt,
+        setup.fall_endpoints,
+    )
+    return run.terms, run.active_rule, run.rod_ends, run.com
+
+
+@dataclass(frozen=True)
+class RecordedRun:
+    """One controller's run, every step: terms (len(TERMS),), active_rule (steps + 1,), rod_ends
+    (steps + 1, N, 2, 2) m, com (steps + 1, 2) m, and where it ended: final_state (S,) and the
+    endpoints' normal forces final_force (E,) N."""
+
+    terms: np.ndarray
+    active_rule: np.ndarray
+    rod_ends: np.ndarray
+    com: np.ndarray
+    final_state: np.ndarray
+    final_force: np.ndarray
+
+
+def record_run(
+    figure: BsrFigure,
+    controller: BsrController,
+    start: np.ndarray,
+    steps: int,
+    dt: float,
+    fall_endpoints: np.ndarray | None = None,
+    start_force: np.ndarray | None = None,
+    carry_over: bool = False,
+) -> RecordedRun:
+    """Run ``controller`` for ``steps`` steps of dt s from the state ``start`` (S,), recording
+    every step. ``start_force`` (E,) N and ``carry_over``: a controller taking over from another
+    keeps the senses (contact forces) where the last one left them and starts with the rule
+    they select."""
+    n_ends = figure.endpoints.shape[0]
+    time_based = controller.kind == "time"
+    segment_end = np.cumsum(controller.segment) if time_based else np.zeros(controller.rules)
+    if time_based:
         segment_end[-1] = controller.period
+    run = RecordedRun(
+        terms=np.zeros(len(TERMS)),
+        active_rule=np.zeros(steps + 1, np.int64),
+        rod_ends=np.zeros((steps + 1, figure.parent.shape[0], 2, 2)),
+        com=np.zeros((steps + 1, 2)),
+        final_state=np.empty_like(start),
+        final_force=np.empty(n_ends),
+    )
     run_controller(
         *figure.kernel_arrays,
         figure.gravity,
         figure.floor,
         figure.reach,
-        controller.kind == "time",
+        time_based,
         controller.target,
         controller.tau,
         controller.center,
         controller.side,
-        segment_end if controller.kind == "time" else np.zeros(controller.rules),
-        controller.period if controller.kind == "time" else 1.0,
-        standing_state(figure, setup.root_angle, setup.joints, setup.x),
+        segment_end,
+        controller.period if time_based else 1.0,
+        np.asarray(start, np.float64),
         steps,
-        spec.dt,
-        setup.fall_endpoints,
-        senses,
-        rules,
-        terms,
-        ends,
-        com,
+        dt,
+        np.zeros(0, np.int64) if fall_endpoints is None else fall_endpoints,
+        np.zeros((steps + 1, len(figure.sense_names))),
+        run.active_rule,
+        run.terms,
+        run.rod_ends,
+        run.com,
+        np.zeros(n_ends) if start_force is None else np.asarray(start_force, np.float64),
+        carry_over,
+        run.final_state,
+        run.final_force,
     )
-    return terms, rules, ends, com
+    return run

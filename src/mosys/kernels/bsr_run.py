@@ -124,6 +124,10 @@ def run_controller(
     terms_out,
     ends_out,
     com_out,
+    start_force,
+    carry_over,
+    final_state,
+    final_force,
 ):
     """Run a controller for ``steps`` steps of dt seconds from the state ``start`` (S,).
 
@@ -132,6 +136,10 @@ def run_controller(
     Fills senses_out (steps + 1, V) and rule_out (steps + 1,) (sample 0: the start, with rule 0
     active as Figure 2 begins), terms_out (len(TERMS),), and, if ends_out has steps + 1 rows,
     ends_out (steps + 1, N, 2, 2) and com_out (steps + 1, 2), world metres.
+    start_force (E,): the endpoints' normal forces at the start, N (zeros for a fresh start);
+    carry_over: a controller taking over from another (a composite motion) starts with the rule
+    its score picks from the carried-over senses (rule 0 if none scores positive) instead of
+    rule 0. Fills final_state (S,) and final_force (E,) with the state and forces at the end.
     """
     state = start.copy()
     n_rods = parent.shape[0]
@@ -139,7 +147,7 @@ def run_controller(
     rod_ends = np.empty((n_rods, 2, 2))
     end_offset = np.empty((n_ends, 2))
     end_velocity = np.empty((n_ends, 2))
-    end_force = np.zeros(n_ends)
+    end_force = start_force.copy()
     end_x = np.empty(n_ends)
     touching = np.zeros(n_ends, np.bool_)
     previous = np.zeros(1)
@@ -190,6 +198,8 @@ def run_controller(
         state, joint_min, joint_max, end_force, weight, floor, reach, gravity, senses_out[0]
     )
     rule = 0
+    if carry_over and not time_based:
+        rule = active_rule(senses_out[0], center, side, weights, 0)
     rule_out[0] = rule
     start_x = state[CX]
     start_phi = state[PHI]
@@ -258,6 +268,8 @@ def run_controller(
     terms_out[2] = contact_distance
     terms_out[3] = abs(state[PHI] - start_phi) / (2.0 * math.pi)
     terms_out[4] = fallen_steps / steps
+    final_state[:] = state
+    final_force[:] = end_force
 
 
 @njit(cache=True, parallel=True)
@@ -297,6 +309,7 @@ def run_population(
     (C, steps + 1, V), rule_out (C, steps + 1), terms_out (C, len(TERMS))."""
     no_ends = np.empty((0, parent.shape[0], 2, 2))
     no_com = np.empty((0, 2))
+    n_ends = endpoints.shape[0]
     for c in prange(target.shape[0]):
         run_controller(
             parent,
@@ -329,4 +342,8 @@ def run_population(
             terms_out[c],
             no_ends,
             no_com,
+            np.zeros(n_ends),
+            False,
+            np.empty(start.shape[1]),
+            np.empty(n_ends),
         )
