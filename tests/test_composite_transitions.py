@@ -17,7 +17,7 @@ def test_it_finds_the_best_durations_from_a_careless_guess():
     found = search_transitions(peaked(best), [159, 90, 100], 3)
     assert found.durations.sum() == 349
     assert np.abs(found.durations - best).max() <= 2  # within two ticks of the best
-    assert found.guess_score == -78.0 and found.score >= -4.0
+    assert found.guess_score == -138.0 and found.score >= -4.0
     assert found.simulations == 1 + 16 * 16 * 4
     assert np.all(np.diff(found.best_by_generation) >= 0)
 
