@@ -142,6 +142,8 @@ class _Population:
     """C controllers as stacked arrays (what ``run_population`` takes), their fitness and the
     sense trajectory of each one's last run (for the relevance heuristic)."""
 
+    ARRAYS = ("target", "tau", "center", "side", "segment", "senses", "fitness")
+
     def __init__(self, setup: SearchSetup, rng: np.random.Generator):
         spec, figure = setup.spec, setup.figure
         c, r, j, v = spec.controllers, spec.rules, len(figure.joint_names), 0
@@ -207,8 +209,16 @@ class _Population:
                 SEGMENT_WEIGHT_MAX,
             )
 
+    def copy(self) -> _Population:
+        """An independent copy (its arrays are new)."""
+        twin = _Population.__new__(_Population)
+        twin.setup = self.setup
+        for name in _Population.ARRAYS:
+            setattr(twin, name, getattr(self, name).copy())
+        return twin
+
     def copy_from(self, other: _Population, k_to: int, k_from: int) -> None:
-        for name in ("target", "tau", "center", "side", "segment", "senses", "fitness"):
+        for name in _Population.ARRAYS:
             getattr(self, name)[k_to] = getattr(other, name)[k_from]
 
     def segment_end(self) -> np.ndarray:
@@ -283,9 +293,7 @@ def run_search(setup: SearchSetup, seed: int, label: str = "search") -> SearchOu
     began = time.perf_counter()
     current = _Population(setup, rng)
     current.fitness[:] = _evaluate(setup, current, rng)
-    mutant = _Population.__new__(_Population)
-    mutant.__dict__.update({name: np.copy(value) for name, value in vars(current).items()})
-    mutant.setup = setup
+    mutant = current.copy()
     best_k = int(np.argmax(current.fitness))
     best = current.controller(best_k)
     best_fitness = float(current.fitness[best_k])
