@@ -80,6 +80,7 @@ from mosys.parsing.tokens import (
     parse_int,
     parse_number,
     read_spec_text,
+    record_once,
     tokenize,
     unknown_keyword,
     value_token,
@@ -172,12 +173,7 @@ class _Parser:
             keyword = line.keyword
             if keyword.text not in KEYWORDS:
                 raise unknown_keyword(line, KEYWORDS)
-            if keyword.text in self.first_line:
-                first = self.first_line[keyword.text]
-                raise self.error(
-                    keyword, f"one '{keyword.text}' line only (the first is line {first})"
-                )
-            self.first_line[keyword.text] = line.number
+            record_once(line, self.first_line)
             getattr(self, f"line_{keyword.text}")(line)
         for keyword in REQUIRED:
             if keyword not in self.first_line:

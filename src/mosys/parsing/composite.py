@@ -84,6 +84,7 @@ from mosys.parsing.tokens import (
     parse_int,
     parse_name,
     read_spec_text,
+    record_once,
     tokenize,
     unknown_keyword,
     value_token,
@@ -428,19 +429,14 @@ class _Parser:
             keyword = line.keyword
             if keyword.text not in KEYWORDS:
                 raise unknown_keyword(line, KEYWORDS)
-            if keyword.text in self.first_line:
-                first = self.first_line[keyword.text]
-                raise self.error(
-                    keyword, f"one '{keyword.text}' line only (the first is line {first})"
-                )
-            if keyword.text in ("phase", "score") and "total" in self.first_line:
+            if keyword.text in ("figure", "total", "search"):
+                record_once(line, self.first_line)
+            elif "total" in self.first_line:  # a phase or score line after the total
                 raise self.error(
                     keyword,
                     f"no '{keyword.text}' line after the 'total' line "
                     f"(line {self.first_line['total']})",
                 )
-            if keyword.text in ("figure", "total", "search"):
-                self.first_line[keyword.text] = line.number
             getattr(self, f"line_{keyword.text}")(line)
         if "figure" not in self.first_line:
             raise missing_line(self.path, lines, "figure")

@@ -39,6 +39,7 @@ from mosys.parsing.tokens import (
     missing_line,
     parse_number,
     read_spec_text,
+    record_once,
     tokenize,
     unknown_keyword,
     value_token,
@@ -255,7 +256,7 @@ class _Parser:
             if keyword not in KEYWORDS:
                 raise unknown_keyword(line, KEYWORDS)
             if keyword in ("dyn", "dest", "tol", "maxiter", "dt", "domain", "hold"):
-                self.once(line)
+                record_once(line, self.first_line)
             getattr(self, f"line_{keyword}")(line)
         for keyword, given in (
             ("dyn", self.figure),
@@ -281,15 +282,6 @@ class _Parser:
             domain=self.domain,
             hold=self.hold,
         )
-
-    def once(self, line: Line) -> None:
-        keyword = line.keyword
-        if keyword.text in self.first_line:
-            first = self.first_line[keyword.text]
-            raise self.error(
-                keyword, f"one '{keyword.text}' line only (the first is line {first})", keyword.text
-            )
-        self.first_line[keyword.text] = line.number
 
     def new_name(self, reader: LineReader, what: str) -> Token:
         """A name for an ssd or torq line, unused by any other ssd or torq line."""

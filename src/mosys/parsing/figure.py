@@ -29,6 +29,7 @@ from mosys.parsing.tokens import (
     parse_name,
     parse_number,
     read_spec,
+    record_once,
     tokenize,
     unknown_keyword,
     value_token,
@@ -362,7 +363,7 @@ class _Parser:
             if keyword not in KEYWORDS:
                 raise unknown_keyword(line, KEYWORDS)
             if keyword in ("gravity", "terrain"):
-                self.once(line)
+                record_once(line, self.first_line)
             getattr(self, f"line_{keyword}")(line)
         end = Token(END_OF_FILE, lines[-1].number + 1 if lines else 1, 1)
         if not self.rods:
@@ -383,13 +384,6 @@ class _Parser:
         )
 
     # --- helpers
-
-    def once(self, line: Line) -> None:
-        keyword = line.keyword
-        if keyword.text in self.first_line:
-            first = self.first_line[keyword.text]
-            raise self.error(keyword, f"one '{keyword.text}' line only (the first is line {first})")
-        self.first_line[keyword.text] = line.number
 
     def name_token(self, reader: LineReader, what: str) -> Token:
         token = reader.peek()

@@ -48,6 +48,7 @@ from mosys.parsing.tokens import (
     missing_line,
     parse_number,
     read_spec_text,
+    record_once,
     tokenize,
     unknown_keyword,
     value_token,
@@ -216,7 +217,7 @@ class _Parser:
                         keyword, "a 'figure' line before the first 'phase'", keyword.text
                     )
             else:
-                self.once(line)
+                record_once(line, self.first_line)
                 if self.phases:
                     raise self.error(
                         keyword,
@@ -238,15 +239,6 @@ class _Parser:
             phases=tuple(self.phases),
             spec_sha256=spec_sha256,
         )
-
-    def once(self, line: Line) -> None:
-        keyword = line.keyword
-        if keyword.text in self.first_line:
-            first = self.first_line[keyword.text]
-            raise self.error(
-                keyword, f"one '{keyword.text}' line only (the first is line {first})", keyword.text
-            )
-        self.first_line[keyword.text] = line.number
 
     def assignment(self, token: Token, expected: str) -> tuple[str, Token]:
         """A ``name=value`` token: the name and the value part (its own column)."""

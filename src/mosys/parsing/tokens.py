@@ -241,6 +241,19 @@ def unknown_keyword(line: Line, keywords: tuple[str, ...]) -> SpecError:
     )
 
 
+def record_once(line: Line, first_line: dict[str, int]) -> None:
+    """Note a line whose keyword may appear once in ``first_line`` (keyword -> line number);
+    a second one is an error at its keyword naming the first."""
+    keyword = line.keyword
+    if keyword.text in first_line:
+        raise SpecError.at(
+            line.path,
+            keyword,
+            f"one '{keyword.text}' line only (the first is line {first_line[keyword.text]})",
+        )
+    first_line[keyword.text] = line.number
+
+
 def missing_line(path: str, lines: list[Line], keyword: str) -> SpecError:
     """The error for a required line that never came: points just past the last line."""
     last = lines[-1].number + 1 if lines else 1
