@@ -28,6 +28,8 @@ from mosys.kernels.bsr_simulate import (
     PHI,
     VY,
     body_frame,
+    endpoint_position,
+    place_in_world,
     step,
 )
 
@@ -182,16 +184,10 @@ def run_controller(
     cos_phi = math.cos(state[PHI])
     sin_phi = math.sin(state[PHI])
     for e in range(n_ends):
-        end_x[e] = state[CX] + cos_phi * end_offset[e, 0] - sin_phi * end_offset[e, 1]
-        y = state[CY] + sin_phi * end_offset[e, 0] + cos_phi * end_offset[e, 1]
+        end_x[e], y = endpoint_position(state, cos_phi, sin_phi, end_offset, e)
         touching[e] = not math.isnan(floor) and y <= floor + CONTACT_TOLERANCE
     if record:
-        for k in range(n_rods):
-            for end in range(2):
-                bx = rod_ends[k, end, 0]
-                by = rod_ends[k, end, 1]
-                ends_out[0, k, end, 0] = state[CX] + cos_phi * bx - sin_phi * by
-                ends_out[0, k, end, 1] = state[CY] + sin_phi * bx + cos_phi * by
+        place_in_world(state, cos_phi, sin_phi, rod_ends, ends_out[0])
         com_out[0, 0] = state[CX]
         com_out[0, 1] = state[CY]
     measure_senses(
@@ -238,8 +234,7 @@ def run_controller(
         sin_phi = math.sin(state[PHI])
         fallen = False
         for e in range(n_ends):
-            x = state[CX] + cos_phi * end_offset[e, 0] - sin_phi * end_offset[e, 1]
-            y = state[CY] + sin_phi * end_offset[e, 0] + cos_phi * end_offset[e, 1]
+            x, y = endpoint_position(state, cos_phi, sin_phi, end_offset, e)
             now_touching = not math.isnan(floor) and y <= floor + CONTACT_TOLERANCE
             if now_touching and touching[e]:
                 contact_distance += abs(x - end_x[e])

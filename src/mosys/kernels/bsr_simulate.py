@@ -133,6 +133,28 @@ def body_frame(
     return total_mass, total_inertia, deformation_momentum
 
 
+@njit(cache=True, inline="always")
+def endpoint_position(state, cos_phi, sin_phi, end_offset, e):
+    """World (x, y) of endpoint e, m, from its offset from the centre of mass in the body frame
+    (end_offset (E, 2)) and the body's orientation (cos_phi, sin_phi)."""
+    x = state[CX] + cos_phi * end_offset[e, 0] - sin_phi * end_offset[e, 1]
+    y = state[CY] + sin_phi * end_offset[e, 0] + cos_phi * end_offset[e, 1]
+    return x, y
+
+
+@njit(cache=True, inline="always")
+def place_in_world(state, cos_phi, sin_phi, body_ends, out):
+    """Every rod's ends in the world, m: body_ends (N, 2, 2) relative to the centre of mass in
+    the body frame, turned by the body's orientation and moved to the state's centre of mass;
+    written to out (N, 2, 2), which may be body_ends itself."""
+    for k in range(body_ends.shape[0]):
+        for end in range(2):
+            bx = body_ends[k, end, 0]
+            by = body_ends[k, end, 1]
+            out[k, end, 0] = state[CX] + cos_phi * bx - sin_phi * by
+            out[k, end, 1] = state[CY] + sin_phi * bx + cos_phi * by
+
+
 @njit(cache=True)
 def deform_joints(theta, theta_rate, target, tau, joint_min, joint_max, dt):
     """Advance every joint dt seconds along tau² θ'' + 2 tau θ' + (θ - target) = 0, exactly
@@ -308,7 +330,7 @@ def step(
     cos_phi = math.cos(state[PHI])
     sin_phi = math.sin(state[PHI])
     for e in range(endpoints.shape[0]):
-        entry_x[e] = state[CX] + cos_phi * end_offset[e, 0] - sin_phi * end_offset[e, 1]
+        entry_x[e] = endpoint_position(state, cos_phi, sin_phi, end_offset, e)[0]
     n_joints = target.shape[0]
     theta = state[JOINTS : JOINTS + n_joints]
     theta_rate = state[JOINTS + n_joints : JOINTS + 2 * n_joints]
@@ -421,13 +443,7 @@ def step(
     if not math.isnan(floor):
         lowest = np.inf
         for e in range(endpoints.shape[0]):
-            y = state[CY] + sin_phi * end_offset[e, 0] + cos_phi * end_offset[e, 1]
-            lowest = min(lowest, y)
+            lowest = min(lowest, endpoint_position(state, cos_phi, sin_phi, end_offset, e)[1])
         if lowest < floor:
             state[CY] += floor - lowest  # no sinking: lift the figure out of the floor
-    for k in range(parent.shape[0]):
-        for end in range(2):
-            bx = rod_ends[k, end, 0]
-            by = rod_ends[k, end, 1]
-            rod_ends[k, end, 0] = state[CX] + cos_phi * bx - sin_phi * by
-            rod_ends[k, end, 1] = state[CY] + sin_phi * bx + cos_phi * by
+    place_in_world(state, cos_phi, sin_phi, rod_ends, rod_ends)
