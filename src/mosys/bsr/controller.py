@@ -14,12 +14,12 @@ from dataclasses import dataclass
 import numpy as np
 
 # Table 2 of the paper: the hyper-rectangle's side 2/lambda lies in [SIDE_MIN, SIDE_MAX], so
-# lambda_min = 2 / SIDE_MAX; centres are drawn in [CENTER_MIN, CENTER_MAX].
+# lambda_min = 2 / SIDE_MAX (the rule weights of kernels.bsr_run); centres are drawn in
+# [CENTER_MIN, CENTER_MAX].
 SIDE_MIN = 0.4
 SIDE_MAX = 4.0
 CENTER_MIN = -0.5
 CENTER_MAX = 1.5
-LAMBDA_MIN = 2.0 / SIDE_MAX
 
 
 @dataclass(frozen=True)

@@ -333,21 +333,19 @@ def run_search(setup: SearchSetup, seed: int, label: str = "search") -> SearchOu
         best_fitness=np.array(curve),
         controller=best,
         fitness=best_fitness,
-        nominal_fitness=float(run[0] @ setup.weights),
-        terms=run[0],
-        active_rule=run[1],
-        rod_ends=run[2],
-        com=run[3],
+        nominal_fitness=float(run.terms @ setup.weights),
+        terms=run.terms,
+        active_rule=run.active_rule,
+        rod_ends=run.rod_ends,
+        com=run.com,
         wall_seconds=wall,
         steps_per_second=evaluations[-1] * spec.steps / wall,
     )
 
 
-def nominal_run(setup: SearchSetup, controller: BsrController):
-    """Run one controller from the nominal start, recording everything: returns terms
-    (len(TERMS),), active rule (steps + 1,), rod ends (steps + 1, N, 2, 2) m, com
-    (steps + 1, 2) m."""
-    run = record_run(
+def nominal_run(setup: SearchSetup, controller: BsrController) -> RecordedRun:
+    """Run one controller from the nominal start, recording every step."""
+    return record_run(
         setup.figure,
         controller,
         standing_state(setup.figure, setup.root_angle, setup.joints, setup.x),
@@ -355,7 +353,6 @@ def nominal_run(setup: SearchSetup, controller: BsrController):
         setup.spec.dt,
         setup.fall_endpoints,
     )
-    return run.terms, run.active_rule, run.rod_ends, run.com
 
 
 @dataclass(frozen=True)

@@ -20,6 +20,8 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from mosys.bsr.controller import SIDE_MAX  # the largest side (Table 2): lambda_min = 2 / SIDE_MAX
+from mosys.bsr.spec import FITNESS_TERMS
 from mosys.kernels.bsr_simulate import (
     CONTACT_TOLERANCE,
     CX,
@@ -33,8 +35,7 @@ from mosys.kernels.bsr_simulate import (
     step,
 )
 
-TERMS = ("distance", "max_height", "contact_distance", "rotations", "fall")
-SIDE_MAX = 4.0  # the largest hyper-rectangle side (Table 2): lambda_min = 2 / SIDE_MAX
+TERMS = FITNESS_TERMS  # the order of terms_out
 
 
 @njit(cache=True)

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from mosys.bsr.spec import FITNESS_TERMS
 from mosys.io.atomic import write_text_atomically
 from mosys.io.bsr_result import read_bsr_result
 
@@ -20,7 +21,6 @@ PAPER_FIGURE = {
     "sense": "3-6 min per 40,000 evaluations (DEC 3000/400)",
     "time": "tens of seconds (DEC 3000/400)",
 }
-TERMS_SHOWN = ("distance", "max_height", "contact_distance", "rotations", "fall")
 
 
 def runs_frame(result_paths: list[str | Path]) -> pd.DataFrame:
@@ -53,17 +53,16 @@ def runs_frame(result_paths: list[str | Path]) -> pd.DataFrame:
             "evaluations per seed": int(np.median(evaluations)),
             "wall per seed (s)": round(float(np.median(wall)), 2),
             "ms per evaluation": round(ms_per_evaluation, 3),
-            "steps per second": float(np.median([a["steps_per_second"] for a in attrs])),
+            "steps per second": f"{np.median([a['steps_per_second'] for a in attrs]):.3g}",
             "40k evaluations (s)": round(seconds_40k, 1),
             "paper": PAPER_FIGURE[kind],
             "speed-up vs paper": f"{paper_low / seconds_40k:.0f}-{paper_high / seconds_40k:.0f}x",
             "best fitness": round(float(fitness.max()), 3),
             "median fitness": round(float(np.median(fitness)), 3),
         }
-        for term in TERMS_SHOWN:
+        for term in FITNESS_TERMS:
             values = [result.fitness_terms[term] for result in results]
             row[f"median {term}"] = round(float(np.median(values)), 3)
-        row["steps per second"] = f"{row['steps per second']:.3g}"
         rows.append(row)
     return pd.DataFrame(rows)
 
