@@ -161,6 +161,41 @@ def _bsr_search(args: argparse.Namespace) -> None:
     )
 
 
+def _composite_controller_files(args: argparse.Namespace, script) -> dict:
+    """The BSR result files the script may use: the ``--controllers`` given (grouped by their
+    directory, the search's name), else every seed file under ``--bsr-results``."""
+    from mosys.composite.session import find_controller_files
+
+    if not args.controllers:
+        return find_controller_files(script, args.bsr_results)
+    grouped: dict[str, list[Path]] = {}
+    for path in map(Path, args.controllers):
+        grouped.setdefault(path.parent.name, []).append(path)
+    return grouped
+
+
+def _composite(args: argparse.Namespace) -> None:
+    from mosys.composite.run import composite_to_file
+    from mosys.parsing.composite import parse_composite_script
+
+    script = parse_composite_script(args.script)
+    sizes = {key: getattr(args, key) for key in ("q", "g", "h") if getattr(args, key)}
+    found = composite_to_file(
+        args.script,
+        _composite_controller_files(args, script),
+        args.output,
+        args.figures,
+        args.bsr_specs,
+        sizes,
+        args.budget,
+    )
+    print(
+        f"{args.output}: total {found.guess_score:.3f} -> {found.score:.3f}, durations "
+        f"{found.guess_durations.tolist()} -> {found.durations.tolist()} ticks, "
+        f"{found.simulations} simulations"
+    )
+
+
 def _bsr_table(args: argparse.Namespace) -> None:
     from mosys.tables.bsr import write_bsr_table
 
@@ -304,6 +339,24 @@ def build_parser() -> argparse.ArgumentParser:
     search.add_argument("--threads", type=int, help="threads that run the population")
     search.add_argument("-o", "--output", required=True)
     search.set_defaults(handler=_bsr_search)
+
+    composite = verbs.add_parser(
+        "composite", help="composite script (.comp) -> refined transition points (.h5)"
+    )
+    composite.add_argument("script", help="the composite-motion script (.comp)")
+    composite.add_argument(
+        "--controllers", nargs="+", help="BSR result files (SEARCH/seedK.h5) the phases may use"
+    )
+    composite.add_argument(
+        "--bsr-results", default="results/bsr", help="where SEARCH/seedK.h5 live (no --controllers)"
+    )
+    composite.add_argument("--figures", default="specs/figures", help="where NAME.fig lives")
+    composite.add_argument("--bsr-specs", default="specs/bsr", help="where SEARCH.bsr lives")
+    for key, what in (("q", "Q arrays"), ("g", "G generations"), ("h", "H mutations")):
+        composite.add_argument(f"--{key}", type=int, help=f"override the script's {what}")
+    composite.add_argument("--budget", default="paper", help="name of the config that built it")
+    composite.add_argument("-o", "--output", required=True)
+    composite.set_defaults(handler=_composite)
 
     bsr_table = verbs.add_parser("bsr-table", help="the BSR runs table")
     bsr_table.add_argument("results", nargs="+", help="seed files (.h5) of the searches")

@@ -53,7 +53,7 @@ def search_to_file(
         evaluations=outcome.evaluations,
         best_fitness=outcome.best_fitness,
         controller=outcome.controller,
-        motion=figure_motion(figure, outcome, spec.dt),
+        motion=figure_motion(figure, outcome.rod_ends, outcome.com, spec.dt),
         active_rule=outcome.active_rule,
         joint_names=figure.joint_names,
         sense_names=figure.sense_names if spec.kind == "sense" else (),
@@ -88,15 +88,18 @@ def search_to_file(
     return outcome
 
 
-def figure_motion(figure: BsrFigure, outcome: SearchOutcome, dt: float) -> FigureMotion:
-    """The best run as the ``figure_motion`` contract (a sample every simulator step)."""
+def figure_motion(
+    figure: BsrFigure, rod_ends: np.ndarray, com: np.ndarray, dt: float
+) -> FigureMotion:
+    """A run of the figure as the ``figure_motion`` contract: rod_ends (N, rods, 2, 2) m and
+    com (N, 2) m, one sample every simulator step of dt s from t = 0."""
     parsed = figure.figure
     floor = 0.0 if np.isnan(figure.floor) else figure.floor
     terrain = [] if np.isnan(figure.floor) else [[-1000.0, floor], [1000.0, floor]]
     return FigureMotion(
-        t=np.arange(outcome.com.shape[0]) * dt,
-        endpoints=outcome.rod_ends,
-        com=outcome.com,
+        t=np.arange(com.shape[0]) * dt,
+        endpoints=rod_ends,
+        com=com,
         rod_names=tuple(rod.name for rod in parsed.rods),
         rod_mass=figure.mass,
         rod_length=figure.length,

@@ -36,6 +36,13 @@ class TransitionSearch:
     simulations: int
 
 
+def equal_split(length: int, phases: int) -> np.ndarray:
+    """``length`` ticks in ``phases`` equal durations (P,), the last taking the remainder."""
+    durations = np.full(phases, length // phases, np.int64)
+    durations[-1] += length - durations.sum()
+    return durations
+
+
 def durations_of(switches: np.ndarray, length: int) -> np.ndarray:
     """Phase durations (P,) ticks from sorted switch ticks (P - 1,) in a motion of ``length``."""
     return np.diff(np.concatenate([[0], switches, [length]])).astype(np.int64)
@@ -60,8 +67,7 @@ def search_transitions(
     else:
         if length is None:
             raise ValueError("without a guess, the motion's length in ticks is needed")
-        start = np.full(phases, length // phases, np.int64)
-        start[-1] += length - start.sum()
+        start = equal_split(length, phases)
     if start.shape != (phases,) or np.any(start < 0) or length < 1:
         raise ValueError(f"durations {start.tolist()} do not make {phases} phases")
     rng = np.random.default_rng(seed)

@@ -1,0 +1,109 @@
+"""One composite motion end to end: script and BSR results in, ``results/composite/NAME.h5``
+out (the guessed concatenation, Figure 5's search, the refined concatenation)."""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from mosys.bsr.run import figure_motion
+from mosys.composite.session import CompositeSession, ScoredMotion, open_session
+from mosys.composite.transitions import TransitionSearch, search_transitions
+from mosys.io.composite_result import CompositeMotion, CompositeResult, write_composite_result
+from mosys.parsing.composite import parse_composite_script
+from mosys.parsing.tokens import read_spec_text
+
+
+def phase_table(session: CompositeSession, ticks: np.ndarray) -> list[dict]:
+    """The contract's ``phases`` entry for these durations: per phase its controller, start and
+    end s (and ours: name, seed, ticks)."""
+    bounds = np.concatenate([[0], np.cumsum(ticks)]) * session.dt
+    return [
+        {
+            "name": phase.name,
+            "controller": phase.controller,
+            "seed": session.seeds[k],
+            "ticks": int(ticks[k]),
+            "start": float(bounds[k]),
+            "end": float(bounds[k + 1]),
+        }
+        for k, phase in enumerate(session.script.phases)
+    ]
+
+
+def stored_motion(session: CompositeSession, scored: ScoredMotion) -> CompositeMotion:
+    motion = scored.motion
+    return CompositeMotion(
+        motion=figure_motion(session.figure, motion.rod_ends, motion.com, session.dt),
+        phase=motion.phase,
+        active_rule=motion.active_rule,
+    )
+
+
+def composite_to_file(
+    script_path: str | Path,
+    controller_files: Mapping[str, Sequence[str | Path]],
+    output: str | Path,
+    figures_dir: str | Path = "specs/figures",
+    bsr_specs_dir: str | Path = "specs/bsr",
+    search_sizes: Mapping[str, int] | None = None,
+    budget: str = "paper",
+) -> TransitionSearch:
+    """Parse the script, bind it to its controllers (``controller_files``: search -> its
+    seedK.h5 files), score the guess, run Figure 5's search and write both motions atomically.
+    ``search_sizes`` overrides the script's q, g, h or seed (a config's budget)."""
+    script = parse_composite_script(script_path)
+    if search_sizes:
+        script = replace(script, search=replace(script.search, **search_sizes))
+    session = open_session(script, controller_files, figures_dir, bsr_specs_dir)
+    before = session.score(session.guess)  # also compiles the kernels before the clock starts
+    settings = script.search
+    began = time.perf_counter()
+    found = search_transitions(
+        session.total,
+        before.ticks,
+        len(script.phases),
+        q=settings.q,
+        g=settings.g,
+        h=settings.h,
+        seed=settings.seed,
+    )
+    wall = time.perf_counter() - began
+    after = session.score(found.durations)
+    result = CompositeResult(
+        after=stored_motion(session, after),
+        before=stored_motion(session, before),
+        best_by_generation=found.best_by_generation,
+        attrs={
+            "script": script.name,
+            "phases": json.dumps(phase_table(session, after.ticks)),
+            "phases_before": json.dumps(phase_table(session, before.ticks)),
+            "score_before": before.total,
+            "score_after": after.total,
+            "simulations": found.simulations,
+            "spec_sha256": script.spec_sha256,
+            "wall_seconds": wall,
+            "name": script.name,
+            "figure": script.figure,
+            "dt": session.dt,
+            "ticks_before": before.ticks,
+            "ticks_after": after.ticks,
+            "scores_before": json.dumps(before.scores),
+            "scores_after": json.dumps(after.scores),
+            "seeds": np.array(session.seeds, np.int64),
+            "controller_files": list(session.controller_files),
+            "search_q": settings.q,
+            "search_g": settings.g,
+            "search_h": settings.h,
+            "search_seed": settings.seed,
+            "budget": budget,
+            "script_text": read_spec_text(script_path)[0],
+        },
+    )
+    write_composite_result(output, result)
+    return found

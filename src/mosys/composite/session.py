@@ -1,0 +1,184 @@
+"""A composite script bound to what it runs: the figure, each phase's BSR controller, the start
+state and the time step. The pipeline's transition search and the interactive editor both score
+phase durations through one ``CompositeSession``.
+
+Each phase names a BSR search (``results/bsr/SEARCH/seedK.h5``). Its controller is the seed the
+phase names, or else the seed whose best controller scores best from the search's own nominal
+start (the ``nominal_fitness`` attribute; the search's ``best_fitness`` of a perturbed search is
+one lucky draw). The motion starts from the first phase's search's nominal start pose, at rest.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from mosys.bsr.controller import BsrController
+from mosys.bsr.figure import BsrFigure, bsr_figure
+from mosys.bsr.search import bind_search
+from mosys.bsr.start import standing_state
+from mosys.composite.evaluate import PhaseMotion, score_script
+from mosys.composite.runtime import ConcatenatedMotion, run_concatenation
+from mosys.composite.script import CompositeScript
+from mosys.composite.transitions import equal_split
+from mosys.io.bsr_result import read_bsr_result
+from mosys.parsing.bsr import parse_bsr_spec
+from mosys.parsing.figure import Figure, parse_figure_spec
+from mosys.parsing.tokens import SpecError
+
+_SEED_FILE = re.compile(r"seed(\d+)\.h5$")
+
+
+@dataclass(frozen=True)
+class ScoredMotion:
+    """One concatenation and its script scores: ``ticks`` (P,) the phase durations, the motion,
+    each phase's score (phase name -> score) and the total."""
+
+    ticks: np.ndarray
+    motion: ConcatenatedMotion
+    scores: dict[str, float]
+    total: float
+
+
+@dataclass(frozen=True)
+class CompositeSession:
+    """The script, its figure, one controller per phase (and the seed it came from, and its
+    file), the start state (S,), the time step dt s, and the length in ticks a script without
+    guessed durations splits equally: the phases' searches' run lengths (each its T) together."""
+
+    script: CompositeScript
+    figure: BsrFigure
+    controllers: tuple[BsrController, ...]
+    seeds: tuple[int, ...]
+    controller_files: tuple[str, ...]
+    start: np.ndarray
+    dt: float
+    default_length: int
+
+    @property
+    def guess(self) -> np.ndarray:
+        """The guessed phase durations (P,) ticks: the script's, or the phases' searches' run
+        lengths together split equally."""
+        if self.script.guessed_ticks is not None:
+            return np.array(self.script.guessed_ticks, np.int64)
+        return equal_split(self.default_length, len(self.controllers))
+
+    def run(self, ticks: Sequence[int]) -> ConcatenatedMotion:
+        """The concatenated motion with these phase durations (P,) ticks."""
+        return run_concatenation(self.figure, self.controllers, ticks, self.start, self.dt)
+
+    def score(self, ticks: Sequence[int]) -> ScoredMotion:
+        """Run the phases for ``ticks`` (P,) and score the motion with the script."""
+        ticks = np.asarray(ticks, np.int64)
+        motion = self.run(ticks)
+        phases = {}
+        for k, phase in enumerate(self.script.phases):
+            samples = motion.phase_samples(k)
+            phases[phase.name] = PhaseMotion.from_rod_ends(
+                motion.com[samples], motion.rod_ends[samples], int(ticks[k])
+            )
+        scores, total = score_script(self.script, phases)
+        return ScoredMotion(ticks=ticks, motion=motion, scores=scores, total=total)
+
+    def total(self, ticks: Sequence[int]) -> float:
+        """The script's total for these phase durations (what the search maximises)."""
+        return self.score(ticks).total
+
+
+def find_controller_files(script: CompositeScript, results_dir: str | Path) -> dict[str, list]:
+    """Each phase's search -> its result files ``results_dir/SEARCH/seed*.h5``, sorted by seed."""
+    found = {}
+    for phase in script.phases:
+        files = Path(results_dir, phase.controller).glob("seed*.h5")
+        found[phase.controller] = sorted(
+            (path for path in files if _SEED_FILE.search(path.name)),
+            key=lambda path: int(_SEED_FILE.search(path.name).group(1)),
+        )
+    return found
+
+
+def open_session(
+    script: CompositeScript,
+    controller_files: Mapping[str, Sequence[str | Path]],
+    figures_dir: str | Path = "specs/figures",
+    bsr_specs_dir: str | Path = "specs/bsr",
+) -> CompositeSession:
+    """Bind the script: ``controller_files`` maps each phase's search to its result files
+    (``.../seedK.h5``). A figure, search or seed that is not there raises SpecError at the word
+    of the script that names it."""
+    figure_path = Path(figures_dir) / f"{script.figure}.fig"
+    if not figure_path.is_file():
+        raise SpecError.at(script.path, script.tokens["figure"], f"a figure in {figures_dir}")
+    parsed = parse_figure_spec(figure_path)
+    if not isinstance(parsed, Figure):
+        raise SpecError.at(script.path, script.tokens["figure"], "a figure of rods, not a vehicle")
+    figure = bsr_figure(parsed)
+    controllers, seeds, files, dts, lengths = [], [], [], [], []
+    for phase in script.phases:
+        token = script.tokens[f"phase.{phase.name}.controller"]
+        candidates = {}
+        for path in controller_files.get(phase.controller, ()):
+            match = _SEED_FILE.search(Path(path).name)
+            if match:
+                candidates[int(match.group(1))] = Path(path)
+        if not candidates:
+            raise SpecError.at(
+                script.path,
+                token,
+                f"a built BSR search (no results/bsr/{phase.controller}/seed*.h5: build it with"
+                f" snakemake results/bsr_all or a composite target)",
+            )
+        if phase.seed is not None:
+            if phase.seed not in candidates:
+                raise SpecError.at(
+                    script.path,
+                    script.tokens[f"phase.{phase.name}.seed"],
+                    f"a built seed of {phase.controller} ({', '.join(map(str, candidates))})",
+                )
+            seed = phase.seed
+            result = read_bsr_result(candidates[seed])
+        else:
+            results = {k: read_bsr_result(path) for k, path in sorted(candidates.items())}
+            seed = max(results, key=lambda k: float(results[k].attrs["nominal_fitness"]))
+            result = results[seed]
+        if str(result.attrs["figure"]) != script.figure:
+            raise SpecError.at(
+                script.path,
+                token,
+                f"a search of figure '{script.figure}' ({phase.controller} moves "
+                f"'{result.attrs['figure']}')",
+            )
+        controllers.append(result.controller)
+        seeds.append(seed)
+        files.append(str(candidates[seed]))
+        dts.append(float(result.attrs["dt"]))
+        lengths.append(int(round(float(result.attrs["duration"]) / dts[-1])))
+    if len(set(dts)) > 1:
+        raise SpecError.at(
+            script.path,
+            script.tokens[f"phase.{script.phases[-1].name}.controller"],
+            f"searches with one time step (their dt: {', '.join(map(str, dts))} s)",
+        )
+    first = script.phases[0]
+    spec_path = Path(bsr_specs_dir) / f"{first.controller}.bsr"
+    if not spec_path.is_file():
+        raise SpecError.at(
+            script.path,
+            script.tokens[f"phase.{first.name}.controller"],
+            f"a BSR spec {spec_path} (its start pose starts the motion)",
+        )
+    setup = bind_search(parse_bsr_spec(spec_path), figure)
+    return CompositeSession(
+        script=script,
+        figure=figure,
+        controllers=tuple(controllers),
+        seeds=tuple(seeds),
+        controller_files=tuple(files),
+        start=standing_state(figure, setup.root_angle, setup.joints, setup.x),
+        dt=dts[0],
+        default_length=sum(lengths),
+    )
