@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import shutil
 import textwrap
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
@@ -68,3 +70,58 @@ def pendulum_tables(tmp_path_factory, link1):
         spec = parse_controller_spec(SPECS / "controllers" / "pendulum" / f"{name}.ssc")
         generate_controller(spec, link1, directory / f"{name}.h5", quiet=True)
     return directory
+
+
+@dataclass(frozen=True)
+class CompositeWorkspace:
+    """The three robust Star-Man searches built at a tiny budget (``bsr_results``/NAME/seedK.h5,
+    two seeds each), the Table 4 script copied beside them, and its composite result made with
+    a small search (``result``)."""
+
+    root: Path
+    bsr_results: Path
+    script: Path
+    result: Path
+
+    def controller_files(self) -> dict[str, list[Path]]:
+        from mosys.composite.session import find_controller_files
+        from mosys.parsing.composite import parse_composite_script
+
+        return find_controller_files(parse_composite_script(self.script), self.bsr_results)
+
+
+COMPOSITE_SEARCHES = ("starman_cartwheel_robust", "starman_jump_robust", "starman_shuffle_robust")
+
+
+@pytest.fixture(scope="session")
+def composite_workspace(tmp_path_factory) -> CompositeWorkspace:
+    """Real BSR searches (G = 8, seeds 1 and 2) and a real composite result (Q = 4, G = 3,
+    H = 2): the composite tests' input, made by the same functions as the pipeline."""
+    from mosys.bsr.run import search_to_file
+    from mosys.composite.run import composite_to_file
+
+    root = tmp_path_factory.mktemp("composite")
+    bsr_results = root / "results" / "bsr"
+    for name in COMPOSITE_SEARCHES:
+        for seed in (1, 2):
+            search_to_file(
+                SPECS / "bsr" / f"{name}.bsr",
+                SPECS / "figures",
+                seed,
+                bsr_results / name / f"seed{seed}.h5",
+                generations=8,
+                budget="test",
+            )
+    script = root / "starman_show.comp"
+    shutil.copy(SPECS / "composite" / "starman_show.comp", script)
+    workspace = CompositeWorkspace(root, bsr_results, script, root / "starman_show.h5")
+    composite_to_file(
+        script,
+        workspace.controller_files(),
+        workspace.result,
+        SPECS / "figures",
+        SPECS / "bsr",
+        {"q": 4, "g": 3, "h": 2},
+        budget="test",
+    )
+    return workspace
