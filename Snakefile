@@ -12,6 +12,7 @@ include: "workflow/rules/tables.smk"
 include: "workflow/rules/car.smk"
 include: "workflow/rules/luxo.smk"
 include: "workflow/rules/bsr.smk"
+include: "workflow/rules/composite.smk"
 
 
 rule all:
@@ -20,6 +21,7 @@ rule all:
         "results/car_all",
         "results/luxo_all",
         "results/bsr_all",
+        "results/composite_all",
         "results/paper_tables",
 
 
@@ -67,9 +69,21 @@ rule bsr_all:
         "mosys index {input} -o {output} 2> {log}"
 
 
+rule composite_all:
+    input:
+        composite_targets(),
+    output:
+        "results/composite_all",
+    log:
+        "results/logs/composite_all.log",
+    shell:
+        "mosys index {input} -o {output} 2> {log}"
+
+
 rule paper_tables:
     input:
-        paper_table_targets() + car_table_targets() + luxo_table_targets() + bsr_table_targets(),
+        paper_table_targets() + car_table_targets() + luxo_table_targets()
+        + bsr_table_targets() + composite_table_targets(),
     output:
         "results/paper_tables",
     log:

@@ -196,6 +196,25 @@ def _composite(args: argparse.Namespace) -> None:
     )
 
 
+def _composite_table(args: argparse.Namespace) -> None:
+    from mosys.tables.composite import write_composite_table
+
+    write_composite_table(args.results, args.csv, args.md)
+
+
+def _robustness_table(args: argparse.Namespace) -> None:
+    from mosys.tables.robustness import write_robustness_table
+
+    write_robustness_table(
+        [tuple(pair) for pair in args.pair],
+        args.results,
+        args.csv,
+        args.md,
+        args.bsr_specs,
+        args.figures,
+    )
+
+
 def _bsr_table(args: argparse.Namespace) -> None:
     from mosys.tables.bsr import write_bsr_table
 
@@ -357,6 +376,30 @@ def build_parser() -> argparse.ArgumentParser:
     composite.add_argument("--budget", default="paper", help="name of the config that built it")
     composite.add_argument("-o", "--output", required=True)
     composite.set_defaults(handler=_composite)
+
+    composite_table = verbs.add_parser("composite-table", help="the composite-motion table")
+    composite_table.add_argument("results", nargs="+", help="composite results (.h5)")
+    composite_table.add_argument("--csv", required=True)
+    composite_table.add_argument("--md", required=True)
+    composite_table.set_defaults(handler=_composite_table)
+
+    robustness = verbs.add_parser(
+        "robustness-table", help="robust BSR searches against their plain twins"
+    )
+    robustness.add_argument("results", nargs="+", help="seed files (SEARCH/seedK.h5) of both")
+    robustness.add_argument(
+        "--pair",
+        nargs=2,
+        action="append",
+        required=True,
+        metavar=("ROBUST", "PLAIN"),
+        help="a robust search and its plain twin (search names); repeat for more",
+    )
+    robustness.add_argument("--bsr-specs", default="specs/bsr", help="where SEARCH.bsr lives")
+    robustness.add_argument("--figures", default="specs/figures", help="where NAME.fig lives")
+    robustness.add_argument("--csv", required=True)
+    robustness.add_argument("--md", required=True)
+    robustness.set_defaults(handler=_robustness_table)
 
     bsr_table = verbs.add_parser("bsr-table", help="the BSR runs table")
     bsr_table.add_argument("results", nargs="+", help="seed files (.h5) of the searches")

@@ -22,6 +22,7 @@ STAGE_MODULES = {
                 "io/trajectory.py", "io/start_grid.py", "dynamics/motion.py"],
     "bsr": ["parsing/bsr.py", "parsing/figure.py", "bsr", "kernels/bsr_simulate.py",
             "kernels/bsr_run.py", "io/bsr_result.py", "io/trajectory.py", "progress.py"],
+    "composite": ["parsing/composite.py", "composite", "io/composite_result.py"],
     "plots": ["plots"],
     "tables": ["tables", "ssc/quality.py"],
 }
@@ -219,3 +220,55 @@ def bsr_targets():
     plots = [f"results/plots/bsr/{name}/{plot}" for name in config["bsr"]["searches"]
              for plot in ("learning.png", "filmstrip.png", "motion.gif")]
     return bsr_all_results() + plots + ["results/plots/bsr/learning_curves.png"] + bsr_table_targets()
+
+
+def composite_searches(name):
+    """The BSR searches a composite script's phases name (controller=SEARCH), in order."""
+    words = spec_words(f"specs/composite/{name}.comp", "phase")
+    found = [match.group(1) for line in words for word in line[2:]
+             for match in [re.fullmatch(r"controller=(\w+)", word)] if match]
+    return list(dict.fromkeys(found))
+
+
+def composite_inputs(wildcards):
+    """A composite search's inputs: the script, its figure, its phases' search specs (the first
+    one's start pose starts the motion) and their seed files."""
+    searches = composite_searches(wildcards.name)
+    figure = [f"specs/figures/{words[1]}.fig"
+              for words in spec_words(f"specs/composite/{wildcards.name}.comp", "figure")[:1]
+              if len(words) > 1 and re.fullmatch(r"\w+", words[1])]
+    return {
+        "script": f"specs/composite/{wildcards.name}.comp",
+        "figure": figure,
+        "specs": [f"specs/bsr/{search}.bsr" for search in searches],
+        "controllers": [f"results/bsr/{search}/seed{seed}.h5"
+                        for search in searches for seed in bsr_seeds(search)],
+    }
+
+
+def composite_search_options(wildcards):
+    """'--q Q --g G --h H' for the sizes the config sets (null: the script's own)."""
+    return " ".join(f"--{key} {config['composite'][key]}" for key in ("q", "g", "h")
+                    if config["composite"][key] is not None)
+
+
+def robustness_pairs():
+    return list(config["composite"]["robustness"].items())
+
+
+def robustness_results():
+    return [f"results/bsr/{search}/seed{seed}.h5"
+            for pair in robustness_pairs() for search in pair for seed in bsr_seeds(search)]
+
+
+def composite_table_targets():
+    return [f"results/tables/{table}.{ext}" for table in ("composite", "composite_robustness")
+            for ext in ("csv", "md")]
+
+
+def composite_targets():
+    scripts = config["composite"]["scripts"]
+    plots = [f"results/plots/composite/{name}/{plot}" for name in scripts
+             for plot in ("filmstrips.png", "search.png", "motion.gif")]
+    return ([f"results/composite/{name}.h5" for name in scripts] + plots
+            + composite_table_targets())

@@ -1,0 +1,93 @@
+"""How well a BSR controller holds up from starts it was not searched from (the 1995 paper's
+enhanced controllers, §3): its fitness over many randomly perturbed start states.
+
+A robust (perturbed) search and its plain twin are compared on the same starts, drawn with the
+robust spec's perturbation, and scored with each spec's own fitness weights (a robust spec is its
+twin plus a ``perturb`` line, so the weights agree)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from mosys.bsr.controller import BsrController
+from mosys.bsr.figure import bsr_figure
+from mosys.bsr.search import SearchSetup, bind_search, record_run
+from mosys.bsr.spec import Perturbation
+from mosys.bsr.start import perturbed_state
+from mosys.io.bsr_result import read_bsr_result
+from mosys.parsing.bsr import parse_bsr_spec
+from mosys.parsing.figure import parse_figure_spec
+from mosys.parsing.tokens import SpecError
+
+
+@dataclass(frozen=True)
+class SeedFitness:
+    """One seed's best controller: its fitness from the nominal start and from each perturbed
+    start (starts,)."""
+
+    seed: int
+    nominal: float
+    perturbed: np.ndarray
+
+
+def bind_spec(spec_path: str | Path, figures_dir: str | Path) -> SearchSetup:
+    """A search spec bound to its figure (its start pose, fall endpoints and weights)."""
+    spec = parse_bsr_spec(spec_path)
+    figure_path = Path(figures_dir) / f"{spec.figure}.fig"
+    if not figure_path.is_file():
+        raise SpecError.at(spec.path, spec.tokens["figure"], f"a figure in {figures_dir}")
+    return bind_search(spec, bsr_figure(parse_figure_spec(figure_path)))
+
+
+def perturbed_starts(
+    setup: SearchSetup, perturbation: Perturbation, count: int, seed: int
+) -> np.ndarray:
+    """``count`` start states (count, S) around the setup's nominal pose, drawn as a perturbed
+    search draws them, from a generator seeded with ``seed``."""
+    rng = np.random.default_rng(seed)
+    return np.stack(
+        [
+            perturbed_state(
+                setup.figure, setup.root_angle, setup.joints, setup.x, perturbation, rng
+            )
+            for _ in range(count)
+        ]
+    )
+
+
+def fitness_from_starts(
+    setup: SearchSetup, controller: BsrController, starts: np.ndarray
+) -> np.ndarray:
+    """The controller's fitness (starts,) from each start (starts, S): the setup's T, dt,
+    fall endpoints and weights."""
+    spec = setup.spec
+    return np.array(
+        [
+            record_run(
+                setup.figure, controller, start, spec.steps, spec.dt, setup.fall_endpoints
+            ).terms
+            @ setup.weights
+            for start in starts
+        ]
+    )
+
+
+def seed_fitness(
+    setup: SearchSetup, result_paths: list[str | Path], starts: np.ndarray
+) -> list[SeedFitness]:
+    """Each seed file's best controller from the nominal start (its ``nominal_fitness``) and
+    from every start (starts, S)."""
+    rows = []
+    for path in result_paths:
+        result = read_bsr_result(path)
+        rows.append(
+            SeedFitness(
+                seed=int(result.attrs["seed"]),
+                nominal=float(result.attrs["nominal_fitness"]),
+                perturbed=fitness_from_starts(setup, result.controller, starts),
+            )
+        )
+    return rows

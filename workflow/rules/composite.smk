@@ -1,0 +1,72 @@
+# Composite motion (the 1995 paper's section 3): a script's transition-point search over the
+# robust BSR controllers its phases name, the plots of the motion before and after, the
+# composite table and the robustness table of the enhanced controllers.
+
+rule composite_search:
+    input:
+        unpack(composite_inputs),
+        code=package_sources("bsr", "composite"),
+    output:
+        "results/composite/{name}.h5",
+    log:
+        "results/logs/composite/{name}.log",
+    benchmark:
+        "results/benchmarks/composite/{name}.tsv"
+    params:
+        sizes=composite_search_options,
+        budget=config["budget"],
+    threads: 1
+    shell:
+        "mosys composite {input.script} --controllers {input.controllers}"
+        " --figures specs/figures --bsr-specs specs/bsr {params.sizes}"
+        " --budget {params.budget} -o {output} 2> {log} || (cat {log} >&2; exit 1)"
+
+
+rule composite_plots:
+    input:
+        result="results/composite/{name}.h5",
+        code=package_sources("plots"),
+    output:
+        filmstrips="results/plots/composite/{name}/filmstrips.png",
+        search="results/plots/composite/{name}/search.png",
+        gif="results/plots/composite/{name}/motion.gif",
+    log:
+        "results/logs/plots/composite/{name}.log",
+    threads: 1
+    shell:
+        "mosys plot composite {input.result} --filmstrips {output.filmstrips}"
+        " --search {output.search} --gif {output.gif} 2> {log} || (cat {log} >&2; exit 1)"
+
+
+rule composite_table:
+    input:
+        results=expand("results/composite/{name}.h5", name=config["composite"]["scripts"]),
+        code=package_sources("tables"),
+    output:
+        csv="results/tables/composite.csv",
+        md="results/tables/composite.md",
+    log:
+        "results/logs/tables/composite.log",
+    threads: 1
+    shell:
+        "mosys composite-table {input.results} --csv {output.csv} --md {output.md}"
+        " 2> {log} || (cat {log} >&2; exit 1)"
+
+
+rule composite_robustness_table:
+    input:
+        results=robustness_results(),
+        specs=[f"specs/bsr/{search}.bsr" for pair in robustness_pairs() for search in pair],
+        code=package_sources("bsr", "composite", "tables"),
+    output:
+        csv="results/tables/composite_robustness.csv",
+        md="results/tables/composite_robustness.md",
+    log:
+        "results/logs/tables/composite_robustness.log",
+    params:
+        pairs=" ".join(f"--pair {robust} {plain}" for robust, plain in robustness_pairs()),
+    threads: 1
+    shell:
+        "mosys robustness-table {input.results} {params.pairs} --bsr-specs specs/bsr"
+        " --figures specs/figures --csv {output.csv} --md {output.md}"
+        " 2> {log} || (cat {log} >&2; exit 1)"
