@@ -1,0 +1,297 @@
+"""A composite motion end to end (§3): the script bound to real BSR controllers, Figure 5's
+search, the result file's contract, its table and the robustness comparison."""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from mosys.bsr.search import nominal_run
+from mosys.cli import main
+from mosys.composite.measures import phase_measures
+from mosys.composite.robustness import bind_spec, fitness_from_starts, perturbed_starts
+from mosys.composite.run import composite_to_file
+from mosys.composite.session import open_session
+from mosys.io.bsr_result import read_bsr_result
+from mosys.io.composite_result import CompositeMotion, read_composite_result
+from mosys.io.trajectory import FigureMotion
+from mosys.parsing.composite import parse_composite_script
+from mosys.parsing.tokens import SpecError
+from mosys.tables.composite import composite_frame
+from mosys.tables.robustness import robustness_frame
+
+ROOT = Path(__file__).resolve().parents[1]
+SPECS = ROOT / "specs"
+
+
+def session_of(workspace, script_path=None):
+    script = parse_composite_script(script_path or workspace.script)
+    return open_session(script, workspace.controller_files(), SPECS / "figures", SPECS / "bsr")
+
+
+def test_the_result_file_keeps_the_contract(composite_workspace):
+    with h5py.File(composite_workspace.result, "r") as h5:
+        for group in ("figure_motion", "before/figure_motion"):
+            n = h5[f"{group}/t"].shape[0]
+            assert h5[f"{group}/endpoints"].shape == (n, 5, 2, 2)
+            assert h5[f"{group}/com"].shape == (n, 2)
+            assert np.all(np.diff(h5[f"{group}/t"][()]) > 0)
+            for key in ("rod_names", "rod_mass", "rod_length", "rod_com", "rod_inertia"):
+                assert key in h5[group].attrs
+        for key in (
+            "format_version",
+            "script",
+            "phases",
+            "phases_before",
+            "score_before",
+            "score_after",
+            "simulations",
+            "spec_sha256",
+            "wall_seconds",
+        ):
+            assert key in h5.attrs, key
+        assert h5.attrs["simulations"] == 4 * 3 * 2 + 1  # Q x G x H mutants and the guess
+        phases = json.loads(h5.attrs["phases"])
+        guess = json.loads(h5.attrs["phases_before"])
+    assert [p["ticks"] for p in guess] == [159, 90, 100]
+    for listed in (phases, guess):
+        assert [p["controller"] for p in listed] == [
+            "starman_cartwheel_robust",
+            "starman_jump_robust",
+            "starman_shuffle_robust",
+        ]
+        assert listed[0]["start"] == 0.0
+        assert all(a["end"] == b["start"] for a, b in zip(listed, listed[1:], strict=False))
+        assert listed[-1]["end"] == pytest.approx(3.49)
+        assert all(p["end"] - p["start"] == pytest.approx(p["ticks"] * 0.01) for p in listed)
+
+
+def test_the_stored_scores_are_the_sessions(composite_workspace):
+    result = read_composite_result(composite_workspace.result)
+    session = session_of(composite_workspace)
+    for stored, ticks, total, scores in (
+        (result.before, result.attrs["ticks_before"], "score_before", result.scores_before),
+        (result.after, result.attrs["ticks_after"], "score_after", result.scores_after),
+    ):
+        scored = session.score(ticks)
+        assert scored.total == result.attrs[total]
+        assert scored.scores == scores
+        np.testing.assert_array_equal(stored.motion.endpoints, scored.motion.rod_ends)
+        np.testing.assert_array_equal(stored.phase, scored.motion.phase)
+    curve = result.best_by_generation
+    assert np.all(np.diff(curve) >= 0) and curve[-1] == result.attrs["score_after"]
+    assert result.attrs["score_after"] >= result.attrs["score_before"]
+
+
+def test_the_search_is_deterministic(composite_workspace, tmp_path):
+    again = tmp_path / "again.h5"
+    composite_to_file(
+        composite_workspace.script,
+        composite_workspace.controller_files(),
+        again,
+        SPECS / "figures",
+        SPECS / "bsr",
+        {"q": 4, "g": 3, "h": 2},
+        budget="test",
+    )
+    first, second = (read_composite_result(p) for p in (composite_workspace.result, again))
+    np.testing.assert_array_equal(first.after.motion.endpoints, second.after.motion.endpoints)
+    np.testing.assert_array_equal(first.best_by_generation, second.best_by_generation)
+    assert first.attrs["phases"] == second.attrs["phases"]
+
+
+def test_each_phase_takes_the_seed_best_from_the_nominal_start(composite_workspace, tmp_path):
+    session = session_of(composite_workspace)
+    for phase, seed in zip(session.script.phases, session.seeds, strict=True):
+        files = composite_workspace.controller_files()[phase.controller]
+        nominal = {
+            int(read_bsr_result(f).attrs["seed"]): read_bsr_result(f).attrs["nominal_fitness"]
+            for f in files
+        }
+        assert seed == max(nominal, key=nominal.get)
+    # seed= on a phase line overrides the choice
+    text = composite_workspace.script.read_text()
+    other = 3 - session.seeds[1]
+    script = tmp_path / "seeded.comp"
+    script.write_text(
+        text.replace(
+            "controller=starman_jump_robust", f"controller=starman_jump_robust seed={other}"
+        )
+    )
+    assert session_of(composite_workspace, script).seeds[1] == other
+
+
+def test_the_motion_starts_from_the_first_searchs_start_pose(composite_workspace):
+    session = session_of(composite_workspace)
+    setup = bind_spec(SPECS / "bsr" / "starman_cartwheel_robust.bsr", SPECS / "figures")
+    files = composite_workspace.controller_files()["starman_cartwheel_robust"]
+    chosen = next(f for f in files if f.name == f"seed{session.seeds[0]}.h5")
+    run = nominal_run(setup, read_bsr_result(chosen).controller)
+    motion = session.run([100, 50, 50])
+    np.testing.assert_array_equal(motion.rod_ends[:101], run.rod_ends[:101])
+
+
+@pytest.mark.parametrize(
+    ("edit", "message"),
+    [
+        (
+            ("controller=starman_jump_robust", "controller=starman_hop"),
+            r"seeded\.comp:9:\d+: expected a built BSR search .*, found 'starman_hop'",
+        ),
+        (
+            ("controller=starman_jump_robust", "controller=starman_jump_robust seed=7"),
+            r"seeded\.comp:9:\d+: expected a built seed of starman_jump_robust \(1, 2\), found '7'",
+        ),
+        (
+            ("figure starman", "figure beryl"),
+            r"seeded\.comp:8:\d+: expected a search of figure 'beryl' .*",
+        ),
+    ],
+)
+def test_what_the_script_names_must_exist(composite_workspace, tmp_path, edit, message):
+    script = tmp_path / "seeded.comp"
+    script.write_text(composite_workspace.script.read_text().replace(*edit))
+    with pytest.raises(SpecError, match=message):
+        session_of(composite_workspace, script)
+
+
+@pytest.mark.parametrize(
+    ("edit", "message"),
+    [
+        (
+            ("total = (1.0 + cartwheel)", "total = (1.0 + cartwheels)"),
+            r":\d+:\d+: expected .*, found 'cartwheels'",
+        ),
+        (("max_t(min_i(y_i(t)))", "max_t(min_i(y_i(t))"), r":\d+:\d+: expected .*"),
+        (("max_t(min_i(y_i(t)))", "mean_t(min_i(y_i(t)))"), r":\d+:\d+: expected .*'mean_t'"),
+    ],
+)
+def test_a_malformed_script_fails_at_its_column_and_writes_nothing(
+    composite_workspace, tmp_path, capsys, edit, message
+):
+    script = tmp_path / "bad.comp"
+    text = composite_workspace.script.read_text()
+    assert edit[0] in text
+    script.write_text(text.replace(*edit))
+    output = tmp_path / "out.h5"
+    code = main(
+        [
+            "composite",
+            str(script),
+            "--bsr-results",
+            str(composite_workspace.bsr_results),
+            "--q",
+            "2",
+            "--g",
+            "1",
+            "--h",
+            "1",
+            "-o",
+            str(output),
+        ]
+    )
+    assert code == 2
+    error = capsys.readouterr().err
+    assert re.search(rf"^{re.escape(str(script))}{message}", error, re.M), error
+    assert not output.exists() and not list(tmp_path.glob(".*partial"))
+
+
+def test_the_cli_writes_the_result(composite_workspace, tmp_path, capsys):
+    output = tmp_path / "show.h5"
+    files = [str(f) for fs in composite_workspace.controller_files().values() for f in fs]
+    code = main(
+        [
+            "composite",
+            str(composite_workspace.script),
+            "--controllers",
+            *files,
+            "--q",
+            "4",
+            "--g",
+            "3",
+            "--h",
+            "2",
+            "--budget",
+            "test",
+            "-o",
+            str(output),
+        ]
+    )
+    assert code == 0
+    assert "159, 90, 100" in capsys.readouterr().out
+    ours, theirs = (read_composite_result(p) for p in (output, composite_workspace.result))
+    assert ours.attrs["score_after"] == theirs.attrs["score_after"]
+
+
+def stored(endpoints: np.ndarray, phase: np.ndarray) -> CompositeMotion:
+    n = endpoints.shape[0]
+    motion = FigureMotion(
+        t=np.arange(n) * 0.01,
+        endpoints=endpoints,
+        com=endpoints.mean(axis=(1, 2)),
+        rod_names=("a",),
+        rod_mass=np.ones(1),
+        rod_length=np.ones(1),
+        rod_com=np.full(1, 0.5),
+        rod_inertia=np.ones(1),
+        gravity=9.81,
+        terrain=[],
+        contact="none",
+    )
+    return CompositeMotion(motion=motion, phase=phase, active_rule=np.zeros(n, np.int64))
+
+
+def test_phase_measures_count_turns_distance_and_clearance():
+    # one rod spinning about its middle: 1.5 turns over phase 0, then rising 0.5 m in phase 1
+    angle = np.concatenate([np.linspace(0, 3 * np.pi, 101), np.full(50, 3 * np.pi)])
+    centre = np.stack([np.linspace(0, 2, 151), np.r_[np.ones(101), np.linspace(1, 1.5, 50)]], 1)
+    half = 0.5 * np.stack([np.cos(angle), np.sin(angle)], 1)
+    ends = np.stack([centre - half, centre + half], 1)[:, None]
+    phase = np.r_[np.zeros(101, np.int64), np.ones(50, np.int64)]
+    first, second = phase_measures(stored(ends, phase))
+    assert first.rotations == pytest.approx(1.5)
+    assert first.distance == pytest.approx(centre[101, 0] - centre[0, 0])
+    assert first.clearance == pytest.approx(1.0)  # the lowest end is at 1 - 0.5 |sin|
+    assert second.rotations == pytest.approx(0.0, abs=1e-9)
+    assert second.clearance == pytest.approx(1.5)  # level, its middle risen to 1.5 m
+
+
+def test_robustness_compares_both_twins_on_the_same_starts(composite_workspace):
+    setup = bind_spec(SPECS / "bsr" / "starman_jump_robust.bsr", SPECS / "figures")
+    path = composite_workspace.bsr_results / "starman_jump_robust" / "seed1.h5"
+    result = read_bsr_result(path)
+    start = nominal_run(setup, result.controller)  # the nominal start reproduces the attr
+    assert start.terms @ setup.weights == pytest.approx(result.attrs["nominal_fitness"])
+    starts = perturbed_starts(setup, setup.spec.perturbation, 5, 1)
+    np.testing.assert_array_equal(starts, perturbed_starts(setup, setup.spec.perturbation, 5, 1))
+    fitness = fitness_from_starts(setup, result.controller, starts)
+    assert fitness.shape == (5,) and np.unique(fitness).size > 1
+    plain = composite_workspace.root / "plain" / "starman_jump"
+    plain.mkdir(parents=True)
+    shutil.copy(path, plain / "seed1.h5")  # a stand-in twin: the same controller
+    frame = robustness_frame(
+        [("starman_jump_robust", "starman_jump")],
+        [path, plain / "seed1.h5"],
+        SPECS / "bsr",
+        SPECS / "figures",
+        starts=5,
+    )
+    assert list(frame["controller"]) == ["robust", "plain"]
+    assert frame["chosen perturbed mean"].iloc[0] == pytest.approx(round(fitness.mean(), 2))
+
+
+def test_the_composite_table(composite_workspace):
+    frame = composite_frame([composite_workspace.result])
+    row = frame.iloc[0]
+    assert row["script"] == "starman_show" and row["budget"] == "test"
+    assert row["simulations"] == 25 and row["Q x G x H"] == "4 x 3 x 2"
+    assert row["cartwheel ticks before"] == 159
+    assert (
+        row["cartwheel ticks after"] + row["jump ticks after"] + row["shuffle ticks after"] == 349
+    )
