@@ -260,6 +260,22 @@ def test_phase_measures_count_turns_distance_and_clearance():
     assert first.clearance == pytest.approx(1.0)  # the lowest end is at 1 - 0.5 |sin|
     assert second.rotations == pytest.approx(0.0, abs=1e-9)
     assert second.clearance == pytest.approx(1.5)  # level, its middle risen to 1.5 m
+    assert first.flight == second.flight == 0.0  # never on the ground
+
+
+def test_a_flight_counts_from_the_phases_first_touchdown():
+    # a level rod falling from 1 m to the ground at sample 60, then hopping to 0.3 m
+    height = np.r_[np.linspace(1.0, 0.0, 61), 0.3 * np.sin(np.linspace(0, np.pi, 40))]
+    ends = np.zeros((101, 1, 2, 2))
+    ends[:, 0, 1, 0] = 1.0
+    ends[:, 0, :, 1] = height[:, None]
+    first, second = phase_measures(
+        stored(ends, np.r_[np.zeros(31, np.int64), np.ones(70, np.int64)])
+    )
+    assert first.clearance == 1.0 and first.flight == 0.0
+    assert second.clearance == pytest.approx(1 - 31 / 60) and second.flight == pytest.approx(
+        0.3, abs=1e-3
+    )
 
 
 def test_robustness_compares_both_twins_on_the_same_starts(composite_workspace):
