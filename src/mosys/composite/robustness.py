@@ -1,9 +1,9 @@
 """How well a BSR controller holds up from starts it was not searched from (the 1995 paper's
 enhanced controllers, §3): its fitness over many randomly perturbed start states.
 
-A robust (perturbed) search and its plain twin are compared on the same starts, drawn with the
-robust spec's perturbation, and scored with each spec's own fitness weights (a robust spec is its
-twin plus a ``perturb`` line, so the weights agree)."""
+A robust (perturbed) search and its plain twin are compared under the robust spec (its T,
+fitness weights and fall endpoints: the conditions the robust controller is made for) on the
+same starts, drawn with the robust spec's perturbation."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ import numpy as np
 
 from mosys.bsr.controller import BsrController
 from mosys.bsr.figure import bsr_figure
-from mosys.bsr.search import SearchSetup, bind_search, record_run
+from mosys.bsr.search import SearchSetup, bind_search, nominal_run, record_run
 from mosys.bsr.spec import Perturbation
 from mosys.bsr.start import perturbed_state
 from mosys.io.bsr_result import read_bsr_result
@@ -78,15 +78,15 @@ def fitness_from_starts(
 def seed_fitness(
     setup: SearchSetup, result_paths: list[str | Path], starts: np.ndarray
 ) -> list[SeedFitness]:
-    """Each seed file's best controller from the nominal start (its ``nominal_fitness``) and
-    from every start (starts, S)."""
+    """Each seed file's best controller under ``setup``: from its nominal start and from every
+    start (starts, S)."""
     rows = []
     for path in result_paths:
         result = read_bsr_result(path)
         rows.append(
             SeedFitness(
                 seed=int(result.attrs["seed"]),
-                nominal=float(result.attrs["nominal_fitness"]),
+                nominal=float(nominal_run(setup, result.controller).terms @ setup.weights),
                 perturbed=fitness_from_starts(setup, result.controller, starts),
             )
         )

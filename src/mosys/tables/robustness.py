@@ -33,18 +33,18 @@ def robustness_frame(
     starts: int = STARTS,
     seed: int = STARTS_SEED,
 ) -> pd.DataFrame:
-    """Two rows per (robust, plain) pair of search names: ``starts`` start states drawn with
-    the robust spec's perturbation (generator seed ``seed``), every seed's best controller run
-    from each. The chosen controller is the seed with the best nominal fitness, as a composite
-    script picks it."""
+    """Two rows per (robust, plain) pair of search names: every seed's best controller run
+    under the robust spec (its T, weights and fall endpoints: the conditions the robust
+    controller is made for) from its nominal start and from ``starts`` start states drawn with
+    its perturbation (generator seed ``seed``). The chosen controller is the seed with the best
+    nominal fitness so measured, as a composite script picks it by its own search's."""
     found = files_by_search(result_paths)
     rows = []
     for robust, plain in pairs:
-        robust_setup = bind_spec(Path(specs_dir) / f"{robust}.bsr", figures_dir)
-        perturbation = robust_setup.spec.perturbation
-        drawn = perturbed_starts(robust_setup, perturbation, starts, seed)
+        setup = bind_spec(Path(specs_dir) / f"{robust}.bsr", figures_dir)
+        perturbation = setup.spec.perturbation
+        drawn = perturbed_starts(setup, perturbation, starts, seed)
         for name, role in ((robust, "robust"), (plain, "plain")):
-            setup = bind_spec(Path(specs_dir) / f"{name}.bsr", figures_dir)
             seeds = seed_fitness(setup, sorted(found.get(name, [])), drawn)
             if not seeds:
                 raise FileNotFoundError(f"no result files of the search {name!r} were given")
@@ -59,6 +59,7 @@ def robustness_frame(
                         f"angle ±{perturbation.angle:g}°, joints ±{perturbation.joints:g}°, "
                         f"speed ±{perturbation.speed:g} m/s, spin ±{perturbation.spin:g}°/s"
                     ),
+                    "T (s)": setup.spec.duration,
                     "seeds": len(seeds),
                     "median nominal fitness": round(
                         float(np.median([r.nominal for r in seeds])), 2
@@ -89,12 +90,11 @@ def write_robustness_table(
     write_text_atomically(csv_path, frame.to_csv(index=False))
     caption = (
         "Enhanced (robust) BSR controllers after Auslander et al. (1995), §3: each robust search "
-        f"and its plain twin, every seed's best controller run from the same {STARTS} start "
-        "states drawn at random with the robust spec's perturbation (uniform in each range; "
-        f"generator seed {STARTS_SEED}) and scored with the spec's fitness. nominal: from the "
-        "unperturbed start. chosen: the seed with the best nominal fitness, the one a composite "
-        "script uses. The robust search perturbs its start at every evaluation; the plain one "
-        "never does.\n\n"
+        "and its plain twin, every seed's best controller run under the robust spec (its T, "
+        f"fitness and fall endpoints) from the same {STARTS} start states, drawn at random with "
+        f"the robust spec's perturbation (uniform in each range; generator seed {STARTS_SEED}). "
+        "nominal: from the unperturbed start. chosen: the seed with the best nominal fitness. "
+        "The robust search perturbs its start at every evaluation; the plain one never does.\n\n"
     )
     write_text_atomically(md_path, caption + frame.to_markdown(index=False) + "\n")
     return frame
