@@ -8,6 +8,8 @@ import re
 import shutil
 import subprocess
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -242,16 +244,102 @@ def test_editing_one_weight_reruns_only_that_search_and_its_plots(bsr_built):
     text = spec.read_text()
     edited = re.sub(r"max_height=[\d.]+", "max_height=7.5", text)
     assert edited != text
-    spec.write_text(edited)
-    jobs = planned_jobs(bsr_built, "results/bsr_all", "--configfile", "config/ci.yaml")
-    assert jobs == {
-        "bsr_search": 5,
-        "bsr_plots": 1,
-        "bsr_learning_curves": 1,
-        "bsr_runs_table": 1,
-        "bsr_all": 1,
-    }
-    output = snakemake(bsr_built, "--dry-run", "results/bsr_all", "--configfile", "config/ci.yaml")
-    searched = re.findall(r"wildcards: name=(\w+), seed=(\d+)", output)
-    assert sorted(searched) == [("starman_jump", str(seed)) for seed in range(1, 6)]
-    assert set(re.findall(r"wildcards: name=(\w+)$", output, re.M)) == {"starman_jump"}
+    with edited_spec(spec, edited):
+        jobs = planned_jobs(bsr_built, "results/bsr_all", "--configfile", "config/ci.yaml")
+        assert jobs == {
+            "bsr_search": 5,
+            "bsr_plots": 1,
+            "bsr_learning_curves": 1,
+            "bsr_runs_table": 1,
+            "bsr_all": 1,
+        }
+        output = snakemake(
+            bsr_built, "--dry-run", "results/bsr_all", "--configfile", "config/ci.yaml"
+        )
+        searched = re.findall(r"wildcards: name=(\w+), seed=(\d+)", output)
+        assert sorted(searched) == [("starman_jump", str(seed)) for seed in range(1, 6)]
+        assert set(re.findall(r"wildcards: name=(\w+)$", output, re.M)) == {"starman_jump"}
+
+
+@contextmanager
+def edited_spec(path: Path, text: str) -> Iterator[None]:
+    """The spec holds ``text`` inside the block; after it, its old text and time stamp (so that
+    the built results are up to date again)."""
+    old_text, old = path.read_text(), path.stat()
+    path.write_text(text)
+    try:
+        yield
+    finally:
+        path.write_text(old_text)
+        os.utime(path, ns=(old.st_atime_ns, old.st_mtime_ns))
+
+
+@pytest.fixture(scope="module")
+def composite_built(bsr_built) -> Path:
+    """results/composite_all at CI's reduced budget: the robust searches, the transition search
+    of starman_show, its plots and tables."""
+    snakemake(bsr_built, "results/composite_all", "--configfile", "config/ci.yaml")
+    return bsr_built
+
+
+JUMP_CLEARANCE = 0.75  # m: the refined jump's own flight lifts every endpoint at least this high
+
+
+def test_the_refined_composite_motion_does_all_three_phases(composite_built):
+    from mosys.composite.measures import phase_measures
+    from mosys.io.composite_result import read_composite_result
+
+    result = read_composite_result(composite_built / "results/composite/starman_show.h5")
+    cartwheel, jump, shuffle = phase_measures(result.after)
+    guessed_jump = phase_measures(result.before)[1]
+    # the cartwheel covers ground turning over (see the README: just short of a full turn at
+    # this budget)
+    assert cartwheel.distance > 1.0 and cartwheel.rotations > 0.95
+    # the jump phase takes off on its own and clears the ground by far more than the guess's
+    assert jump.flight >= JUMP_CLEARANCE and jump.flight > 1.5 * guessed_jump.flight
+    # the shuffle covers ground
+    assert shuffle.distance > 0.5
+    # the search improves the script's total by a clear margin
+    assert result.attrs["score_after"] > 1.1 * result.attrs["score_before"]
+    assert result.attrs["simulations"] == 16 * 16 * 4 + 1
+    index = (composite_built / "results/composite_all").read_text().split()
+    for made in (
+        "composite/starman_show.h5",
+        "plots/composite/starman_show/filmstrips.png",
+        "plots/composite/starman_show/motion.gif",
+        "tables/composite.md",
+    ):
+        assert f"results/{made}" in index
+
+
+def test_the_robust_controllers_hold_up_better(composite_built):
+    import pandas as pd
+
+    table = pd.read_csv(composite_built / "results/tables/composite_robustness.csv")
+    assert set(table["budget"]) == {"ci"}
+    rows = table.to_dict("records")
+    for robust, plain in zip(rows[::2], rows[1::2], strict=True):
+        assert (robust["controller"], plain["controller"]) == ("robust", "plain")
+        assert robust["starts"] == plain["starts"] == 50
+        for column in ("mean perturbed fitness (seed average)", "chosen perturbed mean"):
+            assert robust[column] > plain[column], (robust["search"], column)
+
+
+def test_editing_the_script_reruns_only_the_transition_search(composite_built):
+    script = composite_built / "specs/composite/starman_show.comp"
+    text = script.read_text()
+    assert "ticks=90" in text
+    with edited_spec(script, text.replace("ticks=90", "ticks=95")):
+        jobs = planned_jobs(
+            composite_built, "results/composite_all", "--configfile", "config/ci.yaml"
+        )
+        assert jobs == {
+            "composite_search": 1,
+            "composite_plots": 1,
+            "composite_table": 1,
+            "composite_all": 1,
+        }
+    assert (
+        planned_jobs(composite_built, "results/composite_all", "--configfile", "config/ci.yaml")
+        == {}
+    )

@@ -26,9 +26,10 @@ from mosys.parsing.tokens import SpecError
 @dataclass(frozen=True)
 class SeedFitness:
     """One seed's best controller: its fitness from the nominal start and from each perturbed
-    start (starts,)."""
+    start (starts,), and the budget its search ran at."""
 
     seed: int
+    budget: str
     nominal: float
     perturbed: np.ndarray
 
@@ -86,6 +87,7 @@ def seed_fitness(
         rows.append(
             SeedFitness(
                 seed=int(result.attrs["seed"]),
+                budget=str(result.attrs["budget"]),
                 nominal=float(nominal_run(setup, result.controller).terms @ setup.weights),
                 perturbed=fitness_from_starts(setup, result.controller, starts),
             )

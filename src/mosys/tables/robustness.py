@@ -59,6 +59,7 @@ def robustness_frame(
                         f"angle ±{perturbation.angle:g}°, joints ±{perturbation.joints:g}°, "
                         f"speed ±{perturbation.speed:g} m/s, spin ±{perturbation.spin:g}°/s"
                     ),
+                    "budget": ", ".join(sorted({row.budget for row in seeds})),
                     "T (s)": setup.spec.duration,
                     "seeds": len(seeds),
                     "median nominal fitness": round(
@@ -94,7 +95,8 @@ def write_robustness_table(
         f"fitness and fall endpoints) from the same {STARTS} start states, drawn at random with "
         f"the robust spec's perturbation (uniform in each range; generator seed {STARTS_SEED}). "
         "nominal: from the unperturbed start. chosen: the seed with the best nominal fitness. "
-        "The robust search perturbs its start at every evaluation; the plain one never does.\n\n"
+        "The robust search perturbs its start at every evaluation; the plain one never does. "
+        "budget: the config that set the searches' generations.\n\n"
     )
     write_text_atomically(md_path, caption + frame.to_markdown(index=False) + "\n")
     return frame
