@@ -196,6 +196,12 @@ def _composite(args: argparse.Namespace) -> None:
     )
 
 
+def _edit(args: argparse.Namespace) -> None:
+    from mosys.composite.editor import run_editor
+
+    run_editor(args.script, args.bsr_results, args.figures, args.bsr_specs)
+
+
 def _composite_table(args: argparse.Namespace) -> None:
     from mosys.tables.composite import write_composite_table
 
@@ -376,6 +382,15 @@ def build_parser() -> argparse.ArgumentParser:
     composite.add_argument("--budget", default="paper", help="name of the config that built it")
     composite.add_argument("-o", "--output", required=True)
     composite.set_defaults(handler=_composite)
+
+    edit = verbs.add_parser(
+        "edit", help="the concatenation editor: a slider per phase of a script (.comp)"
+    )
+    edit.add_argument("script", help="the composite-motion script (.comp); Save rewrites it")
+    edit.add_argument("--bsr-results", default="results/bsr", help="where SEARCH/seedK.h5 live")
+    edit.add_argument("--figures", default="specs/figures", help="where NAME.fig lives")
+    edit.add_argument("--bsr-specs", default="specs/bsr", help="where SEARCH.bsr lives")
+    edit.set_defaults(handler=_edit)
 
     composite_table = verbs.add_parser("composite-table", help="the composite-motion table")
     composite_table.add_argument("results", nargs="+", help="composite results (.h5)")
