@@ -39,7 +39,7 @@ def test_splitting_a_run_in_two_phases_changes_nothing():
     np.testing.assert_array_equal(split.rod_ends, whole.rod_ends)
     np.testing.assert_array_equal(split.com, whole.com)
     assert list(split.starts) == [0, 70, 150]
-    assert np.all(split.phase[:70] == 0) and np.all(split.phase[71:] == 1)
+    assert np.all(split.phase[:70] == 0) and np.all(split.phase[70:] == 1)  # 70: the switch
     assert split.com[split.phase_samples(1)].shape == (81, 2)
 
 

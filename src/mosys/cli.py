@@ -137,6 +137,17 @@ def _plot_bsr(args: argparse.Namespace) -> None:
             bsr.write_motion_gif(best, args.gif)
 
 
+def _plot_composite(args: argparse.Namespace) -> None:
+    from mosys.plots import composite
+
+    if args.filmstrips:
+        composite.plot_filmstrips(args.result, args.filmstrips)
+    if args.search:
+        composite.plot_search(args.result, args.search)
+    if args.gif:
+        composite.write_composite_gif(args.result, args.gif)
+
+
 def _plot_bsr_learning(args: argparse.Namespace) -> None:
     from mosys.plots import bsr
 
@@ -355,6 +366,15 @@ def build_parser() -> argparse.ArgumentParser:
     bsr_learning.add_argument("-o", "--output", required=True, help="PNG")
     bsr_learning.set_defaults(handler=_plot_bsr_learning)
 
+    composite_plot = plot.add_parser(
+        "composite", help="a composite motion: filmstrips before/after, the search, a GIF"
+    )
+    composite_plot.add_argument("result", help="results/composite/NAME.h5")
+    composite_plot.add_argument("--filmstrips", help="PNG: before and after (Figures 13-14 style)")
+    composite_plot.add_argument("--search", help="PNG: the best total after each generation")
+    composite_plot.add_argument("--gif", help="animated GIF of the refined motion")
+    composite_plot.set_defaults(handler=_plot_composite)
+
     search = verbs.add_parser("bsr-search", help="BSR search spec (.bsr) -> result (.h5)")
     search.add_argument("spec", help="the search spec (.bsr)")
     search.add_argument("--seed", type=int, required=True, help="one of the spec's seeds")
@@ -460,6 +480,12 @@ def main(argv: list[str] | None = None) -> int:
         and not (args.learning or args.filmstrip or args.gif)
     ):
         parser.error("plot bsr: give --learning, --filmstrip and/or --gif")
+    if (
+        args.verb == "plot"
+        and args.kind == "composite"
+        and not (args.filmstrips or args.search or args.gif)
+    ):
+        parser.error("plot composite: give --filmstrips, --search and/or --gif")
     from mosys.errors import InputError
     from mosys.parsing.tokens import SpecError
 

@@ -51,7 +51,9 @@ def run_concatenation(
             run = record_run(
                 figure, controller, state, int(count), dt, start_force=force, carry_over=k > 0
             )
-            first = 0 if not ends else 1  # the switch sample is the last phase's end
+            first = 0 if not ends else 1  # the switch sample is the last phase's end...
+            if first:
+                phases[-1][-1] = k  # ...and belongs to the phase it starts
             ends.append(run.rod_ends[first:])
             coms.append(run.com[first:])
             rules.append(run.active_rule[first:])

@@ -194,7 +194,7 @@ def rule_letter(rule: int) -> str:
     return letters
 
 
-def _minus(text: str) -> str:
+def minus_signs(text: str) -> str:
     """A true minus sign for hyphens in numbers."""
     return text.replace("-", "−")
 
@@ -222,7 +222,7 @@ def terms_text(terms: Mapping[str, float]) -> str:
     parts = []
     for name in shown:
         label, unit, fmt = TERMS.get(name, (name.replace("_", " "), "", ".3g"))
-        value = _minus(format(float(terms[name]), fmt))
+        value = minus_signs(format(float(terms[name]), fmt))
         parts.append(f"{label} {value}{' ' + unit if unit else ''}")
     return ", ".join(parts)
 
@@ -345,7 +345,7 @@ def plot_learning(results: Sequence[str | Path], path: str | Path) -> None:
             finals.text(
                 0.32,
                 label_y,
-                f"seed {seed}: {_minus(f'{value:.3g}')}",
+                f"seed {seed}: {minus_signs(f'{value:.3g}')}",
                 va="center",
                 ha="left",
                 fontsize=8.5,
@@ -556,7 +556,7 @@ def letter_levels(x: np.ndarray, space: float) -> np.ndarray:
     return levels
 
 
-def _draw_pose(ax: Axes, pose: np.ndarray, color, zorder: float) -> None:
+def draw_pose(ax: Axes, pose: np.ndarray, color, zorder: float) -> None:
     """One pose (rods, 2, 2) m: rods as lines with round ends, outlined thinly."""
     outline = [patheffects.withStroke(linewidth=ROD_WIDTH + 1.0, foreground=OUTLINE)]
     rods = LineCollection(
@@ -590,7 +590,7 @@ def _result_title(result: BsrResult, path: str | Path) -> str:
     figure_name = result.attrs.get("figure", "")
     on = f" ({figure_name})" if figure_name else ""
     seed = int(result.attrs["seed"])
-    fitness = _minus(f"{float(result.attrs['best_fitness']):.4g}")
+    fitness = minus_signs(f"{float(result.attrs['best_fitness']):.4g}")
     return (
         f"BSR search {name}{on}, seed {seed}: {_controller_text(result)}\n"
         f"fitness {fitness}: {terms_text(result.fitness_terms)}"
@@ -662,7 +662,7 @@ def plot_filmstrip(
         side = "left" if offsets[-1] < 0 else "right"
         subtitle += (
             f"\neach pose shifted {side} by {spacing:g} m more than the one before, so that "
-            f"they do not overlap (the figure itself travels {_minus(f'{travel:+.2f}')} m)"
+            f"they do not overlap (the figure itself travels {minus_signs(f'{travel:+.2f}')} m)"
         )
     title = _result_title(result, result_path) + "\n" + subtitle
     title_lines = title.count("\n") + 1
@@ -697,7 +697,7 @@ def plot_filmstrip(
                 draw_terrain(ax, motion.terrain, y0 - 1.0)
             for j, level in zip(row, levels[k], strict=True):
                 color = POSE_TIMES(norm(t[samples[j]]))
-                _draw_pose(ax, drawn[j], color, 3 + j / count)
+                draw_pose(ax, drawn[j], color, 3 + j / count)
                 ax.text(
                     (left[j] + right[j]) / 2,
                     letter_base + level * LETTER_ROW * scale,

@@ -1,0 +1,215 @@
+"""The composite plots (the 1995 paper's Figures 13 and 14, Figure 5's search, the refined
+motion's GIF) from the real small composite result of the ``composite_workspace`` fixture."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+from matplotlib.colors import to_rgba
+from PIL import Image
+
+import mosys.plots.composite as composite
+from mosys.plots.car import frame_indices
+from mosys.plots.composite import (
+    phase_colors,
+    plot_filmstrips,
+    plot_search,
+    read_composite,
+    search_curve,
+    shade,
+    strip_poses,
+    switch_label_places,
+    switch_samples,
+    write_composite_gif,
+)
+from mosys.plots.pendulum import PlotInputError
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+def assert_png(path: Path) -> tuple[int, int]:
+    data = path.read_bytes()
+    assert data.startswith(PNG_MAGIC)
+    assert 10_000 < len(data) < 3_000_000
+    with Image.open(path) as image:
+        width, height = image.size
+    assert 600 < width < 2500 and 300 < height < 2500
+    assert not list(path.parent.glob(".*.partial"))  # written atomically
+    return width, height
+
+
+@pytest.fixture(scope="module")
+def result_path(composite_workspace) -> Path:
+    return composite_workspace.result
+
+
+def test_strip_poses_of_a_known_motion() -> None:
+    t = np.round(np.arange(301) * 0.01, 10)  # 0 to 3 s
+    phase = np.searchsorted([1.0, 2.05], t, side="right")  # switch samples: the phase they start
+    phases = [
+        {"name": "a", "start": 0.0, "end": 1.0},
+        {"name": "b", "start": 1.0, "end": 2.05},
+        {"name": "c", "start": 2.05, "end": 3.0},
+    ]
+    np.testing.assert_array_equal(switch_samples(t, phases), [100, 205])
+    poses = strip_poses(t, phase, phases, 0.25)
+    # every 0.25 s, but 2.0 s is within a third of an interval of the switch at 2.05 s
+    expected = [0, 25, 50, 75, 100, 125, 150, 175, 205, 225, 250, 275, 300]
+    np.testing.assert_array_equal(poses.samples, expected)
+    np.testing.assert_array_equal(np.flatnonzero(poses.switch), [4, 8])
+    np.testing.assert_array_equal(poses.phase, [0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 2])
+    np.testing.assert_allclose(poses.fraction[:4], [0, 0.25, 0.5, 0.75])
+    assert poses.fraction[4] == 0 and poses.fraction[8] == 0 and poses.fraction[-1] == 1
+
+
+def test_strip_poses_of_the_real_result(result_path: Path) -> None:
+    result = read_composite(result_path)
+    interval = 0.25
+    for stored, phases in ((result.before, result.phases_before), (result.after, result.phases)):
+        t = stored.motion.t
+        poses = strip_poses(t, stored.phase, phases, interval)
+        assert np.all(np.diff(poses.samples) > 0) and poses.samples[-1] == len(t) - 1
+        switches = poses.samples[poses.switch]
+        starts = [p["start"] for p in phases[1:]]
+        np.testing.assert_allclose(t[switches], starts, atol=1e-9)  # at each switch time
+        np.testing.assert_array_equal(poses.phase[poses.switch], np.arange(1, len(phases)))
+        regular = ~poses.switch
+        np.testing.assert_array_equal(poses.phase[regular], stored.phase[poses.samples[regular]])
+        assert set(poses.phase) == set(range(len(phases)))  # every phase drawn
+        gaps = np.abs(t[poses.samples[regular]][:, None] - t[switches][None, :])
+        assert gaps.min() >= interval / 3 - 1e-9
+        assert np.all((poses.fraction >= 0) & (poses.fraction <= 1))
+
+
+def test_switch_labels_keep_apart_inside_the_view() -> None:
+    scale = 0.5  # m per inch: labels SWITCH_LABEL_WIDTH inches wide are 0.875 m
+    gap = composite.SWITCH_LABEL_WIDTH * scale
+    x, levels = switch_label_places(np.array([1.0, 1.2, 5.0]), 0.0, 6.0, scale)
+    assert not levels.any()  # one row holds them
+    assert x[1] - x[0] == pytest.approx(gap) and x[2] == 5.0
+    x, levels = switch_label_places(np.array([5.9]), 0.0, 6.0, scale)
+    assert x[0] == pytest.approx(6.0 - gap / 2)  # kept inside the view
+    # five labels in a 2 m view: two a row, three rows, taken in turn from the left
+    x, levels = switch_label_places(np.linspace(0.2, 1.8, 5), 0.0, 2.0, scale)
+    np.testing.assert_array_equal(levels, [0, 1, 2, 0, 1])
+    for row in range(3):
+        assert np.all(np.diff(np.sort(x[levels == row])) >= gap - 1e-9)
+    assert x.min() >= gap / 2 - 1e-9 and x.max() <= 2.0 - gap / 2 + 1e-9
+
+
+def test_phase_colours_are_distinct_and_shaded(result_path: Path) -> None:
+    phases = read_composite(result_path).phases
+    colors = phase_colors(phases)
+    assert len(set(colors)) == len(phases) == 3
+    color = colors[0]
+    assert shade(color, 1.0) == pytest.approx(to_rgba(color))
+    assert min(shade(color, 0.0)[:3]) > min(to_rgba(color)[:3])  # lighter: towards white
+    assert sum(shade(color, 0.3)[:3]) > sum(shade(color, 0.7)[:3])
+
+
+def test_filmstrips_draw_both_panels_in_phase_colours(
+    result_path: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    drawn: list[tuple[object, tuple]] = []  # (axes, colour) of each pose drawn
+    real = composite.draw_pose
+
+    def recorded(ax, pose, color, zorder):
+        drawn.append((ax, tuple(to_rgba(color))))
+        real(ax, pose, color, zorder)
+
+    monkeypatch.setattr(composite, "draw_pose", recorded)
+    out = tmp_path / "strips.png"
+    plot_filmstrips(result_path, out, interval=0.25)
+    assert_png(out)
+
+    result = read_composite(result_path)
+    colors = phase_colors(result.phases)
+    panels = list(dict.fromkeys(ax for ax, _ in drawn))
+    assert len(panels) == 2  # before above after
+    assert panels[0].get_position().y0 > panels[1].get_position().y0
+    for ax, stored, phases in zip(
+        panels, (result.before, result.after), (result.phases_before, result.phases), strict=True
+    ):
+        poses = strip_poses(stored.motion.t, stored.phase, phases, 0.25)
+        expected = [
+            to_rgba(composite.SWITCH_COLOR) if switch else shade(colors[k], fraction)
+            for k, switch, fraction in zip(poses.phase, poses.switch, poses.fraction, strict=True)
+        ]
+        got = [color for a, color in drawn if a is ax]
+        assert got == [pytest.approx(color) for color in expected]
+        assert ax.get_aspect() == 1.0
+        assert sum(c == to_rgba("black") for c in got) == len(phases) - 1
+    assert panels[0].get_xlim() == panels[1].get_xlim()  # one view for both
+
+
+def test_search_plot(result_path: Path, tmp_path: Path) -> None:
+    result = read_composite(result_path)
+    generations, scores = search_curve(result)
+    np.testing.assert_array_equal(generations, np.arange(int(result.attrs["search_g"]) + 1))
+    assert scores[0] == result.attrs["score_before"]
+    assert scores[-1] == pytest.approx(result.attrs["score_after"])
+    assert np.all(np.diff(scores) >= 0)  # the best so far never falls
+    out = tmp_path / "search.png"
+    plot_search(result_path, out)
+    assert_png(out)
+
+
+def test_gif_plays_the_refined_motion_in_real_time(result_path: Path, tmp_path: Path) -> None:
+    result = read_composite(result_path)
+    t = result.after.motion.t
+    duration_ms = 1000 * (t[-1] - t[0])
+    out = tmp_path / "show.gif"
+    write_composite_gif(result_path, out)
+    assert 10_000 < out.stat().st_size < 2_000_000
+    with Image.open(out) as gif:
+        frames = gif.n_frames
+        assert gif.info["duration"] == 40
+        durations = []
+        for k in range(frames):
+            gif.seek(k)
+            durations.append(gif.info["duration"])
+    expected = len(frame_indices(t, 0.04))
+    assert frames in (expected, expected + 1)  # every 40 ms, and the last sample
+    assert abs(sum(durations[:-1]) - duration_ms) <= 40  # real time
+    assert durations[-1] == composite.GIF_HOLD_MS
+    assert not list(tmp_path.glob(".*.partial"))
+    short = tmp_path / "short.gif"
+    write_composite_gif(result_path, short, max_frames=9)
+    with Image.open(short) as gif:
+        assert gif.n_frames == 9
+        assert abs(8 * gif.info["duration"] - duration_ms) <= 8 * 10  # GIF keeps 10 ms units
+
+
+def _without(source: Path, target: Path, attribute: str) -> Path:
+    shutil.copy(source, target)
+    with h5py.File(target, "r+") as h5:
+        del h5.attrs[attribute]
+    return target
+
+
+@pytest.mark.parametrize(
+    "write", [plot_filmstrips, plot_search, write_composite_gif], ids=lambda f: f.__name__
+)
+def test_bad_input_raises_and_writes_nothing(result_path: Path, tmp_path: Path, write) -> None:
+    out = tmp_path / "out.png"
+    not_hdf5 = tmp_path / "bogus.h5"
+    not_hdf5.write_text("not hdf5")
+    other = tmp_path / "other.h5"
+    with h5py.File(other, "w") as h5:
+        h5.create_dataset("t", data=np.zeros(3))
+    cases = {
+        tmp_path / "missing.h5": "cannot read",
+        not_hdf5: "cannot read",
+        other: "not a composite result file",
+        _without(result_path, tmp_path / "noscores.h5", "scores_after"): "'scores_after'",
+    }
+    for path, message in cases.items():
+        with pytest.raises(PlotInputError, match=message) as error:
+            write(path, out)
+        assert str(path) in str(error.value)
+        assert not out.exists()
+        assert not list(tmp_path.glob(".*.partial"))
