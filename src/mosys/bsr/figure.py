@@ -11,12 +11,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from mosys.bsr.spec import ENDPOINT_ENDS
-from mosys.parsing.figure import Figure
-from mosys.parsing.tokens import SpecError
+from mosys.parsing.figure import Figure, parse_figure_spec
+from mosys.parsing.tokens import SpecError, Token
 
 _SAME_POINT = 1e-12  # m: a hinge this close to an end of its parent sits on that endpoint
 
@@ -149,6 +150,18 @@ def bsr_figure(figure: Figure) -> BsrFigure:
         root_angle=root.coordinates[2].name,
         root_x=root.coordinates[0].name,
     )
+
+
+def load_bsr_figure(figures_dir: str | Path, spec_path: str, token: Token) -> BsrFigure:
+    """The figure a spec names (``token``, its word in ``spec_path``), read from
+    ``figures_dir``/NAME.fig; one that is missing or is a vehicle raises SpecError at the word."""
+    figure_path = Path(figures_dir) / f"{token.text}.fig"
+    if not figure_path.is_file():
+        raise SpecError.at(spec_path, token, f"a figure in {figures_dir}")
+    parsed = parse_figure_spec(figure_path)
+    if not isinstance(parsed, Figure):
+        raise SpecError.at(spec_path, token, "a figure of rods, not a vehicle")
+    return bsr_figure(parsed)
 
 
 def _distinct_endpoints(parent: np.ndarray, hinge: np.ndarray, length: np.ndarray) -> np.ndarray:

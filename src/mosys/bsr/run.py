@@ -8,12 +8,11 @@ from pathlib import Path
 
 import numpy as np
 
-from mosys.bsr.figure import BsrFigure, bsr_figure
+from mosys.bsr.figure import BsrFigure, load_bsr_figure
 from mosys.bsr.search import SearchOutcome, bind_search, run_search
 from mosys.io.bsr_result import BsrResult, write_bsr_result
 from mosys.io.trajectory import FigureMotion
 from mosys.parsing.bsr import parse_bsr_spec
-from mosys.parsing.figure import Figure, parse_figure_spec
 from mosys.parsing.tokens import SpecError
 
 CONTACT_MODEL = "bsr-impulse: rigid-body impulses at <= 2 rod endpoints, paper's friction"
@@ -36,13 +35,7 @@ def search_to_file(
         raise SpecError(
             spec.path, 1, 1, f"seed {seed} among the spec's seeds {list(spec.seeds)}", None
         )
-    figure_path = Path(figures_dir) / f"{spec.figure}.fig"
-    if not figure_path.is_file():
-        raise SpecError.at(spec.path, spec.tokens["figure"], f"a figure in {figures_dir}")
-    parsed = parse_figure_spec(figure_path)
-    if not isinstance(parsed, Figure):
-        raise SpecError.at(spec.path, spec.tokens["figure"], "a figure of rods, not a vehicle")
-    figure = bsr_figure(parsed)
+    figure = load_bsr_figure(figures_dir, spec.path, spec.tokens["figure"])
     setup = bind_search(spec, figure, generations)
     if threads:
         import numba

@@ -13,14 +13,12 @@ from pathlib import Path
 import numpy as np
 
 from mosys.bsr.controller import BsrController
-from mosys.bsr.figure import bsr_figure
+from mosys.bsr.figure import load_bsr_figure
 from mosys.bsr.search import SearchSetup, bind_search, nominal_run, record_run
 from mosys.bsr.spec import Perturbation
 from mosys.bsr.start import perturbed_state
 from mosys.io.bsr_result import read_bsr_result
 from mosys.parsing.bsr import parse_bsr_spec
-from mosys.parsing.figure import parse_figure_spec
-from mosys.parsing.tokens import SpecError
 
 
 @dataclass(frozen=True)
@@ -37,10 +35,7 @@ class SeedFitness:
 def bind_spec(spec_path: str | Path, figures_dir: str | Path) -> SearchSetup:
     """A search spec bound to its figure (its start pose, fall endpoints and weights)."""
     spec = parse_bsr_spec(spec_path)
-    figure_path = Path(figures_dir) / f"{spec.figure}.fig"
-    if not figure_path.is_file():
-        raise SpecError.at(spec.path, spec.tokens["figure"], f"a figure in {figures_dir}")
-    return bind_search(spec, bsr_figure(parse_figure_spec(figure_path)))
+    return bind_search(spec, load_bsr_figure(figures_dir, spec.path, spec.tokens["figure"]))
 
 
 def perturbed_starts(

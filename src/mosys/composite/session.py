@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from mosys.bsr.controller import BsrController
-from mosys.bsr.figure import BsrFigure, bsr_figure
+from mosys.bsr.figure import BsrFigure, load_bsr_figure
 from mosys.bsr.search import bind_search
 from mosys.bsr.start import standing_state
 from mosys.composite.evaluate import PhaseMotion, score_script
@@ -27,7 +27,6 @@ from mosys.composite.script import CompositeScript
 from mosys.composite.transitions import equal_split
 from mosys.io.bsr_result import read_bsr_result
 from mosys.parsing.bsr import parse_bsr_spec
-from mosys.parsing.figure import Figure, parse_figure_spec
 from mosys.parsing.tokens import SpecError
 
 _SEED_FILE = re.compile(r"seed(\d+)\.h5$")
@@ -110,13 +109,7 @@ def open_session(
     """Bind the script: ``controller_files`` maps each phase's search to its result files
     (``.../seedK.h5``). A figure, search or seed that is not there raises SpecError at the word
     of the script that names it."""
-    figure_path = Path(figures_dir) / f"{script.figure}.fig"
-    if not figure_path.is_file():
-        raise SpecError.at(script.path, script.tokens["figure"], f"a figure in {figures_dir}")
-    parsed = parse_figure_spec(figure_path)
-    if not isinstance(parsed, Figure):
-        raise SpecError.at(script.path, script.tokens["figure"], "a figure of rods, not a vehicle")
-    figure = bsr_figure(parsed)
+    figure = load_bsr_figure(figures_dir, script.path, script.tokens["figure"])
     controllers, seeds, files, dts, lengths = [], [], [], [], []
     for phase in script.phases:
         token = script.tokens[f"phase.{phase.name}.controller"]
