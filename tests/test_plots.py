@@ -285,3 +285,14 @@ def test_cli_gif_of_a_trajectory_without_figure_motion_exits_2(trajectory, tmp_p
     assert main(["plot", "script", str(bare), "--gif", str(out)]) == 2
     assert capsys.readouterr().err.startswith("mosys: ")
     assert not out.exists()
+
+
+@pytest.mark.parametrize(("span", "max_frames"), [(3.49, 9), (17.3, 120), (2.0, 200), (0.01, 5)])
+def test_animation_steps_are_whole_hundredths_so_gifs_play_in_real_time(span, max_frames):
+    from mosys.plots.style import frame_samples
+
+    t = np.arange(0.0, span + 1e-9, 0.001)
+    samples, step = frame_samples(t, 25, max_frames)
+    assert round(step * 100) == pytest.approx(step * 100, abs=1e-9)  # a GIF stores centiseconds
+    assert step >= 1 / 25 and len(samples) <= max_frames
+    assert samples[-1] == len(t) - 1

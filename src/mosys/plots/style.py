@@ -7,6 +7,7 @@ state), so plotting works headless and in parallel Snakemake jobs.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
@@ -247,12 +248,14 @@ GIF_DPI = 80  # dots per inch of animation frames
 
 def frame_samples(t: np.ndarray, fps: int, max_frames: int) -> tuple[np.ndarray, float]:
     """The samples of ``t`` (s, non-decreasing) an animation shows, one per 1/fps s of motion
-    time (the step widened to keep to ``max_frames``), the last sample always included; and
-    the step, s."""
+    time (the step widened to keep to ``max_frames``, and rounded up to whole hundredths, the
+    unit of a GIF's frame durations, so that the animation plays in real time), the last sample
+    always included; and the step, s."""
     from mosys.plots.car import frame_indices  # here: car imports this module
 
     span = float(t[-1] - t[0])
     step = max(1.0 / fps, span / (max_frames - 1)) if span > 0 else 1.0 / fps
+    step = math.ceil(step * 100.0 - 1e-9) / 100.0
     samples = frame_indices(t, step)
     if samples[-1] != len(t) - 1:
         samples = np.append(samples[: max_frames - 1], len(t) - 1)
