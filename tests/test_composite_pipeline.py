@@ -202,6 +202,29 @@ def test_a_malformed_script_fails_at_its_column_and_writes_nothing(
     assert not output.exists() and not list(tmp_path.glob(".*partial"))
 
 
+def test_a_search_the_pipeline_has_no_results_for_is_named_at_its_column(
+    composite_workspace, tmp_path, capsys
+):
+    # the workflow passes every seed file of the phases' searches; a misspelt search has none
+    script = tmp_path / "typo.comp"
+    script.write_text(
+        composite_workspace.script.read_text().replace("=starman_jump_robust", "=starman_jmp")
+    )
+    files = [
+        str(f) for f in (composite_workspace.bsr_results / "starman_cartwheel_robust").glob("*.h5")
+    ]
+    output = tmp_path / "out.h5"
+    assert main(["composite", str(script), "--controllers", *files, "-o", str(output)]) == 2
+    assert re.search(
+        rf"^{re.escape(str(script))}:9:\d+: expected a built BSR search .*found 'starman_jmp'",
+        capsys.readouterr().err,
+        re.M,
+    )
+    assert main(["composite", str(script), "--controllers", "-o", str(output)]) == 2
+    assert "expected a built BSR search" in capsys.readouterr().err
+    assert not output.exists()
+
+
 def test_the_cli_writes_the_result(composite_workspace, tmp_path, capsys):
     output = tmp_path / "show.h5"
     files = [str(f) for fs in composite_workspace.controller_files().values() for f in fs]

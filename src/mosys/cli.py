@@ -177,7 +177,7 @@ def _composite_controller_files(args: argparse.Namespace, script) -> dict:
     directory, the search's name), else every seed file under ``--bsr-results``."""
     from mosys.composite.session import find_controller_files
 
-    if not args.controllers:
+    if args.controllers is None:
         return find_controller_files(script, args.bsr_results)
     grouped: dict[str, list[Path]] = {}
     for path in map(Path, args.controllers):
@@ -390,7 +390,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     composite.add_argument("script", help="the composite-motion script (.comp)")
     composite.add_argument(
-        "--controllers", nargs="+", help="BSR result files (SEARCH/seedK.h5) the phases may use"
+        "--controllers",
+        nargs="*",
+        help="BSR result files (SEARCH/seedK.h5) the phases may use (the pipeline lists them)",
     )
     composite.add_argument(
         "--bsr-results", default="results/bsr", help="where SEARCH/seedK.h5 live (no --controllers)"
