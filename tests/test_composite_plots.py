@@ -13,6 +13,7 @@ from matplotlib.colors import to_rgba
 from PIL import Image
 
 import mosys.plots.composite as composite
+import mosys.plots.style as style
 from mosys.plots.car import frame_indices
 from mosys.plots.composite import (
     phase_colors,
@@ -175,7 +176,7 @@ def test_gif_plays_the_refined_motion_in_real_time(result_path: Path, tmp_path: 
     expected = len(frame_indices(t, 0.04))
     assert frames in (expected, expected + 1)  # every 40 ms, and the last sample
     assert abs(sum(durations[:-1]) - duration_ms) <= 40  # real time
-    assert durations[-1] == composite.GIF_HOLD_MS
+    assert durations[-1] == style.GIF_HOLD_MS
     assert not list(tmp_path.glob(".*.partial"))
     short = tmp_path / "short.gif"
     write_composite_gif(result_path, short, max_frames=9)

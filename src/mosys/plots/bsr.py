@@ -19,7 +19,7 @@ a line with round ends, metres in the world frame, y up, equal aspect, over the 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 import h5py
@@ -47,6 +47,7 @@ from mosys.plots.style import (
     TITLE_LINE,
     add_legend,
     animation_frames,
+    check_animation_options,
     controller_colors,
     draw_terrain,
     frame_samples,
@@ -54,7 +55,7 @@ from mosys.plots.style import (
     plot_style,
     save_png,
     scene_figure,
-    write_gif,
+    write_real_time_gif,
 )
 
 KIND_TEXT = {"sense": "sense-based", "time": "time-based"}
@@ -101,7 +102,6 @@ OUTLINE = "0.2"  # the thin outline that keeps light poses visible on white
 GIF_WIDTH = 6.0  # inches, the scene's data area
 GIF_FPS = 25  # frames per second of motion time: a frame every 40 ms at most
 GIF_MAX_FRAMES = 150
-GIF_HOLD_MS = 1500  # ms the last frame stays up before the loop restarts
 FOLLOW_POSES = 3.0  # a figure ranging wider than this many pose widths is followed by the view
 NONE_COLOR = "0.45"  # rods while no rule is active
 
@@ -727,6 +727,52 @@ def plot_filmstrip(
 # --------------------------------------------------------------------------- the animation
 
 
+def animate_stick_figure(
+    figure,
+    ax: Axes,
+    t: np.ndarray,
+    endpoints: np.ndarray,
+    samples: np.ndarray,
+    look: Callable[[int], tuple],
+    label_size: float,
+    follow: np.ndarray | None = None,
+) -> list:
+    """The frames (``animation_frames``) of a stick figure at ``samples`` of its motion (t (N,)
+    s, endpoints (N, rods, 2, 2) m) on ``ax``: the rods as lines with round ends and their
+    joints, the time in the top left corner and a label in the top right. ``look(frame)`` gives
+    that frame's rod colour, label text and label colour; ``follow`` (frames,) m: the x the view
+    keeps in sight, panning (``mosys.plots.luxo.pan``), or None for a fixed view."""
+    rods = LineCollection(
+        np.zeros((endpoints.shape[1], 2, 2)), linewidths=ROD_WIDTH + 1.0, capstyle="round", zorder=3
+    )
+    ax.add_collection(rods, autolim=False)
+    (joints,) = ax.plot([], [], "o", markersize=JOINT_SIZE + 1.5, zorder=3.1)
+    box = {"boxstyle": "round,pad=0.3", "facecolor": "white", "alpha": 0.9}
+    corner = {"transform": ax.transAxes, "va": "top", "bbox": box, "zorder": 10}
+    clock = ax.text(0.02, 0.97, "", ha="left", fontsize=10, family="monospace", **corner)
+    label = ax.text(0.98, 0.97, "", ha="right", fontsize=label_size, fontweight="bold", **corner)
+
+    def update(frame: int) -> bool:
+        sample = int(samples[frame])
+        pose = endpoints[sample]
+        color, text, text_color = look(frame)
+        rods.set_segments(pose)
+        rods.set_color(color)
+        joints.set_data(pose[..., 0].ravel(), pose[..., 1].ravel())
+        joints.set_color(color)
+        joints.set_markeredgecolor(OUTLINE)
+        clock.set_text(f"t = {t[sample]:5.2f} s")
+        label.set_text(text)
+        label.set_color(text_color)
+        view = None if follow is None else pan(ax.get_xlim(), follow[frame])
+        if view is None:
+            return False
+        ax.set_xlim(*view)
+        return True
+
+    return animation_frames(figure, [rods, joints, clock, label], range(len(samples)), update)
+
+
 def write_motion_gif(
     result_path: str | Path,
     path: str | Path,
@@ -739,10 +785,7 @@ def write_motion_gif(
     played in real time, the step widened to keep to ``max_frames`` frames; the last frame held
     GIF_HOLD_MS ms; loops. A figure ranging wider than FOLLOW_POSES of its widths is followed by
     a view that pans (``mosys.plots.luxo.pan``). Written atomically."""
-    if not (isinstance(fps, int | np.integer) and fps > 0):
-        raise ValueError(f"fps must be a positive whole number, got {fps!r}")
-    if not (isinstance(max_frames, int | np.integer) and max_frames >= 2):
-        raise ValueError(f"max_frames must be a whole number of at least 2, got {max_frames!r}")
+    check_animation_options(fps, max_frames)
     result = read_result(result_path)
     motion = result.motion
     t, endpoints = motion.t, motion.endpoints
@@ -770,59 +813,20 @@ def write_motion_gif(
         )
         figure.suptitle(title, y=1 - 0.08 / figure.get_size_inches()[1], va="top", fontsize=9)
         draw_terrain(ax, motion.terrain, limits[0, 1] - 1.0)
-        rods = LineCollection(
-            np.zeros((endpoints.shape[1], 2, 2)),
-            linewidths=ROD_WIDTH + 1.0,
-            capstyle="round",
-            zorder=3,
-        )
-        ax.add_collection(rods, autolim=False)
-        (joints,) = ax.plot([], [], "o", markersize=JOINT_SIZE + 1.5, zorder=3.1)
-        joints.set_markeredgecolor(OUTLINE)
-        clock = ax.text(
-            0.02,
-            0.97,
-            "",
-            transform=ax.transAxes,
-            ha="left",
-            va="top",
-            fontsize=10,
-            family="monospace",
-            bbox={"boxstyle": "round,pad=0.3", "facecolor": "white", "alpha": 0.9},
-            zorder=10,
-        )
-        rule = ax.text(
-            0.98,
-            0.97,
-            "",
-            transform=ax.transAxes,
-            ha="right",
-            va="top",
-            fontsize=13,
-            fontweight="bold",
-            bbox={"boxstyle": "round,pad=0.3", "facecolor": "white", "alpha": 0.9},
-            zorder=10,
-        )
 
-        def update(frame: int) -> bool:
-            sample = int(samples[frame])
-            pose = endpoints[sample]
+        def look(frame: int) -> tuple:
             which = int(active[frame])
             color = colors[letters[which]] if 0 <= which < rules else NONE_COLOR
-            rods.set_segments(pose)
-            rods.set_color(color)
-            joints.set_data(pose[..., 0].ravel(), pose[..., 1].ravel())
-            joints.set_color(color)
-            joints.set_markeredgecolor(OUTLINE)
-            clock.set_text(f"t = {t[sample]:5.2f} s")
-            rule.set_text(f"rule {rule_letter(which)}")
-            rule.set_color(color if which >= 0 else "black")
-            view = pan(ax.get_xlim(), centre[frame]) if follow else None
-            if view is None:
-                return False
-            ax.set_xlim(*view)
-            return True
+            return color, f"rule {rule_letter(which)}", color if which >= 0 else "black"
 
-        frames = animation_frames(figure, [rods, joints, clock, rule], range(len(samples)), update)
-    frame_ms = max(20, round(1000 * step))
-    write_gif(frames, path, [frame_ms] * (len(frames) - 1) + [GIF_HOLD_MS])
+        frames = animate_stick_figure(
+            figure,
+            ax,
+            t,
+            endpoints,
+            samples,
+            look,
+            label_size=13,
+            follow=centre if follow else None,
+        )
+    write_real_time_gif(frames, path, step)

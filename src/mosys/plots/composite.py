@@ -30,13 +30,11 @@ from matplotlib.lines import Line2D
 from mosys.io.composite_result import CompositeMotion, CompositeResult, read_composite_result
 from mosys.plots.bsr import (
     GIF_FPS,
-    GIF_HOLD_MS,
     GIF_MAX_FRAMES,
     GROUND_SHOWN,
-    JOINT_SIZE,
-    OUTLINE,
     ROD_WIDTH,
     SCENE_MARGIN,
+    animate_stick_figure,
     choose_interval,
     draw_pose,
     minus_signs,
@@ -54,7 +52,7 @@ from mosys.plots.style import (
     MARGIN_TOP,
     TITLE_LINE,
     add_legend,
-    animation_frames,
+    check_animation_options,
     controller_colors,
     draw_terrain,
     frame_samples,
@@ -62,7 +60,7 @@ from mosys.plots.style import (
     plot_style,
     save_png,
     scene_figure,
-    write_gif,
+    write_real_time_gif,
 )
 
 # filmstrips
@@ -586,10 +584,7 @@ def write_composite_gif(
     name. One frame per 1/``fps`` s of motion time (every 40 ms by default), played in real
     time, the step widened to keep to ``max_frames`` frames (``frame_samples``); the last frame
     held GIF_HOLD_MS ms; loops. Written atomically."""
-    if not (isinstance(fps, int | np.integer) and fps > 0):
-        raise ValueError(f"fps must be a positive whole number, got {fps!r}")
-    if not (isinstance(max_frames, int | np.integer) and max_frames >= 2):
-        raise ValueError(f"max_frames must be a whole number of at least 2, got {max_frames!r}")
+    check_animation_options(fps, max_frames)
     result = read_composite(result_path)
     stored, phases = result.after, result.phases
     motion = stored.motion
@@ -614,54 +609,10 @@ def write_composite_gif(
         figure.suptitle(title, y=1 - 0.08 / figure.get_size_inches()[1], va="top", fontsize=9)
         add_legend(figure, entries, ncols=1, fontsize=8)
         draw_terrain(ax, motion.terrain, limits[0, 1] - 1.0)
-        rods = LineCollection(
-            np.zeros((endpoints.shape[1], 2, 2)),
-            linewidths=ROD_WIDTH + 1.0,
-            capstyle="round",
-            zorder=3,
-        )
-        ax.add_collection(rods, autolim=False)
-        (joints,) = ax.plot([], [], "o", markersize=JOINT_SIZE + 1.5, zorder=3.1)
-        box = {"boxstyle": "round,pad=0.3", "facecolor": "white", "alpha": 0.9}
-        clock = ax.text(
-            0.02,
-            0.96,
-            "",
-            transform=ax.transAxes,
-            ha="left",
-            va="top",
-            fontsize=10,
-            family="monospace",
-            bbox=box,
-            zorder=10,
-        )
-        name = ax.text(
-            0.98,
-            0.96,
-            "",
-            transform=ax.transAxes,
-            ha="right",
-            va="top",
-            fontsize=12,
-            fontweight="bold",
-            bbox=box,
-            zorder=10,
-        )
 
-        def update(frame: int) -> bool:
-            sample = int(samples[frame])
-            pose = endpoints[sample]
+        def look(frame: int) -> tuple:
             k = int(phase[frame])
-            rods.set_segments(pose)
-            rods.set_color(colors[k])
-            joints.set_data(pose[..., 0].ravel(), pose[..., 1].ravel())
-            joints.set_color(colors[k])
-            joints.set_markeredgecolor(OUTLINE)
-            clock.set_text(f"t = {t[sample]:5.2f} s")
-            name.set_text(str(phases[k]["name"]))
-            name.set_color(colors[k])
-            return False
+            return colors[k], str(phases[k]["name"]), colors[k]
 
-        frames = animation_frames(figure, [rods, joints, clock, name], range(len(samples)), update)
-    frame_ms = max(20, round(1000 * step))
-    write_gif(frames, path, [frame_ms] * (len(frames) - 1) + [GIF_HOLD_MS])
+        frames = animate_stick_figure(figure, ax, t, endpoints, samples, look, label_size=12)
+    write_real_time_gif(frames, path, step)

@@ -42,6 +42,7 @@ from mosys.plots.style import (
     add_legend,
     animation_frames,
     arrange,
+    check_animation_options,
     controller_colors,
     draw_terrain,
     frame_samples,
@@ -49,7 +50,7 @@ from mosys.plots.style import (
     plot_style,
     save_png,
     scene_figure,
-    write_gif,
+    write_real_time_gif,
 )
 
 HEAD_ROD = "upper"  # the rod whose far end carries the head
@@ -68,7 +69,6 @@ STRIP_WIDTH = 7.5  # inches, the strip's data area
 GIF_WIDTH = 6.0  # inches, the animation's data area
 GIF_FPS = 25  # frames per second of motion time
 GIF_MAX_FRAMES = 600
-GIF_HOLD_MS = 1500  # ms the last frame stays up before the loop restarts
 FOLLOW_WIDTH = 3.0  # m: a lamp ranging wider in x is followed by a view this wide (at least)
 SERIES_WIDTH = 7.2  # inches, the data area of the time series
 SIDE_LEGEND = 2.0  # inches right of the time series for their legends
@@ -389,10 +389,7 @@ def write_show_gif(
     view's height over ASPECT_RANGE's largest, if more), a window that wide which pans to keep
     the lamp in its middle half (``pan``). The last frame is held GIF_HOLD_MS
     ms; loops. Written atomically."""
-    if not (isinstance(fps, int | np.integer) and fps > 0):
-        raise ValueError(f"fps must be a positive whole number, got {fps!r}")
-    if not (isinstance(max_frames, int | np.integer) and max_frames >= 2):
-        raise ValueError(f"max_frames must be a whole number of at least 2, got {max_frames!r}")
+    check_animation_options(fps, max_frames)
     trajectory = read_luxo_trajectory(trajectory_path)
     figure_motion = trajectory.motion
     t, endpoints = trajectory.t, figure_motion.endpoints
@@ -458,8 +455,7 @@ def write_show_gif(
             return True
 
         frames = animation_frames(figure, [*lamp.artists, title], range(len(samples)), update)
-    frame_ms = max(20, round(1000 * step))
-    write_gif(frames, out_path, [frame_ms] * (len(frames) - 1) + [GIF_HOLD_MS])
+    write_real_time_gif(frames, out_path, step)
 
 
 def _program_end(trajectory: Trajectory, motion: Motion) -> int:

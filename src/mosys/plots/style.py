@@ -244,6 +244,15 @@ def scene_figure(
 # --------------------------------------------------------------------------- animations
 
 GIF_DPI = 80  # dots per inch of animation frames
+GIF_HOLD_MS = 1500  # ms the last frame of an animation stays up before the loop restarts
+
+
+def check_animation_options(fps, max_frames) -> None:
+    """ValueError unless ``fps`` is a positive whole number and ``max_frames`` one >= 2."""
+    if not (isinstance(fps, int | np.integer) and fps > 0):
+        raise ValueError(f"fps must be a positive whole number, got {fps!r}")
+    if not (isinstance(max_frames, int | np.integer) and max_frames >= 2):
+        raise ValueError(f"max_frames must be a whole number of at least 2, got {max_frames!r}")
 
 
 def frame_samples(t: np.ndarray, fps: int, max_frames: int) -> tuple[np.ndarray, float]:
@@ -306,6 +315,13 @@ def shared_palette(frames: list, samples: int = 8) -> list:
         montage.paste(frame, (0, height * k))
     palette = montage.quantize(256)
     return [frame.quantize(palette=palette, dither=Image.Dither.NONE) for frame in frames]
+
+
+def write_real_time_gif(frames: list, path: str | Path, step: float) -> None:
+    """Write ``frames`` shown ``step`` s of motion apart (``frame_samples``) as a GIF that plays
+    in real time (at least 20 ms a frame), its last frame held GIF_HOLD_MS ms."""
+    frame_ms = max(20, round(1000 * step))
+    write_gif(frames, path, [frame_ms] * (len(frames) - 1) + [GIF_HOLD_MS])
 
 
 def write_gif(frames: list, path: str | Path, durations: int | Sequence[int]) -> None:
