@@ -175,14 +175,11 @@ def _bsr_search(args: argparse.Namespace) -> None:
 def _composite_controller_files(args: argparse.Namespace, script) -> dict:
     """The BSR result files the script may use: the ``--controllers`` given (grouped by their
     directory, the search's name), else every seed file under ``--bsr-results``."""
-    from mosys.composite.session import find_controller_files
+    from mosys.composite.session import files_by_search, find_controller_files
 
     if args.controllers is None:
         return find_controller_files(script, args.bsr_results)
-    grouped: dict[str, list[Path]] = {}
-    for path in map(Path, args.controllers):
-        grouped.setdefault(path.parent.name, []).append(path)
-    return grouped
+    return files_by_search(args.controllers)
 
 
 def _composite(args: argparse.Namespace) -> None:

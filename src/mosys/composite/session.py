@@ -88,6 +88,14 @@ class CompositeSession:
         return self.score(ticks).total
 
 
+def files_by_search(result_paths: Sequence[str | Path]) -> dict[str, list[Path]]:
+    """Seed files grouped by their directory: results/bsr/SEARCH/seedK.h5 -> SEARCH."""
+    grouped: dict[str, list[Path]] = {}
+    for path in map(Path, result_paths):
+        grouped.setdefault(path.parent.name, []).append(path)
+    return grouped
+
+
 def find_controller_files(script: CompositeScript, results_dir: str | Path) -> dict[str, list]:
     """Each phase's search -> its result files ``results_dir/SEARCH/seed*.h5``, sorted by seed."""
     found = {}

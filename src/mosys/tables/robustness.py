@@ -3,7 +3,6 @@ and its plain twin, their best controllers run from the same randomly perturbed 
 
 from __future__ import annotations
 
-from collections import defaultdict
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -11,18 +10,11 @@ import numpy as np
 import pandas as pd
 
 from mosys.composite.robustness import bind_spec, perturbed_starts, seed_fitness
+from mosys.composite.session import files_by_search
 from mosys.io.atomic import write_text_atomically
 
 STARTS = 50
 STARTS_SEED = 1
-
-
-def files_by_search(result_paths: Sequence[str | Path]) -> dict[str, list[Path]]:
-    """Seed files grouped by their directory: results/bsr/SEARCH/seedK.h5 -> SEARCH."""
-    grouped: dict[str, list[Path]] = defaultdict(list)
-    for path in map(Path, result_paths):
-        grouped[path.parent.name].append(path)
-    return dict(grouped)
 
 
 def robustness_frame(
