@@ -206,7 +206,7 @@ def test_a_new_luxo_script_reuses_the_controller_and_motor_programs(workflow):
 
 @pytest.fixture(scope="module")
 def bsr_built(workflow) -> Path:
-    """results/bsr_all at CI's reduced budget (config/ci.yaml: G = 300, five seeds)."""
+    """results/bsr_all at CI's reduced budget (config/ci.yaml: G = 600, five seeds)."""
     snakemake(workflow, "results/bsr_all", "--configfile", "config/ci.yaml")
     return workflow
 
@@ -276,13 +276,14 @@ def edited_spec(path: Path, text: str) -> Iterator[None]:
 
 @pytest.fixture(scope="module")
 def composite_built(bsr_built) -> Path:
-    """results/composite_all at CI's reduced budget: the robust searches, the transition search
-    of starman_show, its plots and tables."""
+    """results/composite_all at CI's reduced budget: the robust searches (exempt: the spec's own
+    G = 4000), the transition search of starman_show, its plots and tables."""
     snakemake(bsr_built, "results/composite_all", "--configfile", "config/ci.yaml")
     return bsr_built
 
 
 JUMP_CLEARANCE = 0.75  # m: the refined jump's own flight lifts every endpoint at least this high
+GROUNDED = 0.1  # m: a jump whose own flight stays below this did not leave the ground
 
 
 def test_the_refined_composite_motion_does_all_three_phases(composite_built):
@@ -292,15 +293,14 @@ def test_the_refined_composite_motion_does_all_three_phases(composite_built):
     result = read_composite_result(composite_built / "results/composite/starman_show.h5")
     cartwheel, jump, shuffle = phase_measures(result.after)
     guessed_jump = phase_measures(result.before)[1]
-    # the cartwheel covers ground turning over (see the README: just short of a full turn at
-    # this budget)
-    assert cartwheel.distance > 1.0 and cartwheel.rotations > 0.95
-    # the jump phase takes off on its own and clears the ground by far more than the guess's
-    assert jump.flight >= JUMP_CLEARANCE and jump.flight > 1.5 * guessed_jump.flight
+    # the cartwheel covers ground with at least one full turn
+    assert cartwheel.distance > 1.0 and cartwheel.rotations >= 1.0
+    # the jump phase takes off on its own where the careless guess's did not
+    assert jump.flight >= JUMP_CLEARANCE and guessed_jump.flight < GROUNDED
     # the shuffle covers ground
     assert shuffle.distance > 0.5
     # the search improves the script's total by a clear margin
-    assert result.attrs["score_after"] > 1.1 * result.attrs["score_before"]
+    assert result.attrs["score_after"] > 1.5 * result.attrs["score_before"]
     assert result.attrs["simulations"] == 16 * 16 * 4 + 1
     index = (composite_built / "results/composite_all").read_text().split()
     for made in (
@@ -316,11 +316,13 @@ def test_the_robust_controllers_hold_up_better(composite_built):
     import pandas as pd
 
     table = pd.read_csv(composite_built / "results/tables/composite_robustness.csv")
-    assert set(table["budget"]) == {"ci"}
     rows = table.to_dict("records")
     for robust, plain in zip(rows[::2], rows[1::2], strict=True):
         assert (robust["controller"], plain["controller"]) == ("robust", "plain")
         assert robust["starts"] == plain["starts"] == 50
+        # the table says what each twin ran at: CI exempts the robust searches from its cap
+        assert (robust["budget"], str(robust["generations"])) == ("paper", "4000")
+        assert (plain["budget"], str(plain["generations"])) == ("ci", "600")
         for column in ("mean perturbed fitness (seed average)", "chosen perturbed mean"):
             assert robust[column] > plain[column], (robust["search"], column)
 

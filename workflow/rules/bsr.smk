@@ -14,7 +14,7 @@ rule bsr_search:
         "results/benchmarks/bsr/{name}/seed{seed}.tsv"
     params:
         generations=bsr_generations_option,
-        budget=config["budget"],
+        budget=bsr_budget,
     threads: config["bsr"]["threads"]
     shell:
         "mosys bsr-search {input.spec} --seed {wildcards.seed} --figures specs/figures"

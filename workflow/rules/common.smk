@@ -206,10 +206,23 @@ def bsr_figure_spec(wildcards):
             if len(words) > 1 and re.fullmatch(r"\w+", words[1])]
 
 
+def bsr_full_budget(name):
+    """Whether a search runs at its spec's own G: no cap is set, or the config exempts it."""
+    return config["bsr"]["generations"] is None or name in config["bsr"]["full_budget"]
+
+
 def bsr_generations_option(wildcards):
-    """'--generations G' when the config caps the searches' generations, else nothing."""
-    generations = config["bsr"]["generations"]
-    return "" if generations is None else f"--generations {generations}"
+    """'--generations G' when the config caps this search's generations, else nothing."""
+    if bsr_full_budget(wildcards.name):
+        return ""
+    return f"--generations {config['bsr']['generations']}"
+
+
+def bsr_budget(wildcards):
+    """The budget a search's result is labelled with: the config's, or 'paper' for a search
+    the config exempts from its cap."""
+    exempt = config["bsr"]["generations"] is not None and bsr_full_budget(wildcards.name)
+    return "paper" if exempt else config["budget"]
 
 
 def bsr_table_targets():

@@ -24,10 +24,11 @@ from mosys.parsing.bsr import parse_bsr_spec
 @dataclass(frozen=True)
 class SeedFitness:
     """One seed's best controller: its fitness from the nominal start and from each perturbed
-    start (starts,), and the budget its search ran at."""
+    start (starts,), and the budget and generations its search ran at."""
 
     seed: int
     budget: str
+    generations: int
     nominal: float
     perturbed: np.ndarray
 
@@ -83,6 +84,7 @@ def seed_fitness(
             SeedFitness(
                 seed=int(result.attrs["seed"]),
                 budget=str(result.attrs["budget"]),
+                generations=int(result.attrs["generations"]),
                 nominal=float(nominal_run(setup, result.controller).terms @ setup.weights),
                 perturbed=fitness_from_starts(setup, result.controller, starts),
             )

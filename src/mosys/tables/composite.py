@@ -59,7 +59,8 @@ def write_composite_table(
         "the concatenations the search ran (Q x G x H mutants and the guess). wall: the search "
         "alone, one thread, kernels compiled. speed-up: the paper's minute scaled to our "
         "simulations over our wall time (a lower bound: the paper says under a minute). budget: "
-        "the config that built the BSR controllers. Scores are the script's; ticks are 0.01 s.\n\n"
+        "the config the pipeline ran with (the robustness table gives each controller's budget "
+        "and generations). Scores are the script's; ticks are 0.01 s.\n\n"
     )
     write_text_atomically(md_path, caption + frame.to_markdown(index=False) + "\n")
     return frame

@@ -52,6 +52,9 @@ def robustness_frame(
                         f"speed ±{perturbation.speed:g} m/s, spin ±{perturbation.spin:g}°/s"
                     ),
                     "budget": ", ".join(sorted({row.budget for row in seeds})),
+                    "generations": ", ".join(
+                        str(g) for g in sorted({row.generations for row in seeds})
+                    ),
                     "T (s)": setup.spec.duration,
                     "seeds": len(seeds),
                     "median nominal fitness": round(
@@ -88,7 +91,8 @@ def write_robustness_table(
         f"the robust spec's perturbation (uniform in each range; generator seed {STARTS_SEED}). "
         "nominal: from the unperturbed start. chosen: the seed with the best nominal fitness. "
         "The robust search perturbs its start at every evaluation; the plain one never does. "
-        "budget: the config that set the searches' generations.\n\n"
+        "budget, generations: what the searches ran at (a reduced CI budget may exempt the "
+        "robust searches, so compare the twins at one budget).\n\n"
     )
     write_text_atomically(md_path, caption + frame.to_markdown(index=False) + "\n")
     return frame
