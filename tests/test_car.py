@@ -20,7 +20,7 @@ from mosys.kernels.geometry import (
     polygons_overlap,
 )
 from mosys.kernels.integrate import rk4_scratch, rk4_step
-from mosys.parsing.controller import parse_controller_text
+from mosys.parsing.controller import parse_controller_text, render_controller_spec
 from mosys.parsing.figure import parse_figure_text
 from mosys.parsing.tokens import SpecError
 from mosys.parsing.vehicle import Vehicle
@@ -252,6 +252,70 @@ def test_specs_that_do_not_fit_the_car_name_the_line(car, old, new, message):
     with pytest.raises(SpecError) as error:
         build_problem(parse_controller_text(text, "x.ssc"), car)
     assert str(error.value) == message
+
+
+@pytest.mark.parametrize(
+    ("line", "message"),
+    [
+        ("policy", "x.ssc:15:7: expected one of 'interpolate', 'lookahead', found end of line"),
+        (
+            "policy greedy x=0.1",
+            "x.ssc:15:8: expected one of 'interpolate', 'lookahead', found 'greedy'",
+        ),
+        (
+            "policy lookahead",
+            "x.ssc:15:17: expected a 'name=tolerance' arrival tolerance of a dest dimension "
+            "after 'lookahead', found end of line",
+        ),
+        (
+            "policy lookahead steer=5",
+            "x.ssc:15:18: expected a dest name (one of 'x', 'y', 'heading', 'speed') before '=', "
+            "found 'steer'",
+        ),
+        (
+            "policy lookahead x=0.1 x=0.2",
+            "x.ssc:15:24: expected 'x=' only once, found 'x=0.2'",
+        ),
+        (
+            "policy lookahead x=0",
+            "x.ssc:15:20: expected a number > 0 for the tolerance of x, found '0'",
+        ),
+        (
+            "policy lookahead x",
+            "x.ssc:15:18: expected a 'name=tolerance' arrival tolerance, found 'x'",
+        ),
+        (
+            "policy interpolate x=0.1",
+            "x.ssc:15:20: expected the end of the line after 'interpolate', found 'x=0.1'",
+        ),
+        (
+            "policy lookahead x=0.1\npolicy interpolate",
+            "x.ssc:16:1: expected one 'policy' line only (the first is line 15), found 'policy'",
+        ),
+    ],
+)
+def test_bad_policy_lines_name_the_place(line, message):
+    with pytest.raises(SpecError) as error:
+        parse_controller_text(SMALL + line + "\n", "x.ssc")
+    assert str(error.value) == message
+
+
+def test_a_policy_line_round_trips_and_lookahead_needs_a_vehicle(link1):
+    spec = parse_controller_text(SMALL + "policy lookahead x=0.1 heading=4\n", "x.ssc")
+    assert spec.policy.kind == "lookahead"
+    assert spec.policy.arrival == (("x", 0.1), ("heading", 4.0))
+    again = parse_controller_text(render_controller_spec(spec), "x.ssc")
+    assert again.policy.arrival == spec.policy.arrival
+    pendulum = parse_controller_text(
+        "dyn link1\nssd angle -180 170 36 wrap\nssd omega -500 500 21\n"
+        "torq torque -10 10 11 0.1\ndest angle=0 omega=0\npolicy lookahead angle=5\n",
+        "x.ssc",
+    )
+    with pytest.raises(SpecError) as error:
+        build_problem(pendulum, link1)
+    assert str(error.value) == (
+        "x.ssc:6:8: expected 'interpolate': figure 'link1' is not a vehicle, found 'lookahead'"
+    )
 
 
 def test_obstacles_need_a_vehicle(link1):

@@ -84,9 +84,12 @@ def script_group(script):
 
 
 def script_dt(script):
-    """The simulator step of a script, s: Luxo's own (stiff contacts), else the default."""
+    """The simulator step of a script, s: Luxo's own (stiff contacts), the car's own for the
+    car's scripts, else the default."""
     if script_figure(script) == config["luxo"]["figure"]:
         return config["luxo"]["dt"]
+    if script in config["car"]["scripts"]:
+        return config["car"]["dt"]
     return config["simulation"]["dt"]
 
 

@@ -13,11 +13,14 @@
     obstacle curb -20,-1 20,-1 20,0 -20,0   # optional: a polygon the body must not overlap, m
     domain -4,0.5 8,0.5 8,4 -4,4       # optional: a polygon the reference point stays in, m
     hold                               # optional: the destination nodes hold the figure at rest
+    policy lookahead x=0.1 y=0.1 heading=4  # optional: the runtime (default 'interpolate')
 
 ``obstacle`` and ``domain`` are for figures with a body outline (the car): their vertices are in
 metres in the frame of the figure's ``x``/``y`` state variables. ``hold`` is for a destination at
 rest: its nodes store the torques that keep the figure still there (``ssc.generate``), instead of
-the DP's best control sample.
+the DP's best control sample. ``policy`` says how the table runs: ``interpolate`` (the paper's
+n-linear interpolation of the controls) or, for a vehicle, ``lookahead`` (``kernels.lookahead``)
+with the arrival tolerance of some ``dest`` dimensions, where the vehicle brakes and holds.
 
 Values are in spec units: degrees for angles, deg/s for angular rates, metres and m/s otherwise
 (the figure says which). The full grammar is in ``docs/controller-spec.md``.
@@ -45,7 +48,20 @@ from mosys.parsing.tokens import (
     value_token,
 )
 
-KEYWORDS = ("dyn", "ssd", "torq", "dest", "tol", "maxiter", "dt", "obstacle", "domain", "hold")
+KEYWORDS = (
+    "dyn",
+    "ssd",
+    "torq",
+    "dest",
+    "tol",
+    "maxiter",
+    "dt",
+    "obstacle",
+    "domain",
+    "hold",
+    "policy",
+)
+POLICIES = ("interpolate", "lookahead")
 DEFAULT_TOLERANCE = (
     1e-6  # s: largest change of the cost-to-go in one sweep that counts as converged
 )
@@ -136,6 +152,18 @@ class Destination:
 
 
 @dataclass(frozen=True)
+class Policy:
+    """The ``policy`` line: how the table runs. ``kind`` is one of POLICIES; ``arrival`` the
+    ``name=tolerance`` pairs (spec units, > 0, names from ``dest``) of ``lookahead``: where the
+    vehicle's braking point lies within them of the destination, it brakes to rest and holds.
+    ``token`` is the kind's token."""
+
+    kind: str
+    arrival: tuple[tuple[str, float], ...]
+    token: Token
+
+
+@dataclass(frozen=True)
 class Polygon:
     """An ``obstacle`` or the ``domain`` line: a simple polygon, ``vertices`` (x, y) in metres in
     the frame of the figure's ``x``/``y`` state variables. ``name`` is the obstacle's name
@@ -158,7 +186,8 @@ class ControllerSpec:
     SHA-256 of the file's bytes. ``obstacles`` and ``domain`` (None: no such line) restrict a
     figure with a body outline: states whose body overlaps an obstacle or whose reference point
     lies outside the domain are removed from the table. ``hold`` (the keyword's token, None
-    without a ``hold`` line) asks for holding torques at the destination nodes.
+    without a ``hold`` line) asks for holding torques at the destination nodes. ``policy``
+    (None: the paper's interpolation) says how the table runs.
     """
 
     path: str
@@ -174,6 +203,7 @@ class ControllerSpec:
     obstacles: tuple[Polygon, ...] = ()
     domain: Polygon | None = None
     hold: Token | None = None
+    policy: Policy | None = None
 
     @property
     def name(self) -> str:
@@ -246,6 +276,7 @@ class _Parser:
         self.obstacles: list[Polygon] = []
         self.domain: Polygon | None = None
         self.hold: Token | None = None
+        self.policy_line: Line | None = None
 
     def error(self, token: Token, expected: str, found: str | None) -> SpecError:
         return SpecError(self.path, token.line, token.column, expected, found)
@@ -255,7 +286,7 @@ class _Parser:
             keyword = line.keyword.text
             if keyword not in KEYWORDS:
                 raise unknown_keyword(line, KEYWORDS)
-            if keyword in ("dyn", "dest", "tol", "maxiter", "dt", "domain", "hold"):
+            if keyword in ("dyn", "dest", "tol", "maxiter", "dt", "domain", "hold", "policy"):
                 record_once(line, self.first_line)
             getattr(self, f"line_{keyword}")(line)
         for keyword, given in (
@@ -267,13 +298,14 @@ class _Parser:
             if not given:
                 raise missing_line(self.path, lines, keyword)
         assert self.figure is not None and self.dest_line is not None
+        destination = self.destination(self.dest_line)
         return ControllerSpec(
             path=self.path,
             figure=self.figure.text,
             figure_token=self.figure,
             state=tuple(self.state),
             controls=tuple(self.controls),
-            destination=self.destination(self.dest_line),
+            destination=destination,
             tolerance=float(self.options.get("tol", DEFAULT_TOLERANCE)),
             max_iterations=int(self.options.get("maxiter", DEFAULT_MAX_ITERATIONS)),
             dt=float(self.options.get("dt", DEFAULT_DT)),
@@ -281,6 +313,7 @@ class _Parser:
             obstacles=tuple(self.obstacles),
             domain=self.domain,
             hold=self.hold,
+            policy=None if self.policy_line is None else self.policy(self.policy_line, destination),
         )
 
     def new_name(self, reader: LineReader, what: str) -> Token:
@@ -479,6 +512,47 @@ class _Parser:
         line.reader().end()
         self.hold = line.keyword
 
+    def line_policy(self, line: Line) -> None:
+        if len(line.tokens) == 1:
+            choices = ", ".join(f"'{kind}'" for kind in POLICIES)
+            raise SpecError(self.path, line.number, line.end_column, f"one of {choices}", None)
+        self.policy_line = line  # its tolerances are checked against the dest line
+
+    def policy(self, line: Line, destination: tuple[Destination, ...]) -> Policy:
+        kind = line.tokens[1]
+        if kind.text not in POLICIES:
+            choices = ", ".join(f"'{k}'" for k in POLICIES)
+            raise self.error(kind, f"one of {choices}", kind.text)
+        if kind.text == "interpolate" and len(line.tokens) > 2:
+            raise self.error(
+                line.tokens[2], "the end of the line after 'interpolate'", line.tokens[2].text
+            )
+        named = [entry.name for entry in destination]
+        choices = ", ".join(f"'{name}'" for name in named)
+        arrival: list[tuple[str, float]] = []
+        for token in line.tokens[2:]:
+            name, sep, _ = token.text.partition("=")
+            if not sep:
+                raise self.error(token, "a 'name=tolerance' arrival tolerance", token.text)
+            if name not in named:
+                raise self.error(token, f"a dest name (one of {choices}) before '='", name)
+            if name in dict(arrival):
+                raise self.error(token, f"'{name}=' only once", token.text)
+            part = value_token(token, name)
+            tolerance = parse_number(part, self.path, f"arrival tolerance of {name}")
+            if not tolerance > 0:
+                raise self.error(part, f"a number > 0 for the tolerance of {name}", part.text)
+            arrival.append((name, tolerance))
+        if kind.text == "lookahead" and not arrival:
+            raise SpecError(
+                self.path,
+                line.number,
+                line.end_column,
+                "a 'name=tolerance' arrival tolerance of a dest dimension after 'lookahead'",
+                None,
+            )
+        return Policy(kind.text, tuple(arrival), kind)
+
     def line_maxiter(self, line: Line) -> None:
         reader = line.reader()
         self.options["maxiter"] = reader.integer("maxiter", minimum=1)
@@ -562,4 +636,7 @@ def render_controller_spec(spec: ControllerSpec) -> str:
         lines.append(f"domain {vertices(spec.domain)}")
     if spec.hold is not None:
         lines.append("hold")
+    if spec.policy is not None:
+        arrival = "".join(f" {name}={number(value)}" for name, value in spec.policy.arrival)
+        lines.append(f"policy {spec.policy.kind}{arrival}")
     return "\n".join(lines) + "\n"

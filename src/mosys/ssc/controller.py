@@ -15,8 +15,10 @@ import numpy as np
 
 from mosys.io.controller_table import ControllerTable, read_controller_table
 from mosys.kernels.interpolate import clamp_to_domain, interpolate_into
+from mosys.kernels.lookahead import simulate_lookahead
 from mosys.kernels.simulate import simulate_controlled
 from mosys.ssc.grid import FigureGrid, control_scale, figure_grid, figure_state_names, state_unit
+from mosys.ssc.lookahead import MAX_SEGMENT_SECONDS, Lookahead, lookahead_runtime
 from mosys.ssc.regions import ARRIVAL_STEPS, REST_RATE, Bounds, Regions, state_periods
 
 
@@ -59,6 +61,12 @@ class Controller:
         self.torque_table_si = np.ascontiguousarray(self.torque_table * self.control_scale)
         self.control_min_si = np.ascontiguousarray(table.control_min * self.control_scale)
         self.control_max_si = np.ascontiguousarray(table.control_max * self.control_scale)
+        # 'policy lookahead' (a vehicle's spec): run by lookahead on the cost-to-go instead
+        self.lookahead: Lookahead | None = (
+            lookahead_runtime(table, dynamics, self.grid)
+            if table.attrs.get("policy") == "lookahead"
+            else None
+        )
 
     @classmethod
     def load(cls, path: str | Path, dynamics: ModuleType) -> Controller:
@@ -133,8 +141,9 @@ class Controller:
     ) -> ClosedLoopRun:
         """Run the model from ``figure_state`` (S,) SI under this controller for ``seconds``
         (rounded to whole steps of ``dt``), or until the state enters or leaves one of
-        ``regions`` (``kernels.simulate.simulate_controlled``). The run's controls are in spec
-        units."""
+        ``regions`` (``kernels.simulate.simulate_controlled``, or
+        ``kernels.lookahead.simulate_lookahead`` for a table made with ``policy lookahead``).
+        The run's controls are in spec units."""
         steps = int(round(seconds / dt))
         n2 = len(figure_state)
         if regions is None:
@@ -144,28 +153,63 @@ class Controller:
         controls = np.empty((steps, len(self.table.control_names)))
         outside = np.empty(steps, dtype=np.bool_)
         grid = self.grid
-        taken = simulate_controlled(
-            self.dynamics.derivative_into,
-            grid.axis_min,
-            grid.axis_step,
-            grid.axis_count,
-            grid.wrap,
-            self.torque_table_si,
-            self.known,
-            self.control_min_si,
-            self.control_max_si,
-            grid.state_slot,
-            self.control_slot,
-            len(self.dynamics.INPUT_NAMES),
-            state,
-            float(dt),
-            states[:-1],
-            controls,
-            outside,
-            regions.lower,
-            regions.upper,
-            regions.period,
-        )
+        if self.lookahead is not None:
+            policy = self.lookahead
+            taken = simulate_lookahead(
+                self.dynamics.derivative_into,
+                grid.axis_min,
+                grid.axis_step,
+                grid.axis_count,
+                grid.wrap,
+                policy.value,
+                policy.known,
+                policy.control_samples,
+                self.control_slot,
+                len(self.dynamics.INPUT_NAMES),
+                grid.state_slot,
+                policy.pose_slot,
+                policy.outline,
+                policy.obstacle_vertices,
+                policy.obstacle_start,
+                policy.domain,
+                policy.vehicle_slot,
+                policy.wheel_radius,
+                policy.brake,
+                policy.arrival_lower,
+                policy.arrival_upper,
+                int(np.ceil(MAX_SEGMENT_SECONDS / dt)),
+                state,
+                float(dt),
+                states[:-1],
+                controls,
+                outside,
+                regions.lower,
+                regions.upper,
+                regions.period,
+            )
+        else:
+            taken = simulate_controlled(
+                self.dynamics.derivative_into,
+                grid.axis_min,
+                grid.axis_step,
+                grid.axis_count,
+                grid.wrap,
+                self.torque_table_si,
+                self.known,
+                self.control_min_si,
+                self.control_max_si,
+                grid.state_slot,
+                self.control_slot,
+                len(self.dynamics.INPUT_NAMES),
+                state,
+                float(dt),
+                states[:-1],
+                controls,
+                outside,
+                regions.lower,
+                regions.upper,
+                regions.period,
+            )
         states[taken] = state
         return ClosedLoopRun(
             states[: taken + 1], controls[:taken] / self.control_scale, outside[:taken]

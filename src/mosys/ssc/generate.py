@@ -80,6 +80,7 @@ def build_problem(spec: ControllerSpec, dynamics: ModuleType) -> Problem:
                 control.token, f"an actuator of figure '{spec.figure}' (one of {choices})"
             )
         control_slot.append(actuators.index(control.name))
+    check_policy(spec, dynamics)
     samples = np.array(
         list(itertools.product(*(control.values() for control in spec.controls))),
         dtype=np.float64,
@@ -127,6 +128,27 @@ def build_problem(spec: ControllerSpec, dynamics: ModuleType) -> Problem:
         obstacles=obstacles,
         node_valid=node_valid,
     )
+
+
+def check_policy(spec: ControllerSpec, dynamics: ModuleType) -> None:
+    """SpecError at the ``policy`` line when ``lookahead`` cannot run the figure: it steers and
+    brakes a vehicle, and brakes no harder than the ``wheel_accel`` samples reach."""
+    if spec.policy is None or spec.policy.kind != "lookahead":
+        return
+    if getattr(dynamics, "MODEL_KIND", "figure") != "vehicle":
+        raise spec.error(
+            spec.policy.token, f"'interpolate': figure '{spec.figure}' is not a vehicle"
+        )
+    if "wheel_accel" not in (control.name for control in spec.controls):
+        raise spec.error(spec.policy.token, "a torq line for wheel_accel (lookahead brakes by it)")
+
+
+def policy_attributes(spec: ControllerSpec) -> dict:
+    """Root attrs ``policy`` (how the table runs) and, for ``lookahead``,
+    ``arrival_tolerance`` (JSON object: dest name -> tolerance, spec units)."""
+    if spec.policy is None or spec.policy.kind == "interpolate":
+        return {"policy": "interpolate"}
+    return {"policy": "lookahead", "arrival_tolerance": json.dumps(dict(spec.policy.arrival))}
 
 
 def reachable_nodes(
@@ -379,6 +401,7 @@ def generate_controller(
             "hold": spec.hold is not None,
             "mosys_version": __version__,
             **figure_attributes(problem, dynamics),
+            **policy_attributes(spec),
         },
     )
     write_controller_table(out_path, table)

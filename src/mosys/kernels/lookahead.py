@@ -1,0 +1,298 @@
+"""Closed-loop simulation of a vehicle by one-step lookahead on a controller's cost-to-go.
+
+The table's controls are the DP's best samples at the grid nodes; between nodes the paper blends
+them, and for a car's bang-bang table the blend drives neither forward nor back. This runtime
+asks the DP's own question at the vehicle's actual state instead: for every control sample, hold
+it until the state leaves the box of ±1 grid step around the state where the choice is made (the
+DP's cell), and cost that segment as the DP does (its seconds plus the interpolated cost-to-go
+where it leaves). It takes the cheapest sample and holds it to that exit, as the DP's transition
+assumes, then chooses again. A segment is admissible only if no step of it touches an obstacle or
+leaves the domain polygon, and if braking to rest from its exit, steering held, touches nothing
+either; so the vehicle can always stop. Once the point where full braking would bring the
+vehicle to rest lies in the arrival box around the destination, it brakes to rest there and
+holds.
+
+SI units throughout; grids as in ``kernels.interpolate``; obstacles as ``geometry.pose_is_free``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, types
+
+from mosys.kernels.figure_state import read_state
+from mosys.kernels.geometry import pose_is_free
+from mosys.kernels.integrate import (
+    DERIVATIVE_INTO,
+    FLAGS,
+    INDICES,
+    VECTOR,
+    rk4_scratch,
+    rk4_step,
+)
+from mosys.kernels.interpolate import (
+    clamp_to_domain,
+    grid_strides,
+    interpolate_with,
+    interpolation_scratch,
+)
+from mosys.kernels.simulate import region_membership
+
+OUTSIDE_PENALTY = 100.0  # s per grid step beyond the table's axes, added to the cost-to-go
+
+LOOKAHEAD_SIGNATURE = types.int64(
+    DERIVATIVE_INTO,  # derivative_into
+    VECTOR,  # axis_min
+    VECTOR,  # axis_step
+    INDICES,  # axis_count
+    FLAGS,  # wrap
+    types.float64[:, ::1],  # value
+    FLAGS,  # known
+    types.float64[:, ::1],  # control_samples
+    INDICES,  # control_slot
+    types.int64,  # input_size
+    INDICES,  # state_slot
+    INDICES,  # pose_slot
+    types.float64[:, ::1],  # outline
+    types.float64[:, ::1],  # obstacle_vertices
+    INDICES,  # obstacle_start
+    types.float64[:, ::1],  # domain
+    INDICES,  # vehicle_slot
+    types.float64,  # wheel_radius
+    types.float64,  # brake
+    VECTOR,  # arrival_lower
+    VECTOR,  # arrival_upper
+    types.int64,  # max_segment_steps
+    VECTOR,  # state (in/out)
+    types.float64,  # dt
+    types.float64[:, ::1],  # record_state
+    types.float64[:, ::1],  # record_control
+    FLAGS,  # record_outside
+    types.float64[:, ::1],  # region_lower
+    types.float64[:, ::1],  # region_upper
+    VECTOR,  # region_period
+)
+
+
+@njit(cache=True)
+def _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs):
+    """inputs (model's) that hold the steering and brake the wheels toward rest within one step,
+    no harder than ``brake`` (rad/s²)."""
+    for i in range(inputs.shape[0]):
+        inputs[i] = 0.0
+    wanted = -state[vehicle_slot[1]] / (wheel_radius * dt)
+    inputs[vehicle_slot[3]] = min(max(wanted, -brake), brake)
+
+
+@njit(cache=True)
+def _stops_in_box(state, vehicle_slot, pose_slot, wheel_radius, brake, state_slot, lower, upper):
+    """True when the state where full braking from ``state`` ends (the reference point moved
+    v|v| / 2a along heading + steer, at rest; heading and steer unchanged) lies in the arrival
+    box [lower, upper] ((d,) over the controller's axes, ±inf: any)."""
+    speed = state[vehicle_slot[1]]
+    distance = speed * abs(speed) / (2.0 * wheel_radius * brake)
+    direction = state[pose_slot[2]] + state[vehicle_slot[0]]
+    for k in range(state_slot.shape[0]):
+        slot = state_slot[k]
+        value = state[slot]
+        if slot == pose_slot[0]:
+            value += distance * math.cos(direction)
+        elif slot == pose_slot[1]:
+            value += distance * math.sin(direction)
+        elif slot == vehicle_slot[1]:
+            value = 0.0
+        if not lower[k] <= value <= upper[k]:
+            return False
+    return True
+
+
+@njit(cache=True)
+def _cost_to_go(
+    axis_min, axis_step, axis_count, wrap, strides, value, known, exit_state, clamped, scratch, out
+):
+    """Interpolated cost-to-go (s) at a controller state (d,); beyond the axes, the value at the
+    nearest covered state plus OUTSIDE_PENALTY per grid step outside (summed over the axes), so
+    that the way back in is the cheapest; inf where no corner's value is known."""
+    clamp_to_domain(axis_min, axis_step, axis_count, wrap, exit_state, clamped)
+    interpolate_with(
+        axis_min, axis_step, axis_count, wrap, strides, value, known, clamped, scratch, out
+    )
+    steps_outside = 0.0
+    for k in range(exit_state.shape[0]):
+        steps_outside += abs(exit_state[k] - clamped[k]) / axis_step[k]
+    return out[0] + OUTSIDE_PENALTY * steps_outside
+
+
+@njit(LOOKAHEAD_SIGNATURE, cache=True)
+def simulate_lookahead(
+    derivative_into,
+    axis_min,
+    axis_step,
+    axis_count,
+    wrap,
+    value,
+    known,
+    control_samples,
+    control_slot,
+    input_size,
+    state_slot,
+    pose_slot,
+    outline,
+    obstacle_vertices,
+    obstacle_start,
+    domain,
+    vehicle_slot,
+    wheel_radius,
+    brake,
+    arrival_lower,
+    arrival_upper,
+    max_segment_steps,
+    state,
+    dt,
+    record_state,
+    record_control,
+    record_outside,
+    region_lower,
+    region_upper,
+    region_period,
+):
+    """Simulate up to ``record_state.shape[0]`` RK4 steps of dt seconds by lookahead on the
+    cost-to-go (module docstring); return how many were taken.
+
+    value: (N, 1) cost-to-go at the grid nodes, s; known: (N,) bool, the nodes with a finite
+    value (interpolation renormalises over them, as ``interpolate_with``). control_samples:
+    (U, m) the DP's control samples, SI, driving ``control_slot`` (m,) of the model's
+    ``input_size`` inputs. state_slot: (d,) the controller's axes in the model's state.
+    pose_slot, outline, obstacle_vertices, obstacle_start, domain: the obstacles.
+    vehicle_slot: (4,) int64, the state slots of steer and speed, then the input slots of
+    steer_rate and wheel_accel; wheel_radius (m); brake: the largest wheel deceleration, rad/s².
+    arrival_lower, arrival_upper: (d,) the arrival box, SI (±inf where free).
+    max_segment_steps: a segment still in its cell after this many steps ends there.
+    state: (S,) advanced in place. Records and regions as in ``simulate.simulate_controlled``;
+    record_outside marks the steps whose state lies beyond the table's axes.
+    """
+    size = state.shape[0]
+    d = axis_min.shape[0]
+    n_samples = control_samples.shape[0]
+    inputs = np.zeros(input_size)
+    trial_inputs = np.zeros(input_size)
+    scratch = rk4_scratch(size)
+    trial = np.empty(size)
+    braking = np.empty(size)
+    origin = np.empty(d)
+    here = np.empty(d)
+    clamped = np.empty(d)
+    out = np.empty(1)
+    body = np.empty_like(outline)
+    strides = np.empty(d, np.int64)
+    grid_strides(axis_count, strides)
+    interpolation = interpolation_scratch(d)
+    regions = region_lower.shape[0]
+    start_membership = np.empty(regions, np.bool_)
+    membership = np.empty(regions, np.bool_)
+    region_membership(state, region_lower, region_upper, region_period, start_membership)
+    held_until = 0  # the step at which the held sample's segment ends
+    arrived = False
+    for step in range(record_state.shape[0]):
+        region_membership(state, region_lower, region_upper, region_period, membership)
+        for k in range(regions):
+            if membership[k] != start_membership[k]:
+                return step
+        for i in range(size):
+            record_state[step, i] = state[i]
+        read_state(state, state_slot, here)
+        record_outside[step] = not clamp_to_domain(
+            axis_min, axis_step, axis_count, wrap, here, clamped
+        )
+        if not arrived:
+            arrived = _stops_in_box(
+                state,
+                vehicle_slot,
+                pose_slot,
+                wheel_radius,
+                brake,
+                state_slot,
+                arrival_lower,
+                arrival_upper,
+            )
+        if arrived:
+            _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs)
+        elif step >= held_until:
+            best = np.inf
+            best_sample = -1
+            best_steps = 1
+            read_state(state, state_slot, origin)
+            for u in range(n_samples):
+                for i in range(size):
+                    trial[i] = state[i]
+                for i in range(input_size):
+                    trial_inputs[i] = 0.0
+                for j in range(control_slot.shape[0]):
+                    trial_inputs[control_slot[j]] += control_samples[u, j]
+                free = True
+                taken = 0
+                while taken < max_segment_steps:
+                    rk4_step(derivative_into, trial, trial_inputs, dt, scratch)
+                    taken += 1
+                    if not pose_is_free(
+                        trial, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
+                    ):
+                        free = False
+                        break
+                    read_state(trial, state_slot, here)
+                    left = False
+                    for k in range(d):
+                        if abs(here[k] - origin[k]) >= axis_step[k]:
+                            left = True
+                    if left:
+                        break
+                if not free:
+                    continue
+                read_state(trial, state_slot, here)
+                cost = taken * dt + _cost_to_go(
+                    axis_min,
+                    axis_step,
+                    axis_count,
+                    wrap,
+                    strides,
+                    value,
+                    known,
+                    here,
+                    clamped,
+                    interpolation,
+                    out,
+                )
+                if not cost < best:
+                    continue
+                # admissible only if the vehicle can brake to rest from the exit
+                for i in range(size):
+                    braking[i] = trial[i]
+                for _ in range(max_segment_steps):
+                    if abs(braking[vehicle_slot[1]]) < 1e-9:
+                        break
+                    _braking_inputs(braking, vehicle_slot, wheel_radius, brake, dt, trial_inputs)
+                    rk4_step(derivative_into, braking, trial_inputs, dt, scratch)
+                    if not pose_is_free(
+                        braking, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
+                    ):
+                        free = False
+                        break
+                if free:
+                    best = cost
+                    best_sample = u
+                    best_steps = taken
+            if best_sample < 0:  # nothing admissible: brake, and choose again next step
+                _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs)
+                held_until = step + 1
+            else:
+                for i in range(input_size):
+                    inputs[i] = 0.0
+                for j in range(control_slot.shape[0]):
+                    inputs[control_slot[j]] += control_samples[best_sample, j]
+                held_until = step + best_steps
+        for j in range(control_slot.shape[0]):
+            record_control[step, j] = inputs[control_slot[j]]
+        rk4_step(derivative_into, state, inputs, dt, scratch)
+    return record_state.shape[0]

@@ -1,0 +1,101 @@
+"""The lookahead runtime of a vehicle's controller table (``policy lookahead`` in its spec): the
+arrays ``kernels.lookahead.simulate_lookahead`` needs, read from the table's attributes."""
+
+from __future__ import annotations
+
+import itertools
+import json
+from dataclasses import dataclass
+from types import ModuleType
+
+import numpy as np
+
+from mosys.io.controller_table import ControllerTable
+from mosys.kernels.geometry import pack_polygons
+from mosys.ssc.grid import FigureGrid, control_scale, figure_state_names
+
+MAX_SEGMENT_SECONDS = 2.0  # a held sample still in its cell after this long is chosen again
+VEHICLE_STATES = ("steer", "speed")
+VEHICLE_INPUTS = ("steer_rate", "wheel_accel")
+
+
+@dataclass(frozen=True)
+class Lookahead:
+    """Everything the lookahead kernel takes besides the grid and the state, SI.
+
+    value: (N, 1) cost-to-go, s; known: (N,) finite values; control_samples: (U, m) every
+    combination of the table's control samples; pose_slot, outline, obstacle_vertices,
+    obstacle_start, domain: the obstacles (``geometry.pose_is_free``); vehicle_slot: (4,) the
+    state slots of steer and speed, the input slots of steer_rate and wheel_accel;
+    wheel_radius, m; brake: the largest wheel deceleration, rad/s²; arrival_lower,
+    arrival_upper: (d,) the box around the destination where the vehicle brakes and holds.
+    """
+
+    value: np.ndarray
+    known: np.ndarray
+    control_samples: np.ndarray
+    pose_slot: np.ndarray
+    outline: np.ndarray
+    obstacle_vertices: np.ndarray
+    obstacle_start: np.ndarray
+    domain: np.ndarray
+    vehicle_slot: np.ndarray
+    wheel_radius: float
+    brake: float
+    arrival_lower: np.ndarray
+    arrival_upper: np.ndarray
+
+
+def lookahead_runtime(table: ControllerTable, dynamics: ModuleType, grid: FigureGrid) -> Lookahead:
+    """The lookahead arrays of a table whose attrs say ``policy`` = ``lookahead``."""
+    attrs = table.attrs
+    names = figure_state_names(dynamics)
+    inputs = tuple(dynamics.INPUT_NAMES)
+    counts = np.atleast_1d(np.asarray(attrs["control_samples"], dtype=np.int64))
+    axes = [
+        np.linspace(low, high, int(n))
+        for low, high, n in zip(table.control_min, table.control_max, counts, strict=True)
+    ]
+    scale = np.array([control_scale(dynamics, n) for n in table.control_names])
+    samples = np.array(list(itertools.product(*axes)), dtype=np.float64) * scale
+    vertices, start = pack_polygons(
+        [np.array(p, dtype=np.float64) for p in json.loads(attrs.get("obstacles", "[]"))]
+    )
+    pose_slot = np.array([names.index(n) for n in ("x", "y", "heading")], dtype=np.int64)
+    if "body_outline" not in attrs:
+        pose_slot[:] = -1  # no obstacles and no domain polygon: every pose is free
+    brake_control = table.control_names.index("wheel_accel")
+    tolerance = json.loads(attrs["arrival_tolerance"])
+    lower = np.full(len(grid.names), -np.inf)
+    upper = np.full(len(grid.names), np.inf)
+    for k, name in enumerate(grid.names):
+        if name in tolerance:
+            centre = table.dest[name] * grid.scale[k]
+            lower[k] = centre - tolerance[name] * grid.scale[k]
+            upper[k] = centre + tolerance[name] * grid.scale[k]
+    value = table.value.reshape(-1)
+    return Lookahead(
+        value=np.ascontiguousarray(value[:, None]),
+        known=np.ascontiguousarray(np.isfinite(value)),
+        control_samples=np.ascontiguousarray(samples),
+        pose_slot=pose_slot,
+        outline=np.ascontiguousarray(
+            json.loads(attrs.get("body_outline", "[[0, 0]]")), dtype=np.float64
+        ),
+        obstacle_vertices=vertices,
+        obstacle_start=start,
+        domain=np.ascontiguousarray(
+            json.loads(attrs.get("domain", "[]")), dtype=np.float64
+        ).reshape(-1, 2),
+        vehicle_slot=np.array(
+            [names.index(n) for n in VEHICLE_STATES] + [inputs.index(n) for n in VEHICLE_INPUTS],
+            dtype=np.int64,
+        ),
+        wheel_radius=float(dynamics.WHEEL_RADIUS),
+        brake=float(
+            min(abs(table.control_min[brake_control]), abs(table.control_max[brake_control]))
+            * scale[brake_control]
+        ),
+        arrival_lower=lower,
+        arrival_upper=upper,
+    )
