@@ -49,6 +49,17 @@ def double_integrator(tmp_path_factory):
 
 
 @pytest.fixture(scope="session")
+def car(tmp_path_factory):
+    """The car's dynamics, compiled from specs/figures/car.fig."""
+    from mosys.dynamics.compile import compile_figure
+    from mosys.dynamics.load import load_dynamics
+
+    path = tmp_path_factory.mktemp("dynamics") / "car.py"
+    compile_figure(SPECS / "figures" / "car.fig", path)
+    return load_dynamics(path)
+
+
+@pytest.fixture(scope="session")
 def link1(tmp_path_factory):
     """The pendulum's dynamics, compiled from specs/figures/link1.fig."""
     from mosys.dynamics.compile import compile_figure

@@ -7,12 +7,9 @@ import math
 
 import numpy as np
 import pytest
-from conftest import SPECS
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from mosys.dynamics.compile import compile_figure
-from mosys.dynamics.load import load_dynamics
 from mosys.kernels.geometry import (
     first_collision,
     pack_polygons,
@@ -31,14 +28,6 @@ CAR_LINE = (
     "vehicle wheelbase=2.5 length=4.0 width=1.7 front_overhang=0.8 wheel_radius=0.3 "
     "steer_limit=35\n"
 )
-
-
-@pytest.fixture(scope="session")
-def car(tmp_path_factory):
-    """The car's dynamics, compiled from specs/figures/car.fig."""
-    path = tmp_path_factory.mktemp("dynamics") / "car.py"
-    compile_figure(SPECS / "figures" / "car.fig", path)
-    return load_dynamics(path)
 
 
 # --- figure spec

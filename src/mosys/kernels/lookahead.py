@@ -60,6 +60,7 @@ LOOKAHEAD_SIGNATURE = types.int64(
     INDICES,  # obstacle_start
     types.float64[:, ::1],  # domain
     INDICES,  # vehicle_slot
+    types.float64,  # wheelbase
     types.float64,  # wheel_radius
     types.float64,  # brake
     VECTOR,  # arrival_lower
@@ -87,13 +88,18 @@ def _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs):
 
 
 @njit(cache=True)
-def _stops_in_box(state, vehicle_slot, pose_slot, wheel_radius, brake, state_slot, lower, upper):
-    """True when the state where full braking from ``state`` ends (the reference point moved
-    v|v| / 2a along heading + steer, at rest; heading and steer unchanged) lies in the arrival
-    box [lower, upper] ((d,) over the controller's axes, ±inf: any)."""
+def _stops_in_box(
+    state, vehicle_slot, pose_slot, wheelbase, wheel_radius, brake, state_slot, lower, upper
+):
+    """True when the state where full braking from ``state`` ends lies in the arrival box
+    [lower, upper] ((d,) over the controller's axes, ±inf: any). Braking, steering held, the
+    front wheels roll s = v|v| / 2a: the heading turns by s sin(steer) / wheelbase and the
+    reference point moves s along the mean of the start and end heading, plus steer."""
     speed = state[vehicle_slot[1]]
+    steer = state[vehicle_slot[0]]
     distance = speed * abs(speed) / (2.0 * wheel_radius * brake)
-    direction = state[pose_slot[2]] + state[vehicle_slot[0]]
+    turn = distance * math.sin(steer) / wheelbase
+    direction = state[pose_slot[2]] + 0.5 * turn + steer
     for k in range(state_slot.shape[0]):
         slot = state_slot[k]
         value = state[slot]
@@ -101,6 +107,8 @@ def _stops_in_box(state, vehicle_slot, pose_slot, wheel_radius, brake, state_slo
             value += distance * math.cos(direction)
         elif slot == pose_slot[1]:
             value += distance * math.sin(direction)
+        elif slot == pose_slot[2]:
+            value += turn
         elif slot == vehicle_slot[1]:
             value = 0.0
         if not lower[k] <= value <= upper[k]:
@@ -125,6 +133,201 @@ def _cost_to_go(
     return out[0] + OUTSIDE_PENALTY * steps_outside
 
 
+@njit(cache=True)
+def _segment(
+    derivative_into,
+    start,
+    inputs,
+    axis_step,
+    state_slot,
+    pose_slot,
+    outline,
+    obstacle_vertices,
+    obstacle_start,
+    domain,
+    max_steps,
+    dt,
+    end,
+    origin,
+    here,
+    scratch,
+    body,
+):
+    """Hold the model's ``inputs`` from ``start`` (S,) until the controller state lies one grid
+    step from where it began on some axis, or for max_steps; the last state goes to ``end``.
+    Returns the steps taken, or -1 when some step is not free (obstacle or domain polygon).
+    origin, here: (d,) work arrays; scratch: ``rk4_scratch(S)``; body: like outline."""
+    for i in range(start.shape[0]):
+        end[i] = start[i]
+    read_state(start, state_slot, origin)
+    taken = 0
+    while taken < max_steps:
+        rk4_step(derivative_into, end, inputs, dt, scratch)
+        taken += 1
+        if not pose_is_free(
+            end, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
+        ):
+            return -1
+        read_state(end, state_slot, here)
+        for k in range(axis_step.shape[0]):
+            if abs(here[k] - origin[k]) >= axis_step[k]:
+                return taken
+    return taken
+
+
+@njit(cache=True)
+def _can_brake(
+    derivative_into,
+    start,
+    vehicle_slot,
+    wheel_radius,
+    brake,
+    pose_slot,
+    outline,
+    obstacle_vertices,
+    obstacle_start,
+    domain,
+    max_steps,
+    dt,
+    state,
+    inputs,
+    scratch,
+    body,
+):
+    """True when braking to rest from ``start``, steering held, keeps every step free."""
+    for i in range(start.shape[0]):
+        state[i] = start[i]
+    for _ in range(max_steps):
+        if abs(state[vehicle_slot[1]]) < 1e-9:
+            return True
+        _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs)
+        rk4_step(derivative_into, state, inputs, dt, scratch)
+        if not pose_is_free(
+            state, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
+        ):
+            return False
+    return True
+
+
+@njit(cache=True)
+def _sample_inputs(control_samples, control_slot, sample, inputs):
+    """The model's inputs for control sample ``sample`` (other inputs 0)."""
+    for i in range(inputs.shape[0]):
+        inputs[i] = 0.0
+    for j in range(control_slot.shape[0]):
+        inputs[control_slot[j]] += control_samples[sample, j]
+
+
+@njit(cache=True)
+def _choose(
+    derivative_into,
+    axis_min,
+    axis_step,
+    axis_count,
+    wrap,
+    value,
+    known,
+    control_samples,
+    control_slot,
+    input_size,
+    state_slot,
+    pose_slot,
+    outline,
+    obstacle_vertices,
+    obstacle_start,
+    domain,
+    vehicle_slot,
+    wheel_radius,
+    brake,
+    max_steps,
+    dt,
+    state,
+):
+    """(sample, steps): the cheapest admissible control sample from ``state`` (its segment's
+    seconds plus the cost-to-go at its exit) and the length of its segment; (-1, 1) when none is
+    admissible."""
+    size = state.shape[0]
+    d = axis_min.shape[0]
+    n = control_samples.shape[0]
+    strides = np.empty(d, np.int64)
+    grid_strides(axis_count, strides)
+    interpolation = interpolation_scratch(d)
+    scratch = rk4_scratch(size)
+    body = np.empty_like(outline)
+    first = np.empty(size)
+    braking = np.empty(size)
+    origin = np.empty(d)
+    here = np.empty(d)
+    clamped = np.empty(d)
+    out = np.empty(1)
+    inputs = np.zeros(input_size)
+    best = np.inf
+    best_sample = -1
+    best_steps = 1
+    for u in range(n):
+        _sample_inputs(control_samples, control_slot, u, inputs)
+        taken = _segment(
+            derivative_into,
+            state,
+            inputs,
+            axis_step,
+            state_slot,
+            pose_slot,
+            outline,
+            obstacle_vertices,
+            obstacle_start,
+            domain,
+            max_steps,
+            dt,
+            first,
+            origin,
+            here,
+            scratch,
+            body,
+        )
+        if taken < 0:
+            continue
+        read_state(first, state_slot, here)
+        onward = _cost_to_go(
+            axis_min,
+            axis_step,
+            axis_count,
+            wrap,
+            strides,
+            value,
+            known,
+            here,
+            clamped,
+            interpolation,
+            out,
+        )
+        cost = taken * dt + onward
+        if not cost < best:
+            continue
+        if _can_brake(
+            derivative_into,
+            first,
+            vehicle_slot,
+            wheel_radius,
+            brake,
+            pose_slot,
+            outline,
+            obstacle_vertices,
+            obstacle_start,
+            domain,
+            max_steps,
+            dt,
+            braking,
+            inputs,
+            scratch,
+            body,
+        ):
+            best = cost
+            best_sample = u
+            best_steps = taken
+    return best_sample, best_steps
+
+
 @njit(LOOKAHEAD_SIGNATURE, cache=True)
 def simulate_lookahead(
     derivative_into,
@@ -144,6 +347,7 @@ def simulate_lookahead(
     obstacle_start,
     domain,
     vehicle_slot,
+    wheelbase,
     wheel_radius,
     brake,
     arrival_lower,
@@ -167,32 +371,23 @@ def simulate_lookahead(
     ``input_size`` inputs. state_slot: (d,) the controller's axes in the model's state.
     pose_slot, outline, obstacle_vertices, obstacle_start, domain: the obstacles.
     vehicle_slot: (4,) int64, the state slots of steer and speed, then the input slots of
-    steer_rate and wheel_accel; wheel_radius (m); brake: the largest wheel deceleration, rad/s².
-    arrival_lower, arrival_upper: (d,) the arrival box, SI (±inf where free).
-    max_segment_steps: a segment still in its cell after this many steps ends there.
-    state: (S,) advanced in place. Records and regions as in ``simulate.simulate_controlled``;
-    record_outside marks the steps whose state lies beyond the table's axes.
+    steer_rate and wheel_accel; wheelbase and
+    wheel_radius (m); brake: the largest wheel deceleration, rad/s². arrival_lower,
+    arrival_upper: (d,) the arrival box, SI (±inf where free). max_segment_steps: a segment
+    still in its cell after this many steps ends there. state: (S,) advanced in place. Records
+    and regions as in ``simulate.simulate_controlled``; record_outside marks the steps whose
+    state lies beyond the table's axes.
     """
     size = state.shape[0]
     d = axis_min.shape[0]
-    n_samples = control_samples.shape[0]
     inputs = np.zeros(input_size)
-    trial_inputs = np.zeros(input_size)
-    scratch = rk4_scratch(size)
-    trial = np.empty(size)
-    braking = np.empty(size)
-    origin = np.empty(d)
     here = np.empty(d)
     clamped = np.empty(d)
-    out = np.empty(1)
-    body = np.empty_like(outline)
-    strides = np.empty(d, np.int64)
-    grid_strides(axis_count, strides)
-    interpolation = interpolation_scratch(d)
     regions = region_lower.shape[0]
     start_membership = np.empty(regions, np.bool_)
     membership = np.empty(regions, np.bool_)
     region_membership(state, region_lower, region_upper, region_period, start_membership)
+    scratch = rk4_scratch(size)
     held_until = 0  # the step at which the held sample's segment ends
     arrived = False
     for step in range(record_state.shape[0]):
@@ -211,6 +406,7 @@ def simulate_lookahead(
                 state,
                 vehicle_slot,
                 pose_slot,
+                wheelbase,
                 wheel_radius,
                 brake,
                 state_slot,
@@ -220,78 +416,35 @@ def simulate_lookahead(
         if arrived:
             _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs)
         elif step >= held_until:
-            best = np.inf
-            best_sample = -1
-            best_steps = 1
-            read_state(state, state_slot, origin)
-            for u in range(n_samples):
-                for i in range(size):
-                    trial[i] = state[i]
-                for i in range(input_size):
-                    trial_inputs[i] = 0.0
-                for j in range(control_slot.shape[0]):
-                    trial_inputs[control_slot[j]] += control_samples[u, j]
-                free = True
-                taken = 0
-                while taken < max_segment_steps:
-                    rk4_step(derivative_into, trial, trial_inputs, dt, scratch)
-                    taken += 1
-                    if not pose_is_free(
-                        trial, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
-                    ):
-                        free = False
-                        break
-                    read_state(trial, state_slot, here)
-                    left = False
-                    for k in range(d):
-                        if abs(here[k] - origin[k]) >= axis_step[k]:
-                            left = True
-                    if left:
-                        break
-                if not free:
-                    continue
-                read_state(trial, state_slot, here)
-                cost = taken * dt + _cost_to_go(
-                    axis_min,
-                    axis_step,
-                    axis_count,
-                    wrap,
-                    strides,
-                    value,
-                    known,
-                    here,
-                    clamped,
-                    interpolation,
-                    out,
-                )
-                if not cost < best:
-                    continue
-                # admissible only if the vehicle can brake to rest from the exit
-                for i in range(size):
-                    braking[i] = trial[i]
-                for _ in range(max_segment_steps):
-                    if abs(braking[vehicle_slot[1]]) < 1e-9:
-                        break
-                    _braking_inputs(braking, vehicle_slot, wheel_radius, brake, dt, trial_inputs)
-                    rk4_step(derivative_into, braking, trial_inputs, dt, scratch)
-                    if not pose_is_free(
-                        braking, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
-                    ):
-                        free = False
-                        break
-                if free:
-                    best = cost
-                    best_sample = u
-                    best_steps = taken
-            if best_sample < 0:  # nothing admissible: brake, and choose again next step
+            sample, steps = _choose(
+                derivative_into,
+                axis_min,
+                axis_step,
+                axis_count,
+                wrap,
+                value,
+                known,
+                control_samples,
+                control_slot,
+                input_size,
+                state_slot,
+                pose_slot,
+                outline,
+                obstacle_vertices,
+                obstacle_start,
+                domain,
+                vehicle_slot,
+                wheel_radius,
+                brake,
+                max_segment_steps,
+                dt,
+                state,
+            )
+            if sample < 0:  # nothing admissible: brake, and choose again next step
                 _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs)
-                held_until = step + 1
             else:
-                for i in range(input_size):
-                    inputs[i] = 0.0
-                for j in range(control_slot.shape[0]):
-                    inputs[control_slot[j]] += control_samples[best_sample, j]
-                held_until = step + best_steps
+                _sample_inputs(control_samples, control_slot, sample, inputs)
+            held_until = step + steps
         for j in range(control_slot.shape[0]):
             record_control[step, j] = inputs[control_slot[j]]
         rk4_step(derivative_into, state, inputs, dt, scratch)

@@ -173,6 +173,7 @@ class Controller:
                 policy.obstacle_start,
                 policy.domain,
                 policy.vehicle_slot,
+                policy.wheelbase,
                 policy.wheel_radius,
                 policy.brake,
                 policy.arrival_lower,

@@ -27,7 +27,7 @@ class Lookahead:
     combination of the table's control samples; pose_slot, outline, obstacle_vertices,
     obstacle_start, domain: the obstacles (``geometry.pose_is_free``); vehicle_slot: (4,) the
     state slots of steer and speed, the input slots of steer_rate and wheel_accel;
-    wheel_radius, m; brake: the largest wheel deceleration, rad/s²; arrival_lower,
+    wheelbase and wheel_radius, m; brake: the largest wheel deceleration, rad/s²; arrival_lower,
     arrival_upper: (d,) the box around the destination where the vehicle brakes and holds.
     """
 
@@ -40,6 +40,7 @@ class Lookahead:
     obstacle_start: np.ndarray
     domain: np.ndarray
     vehicle_slot: np.ndarray
+    wheelbase: float
     wheel_radius: float
     brake: float
     arrival_lower: np.ndarray
@@ -91,6 +92,7 @@ def lookahead_runtime(table: ControllerTable, dynamics: ModuleType, grid: Figure
             [names.index(n) for n in VEHICLE_STATES] + [inputs.index(n) for n in VEHICLE_INPUTS],
             dtype=np.int64,
         ),
+        wheelbase=float(dynamics.WHEELBASE),
         wheel_radius=float(dynamics.WHEEL_RADIUS),
         brake=float(
             min(abs(table.control_min[brake_control]), abs(table.control_max[brake_control]))

@@ -1,0 +1,119 @@
+"""The lookahead runtime of a car's table (``policy lookahead``): it never drives into an
+obstacle, it holds each chosen sample to the DP cell's exit, and it brakes to rest and holds in
+the arrival box."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from test_car import SMALL
+
+from mosys.kernels.geometry import first_colliding_sample
+from mosys.parsing.controller import parse_controller_text
+from mosys.ssc.controller import Controller
+from mosys.ssc.generate import generate_controller
+
+ARRIVAL = "policy lookahead x=0.1 y=0.1 heading=4\n"
+DT = 0.01
+
+
+@pytest.fixture(scope="module")
+def small(car, tmp_path_factory):
+    """SMALL (curb, a car in front, a coarse grid) generated with the lookahead policy."""
+    path = tmp_path_factory.mktemp("lookahead") / "small.h5"
+    spec = parse_controller_text(SMALL + ARRIVAL, "small.ssc")
+    table = generate_controller(spec, car, path, quiet=True)
+    return Controller("small", table, car)
+
+
+def poses(controller, states):
+    """(N, 3) x, y (m), heading (rad) of model states (N, S)."""
+    names = controller.dynamics.STATE_NAMES
+    return np.ascontiguousarray(states[:, [names.index(n) for n in ("x", "y", "heading")]])
+
+
+def test_the_table_records_the_policy_and_its_arrival_box(small):
+    assert small.table.attrs["policy"] == "lookahead"
+    assert json.loads(small.table.attrs["arrival_tolerance"]) == {
+        "x": 0.1,
+        "y": 0.1,
+        "heading": 4.0,
+    }
+    policy = small.lookahead
+    assert policy is not None
+    assert policy.control_samples.shape == (9, 2)  # torq 3 x 3 samples
+    # the brake is the smaller wheel_accel limit, rad/s²
+    assert policy.brake == pytest.approx(np.radians(200.0))
+    heading = small.grid.names.index("heading")
+    assert policy.arrival_upper[heading] == pytest.approx(np.radians(4.0))
+    assert np.isinf(policy.arrival_upper[small.grid.names.index("steer")])
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_it_never_touches_an_obstacle_or_leaves_the_domain(small, seed):
+    """Random free starts at rest or rolling: every step of the run is free, because a sample is
+    taken only if the vehicle can brake to rest from its segment's exit."""
+    rng = np.random.default_rng(seed)
+    obstacles = small.lookahead
+    while True:
+        start = np.array(
+            [
+                rng.uniform(-2.5, 2.5),
+                rng.uniform(1.0, 2.4),
+                rng.uniform(-20, 20),
+                rng.uniform(-30, 30),
+                rng.uniform(-0.8, 0.8),
+            ]
+        )
+        state = small.figure_state(start)
+        collision, _ = first_colliding_sample(
+            poses(small, state[None, :]),
+            obstacles.outline,
+            obstacles.obstacle_vertices,
+            obstacles.obstacle_start,
+        )
+        if collision < 0 and _in_domain(state, small):
+            break
+    run = small.simulate(state, 8.0, DT)
+    sample, _ = first_colliding_sample(
+        poses(small, run.states),
+        obstacles.outline,
+        obstacles.obstacle_vertices,
+        obstacles.obstacle_start,
+    )
+    assert sample == -1
+    assert all(_in_domain(s, small) for s in run.states)
+
+
+def _in_domain(state, controller) -> bool:
+    domain = controller.lookahead.domain
+    return (
+        domain[:, 0].min() <= state[0] <= domain[:, 0].max()
+        and domain[:, 1].min() <= state[1] <= domain[:, 1].max()
+    )
+
+
+def test_controls_are_the_dp_samples_held_for_whole_segments(small):
+    run = small.simulate(small.figure_state(np.array([1.5, 2.0, 0.0, 0.0, 0.0])), 4.0, DT)
+    samples = small.lookahead.control_samples / small.control_scale
+    moving = run.controls[: np.argmax(np.all(run.controls == 0.0, axis=1)) or None]
+    for control in moving:
+        assert np.any(np.all(np.isclose(samples, control), axis=1)) or control[0] == 0.0
+    changes = np.flatnonzero(np.any(np.diff(run.controls, axis=0) != 0.0, axis=1))
+    assert changes.size > 0
+    assert np.min(np.diff(changes)) >= 2  # held for more than one step between choices
+
+
+def test_in_the_arrival_box_it_brakes_to_rest_and_holds(small):
+    """Rolling back at 0.2 m/s 5 cm in front of the destination: full braking stops it 2 cm
+    further on, inside the box, so it brakes at once and stays, steering held."""
+    start = np.array([0.05, 1.0, 1.0, 10.0, -0.2])
+    run = small.simulate(small.figure_state(start), 3.0, DT)
+    states = small.controller_states(run.states)
+    speed = states[:, small.grid.names.index("speed")]
+    assert np.all(np.diff(np.abs(speed)) <= 1e-12)  # only ever slows
+    assert speed[-1] == 0.0
+    assert np.all(states[:, small.grid.names.index("steer")] == pytest.approx(10.0))
+    assert abs(states[-1, 0]) < 0.1 and abs(states[-1, 1] - 1.0) < 0.1
