@@ -191,7 +191,7 @@ ERRORS = [
     (
         replace_line(2, "ssdd omega -500.0 500.0 21"),
         "x.ssc:2:1: expected one of 'dyn', 'ssd', 'torq', 'dest', 'tol', 'maxiter', 'dt', "
-        "'obstacle', 'domain', 'hold', found 'ssdd'",
+        "'obstacle', 'domain', 'hold', 'policy', found 'ssdd'",
     ),
     (
         replace_line(2, "ssd omega -500.0 500.0"),

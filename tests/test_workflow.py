@@ -3,6 +3,7 @@ one spec rebuilds exactly what depends on it."""
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import shutil
@@ -12,6 +13,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+import h5py
 import numpy as np
 import pytest
 
@@ -150,6 +152,31 @@ def test_broken_spec_fails_with_its_location_and_leaves_no_output(workflow):
 
 
 CAR_SCRIPTS = [f"park_{k}" for k in range(1, 7)]
+
+
+def test_the_car_parks_from_every_figure_19_start(workflow):
+    """Issue 4's targets: every Figure 19 case parks (within 0.15 m and 5 deg, at rest, no
+    collision at any instant) within 20 s, and some case backs up past the destination and
+    then pulls forward into it."""
+    snakemake(workflow, "results/car_all")
+    backed_past = []
+    for script in CAR_SCRIPTS:
+        with h5py.File(workflow / f"results/trajectories/{script}.h5") as h5:
+            attrs = dict(h5.attrs)
+            order = [str(name) for name in attrs["state_order"]]
+            state = h5["state"][:]
+        assert attrs["parked"], script
+        assert attrs["collision_index"] == -1, script
+        assert attrs["parking_seconds"] <= 20.0, script
+        destination = json.loads(attrs["destination"])
+        x, y = state[:, order.index("x")], state[:, order.index("y")]
+        assert np.hypot(x[-1] - destination["x"], y[-1] - destination["y"]) <= 0.15
+        assert abs(state[-1, order.index("heading")] - destination["heading"]) <= 5.0
+        assert state[-1, order.index("speed")] == 0.0
+        deepest = int(np.argmin(x))
+        if x[deepest] < destination["x"] - 0.5 and x[-1] > x[deepest] + 0.5:
+            backed_past.append(script)
+    assert backed_past
 
 
 def test_editing_an_obstacle_rebuilds_the_car_and_nothing_else(workflow):
