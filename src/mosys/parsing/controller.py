@@ -23,7 +23,7 @@ n-linear interpolation of the controls) or, for a vehicle, ``lookahead`` (``kern
 with the arrival tolerance of some ``dest`` dimensions, where the vehicle brakes and holds.
 
 Values are in spec units: degrees for angles, deg/s for angular rates, metres and m/s otherwise
-(the figure says which). The full grammar is in ``docs/controller-spec.md``.
+(the figure says which). The full grammar is in the README, "Controller spec (``.ssc``)".
 """
 
 from __future__ import annotations
