@@ -117,3 +117,13 @@ def test_in_the_arrival_box_it_brakes_to_rest_and_holds(small):
     assert speed[-1] == 0.0
     assert np.all(states[:, small.grid.names.index("steer")] == pytest.approx(10.0))
     assert abs(states[-1, 0]) < 0.1 and abs(states[-1, 1] - 1.0) < 0.1
+
+
+def test_its_choices_do_not_depend_on_the_simulator_step(small):
+    """Segments are simulated with the DP's step, so runs at 0.01 s and 0.0025 s make the same
+    choices at the same times and end in the same place (to RK4 accuracy)."""
+    start = small.figure_state(np.array([1.5, 2.0, 5.0, 0.0, 0.0]))
+    coarse = small.simulate(start, 4.0, 0.01)
+    fine = small.simulate(start, 4.0, 0.0025)
+    np.testing.assert_allclose(fine.controls[::4], coarse.controls)
+    np.testing.assert_allclose(fine.states[-1], coarse.states[-1], atol=1e-6)

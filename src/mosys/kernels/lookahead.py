@@ -66,6 +66,7 @@ LOOKAHEAD_SIGNATURE = types.int64(
     VECTOR,  # arrival_lower
     VECTOR,  # arrival_upper
     types.int64,  # max_segment_steps
+    types.float64,  # segment_dt
     VECTOR,  # state (in/out)
     types.float64,  # dt
     types.float64[:, ::1],  # record_state
@@ -353,6 +354,7 @@ def simulate_lookahead(
     arrival_lower,
     arrival_upper,
     max_segment_steps,
+    segment_dt,
     state,
     dt,
     record_state,
@@ -373,8 +375,10 @@ def simulate_lookahead(
     vehicle_slot: (4,) int64, the state slots of steer and speed, then the input slots of
     steer_rate and wheel_accel; wheelbase and
     wheel_radius (m); brake: the largest wheel deceleration, rad/s². arrival_lower,
-    arrival_upper: (d,) the arrival box, SI (±inf where free). max_segment_steps: a segment
-    still in its cell after this many steps ends there. state: (S,) advanced in place. Records
+    arrival_upper: (d,) the arrival box, SI (±inf where free). Segments are simulated with
+    RK4 steps of segment_dt seconds (the DP's, so that the choices do not depend on dt), at most
+    max_segment_steps of them; the chosen sample is then held for the segment's duration in
+    steps of dt. state: (S,) advanced in place. Records
     and regions as in ``simulate.simulate_controlled``; record_outside marks the steps whose
     state lies beyond the table's axes.
     """
@@ -437,14 +441,14 @@ def simulate_lookahead(
                 wheel_radius,
                 brake,
                 max_segment_steps,
-                dt,
+                segment_dt,
                 state,
             )
             if sample < 0:  # nothing admissible: brake, and choose again next step
                 _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs)
             else:
                 _sample_inputs(control_samples, control_slot, sample, inputs)
-            held_until = step + steps
+            held_until = step + max(1, round(steps * segment_dt / dt))
         for j in range(control_slot.shape[0]):
             record_control[step, j] = inputs[control_slot[j]]
         rk4_step(derivative_into, state, inputs, dt, scratch)

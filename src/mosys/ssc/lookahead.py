@@ -28,7 +28,8 @@ class Lookahead:
     obstacle_start, domain: the obstacles (``geometry.pose_is_free``); vehicle_slot: (4,) the
     state slots of steer and speed, the input slots of steer_rate and wheel_accel;
     wheelbase and wheel_radius, m; brake: the largest wheel deceleration, rad/s²; arrival_lower,
-    arrival_upper: (d,) the box around the destination where the vehicle brakes and holds.
+    arrival_upper: (d,) the box around the destination where the vehicle brakes and holds;
+    segment_dt: the RK4 step of the lookahead's segments, s (the DP's ``dt``).
     """
 
     value: np.ndarray
@@ -45,6 +46,7 @@ class Lookahead:
     brake: float
     arrival_lower: np.ndarray
     arrival_upper: np.ndarray
+    segment_dt: float
 
 
 def lookahead_runtime(table: ControllerTable, dynamics: ModuleType, grid: FigureGrid) -> Lookahead:
@@ -100,4 +102,5 @@ def lookahead_runtime(table: ControllerTable, dynamics: ModuleType, grid: Figure
         ),
         arrival_lower=lower,
         arrival_upper=upper,
+        segment_dt=float(attrs["dt"]),
     )
