@@ -412,23 +412,33 @@ class _Parser:
 
     def destination(self, line: Line) -> tuple[Destination, ...]:
         dimensions = {dimension.name: dimension for dimension in self.state}
-        choices = ", ".join(f"'{name}'" for name in dimensions)
         entries: list[Destination] = []
-        seen: set[str] = set()
-        for token in line.tokens[1:]:
-            name, sep, _ = token.text.partition("=")
-            if not sep:
-                raise self.error(token, "a 'name=value' destination", token.text)
-            if name not in dimensions:
-                raise self.error(token, f"an ssd name (one of {choices}) before '='", name)
-            if name in seen:
-                raise self.error(token, f"'{name}=' only once", token.text)
-            seen.add(name)
-            part = value_token(token, name)
+        for name, part, token in self.named_pairs(
+            line.tokens[1:], tuple(dimensions), "a 'name=value' destination", "an ssd name"
+        ):
             value = parse_number(part, self.path, f"dest {name}")
             index = self.node_index(dimensions[name], value, part)
             entries.append(Destination(name, value, index, token))
         return tuple(entries)
+
+    def named_pairs(
+        self, tokens: Sequence[Token], names: tuple[str, ...], pair: str, kind: str
+    ) -> list[tuple[str, Token, Token]]:
+        """(name, value part, whole token) of ``name=value`` tokens, each name one of ``names``
+        and at most once; ``pair`` and ``kind`` word the errors ("a 'name=value' destination",
+        "an ssd name")."""
+        choices = ", ".join(f"'{name}'" for name in names)
+        pairs: list[tuple[str, Token, Token]] = []
+        for token in tokens:
+            name, sep, _ = token.text.partition("=")
+            if not sep:
+                raise self.error(token, pair, token.text)
+            if name not in names:
+                raise self.error(token, f"{kind} (one of {choices}) before '='", name)
+            if any(name == seen for seen, _, _ in pairs):
+                raise self.error(token, f"'{name}=' only once", token.text)
+            pairs.append((name, value_token(token, name), token))
+        return pairs
 
     def node_index(self, dimension: StateDimension, value: float, token: Token) -> int:
         """The node ``value`` lies on, within GRID_TOLERANCE * step (wrapped first if periodic)."""
@@ -527,18 +537,13 @@ class _Parser:
             raise self.error(
                 line.tokens[2], "the end of the line after 'interpolate'", line.tokens[2].text
             )
-        named = [entry.name for entry in destination]
-        choices = ", ".join(f"'{name}'" for name in named)
         arrival: list[tuple[str, float]] = []
-        for token in line.tokens[2:]:
-            name, sep, _ = token.text.partition("=")
-            if not sep:
-                raise self.error(token, "a 'name=tolerance' arrival tolerance", token.text)
-            if name not in named:
-                raise self.error(token, f"a dest name (one of {choices}) before '='", name)
-            if name in dict(arrival):
-                raise self.error(token, f"'{name}=' only once", token.text)
-            part = value_token(token, name)
+        for name, part, _ in self.named_pairs(
+            line.tokens[2:],
+            tuple(entry.name for entry in destination),
+            "a 'name=tolerance' arrival tolerance",
+            "a dest name",
+        ):
             tolerance = parse_number(part, self.path, f"arrival tolerance of {name}")
             if not tolerance > 0:
                 raise self.error(part, f"a number > 0 for the tolerance of {name}", part.text)
