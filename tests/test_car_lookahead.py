@@ -12,8 +12,9 @@ from test_car import SMALL
 
 from mosys.kernels.geometry import first_colliding_sample
 from mosys.parsing.controller import parse_controller_text
+from mosys.parsing.tokens import SpecError
 from mosys.ssc.controller import Controller
-from mosys.ssc.generate import generate_controller
+from mosys.ssc.generate import build_problem, generate_controller
 
 ARRIVAL = "policy lookahead x=0.1 y=0.1 heading=4\n"
 DT = 0.01
@@ -47,8 +48,8 @@ def test_the_table_records_the_policy_and_its_arrival_box(small):
     # the brake is the smaller wheel_accel limit, rad/s²
     assert policy.brake == pytest.approx(np.radians(200.0))
     heading = small.grid.names.index("heading")
-    assert policy.arrival_upper[heading] == pytest.approx(np.radians(4.0))
-    assert np.isinf(policy.arrival_upper[small.grid.names.index("steer")])
+    assert policy.arrival_box[1, heading] == pytest.approx(np.radians(4.0))
+    assert np.isinf(policy.arrival_box[1, small.grid.names.index("steer")])
 
 
 @pytest.mark.parametrize("seed", range(12))
@@ -127,3 +128,31 @@ def test_its_choices_do_not_depend_on_the_simulator_step(small):
     fine = small.simulate(start, 4.0, 0.0025)
     np.testing.assert_allclose(fine.controls[::4], coarse.controls)
     np.testing.assert_allclose(fine.states[-1], coarse.states[-1], atol=1e-6)
+
+
+def test_lookahead_needs_a_wheel_accel_that_brakes(car):
+    spec = parse_controller_text(
+        SMALL.replace("torq wheel_accel -200 200 3 0", "torq wheel_accel 0 200 3 0") + ARRIVAL,
+        "x.ssc",
+    )
+    with pytest.raises(SpecError) as error:
+        build_problem(spec, car)
+    assert str(error.value) == (
+        "x.ssc:15:8: expected a wheel_accel range from below 0 to above 0 (line 8): lookahead "
+        "brakes by it, found 'lookahead'"
+    )
+
+
+def test_a_car_without_obstacles_parks_in_the_open(car, tmp_path):
+    """No obstacle or domain lines: every pose is free, and the arrival box still stops it."""
+    text = "\n".join(
+        line for line in SMALL.splitlines() if not line.startswith(("obstacle", "domain"))
+    )
+    spec = parse_controller_text(text + "\n" + ARRIVAL, "open.ssc")
+    table = generate_controller(spec, car, tmp_path / "open.h5", quiet=True)
+    controller = Controller("open", table, car)
+    assert np.all(controller.lookahead.pose_slot == -1)
+    run = controller.simulate(controller.figure_state(np.array([0.02, 1.0, 0, 0, 0.2])), 2.0, DT)
+    final = controller.controller_states(run.states)[-1]
+    assert final[4] == pytest.approx(0.0, abs=1e-9)
+    assert abs(final[0]) <= 0.1 and abs(final[1] - 1.0) <= 0.1

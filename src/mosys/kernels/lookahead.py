@@ -63,8 +63,7 @@ LOOKAHEAD_SIGNATURE = types.int64(
     types.float64,  # wheelbase
     types.float64,  # wheel_radius
     types.float64,  # brake
-    VECTOR,  # arrival_lower
-    VECTOR,  # arrival_upper
+    types.float64[:, ::1],  # arrival_box
     types.int64,  # max_segment_steps
     types.float64,  # segment_dt
     VECTOR,  # state (in/out)
@@ -84,35 +83,37 @@ def _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs):
     no harder than ``brake`` (rad/s²)."""
     for i in range(inputs.shape[0]):
         inputs[i] = 0.0
-    wanted = -state[vehicle_slot[1]] / (wheel_radius * dt)
-    inputs[vehicle_slot[3]] = min(max(wanted, -brake), brake)
+    wanted = -state[vehicle_slot[4]] / (wheel_radius * dt)
+    inputs[vehicle_slot[6]] = min(max(wanted, -brake), brake)
 
 
 @njit(cache=True)
-def _stops_in_box(
-    state, vehicle_slot, pose_slot, wheelbase, wheel_radius, brake, state_slot, lower, upper
-):
+def _stops_in_box(state, vehicle_slot, wheelbase, wheel_radius, brake, state_slot, box):
     """True when the state where full braking from ``state`` ends lies in the arrival box
-    [lower, upper] ((d,) over the controller's axes, ±inf: any). Braking, steering held, the
-    front wheels roll s = v|v| / 2a: the heading turns by s sin(steer) / wheelbase and the
-    reference point moves s along the mean of the start and end heading, plus steer."""
-    speed = state[vehicle_slot[1]]
-    steer = state[vehicle_slot[0]]
+    (``box`` (3, d): lower, upper and period over the controller's axes; ±inf: any; period > 0:
+    an angle compared modulo it). Braking, steering held, the front wheels roll s = v|v| / 2a:
+    the heading turns by s sin(steer) / wheelbase and the reference point moves s along the
+    mean of the start and end heading, plus steer."""
+    speed = state[vehicle_slot[4]]
+    steer = state[vehicle_slot[3]]
     distance = speed * abs(speed) / (2.0 * wheel_radius * brake)
     turn = distance * math.sin(steer) / wheelbase
-    direction = state[pose_slot[2]] + 0.5 * turn + steer
+    direction = state[vehicle_slot[2]] + 0.5 * turn + steer
     for k in range(state_slot.shape[0]):
         slot = state_slot[k]
         value = state[slot]
-        if slot == pose_slot[0]:
+        if slot == vehicle_slot[0]:
             value += distance * math.cos(direction)
-        elif slot == pose_slot[1]:
-            value += distance * math.sin(direction)
-        elif slot == pose_slot[2]:
-            value += turn
         elif slot == vehicle_slot[1]:
+            value += distance * math.sin(direction)
+        elif slot == vehicle_slot[2]:
+            value += turn
+        elif slot == vehicle_slot[4]:
             value = 0.0
-        if not lower[k] <= value <= upper[k]:
+        lower = box[0, k]
+        if box[2, k] > 0.0 and math.isfinite(lower):
+            value = lower + (value - lower) % box[2, k]
+        if not lower <= value <= box[1, k]:
             return False
     return True
 
@@ -199,7 +200,7 @@ def _can_brake(
     for i in range(start.shape[0]):
         state[i] = start[i]
     for _ in range(max_steps):
-        if abs(state[vehicle_slot[1]]) < 1e-9:
+        if abs(state[vehicle_slot[4]]) < 1e-9:
             return True
         _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs)
         rk4_step(derivative_into, state, inputs, dt, scratch)
@@ -351,8 +352,7 @@ def simulate_lookahead(
     wheelbase,
     wheel_radius,
     brake,
-    arrival_lower,
-    arrival_upper,
+    arrival_box,
     max_segment_steps,
     segment_dt,
     state,
@@ -372,15 +372,15 @@ def simulate_lookahead(
     (U, m) the DP's control samples, SI, driving ``control_slot`` (m,) of the model's
     ``input_size`` inputs. state_slot: (d,) the controller's axes in the model's state.
     pose_slot, outline, obstacle_vertices, obstacle_start, domain: the obstacles.
-    vehicle_slot: (4,) int64, the state slots of steer and speed, then the input slots of
-    steer_rate and wheel_accel; wheelbase and
-    wheel_radius (m); brake: the largest wheel deceleration, rad/s². arrival_lower,
-    arrival_upper: (d,) the arrival box, SI (±inf where free). Segments are simulated with
-    RK4 steps of segment_dt seconds (the DP's, so that the choices do not depend on dt), at most
+    vehicle_slot: (7,) int64, the state slots of x, y, heading, steer and speed, then the
+    input slots of steer_rate and wheel_accel; wheelbase and wheel_radius (m); brake: the
+    largest wheel deceleration, rad/s². arrival_box: (3, d) lower, upper (SI, ±inf where free)
+    and period (> 0: an angle) of the arrival box. Segments are simulated with RK4 steps of
+    segment_dt seconds (the DP's, so that the choices do not depend on dt), at most
     max_segment_steps of them; the chosen sample is then held for the segment's duration in
-    steps of dt. state: (S,) advanced in place. Records
-    and regions as in ``simulate.simulate_controlled``; record_outside marks the steps whose
-    state lies beyond the table's axes.
+    steps of dt. state: (S,) advanced in place. Records and regions as in
+    ``simulate.simulate_controlled``; record_outside marks the steps whose state lies beyond the
+    table's axes.
     """
     size = state.shape[0]
     d = axis_min.shape[0]
@@ -407,15 +407,7 @@ def simulate_lookahead(
         )
         if not arrived:
             arrived = _stops_in_box(
-                state,
-                vehicle_slot,
-                pose_slot,
-                wheelbase,
-                wheel_radius,
-                brake,
-                state_slot,
-                arrival_lower,
-                arrival_upper,
+                state, vehicle_slot, wheelbase, wheel_radius, brake, state_slot, arrival_box
             )
         if arrived:
             _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs)

@@ -139,8 +139,15 @@ def check_policy(spec: ControllerSpec, dynamics: ModuleType) -> None:
         raise spec.error(
             spec.policy.token, f"'interpolate': figure '{spec.figure}' is not a vehicle"
         )
-    if "wheel_accel" not in (control.name for control in spec.controls):
+    accel = [control for control in spec.controls if control.name == "wheel_accel"]
+    if not accel:
         raise spec.error(spec.policy.token, "a torq line for wheel_accel (lookahead brakes by it)")
+    if not accel[0].minimum < 0.0 < accel[0].maximum:
+        raise spec.error(
+            spec.policy.token,
+            f"a wheel_accel range from below 0 to above 0 (line {accel[0].token.line}): "
+            "lookahead brakes by it",
+        )
 
 
 def policy_attributes(spec: ControllerSpec) -> dict:

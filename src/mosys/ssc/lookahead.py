@@ -15,7 +15,7 @@ from mosys.kernels.geometry import pack_polygons
 from mosys.ssc.grid import FigureGrid, control_scale, figure_state_names
 
 MAX_SEGMENT_SECONDS = 2.0  # a held sample still in its cell after this long is chosen again
-VEHICLE_STATES = ("steer", "speed")
+VEHICLE_STATES = ("x", "y", "heading", "steer", "speed")
 VEHICLE_INPUTS = ("steer_rate", "wheel_accel")
 
 
@@ -25,11 +25,12 @@ class Lookahead:
 
     value: (N, 1) cost-to-go, s; known: (N,) finite values; control_samples: (U, m) every
     combination of the table's control samples; pose_slot, outline, obstacle_vertices,
-    obstacle_start, domain: the obstacles (``geometry.pose_is_free``); vehicle_slot: (4,) the
-    state slots of steer and speed, the input slots of steer_rate and wheel_accel;
-    wheelbase and wheel_radius, m; brake: the largest wheel deceleration, rad/s²; arrival_lower,
-    arrival_upper: (d,) the box around the destination where the vehicle brakes and holds;
-    segment_dt: the RK4 step of the lookahead's segments, s (the DP's ``dt``).
+    obstacle_start, domain: the obstacles (``geometry.pose_is_free``; pose_slot -1: none);
+    vehicle_slot: (7,) the state slots of x, y, heading, steer and speed, the input slots of
+    steer_rate and wheel_accel; wheelbase and wheel_radius, m; brake: the largest wheel
+    deceleration, rad/s²; arrival_box: (3, d) lower, upper and period (> 0: an angle) over the
+    controller's axes, SI, of the box around the destination where the vehicle brakes and
+    holds; segment_dt: the RK4 step of the lookahead's segments, s (the DP's ``dt``).
     """
 
     value: np.ndarray
@@ -44,8 +45,7 @@ class Lookahead:
     wheelbase: float
     wheel_radius: float
     brake: float
-    arrival_lower: np.ndarray
-    arrival_upper: np.ndarray
+    arrival_box: np.ndarray
     segment_dt: float
 
 
@@ -69,13 +69,14 @@ def lookahead_runtime(table: ControllerTable, dynamics: ModuleType, grid: Figure
         pose_slot[:] = -1  # no obstacles and no domain polygon: every pose is free
     brake_control = table.control_names.index("wheel_accel")
     tolerance = json.loads(attrs["arrival_tolerance"])
-    lower = np.full(len(grid.names), -np.inf)
-    upper = np.full(len(grid.names), np.inf)
+    box = np.zeros((3, len(grid.names)))
+    box[0], box[1] = -np.inf, np.inf
+    box[2] = np.where(grid.wrap, grid.axis_count * grid.axis_step, 0.0)
     for k, name in enumerate(grid.names):
         if name in tolerance:
             centre = table.dest[name] * grid.scale[k]
-            lower[k] = centre - tolerance[name] * grid.scale[k]
-            upper[k] = centre + tolerance[name] * grid.scale[k]
+            box[0, k] = centre - tolerance[name] * grid.scale[k]
+            box[1, k] = centre + tolerance[name] * grid.scale[k]
     value = table.value.reshape(-1)
     return Lookahead(
         value=np.ascontiguousarray(value[:, None]),
@@ -100,7 +101,6 @@ def lookahead_runtime(table: ControllerTable, dynamics: ModuleType, grid: Figure
             min(abs(table.control_min[brake_control]), abs(table.control_max[brake_control]))
             * scale[brake_control]
         ),
-        arrival_lower=lower,
-        arrival_upper=upper,
+        arrival_box=box,
         segment_dt=float(attrs["dt"]),
     )
