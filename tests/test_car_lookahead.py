@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from test_car import SMALL
 
-from mosys.kernels.geometry import first_colliding_sample
+from mosys.kernels.geometry import first_colliding_sample, point_in_polygon
 from mosys.parsing.controller import parse_controller_text
 from mosys.parsing.tokens import SpecError
 from mosys.ssc.controller import Controller
@@ -89,11 +89,7 @@ def test_it_never_touches_an_obstacle_or_leaves_the_domain(small, seed):
 
 
 def _in_domain(state, controller) -> bool:
-    domain = controller.lookahead.domain
-    return (
-        domain[:, 0].min() <= state[0] <= domain[:, 0].max()
-        and domain[:, 1].min() <= state[1] <= domain[:, 1].max()
-    )
+    return bool(point_in_polygon(state[0], state[1], controller.lookahead.domain))
 
 
 def test_controls_are_the_dp_samples_held_for_whole_segments(small):

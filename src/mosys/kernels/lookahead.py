@@ -38,7 +38,11 @@ from mosys.kernels.interpolate import (
     interpolate_with,
     interpolation_scratch,
 )
-from mosys.kernels.simulate import region_membership
+from mosys.kernels.simulate import (
+    crossed_a_region_border,
+    inside_region,
+    region_membership,
+)
 
 OUTSIDE_PENALTY = 100.0  # s per grid step beyond the table's axes, added to the cost-to-go
 
@@ -88,12 +92,12 @@ def _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs):
 
 
 @njit(cache=True)
-def _stops_in_box(state, vehicle_slot, wheelbase, wheel_radius, brake, state_slot, box):
+def _stops_in_box(state, vehicle_slot, wheelbase, wheel_radius, brake, state_slot, box, stop):
     """True when the state where full braking from ``state`` ends lies in the arrival box
-    (``box`` (3, d): lower, upper and period over the controller's axes; ±inf: any; period > 0:
-    an angle compared modulo it). Braking, steering held, the front wheels roll s = v|v| / 2a:
-    the heading turns by s sin(steer) / wheelbase and the reference point moves s along the
-    mean of the start and end heading, plus steer."""
+    (``box`` (3, d): lower, upper and period over the controller's axes, as ``inside_region``
+    takes them). Braking, steering held, the front wheels roll s = v|v| / 2a: the heading turns
+    by s sin(steer) / wheelbase and the reference point moves s along the mean of the start and
+    end heading, plus steer. stop: (d,) work array, the controller state where it stops."""
     speed = state[vehicle_slot[4]]
     steer = state[vehicle_slot[3]]
     distance = speed * abs(speed) / (2.0 * wheel_radius * brake)
@@ -101,21 +105,16 @@ def _stops_in_box(state, vehicle_slot, wheelbase, wheel_radius, brake, state_slo
     direction = state[vehicle_slot[2]] + 0.5 * turn + steer
     for k in range(state_slot.shape[0]):
         slot = state_slot[k]
-        value = state[slot]
+        stop[k] = state[slot]
         if slot == vehicle_slot[0]:
-            value += distance * math.cos(direction)
+            stop[k] += distance * math.cos(direction)
         elif slot == vehicle_slot[1]:
-            value += distance * math.sin(direction)
+            stop[k] += distance * math.sin(direction)
         elif slot == vehicle_slot[2]:
-            value += turn
+            stop[k] += turn
         elif slot == vehicle_slot[4]:
-            value = 0.0
-        lower = box[0, k]
-        if box[2, k] > 0.0 and math.isfinite(lower):
-            value = lower + (value - lower) % box[2, k]
-        if not lower <= value <= box[1, k]:
-            return False
-    return True
+            stop[k] = 0.0
+    return inside_region(stop, box[0], box[1], box[2])
 
 
 @njit(cache=True)
@@ -395,10 +394,10 @@ def simulate_lookahead(
     held_until = 0  # the step at which the held sample's segment ends
     arrived = False
     for step in range(record_state.shape[0]):
-        region_membership(state, region_lower, region_upper, region_period, membership)
-        for k in range(regions):
-            if membership[k] != start_membership[k]:
-                return step
+        if crossed_a_region_border(
+            state, region_lower, region_upper, region_period, start_membership, membership
+        ):
+            return step
         for i in range(size):
             record_state[step, i] = state[i]
         read_state(state, state_slot, here)
@@ -407,7 +406,7 @@ def simulate_lookahead(
         )
         if not arrived:
             arrived = _stops_in_box(
-                state, vehicle_slot, wheelbase, wheel_radius, brake, state_slot, arrival_box
+                state, vehicle_slot, wheelbase, wheel_radius, brake, state_slot, arrival_box, here
             )
         if arrived:
             _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs)

@@ -67,6 +67,17 @@ def region_membership(state, region_lower, region_upper, period, out):
         out[k] = inside_region(state, region_lower[k], region_upper[k], period)
 
 
+@njit(cache=True)
+def crossed_a_region_border(state, region_lower, region_upper, period, start_membership, work):
+    """True when ``state`` (S,) lies in a different set of the K boxes than
+    ``start_membership`` (K,) bool, the run's first state's; work: (K,) bool."""
+    region_membership(state, region_lower, region_upper, period, work)
+    crossed = False
+    for k in range(region_lower.shape[0]):
+        crossed |= work[k] != start_membership[k]
+    return crossed
+
+
 @njit(SIMULATE_SIGNATURE, cache=True)
 def simulate_controlled(
     derivative_into,
@@ -126,10 +137,10 @@ def simulate_controlled(
     membership = np.empty(regions, np.bool_)
     region_membership(state, region_lower, region_upper, region_period, start_membership)
     for step in range(record_state.shape[0]):
-        region_membership(state, region_lower, region_upper, region_period, membership)
-        for k in range(regions):
-            if membership[k] != start_membership[k]:
-                return step
+        if crossed_a_region_border(
+            state, region_lower, region_upper, region_period, start_membership, membership
+        ):
+            return step
         for i in range(size):
             record_state[step, i] = state[i]
         read_state(state, state_slot, controller_state)
