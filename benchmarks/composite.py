@@ -23,8 +23,8 @@ from pathlib import Path
 import pandas as pd
 from generation import write_results
 
-from mosys.bsr.run import search_to_file
-from mosys.composite.run import composite_to_file
+from mosys.bsr.result_file import search_to_file
+from mosys.composite.result_file import composite_to_file
 from mosys.composite.session import find_controller_files
 from mosys.io.composite_result import read_composite_result
 from mosys.parsing.composite import parse_composite_script

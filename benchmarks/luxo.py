@@ -29,10 +29,10 @@ DT = 0.0005  # s, config/config.yaml's luxo dt
 
 SIMULATE = """
 import json, sys, time
-from mosys.animation import ScriptSources, load_controllers, load_programs, run_script
+from mosys.animation.runner import ScriptSources, load_controllers, load_programs, run_script
 from mosys.dynamics.load import load_dynamics
 from mosys.parsing.script import parse_script
-from mosys.pipeline import run_animation_script
+from mosys.animation.trajectory_file import run_animation_script
 script, controllers, dynamics, out, dt, motor = sys.argv[1:7]
 times = []
 for _ in range(2):

@@ -108,8 +108,8 @@ COMPOSITE_SEARCHES = ("starman_cartwheel_robust", "starman_jump_robust", "starma
 def composite_workspace(tmp_path_factory) -> CompositeWorkspace:
     """Real BSR searches (G = 8, seeds 1 and 2) and a real composite result (Q = 4, G = 3,
     H = 2): the composite tests' input, made by the same functions as the pipeline."""
-    from mosys.bsr.run import search_to_file
-    from mosys.composite.run import composite_to_file
+    from mosys.bsr.result_file import search_to_file
+    from mosys.composite.result_file import composite_to_file
 
     root = tmp_path_factory.mktemp("composite")
     bsr_results = root / "results" / "bsr"

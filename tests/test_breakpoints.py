@@ -10,11 +10,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from mosys.animation.trajectory_file import run_animation_script
 from mosys.dynamics.compile import compile_figure
 from mosys.dynamics.load import load_dynamics
 from mosys.io.trajectory import read_trajectory
 from mosys.parsing.controller import parse_controller_spec
-from mosys.pipeline import run_animation_script
 from mosys.ssc.generate import generate_controller
 
 SPECS = Path(__file__).resolve().parents[1] / "specs"

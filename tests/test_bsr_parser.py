@@ -12,9 +12,15 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from spec_fuzz import token_mutations
 
-import mosys.parsing.bsr
-from mosys.bsr.spec import FITNESS_TERMS, BsrSpec, Endpoint, Perturbation
-from mosys.parsing.bsr import parse_bsr_spec, parse_bsr_text, render_bsr_spec
+from mosys.parsing.bsr import (
+    FITNESS_TERMS,
+    BsrSpec,
+    Endpoint,
+    Perturbation,
+    parse_bsr_spec,
+    parse_bsr_text,
+    render_bsr_spec,
+)
 from mosys.parsing.tokens import SpecError, Token
 
 EXAMPLE = """\
@@ -88,11 +94,6 @@ def test_example():
         "fall.1": Token("lower.distal", 10, 19),
     }
     assert spec.fall[1].token == Token("lower.distal", 10, 19)
-
-
-def test_the_module_docstring_shows_the_example():
-    doc = mosys.parsing.bsr.__doc__
-    assert "".join(f"    {line}\n" for line in EXAMPLE.splitlines()) in doc
 
 
 def test_defaults_and_a_time_controller():

@@ -14,9 +14,8 @@ import pytest
 from PIL import Image
 
 import mosys.plots.bsr as bsr
-from mosys.bsr.controller import BsrController
 from mosys.cli import main
-from mosys.io.bsr_result import BsrResult, write_bsr_result
+from mosys.io.bsr_result import BsrController, BsrResult, write_bsr_result
 from mosys.io.trajectory import FigureMotion
 from mosys.plots.bsr import (
     best_result_path,

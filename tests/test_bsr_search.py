@@ -13,13 +13,12 @@ import numba
 import numpy as np
 import pytest
 
-from mosys.bsr.controller import SIDE_MAX, SIDE_MIN
 from mosys.bsr.figure import bsr_figure
-from mosys.bsr.run import search_to_file
+from mosys.bsr.result_file import search_to_file
 from mosys.bsr.search import CORNER_INSIDE, _Population, bind_search, run_search
 from mosys.bsr.start import perturbed_state
 from mosys.io.bsr_result import read_bsr_result
-from mosys.kernels.bsr_run import active_rule, rule_weights
+from mosys.kernels.bsr_controller import SIDE_MAX, SIDE_MIN, active_rule, rule_weights
 from mosys.parsing.bsr import parse_bsr_text
 from mosys.parsing.figure import parse_figure_spec
 from mosys.parsing.tokens import SpecError

@@ -10,11 +10,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mosys.bsr.controller import BsrController
 from mosys.bsr.figure import bsr_figure
 from mosys.bsr.search import record_run
 from mosys.bsr.start import standing_state
-from mosys.kernels.bsr_run import active_rule, rule_weights, segment_rule
+from mosys.io.bsr_result import BsrController
+from mosys.kernels.bsr_controller import active_rule, rule_weights, segment_rule
 from mosys.kernels.bsr_simulate import contact_impulses
 from mosys.parsing.figure import parse_figure_spec, parse_figure_text
 

@@ -14,15 +14,15 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from matplotlib.backend_bases import MouseEvent
 
-from mosys.composite.editor import (
+from mosys.composite.session import open_session
+from mosys.composite.transitions import equal_split
+from mosys.editor.concatenation import (
     ConcatenationEditor,
     pose_samples,
     run_editor,
     score_text,
     script_text_with_ticks,
 )
-from mosys.composite.session import open_session
-from mosys.composite.transitions import equal_split
 from mosys.errors import InputError
 from mosys.parsing.composite import parse_composite_script, parse_composite_text
 

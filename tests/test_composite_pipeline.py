@@ -15,16 +15,16 @@ import pytest
 from mosys.bsr.search import nominal_run
 from mosys.cli import main
 from mosys.composite.measures import phase_measures
+from mosys.composite.result_file import composite_to_file
 from mosys.composite.robustness import bind_spec, fitness_from_starts, perturbed_starts
-from mosys.composite.run import composite_to_file
 from mosys.composite.session import open_session
 from mosys.io.bsr_result import read_bsr_result
 from mosys.io.composite_result import CompositeMotion, read_composite_result
 from mosys.io.trajectory import FigureMotion
+from mosys.paper_tables.composite import composite_frame
+from mosys.paper_tables.robustness import robustness_frame
 from mosys.parsing.composite import parse_composite_script
 from mosys.parsing.tokens import SpecError
-from mosys.tables.composite import composite_frame
-from mosys.tables.robustness import robustness_frame
 
 ROOT = Path(__file__).resolve().parents[1]
 SPECS = ROOT / "specs"

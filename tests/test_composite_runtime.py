@@ -7,11 +7,11 @@ from pathlib import Path
 
 import numpy as np
 
-from mosys.bsr.controller import BsrController
 from mosys.bsr.figure import bsr_figure
 from mosys.bsr.search import record_run
 from mosys.bsr.start import standing_state
-from mosys.composite.runtime import run_concatenation
+from mosys.composite.concatenation import run_concatenation
+from mosys.io.bsr_result import BsrController
 from mosys.parsing.figure import parse_figure_spec
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -23,7 +23,14 @@ from mosys.composite.evaluate import (
     falloff,
     score_script,
 )
-from mosys.composite.script import (
+from mosys.parsing.composite import (
+    MAX_DEPTH,
+    parse_composite_script,
+    parse_composite_text,
+    render_composite_script,
+    render_expression,
+)
+from mosys.parsing.composite_script import (
     FUNCTIONS,
     Binary,
     Call,
@@ -33,13 +40,6 @@ from mosys.composite.script import (
     Phase,
     SearchSettings,
     Unary,
-)
-from mosys.parsing.composite import (
-    MAX_DEPTH,
-    parse_composite_script,
-    parse_composite_text,
-    render_composite_script,
-    render_expression,
 )
 from mosys.parsing.tokens import SpecError, Token
 

@@ -13,12 +13,12 @@ import pytest
 from PIL import Image
 
 import mosys.plots.luxo as luxo
+from mosys.animation.motion_measures import motions
+from mosys.animation.motor_program import BoundMotorProgram
 from mosys.dynamics.compile import compile_figure
+from mosys.dynamics.figure_motion import figure_contacts, figure_motion
 from mosys.dynamics.load import load_dynamics
-from mosys.dynamics.motion import figure_contacts, figure_motion
 from mosys.io.trajectory import Trajectory, read_trajectory, write_trajectory
-from mosys.motions import motions
-from mosys.motor import BoundMotorProgram
 from mosys.parsing.motor import parse_motor_program_text
 from mosys.plots.luxo import (
     HEAD_LENGTH,

@@ -11,14 +11,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from mosys.animation.motion_measures import SETTLE_WITHIN, measure, motions
+from mosys.animation.motor_program import load_motor_program
+from mosys.animation.trajectory_file import run_animation_script
 from mosys.dynamics.compile import compile_figure
 from mosys.dynamics.load import load_dynamics
 from mosys.io.controller_table import read_controller_table
 from mosys.io.trajectory import read_trajectory
-from mosys.motions import SETTLE_WITHIN, measure, motions
-from mosys.motor import load_motor_program
 from mosys.parsing.controller import parse_controller_spec
-from mosys.pipeline import run_animation_script
 from mosys.ssc.generate import generate_controller
 
 SPECS = Path(__file__).resolve().parents[1] / "specs"

@@ -38,11 +38,11 @@ from pathlib import Path
 
 import numpy as np
 
+from mosys.animation.motion_measures import ground_height, longest_flight
+from mosys.animation.motor_program import BoundMotorProgram, load_motor_program
 from mosys.dynamics.load import load_dynamics
-from mosys.motions import ground_height, longest_flight
-from mosys.motor import BoundMotorProgram, load_motor_program
+from mosys.io.progress import Progress
 from mosys.parsing.motor import parse_motor_program
-from mosys.progress import Progress
 from mosys.ssc.controller import Controller
 
 DT = 0.0005  # s, the show's step (config/config.yaml luxo: dt)

@@ -40,7 +40,7 @@ def _dp(args: argparse.Namespace) -> None:
 
 
 def _run(args: argparse.Namespace) -> None:
-    from mosys.pipeline import run_animation_script
+    from mosys.animation.trajectory_file import run_animation_script
 
     run_animation_script(
         args.script, args.controllers, args.dynamics_dir, args.output, args.dt, args.motor_dir
@@ -68,7 +68,7 @@ def _plot_script(args: argparse.Namespace) -> None:
 
 
 def _table(args: argparse.Namespace) -> None:
-    from mosys.tables.pendulum import write_pendulum_table
+    from mosys.paper_tables.pendulum import write_pendulum_table
 
     write_pendulum_table(args.controllers, args.dynamics, args.csv, args.md, args.budget)
 
@@ -108,7 +108,7 @@ def _plot_car(args: argparse.Namespace) -> None:
 
 
 def _car_table(args: argparse.Namespace) -> None:
-    from mosys.tables.car import write_car_table
+    from mosys.paper_tables.car import write_car_table
 
     write_car_table(args.table, args.starts, args.trajectories, args.csv, args.md, args.budget)
 
@@ -155,7 +155,7 @@ def _plot_bsr_learning(args: argparse.Namespace) -> None:
 
 
 def _bsr_search(args: argparse.Namespace) -> None:
-    from mosys.bsr.run import search_to_file
+    from mosys.bsr.result_file import search_to_file
 
     outcome = search_to_file(
         args.spec,
@@ -183,7 +183,7 @@ def _composite_controller_files(args: argparse.Namespace, script) -> dict:
 
 
 def _composite(args: argparse.Namespace) -> None:
-    from mosys.composite.run import composite_to_file
+    from mosys.composite.result_file import composite_to_file
     from mosys.parsing.composite import parse_composite_script
 
     script = parse_composite_script(args.script)
@@ -205,19 +205,19 @@ def _composite(args: argparse.Namespace) -> None:
 
 
 def _edit(args: argparse.Namespace) -> None:
-    from mosys.composite.editor import run_editor
+    from mosys.editor.concatenation import run_editor
 
     run_editor(args.script, args.bsr_results, args.figures, args.bsr_specs)
 
 
 def _composite_table(args: argparse.Namespace) -> None:
-    from mosys.tables.composite import write_composite_table
+    from mosys.paper_tables.composite import write_composite_table
 
     write_composite_table(args.results, args.csv, args.md)
 
 
 def _robustness_table(args: argparse.Namespace) -> None:
-    from mosys.tables.robustness import write_robustness_table
+    from mosys.paper_tables.robustness import write_robustness_table
 
     write_robustness_table(
         [tuple(pair) for pair in args.pair],
@@ -230,13 +230,13 @@ def _robustness_table(args: argparse.Namespace) -> None:
 
 
 def _bsr_table(args: argparse.Namespace) -> None:
-    from mosys.tables.bsr import write_bsr_table
+    from mosys.paper_tables.bsr import write_bsr_table
 
     write_bsr_table(args.results, args.csv, args.md)
 
 
 def _luxo_table(args: argparse.Namespace) -> None:
-    from mosys.tables.luxo import write_luxo_table
+    from mosys.paper_tables.luxo import write_luxo_table
 
     write_luxo_table(args.trajectory, args.landing, args.csv, args.md, args.budget)
 

@@ -16,16 +16,15 @@ STAGE_MODULES = {
             "kernels/figure_state.py", "kernels/interpolate.py", "kernels/geometry.py",
             "ssc/generate.py", "ssc/grid.py", "ssc/obstacles.py", "io/controller_table.py",
             "dynamics/load.py"],
-    "scripts": ["parsing/script.py", "parsing/motor.py", "animation.py", "motor.py",
-                "pipeline.py", "ssc/controller.py", "ssc/regions.py", "ssc/parking.py",
+    "scripts": ["parsing/script.py", "parsing/motor.py", "animation", "ssc/controller.py", "ssc/regions.py", "ssc/parking.py",
                 "ssc/lookahead.py", "kernels/simulate.py", "kernels/lookahead.py",
-                "kernels/motor.py", "kernels/motion.py",
-                "io/trajectory.py", "io/start_grid.py", "dynamics/motion.py"],
+                "kernels/motor.py", "kernels/figure_motion.py",
+                "io/trajectory.py", "io/start_grid.py", "dynamics/figure_motion.py"],
     "bsr": ["parsing/bsr.py", "parsing/figure.py", "bsr", "kernels/bsr_simulate.py",
-            "kernels/bsr_run.py", "io/bsr_result.py", "io/trajectory.py", "progress.py"],
-    "composite": ["parsing/composite.py", "composite", "io/composite_result.py"],
+            "kernels/bsr_controller.py", "io/bsr_result.py", "io/trajectory.py", "io/progress.py"],
+    "composite": ["parsing/composite.py", "parsing/composite_script.py", "composite", "io/composite_result.py"],
     "plots": ["plots"],
-    "tables": ["tables", "ssc/quality.py"],
+    "tables": ["paper_tables", "ssc/quality.py"],
 }
 
 

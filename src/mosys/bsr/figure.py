@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mosys.bsr.spec import ENDPOINT_ENDS
+from mosys.parsing.bsr import ENDPOINT_ENDS
 from mosys.parsing.figure import Figure, parse_figure_spec
 from mosys.parsing.tokens import SpecError, Token
 

@@ -25,13 +25,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mosys.bsr.controller import CENTER_MAX, CENTER_MIN, SIDE_MAX, SIDE_MIN, BsrController
 from mosys.bsr.figure import BsrFigure
-from mosys.bsr.spec import BsrSpec
 from mosys.bsr.start import perturbed_state, standing_state
-from mosys.kernels.bsr_run import TERMS, run_controller, run_population
+from mosys.io.bsr_result import BsrController
+from mosys.io.progress import Progress
+from mosys.kernels.bsr_controller import (
+    CENTER_MAX,
+    CENTER_MIN,
+    SIDE_MAX,
+    SIDE_MIN,
+    run_controller,
+    run_population,
+)
+from mosys.parsing.bsr import FITNESS_TERMS, BsrSpec
 from mosys.parsing.tokens import SpecError
-from mosys.progress import Progress
 
 CORNER_INSIDE = 0.98  # a re-initialised box's corner: this fraction of the half-side out
 SEGMENT_WEIGHT_MIN = 0.2
@@ -46,7 +53,7 @@ CREEP_LOG_SEGMENT = 0.2
 @dataclass(frozen=True)
 class SearchSetup:
     """A spec bound to its figure: the nominal start pose (root angle rad, joints (J,) rad, x
-    m), the fall endpoints' indices, the term weights in ``TERMS`` order, and the budget."""
+    m), the fall endpoints' indices, the term weights in ``FITNESS_TERMS`` order, and the budget."""
 
     spec: BsrSpec
     figure: BsrFigure
@@ -72,7 +79,7 @@ class SearchSetup:
 class SearchOutcome:
     """What a search found: the learning curve (evaluations (M,), best fitness (M,)), the best
     controller, its fitness during the search, and its run from the nominal start (terms as
-    ``TERMS``, the active rule (steps + 1,), rod ends (steps + 1, N, 2, 2) m, com
+    ``FITNESS_TERMS``, the active rule (steps + 1,), rod ends (steps + 1, N, 2, 2) m, com
     (steps + 1, 2) m), the wall time s and the simulated steps per second."""
 
     evaluations: np.ndarray
@@ -88,7 +95,7 @@ class SearchOutcome:
     steps_per_second: float
 
     def terms_json(self) -> str:
-        terms = zip(TERMS, self.terms, strict=True)
+        terms = zip(FITNESS_TERMS, self.terms, strict=True)
         return json.dumps({name: float(value) for name, value in terms})
 
 
@@ -133,7 +140,7 @@ def bind_search(spec: BsrSpec, figure: BsrFigure, generations: int | None = None
         joints=joints,
         x=x,
         fall_endpoints=np.array(fall, np.int64),
-        weights=np.array([spec.weights.get(term, 0.0) for term in TERMS]),
+        weights=np.array([spec.weights.get(term, 0.0) for term in FITNESS_TERMS]),
         generations=spec.generations if generations is None else generations,
     )
 
@@ -260,7 +267,7 @@ def _evaluate(setup: SearchSetup, population: _Population, rng: np.random.Genera
         start = standing_state(figure, setup.root_angle, setup.joints, setup.x)
         starts = np.repeat(start[None, :], c, axis=0)
     rules = np.zeros((c, spec.steps + 1), np.int64)
-    terms = np.zeros((c, len(TERMS)))
+    terms = np.zeros((c, len(FITNESS_TERMS)))
     run_population(
         *figure.kernel_arrays,
         figure.gravity,
@@ -357,9 +364,9 @@ def nominal_run(setup: SearchSetup, controller: BsrController) -> RecordedRun:
 
 @dataclass(frozen=True)
 class RecordedRun:
-    """One controller's run, every step: terms (len(TERMS),), active_rule (steps + 1,), rod_ends
-    (steps + 1, N, 2, 2) m, com (steps + 1, 2) m, and where it ended: final_state (S,) and the
-    endpoints' normal forces final_force (E,) N."""
+    """One controller's run, every step: terms (len(FITNESS_TERMS),), active_rule (steps + 1,),
+    rod_ends (steps + 1, N, 2, 2) m, com (steps + 1, 2) m, and where it ended: final_state (S,)
+    and the endpoints' normal forces final_force (E,) N."""
 
     terms: np.ndarray
     active_rule: np.ndarray
@@ -389,7 +396,7 @@ def record_run(
     if time_based:
         segment_end[-1] = controller.period
     run = RecordedRun(
-        terms=np.zeros(len(TERMS)),
+        terms=np.zeros(len(FITNESS_TERMS)),
         active_rule=np.zeros(steps + 1, np.int64),
         rod_ends=np.zeros((steps + 1, figure.parent.shape[0], 2, 2)),
         com=np.zeros((steps + 1, 2)),

@@ -7,8 +7,8 @@ import math
 import numpy as np
 
 from mosys.bsr.figure import BsrFigure
-from mosys.bsr.spec import Perturbation
 from mosys.kernels.bsr_simulate import CX, CY, JOINTS, MOMENTUM, PHI, VX, VY, body_frame
+from mosys.parsing.bsr import Perturbation
 
 
 def state_size(figure: BsrFigure) -> int:

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mosys.composite.script import (
+from mosys.parsing.composite_script import (
     ENDPOINT,
     FALLOFF_FRACTION,
     FUNCTIONS,

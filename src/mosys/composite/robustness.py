@@ -12,13 +12,11 @@ from pathlib import Path
 
 import numpy as np
 
-from mosys.bsr.controller import BsrController
 from mosys.bsr.figure import load_bsr_figure
 from mosys.bsr.search import SearchSetup, bind_search, nominal_run, record_run
-from mosys.bsr.spec import Perturbation
 from mosys.bsr.start import perturbed_state
-from mosys.io.bsr_result import read_bsr_result
-from mosys.parsing.bsr import parse_bsr_spec
+from mosys.io.bsr_result import BsrController, read_bsr_result
+from mosys.parsing.bsr import Perturbation, parse_bsr_spec
 
 
 @dataclass(frozen=True)

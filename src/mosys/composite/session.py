@@ -17,16 +17,15 @@ from pathlib import Path
 
 import numpy as np
 
-from mosys.bsr.controller import BsrController
 from mosys.bsr.figure import BsrFigure, load_bsr_figure
 from mosys.bsr.search import bind_search
 from mosys.bsr.start import standing_state
+from mosys.composite.concatenation import ConcatenatedMotion, run_concatenation
 from mosys.composite.evaluate import PhaseMotion, score_script
-from mosys.composite.runtime import ConcatenatedMotion, run_concatenation
-from mosys.composite.script import CompositeScript
 from mosys.composite.transitions import equal_split
-from mosys.io.bsr_result import read_bsr_result
+from mosys.io.bsr_result import BsrController, read_bsr_result
 from mosys.parsing.bsr import parse_bsr_spec
+from mosys.parsing.composite_script import CompositeScript
 from mosys.parsing.tokens import SpecError
 
 _SEED_FILE = re.compile(r"seed(\d+)\.h5$")

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mosys.progress import Progress
+from mosys.io.progress import Progress
 
 PERTURB_FRACTION = 0.05
 RANDOMIZE = 1.0 / 3.0

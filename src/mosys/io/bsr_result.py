@@ -15,10 +15,49 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from mosys.bsr.controller import BsrController
 from mosys.io.atomic import write_atomically
 from mosys.io.attributes import string_tuple
 from mosys.io.trajectory import FigureMotion, read_figure_motion, write_figure_motion
+
+
+@dataclass(frozen=True)
+class BsrController:
+    """A BSR controller's parameters as arrays (what the kernels read and this file stores).
+
+    A sense-based controller (the 1995 paper's §2.1.2) has R rules, each a stimulus
+    hyper-rectangle over the V normalised sense variables, given by its ``center`` (mu) and
+    ``side`` (2/lambda) per variable, and a response: a target pose (one angle per joint) and a
+    time constant. A time-based controller (§2.3) has R rules, each active for its ``segment`` of
+    the period ``t_per``, one after another, the sequence repeating to fill the run.
+
+    R rules. ``target``: (R, J) joint angles, rad; ``tau``: (R,) time constants, s.
+    Sense-based: ``center`` and ``side``: (R, V), in normalised sense units; ``segment`` is
+    empty. Time-based: ``segment``: (R,) seconds, summing to ``period`` (s); ``center`` and
+    ``side`` are (R, 0)."""
+
+    kind: str
+    target: np.ndarray
+    tau: np.ndarray
+    center: np.ndarray
+    side: np.ndarray
+    segment: np.ndarray
+    period: float
+
+    @property
+    def rules(self) -> int:
+        return int(self.tau.shape[0])
+
+    def copy(self) -> BsrController:
+        return BsrController(
+            self.kind,
+            self.target.copy(),
+            self.tau.copy(),
+            self.center.copy(),
+            self.side.copy(),
+            self.segment.copy(),
+            self.period,
+        )
+
 
 FORMAT_VERSION = 1
 

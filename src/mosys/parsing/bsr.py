@@ -1,53 +1,7 @@
-"""The BSR search spec (``.bsr``): what a search for banked stimulus-response controllers runs
-on (Auslander et al. 1995): the figure, the kind and size of controller, the simulation, the
-genetic search's sizes, the random seeds, the start pose and its perturbation, and the fitness.
-
-::
-
-    # luxo_hop: a sense-based controller that carries Luxo as far as it can
-    figure luxo                                  # the figure: specs/figures/luxo.fig
-    controller sense rules=8                     # R = 8 stimulus-response rules
-    simulate duration=4 dt=0.001                 # T = 4 s in steps of 1 ms (4000 steps)
-    search controllers=40 generations=200 reseed=25 reinitialize=0.25
-    seeds 1 2 3                                  # three independent searches
-    start x=0 base=0 hip=0 elbow=120             # the nominal start pose: m, degrees
-    perturb angle=2 joints=5 speed=0.05 spin=10  # half-widths: deg, deg, m/s, deg/s
-    fitness distance=1 max_height=0.5 fall=-10   # fitness term -> weight
-    fall upper.distal lower.distal               # the endpoints that must not touch the ground
-
-Grammar (one line each; ``#`` comments and blank lines are ignored; every line at most once)::
-
-    figure NAME                             required: the figure spec specs/figures/NAME.fig
-    controller KIND rules=R [period=S]      required. KIND: 'sense' or 'time'; R: whole >= 1.
-                                            period= (s, > 0) only for 'time'; omitted: the
-                                            duration T (an aperiodic sequence of rules)
-    simulate duration=T dt=DT [tau_min=S]   required. T and DT in s, > 0; T / DT a whole number
-                                            (within 1e-9 relative) and 2 DT < T / 4, so that
-                                            Table 2's time-constant range [2 DT, T / 4] is not
-                                            empty. tau_min: the smallest time constant, s, from
-                                            2 DT to below T / 4 (default 2 DT): the paper's
-                                            footnote 2 (a fast deformation needs a huge torque)
-    search controllers=C generations=G reseed=RS [reinitialize=P]
-                                            required. C whole >= 2, G and RS whole >= 1; P the
-                                            probability that a mutation re-initialises a rule
-                                            rather than creeping it, 0 to 1 (default 0.5)
-    seeds K [K ...]                         required: whole numbers >= 0, distinct; one search
-                                            per seed
-    start NAME=VALUE ...                    optional: the nominal start pose, a figure coordinate
-                                            per NAME (m for x and y, degrees for angles), each
-                                            NAME once (default: none)
-    perturb [angle=D] [joints=D] [speed=V] [spin=W]
-                                            optional, at least one key, each >= 0: half-widths of
-                                            the uniform random perturbation of the start state, on
-                                            the root angle (deg), each joint angle (deg), each
-                                            component of the centre of mass's velocity (m/s) and
-                                            the angular velocity (deg/s) (default: all 0)
-    fitness TERM=WEIGHT ...                 required: TERM one of distance, max_height,
-                                            contact_distance, rotations, fall, each once; WEIGHT
-                                            any number
-    fall ROD.END ...                        the endpoints (END: proximal or distal) whose ground
-                                            contact the 'fall' term measures, each once; required
-                                            if fitness names fall=
+"""The BSR search spec (``.bsr``) and its parser: what a search for banked stimulus-response
+controllers runs on (Auslander et al. 1995): the figure, the kind and size of controller, the
+simulation, the genetic search's sizes, the random seeds, the start pose and its perturbation, and
+the fitness. The grammar is the README's "The search spec (`.bsr`)"; ``specs/bsr/`` holds examples.
 
 The parser does not know the figure: start names and fall rods are checked when the spec is bound
 to it, at the tokens kept in ``BsrSpec.tokens``.
@@ -57,18 +11,9 @@ from __future__ import annotations
 
 import hashlib
 import math
+from dataclasses import dataclass, field
 from pathlib import Path
 
-from mosys.bsr.spec import (
-    CONTROLLER_KINDS,
-    ENDPOINT_ENDS,
-    FITNESS_TERMS,
-    BsrSpec,
-    Endpoint,
-    Perturbation,
-)
-
-# the figure spec's number format (shortest repr, no trailing '.0'); private there, reused here
 from mosys.parsing.tokens import (
     NAME,
     Line,
@@ -85,6 +30,87 @@ from mosys.parsing.tokens import (
     unknown_keyword,
     value_token,
 )
+
+_NO_TOKEN = Token("", 0, 0)
+
+CONTROLLER_KINDS = ("sense", "time")
+# fitness terms: the primary term and Table 3's secondary terms, plus the fall penalty
+FITNESS_TERMS = ("distance", "max_height", "contact_distance", "rotations", "fall")
+ENDPOINT_ENDS = ("proximal", "distal")
+
+
+@dataclass(frozen=True)
+class Perturbation:
+    """Half-widths of the uniform random perturbation of the start state drawn at every
+    evaluation (the enhanced controllers of the 1995 paper's section 3): ``angle`` deg on the root
+    angle, ``joints`` deg on each joint angle, ``speed`` m/s on each component of the centre of
+    mass's velocity, ``spin`` deg/s on the angular velocity. All 0: no perturbation."""
+
+    angle: float = 0.0
+    joints: float = 0.0
+    speed: float = 0.0
+    spin: float = 0.0
+
+    @property
+    def any(self) -> bool:
+        return any(value != 0.0 for value in (self.angle, self.joints, self.speed, self.spin))
+
+
+@dataclass(frozen=True)
+class Endpoint:
+    """A rod endpoint named in the spec as ``ROD.END`` (END: proximal or distal)."""
+
+    rod: str
+    end: str
+    token: Token = field(default=_NO_TOKEN, compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class BsrSpec:
+    """One ``.bsr`` file.
+
+    ``kind``: ``sense`` or ``time``; ``rules``: R; ``period``: t_per in s (time-based only; None
+    means the duration T, i.e. aperiodic); ``duration``: T, s; ``dt``: Δt, s; ``controllers``: C;
+    ``generations``: G; ``reseed``: the reseed period (the paper's R of Figure 3);
+    ``reinitialize``: the probability that a mutation re-initialises one rule rather than creeping
+    it; ``seeds``: the random seeds, one search each; ``start``: the nominal start pose, figure
+    coordinate name -> value as written (angles in degrees, ``x`` in m); ``perturbation``: random
+    start perturbation; ``weights``: fitness term -> weight; ``fall``: the endpoints whose ground
+    contact the ``fall`` term measures; ``tau_min``: the smallest time constant, s (None: Table 2's
+    2 Δt). ``tokens`` keeps the token of each setting (keyed like
+    ``figure``, ``start.NAME``, ``fitness.TERM``) so that binding to the figure can point at the
+    offending word."""
+
+    path: str
+    figure: str
+    kind: str
+    rules: int
+    period: float | None
+    duration: float
+    dt: float
+    controllers: int
+    generations: int
+    reseed: int
+    reinitialize: float
+    seeds: tuple[int, ...]
+    start: dict[str, float]
+    perturbation: Perturbation
+    weights: dict[str, float]
+    fall: tuple[Endpoint, ...]
+    tau_min: float | None = None
+    spec_sha256: str = field(default="", compare=False)
+    tokens: dict[str, Token] = field(default_factory=dict, compare=False, repr=False)
+
+    @property
+    def name(self) -> str:
+        """The search's name: the spec file's stem."""
+        return Path(self.path).stem
+
+    @property
+    def steps(self) -> int:
+        """Simulator steps per evaluation: round(T / Δt)."""
+        return int(round(self.duration / self.dt))
+
 
 KEYWORDS = (
     *("figure", "controller", "simulate", "search", "seeds"),

@@ -58,7 +58,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
-from mosys.composite.script import (
+from mosys.parsing.composite_script import (
     ENDPOINT,
     FUNCTIONS,
     SCORE_NAMES,

@@ -11,8 +11,8 @@ The lamp is drawn from ``figure_motion``: the base (rod 0) thick, the arms thinn
 a lamp shade whose mouth is at the far end of the rod named ``upper`` (the last rod if none is),
 where the head's contact point is; the terrain polyline filled grey below. Metres in the world
 frame, y up, equal aspect. Luxo faces -x, so the base's proximal end (fraction 0) is its front
-edge. A motion is one of ``mosys.motions.motions``: from a motor program's start to the next
-one's, the landing included.
+edge. A motion is one of ``mosys.animation.motion_measures.motions``: from a motor program's
+start to the next one's, the landing included.
 """
 
 from __future__ import annotations
@@ -29,8 +29,8 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Polygon
 from matplotlib.transforms import blended_transform_factory
 
+from mosys.animation.motion_measures import Motion, motions
 from mosys.io.trajectory import Trajectory, read_trajectory
-from mosys.motions import Motion, motions
 from mosys.plots.car import frame_indices
 from mosys.plots.pendulum import PlotInputError
 from mosys.plots.style import (

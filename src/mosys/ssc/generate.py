@@ -18,6 +18,7 @@ import numpy as np
 
 from mosys import __version__
 from mosys.io.controller_table import ControllerTable, write_controller_table
+from mosys.io.progress import Progress
 from mosys.kernels.dp import (
     bellman_sweep,
     best_controls,
@@ -28,7 +29,6 @@ from mosys.kernels.dp import (
     reach_sweep,
 )
 from mosys.parsing.controller import ControllerSpec
-from mosys.progress import Progress
 from mosys.ssc.grid import FigureGrid, control_scale, figure_grid, figure_state_names
 from mosys.ssc.obstacles import Obstacles, blocked_reason, spec_obstacles
 

@@ -18,7 +18,7 @@ from types import ModuleType
 
 import numpy as np
 
-from mosys.motor import BoundMotorProgram, load_motor_program
+from mosys.animation.motor_program import BoundMotorProgram, load_motor_program
 from mosys.parsing.script import (
     AnimationScript,
     Breakpoint,

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mosys.bsr.run import figure_motion
+from mosys.bsr.result_file import figure_motion
 from mosys.composite.session import CompositeSession, ScoredMotion, open_session
 from mosys.composite.transitions import TransitionSearch, search_transitions
 from mosys.io.composite_result import CompositeMotion, CompositeResult, write_composite_result

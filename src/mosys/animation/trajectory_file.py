@@ -6,15 +6,15 @@ from __future__ import annotations
 from pathlib import Path
 
 from mosys import __version__
-from mosys.animation import (
+from mosys.animation.runner import (
     ScriptSources,
     controller_table_path,
     load_controllers,
     load_programs,
     run_script,
 )
+from mosys.dynamics.figure_motion import figure_contacts, figure_motion
 from mosys.dynamics.load import figure_dynamics
-from mosys.dynamics.motion import figure_contacts, figure_motion
 from mosys.io.controller_table import read_controller_table
 from mosys.io.trajectory import Trajectory, write_trajectory
 from mosys.parsing.script import SwapController, parse_script

@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from mosys.bsr.spec import FITNESS_TERMS
 from mosys.io.atomic import write_text_atomically
 from mosys.io.bsr_result import read_bsr_result
+from mosys.parsing.bsr import FITNESS_TERMS
 
 PAPER_EVALUATIONS = 40_000
 # §2.1.3: 40,000 sense-based evaluations took 3-6 minutes on a DEC 3000/400 AXP; footnote 6:

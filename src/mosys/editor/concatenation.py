@@ -40,11 +40,11 @@ from matplotlib.patches import Patch
 from matplotlib.text import Text
 from matplotlib.widgets import Button, Slider
 
-from mosys.composite.script import CompositeScript
 from mosys.composite.session import CompositeSession
 from mosys.errors import InputError
 from mosys.io.atomic import write_text_atomically
 from mosys.parsing.composite import parse_composite_text, render_expression
+from mosys.parsing.composite_script import CompositeScript
 from mosys.parsing.tokens import read_spec_text
 from mosys.plots.bsr import JOINT_SIZE, OUTLINE, ROD_WIDTH, choose_interval
 from mosys.plots.style import TERRAIN_EDGE, TERRAIN_FACE, controller_colors, new_figure, plot_style

@@ -6,11 +6,12 @@ Sense variables (V = J + E + 2, each normalised to [0, 1] and clipped): joint an
 weight ``f_e / (M g)``; the centre of mass's height over the floor over the figure's reach
 ``y_cm / reach``; its vertical velocity ``0.5 + vy / (2 sqrt(2 g reach))``.
 
-Fitness terms (TERMS order): ``distance`` com x at the end minus at the start, m;
-``max_height`` the largest com y, m; ``contact_distance`` the horizontal distance travelled by
-endpoints while they touch the floor (within ``CONTACT_TOLERANCE``) at both ends of a step, m;
-``rotations`` |net rotation of the root rod| / 360°; ``fall`` the fraction of steps that end with
-one of the ``fall`` endpoints touching the floor.
+Fitness terms (the columns DISTANCE, MAX_HEIGHT, CONTACT_DISTANCE, ROTATIONS, FALL of
+terms_out; ``parsing.bsr.FITNESS_TERMS`` names them in this order): ``distance`` com x at the end
+minus at the start, m; ``max_height`` the largest com y, m; ``contact_distance`` the horizontal
+distance travelled by endpoints while they touch the floor (within ``CONTACT_TOLERANCE``) at both
+ends of a step, m; ``rotations`` |net rotation of the root rod| / 360°; ``fall`` the fraction of
+steps that end with one of the ``fall`` endpoints touching the floor.
 """
 
 from __future__ import annotations
@@ -20,8 +21,6 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from mosys.bsr.controller import SIDE_MAX  # the largest side (Table 2): lambda_min = 2 / SIDE_MAX
-from mosys.bsr.spec import FITNESS_TERMS
 from mosys.kernels.bsr_simulate import (
     CONTACT_TOLERANCE,
     CX,
@@ -35,7 +34,15 @@ from mosys.kernels.bsr_simulate import (
     step,
 )
 
-TERMS = FITNESS_TERMS  # the order of terms_out
+# Table 2 of the paper: a rule's hyper-rectangle side 2/lambda lies in [SIDE_MIN, SIDE_MAX], so
+# lambda_min = 2 / SIDE_MAX (the rule weights below); centres are drawn in [CENTER_MIN, CENTER_MAX].
+SIDE_MIN = 0.4
+SIDE_MAX = 4.0
+CENTER_MIN = -0.5
+CENTER_MAX = 1.5
+# the columns of terms_out
+DISTANCE, MAX_HEIGHT, CONTACT_DISTANCE, ROTATIONS, FALL = range(5)
+TERM_COUNT = 5
 
 
 @njit(cache=True)
@@ -137,7 +144,7 @@ def run_controller(
     Sense-based (time_based False): center, side (R, V) select the rule; time-based:
     segment_end (R,) and period s do. target (R, J) rad, tau (R,) s. fall_endpoints (F,) int64.
     Fills senses_out (steps + 1, V) and rule_out (steps + 1,) (sample 0: the start, with rule 0
-    active as Figure 2 begins), terms_out (len(TERMS),), and, if ends_out has steps + 1 rows,
+    active as Figure 2 begins), terms_out (TERM_COUNT,), and, if ends_out has steps + 1 rows,
     ends_out (steps + 1, N, 2, 2) and com_out (steps + 1, 2), world metres.
     start_force (E,): the endpoints' normal forces at the start, N (zeros for a fresh start);
     carry_over: a controller taking over from another (a composite motion) starts with the rule
@@ -259,11 +266,11 @@ def run_controller(
             ends_out[n + 1] = rod_ends
             com_out[n + 1, 0] = state[CX]
             com_out[n + 1, 1] = state[CY]
-    terms_out[0] = state[CX] - start_x
-    terms_out[1] = max_height
-    terms_out[2] = contact_distance
-    terms_out[3] = abs(state[PHI] - start_phi) / (2.0 * math.pi)
-    terms_out[4] = fallen_steps / steps
+    terms_out[DISTANCE] = state[CX] - start_x
+    terms_out[MAX_HEIGHT] = max_height
+    terms_out[CONTACT_DISTANCE] = contact_distance
+    terms_out[ROTATIONS] = abs(state[PHI] - start_phi) / (2.0 * math.pi)
+    terms_out[FALL] = fallen_steps / steps
     final_state[:] = state
     final_force[:] = end_force
 
@@ -302,7 +309,7 @@ def run_population(
     """``run_controller`` for C controllers at once, in parallel (each run is independent, so
     the results do not depend on the number of threads). target (C, R, J), tau (C, R),
     center/side (C, R, V), segment_end (C, R), start (C, S); fills senses_out
-    (C, steps + 1, V), rule_out (C, steps + 1), terms_out (C, len(TERMS))."""
+    (C, steps + 1, V), rule_out (C, steps + 1), terms_out (C, TERM_COUNT)."""
     no_ends = np.empty((0, parent.shape[0], 2, 2))
     no_com = np.empty((0, 2))
     n_ends = endpoints.shape[0]

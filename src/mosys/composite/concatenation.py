@@ -10,9 +10,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mosys.bsr.controller import BsrController
 from mosys.bsr.figure import BsrFigure
 from mosys.bsr.search import record_run
+from mosys.io.bsr_result import BsrController
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,7 @@ from types import ModuleType
 import numpy as np
 
 from mosys.io.trajectory import Contacts, FigureMotion
-from mosys.kernels.motion import endpoints_over_time
+from mosys.kernels.figure_motion import endpoints_over_time
 
 
 def figure_motion(dynamics: ModuleType, t: np.ndarray, figure_states: np.ndarray) -> FigureMotion:

@@ -7,10 +7,7 @@ import dataclasses
 
 import pandas as pd
 
-from mosys.io.atomic import write_text_atomically
-from mosys.io.controller_table import read_controller_table
-from mosys.io.trajectory import read_trajectory
-from mosys.motions import (
+from mosys.animation.motion_measures import (
     BASE_FLAT_DEG,
     JOINT_DEG,
     REST_RATE,
@@ -19,6 +16,9 @@ from mosys.motions import (
     measure,
     motions,
 )
+from mosys.io.atomic import write_text_atomically
+from mosys.io.controller_table import read_controller_table
+from mosys.io.trajectory import read_trajectory
 
 
 def motions_frame(trajectory_path: str, landing_table_path: str, budget: str) -> pd.DataFrame:
