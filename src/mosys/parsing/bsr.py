@@ -20,6 +20,7 @@ from mosys.parsing.tokens import (
     LineReader,
     SpecError,
     Token,
+    figure_line,
     format_number,
     missing_line,
     parse_int,
@@ -279,11 +280,8 @@ class _Parser:
     # --- lines ----------------------------------------------------------------------------
 
     def line_figure(self, line: Line) -> None:
-        reader = line.reader()
-        token = reader.peek()
-        self.figure = reader.name("the figure")
-        reader.end()
-        assert token is not None
+        token = figure_line(line)
+        self.figure = token.text
         self.tokens["figure"] = token
 
     def line_controller(self, line: Line) -> None:

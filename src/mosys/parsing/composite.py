@@ -79,6 +79,7 @@ from mosys.parsing.tokens import (
     Line,
     SpecError,
     Token,
+    figure_line,
     format_number,
     missing_line,
     parse_int,
@@ -471,11 +472,8 @@ class _Parser:
         )
 
     def line_figure(self, line: Line) -> None:
-        reader = line.reader()
-        token = reader.peek()
-        self.figure = reader.name("the figure")
-        reader.end()
-        assert token is not None
+        token = figure_line(line)
+        self.figure = token.text
         self.tokens["figure"] = token
 
     def line_phase(self, line: Line) -> None:

@@ -228,6 +228,17 @@ class LineReader:
             raise SpecError(self.path, token.line, token.column, "end of line", token.text)
 
 
+def figure_line(line: Line) -> Token:
+    """The name of a ``figure NAME`` line (a BSR search spec's, a composite script's) as its
+    token: the figure spec ``specs/figures/NAME.fig``. Nothing may follow the name."""
+    reader = line.reader()
+    token = reader.peek()
+    reader.name("the figure")
+    reader.end()
+    assert token is not None
+    return token
+
+
 def value_token(token: Token, key: str) -> Token:
     """The value part of a ``key=value`` token, with its own column, for precise errors."""
     return Token(token.text[len(key) + 1 :], token.line, token.column + len(key) + 1)
