@@ -1,4 +1,4 @@
-"""BSR benchmarks (issue 6): 40,000 sense-based evaluations of Mr. Star-Man (target <= 60 s on 2
+"""BSR benchmarks: 40,000 sense-based evaluations of Mr. Star-Man (target <= 60 s on 2
 cores; the paper: 3-6 min on a DEC 3000/400) and a whole time-based search of Beryl Biped (target
 <= 20 s; the paper: tens of seconds), each on 1 and 2 threads, and the first search of a fresh
 install (cold numba cache: JIT compilation included).

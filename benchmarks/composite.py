@@ -1,4 +1,4 @@
-"""Composite-motion benchmark (issue 7): the transition-point search of Figure 5 on Table 4's
+"""Composite-motion benchmark: the transition-point search of Figure 5 on Table 4's
 script, Q x G x H = 16 x 16 x 4 = 1,024 concatenations of the three robust Star-Man controllers
 (target <= 10 s on 2 cores with the controllers built; the paper: under a minute on a DEC
 3000/400), and the whole ``mosys composite`` command in a new process (imports, numba cache

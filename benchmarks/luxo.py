@@ -1,4 +1,4 @@
-"""Luxo benchmarks (issue 5): the landing controller's generation (target: <= 60 s warm on 2
+"""Luxo benchmarks: the landing controller's generation (target: <= 60 s warm on 2
 cores) and the simulation's speed against real time (target: >= 100x once compiled).
 
     python benchmarks/luxo.py            # full: generation cold and warm, the show simulated

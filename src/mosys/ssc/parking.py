@@ -1,7 +1,8 @@
 """Did the car park? The outcome of a car trajectory against its controller's obstacles and
-destination (the 1990 paper's §6; the issue's targets): no collision at any instant, and the
-reference point within ``position_m`` of the destination, the heading within ``heading_deg`` and
-the speed within ``speed_m_s`` of rest from some instant to the end of the run."""
+destination (the 1990 paper's §6, with the README's parking targets): no collision at any
+instant, and the reference point within ``position_m`` of the destination, the heading within
+``heading_deg`` and the speed within ``speed_m_s`` of rest from some instant to the end of the
+run."""
 
 from __future__ import annotations
 
