@@ -10,6 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from mosys.io.car_scene import CarScene
 from mosys.kernels.geometry import (
     first_collision,
     pack_polygons,
@@ -22,7 +23,7 @@ from mosys.parsing.figure import parse_figure_text
 from mosys.parsing.tokens import SpecError
 from mosys.parsing.vehicle import Vehicle
 from mosys.ssc.generate import build_problem, generate_controller
-from mosys.ssc.parking import Scene, parking_outcome
+from mosys.ssc.parking import parking_outcome
 
 CAR_LINE = (
     "vehicle wheelbase=2.5 length=4.0 width=1.7 front_overhang=0.8 wheel_radius=0.3 "
@@ -368,14 +369,13 @@ def test_states_in_collision_are_removed_and_cost_inf(car, tmp_path):
 
 
 def scene():
-    vertices, start = pack_polygons([box(-20, -1, 20, 0), box(3, 0.15, 7, 1.85)])
-    return Scene(
-        outline=box(-3.2, -0.85, 0.8, 0.85),
-        obstacle_vertices=vertices,
-        obstacle_start=start,
+    return CarScene(
+        body_outline=box(-3.2, -0.85, 0.8, 0.85),
+        obstacles=(box(-20, -1, 20, 0), box(3, 0.15, 7, 1.85)),
         obstacle_names=("curb", "front"),
         destination={"x": 0.0, "y": 1.0, "heading": 0.0},
         wheelbase=2.5,
+        domain=np.zeros((0, 2)),
     )
 
 

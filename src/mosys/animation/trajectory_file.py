@@ -15,10 +15,11 @@ from mosys.animation.runner import (
 )
 from mosys.dynamics.figure_motion import figure_contacts, figure_motion
 from mosys.dynamics.load import figure_dynamics
+from mosys.io.car_scene import car_scene_attributes
 from mosys.io.controller_table import read_controller_table
 from mosys.io.trajectory import Trajectory, write_trajectory
 from mosys.parsing.script import SwapController, parse_script
-from mosys.ssc.parking import Scene, parking_outcome
+from mosys.ssc.parking import parking_outcome, table_scene
 
 
 def run_animation_script(
@@ -53,9 +54,9 @@ def run_animation_script(
     if getattr(dynamics, "MODEL_KIND", "figure") == "vehicle":
         motion = None  # not an articulated figure: no figure_motion (DESIGN.md)
         first_table = next(iter(sources.controllers.values())).table
-        scene = Scene.from_table(first_table)
+        scene = table_scene(first_table)
         outcome = parking_outcome(run.t, run.state, run.state_order, scene)
-        extra = scene.attributes() | outcome.attributes()
+        extra = car_scene_attributes(scene) | outcome.attributes()
     else:
         motion = figure_motion(dynamics, run.t, run.figure_states)
         contacts = figure_contacts(dynamics, run.figure_states)

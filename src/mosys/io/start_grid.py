@@ -1,7 +1,7 @@
 """The start-grid result of a car controller (``results/car/start_grid.h5``): which start states
 park. Datasets ``start`` (n, d) spec units (columns: root attr ``state_order``), ``parked`` (n,)
 bool, ``collided`` (n,) bool, ``parking_seconds`` (n,) float64 (nan: not parked); root attrs
-``controller``, ``simulated_seconds``, ``dt`` and the scene (``ssc.parking.Scene.attributes``)."""
+``controller``, ``simulated_seconds``, ``dt`` and the scene (``io.car_scene``)."""
 
 from __future__ import annotations
 

@@ -10,6 +10,7 @@ from types import ModuleType
 
 import numpy as np
 
+from mosys.io.car_scene import has_car_scene, read_car_scene
 from mosys.io.controller_table import ControllerTable
 from mosys.kernels.geometry import pack_polygons
 from mosys.ssc.grid import FigureGrid, control_scale, figure_state_names
@@ -61,12 +62,15 @@ def lookahead_runtime(table: ControllerTable, dynamics: ModuleType, grid: Figure
     ]
     scale = np.array([control_scale(dynamics, n) for n in table.control_names])
     samples = np.array(list(itertools.product(*axes)), dtype=np.float64) * scale
-    vertices, start = pack_polygons(
-        [np.array(p, dtype=np.float64) for p in json.loads(attrs.get("obstacles", "[]"))]
-    )
     pose_slot = np.array([names.index(n) for n in ("x", "y", "heading")], dtype=np.int64)
-    if "body_outline" not in attrs:
-        pose_slot[:] = -1  # no obstacles and no domain polygon: every pose is free
+    if has_car_scene(attrs):
+        scene = read_car_scene(attrs, f"controller table of {table.figure}", table.dest)
+        outline, domain = scene.body_outline, scene.domain
+        vertices, start = pack_polygons(list(scene.obstacles))
+    else:  # no obstacles and no domain polygon: every pose is free
+        pose_slot[:] = -1
+        outline, domain = np.zeros((1, 2)), np.zeros((0, 2))
+        vertices, start = pack_polygons([])
     brake_control = table.control_names.index("wheel_accel")
     tolerance = json.loads(attrs["arrival_tolerance"])
     box = np.zeros((3, len(grid.names)))
@@ -83,14 +87,10 @@ def lookahead_runtime(table: ControllerTable, dynamics: ModuleType, grid: Figure
         known=np.ascontiguousarray(np.isfinite(value)),
         control_samples=np.ascontiguousarray(samples),
         pose_slot=pose_slot,
-        outline=np.ascontiguousarray(
-            json.loads(attrs.get("body_outline", "[[0, 0]]")), dtype=np.float64
-        ),
+        outline=outline,
         obstacle_vertices=vertices,
         obstacle_start=start,
-        domain=np.ascontiguousarray(
-            json.loads(attrs.get("domain", "[]")), dtype=np.float64
-        ).reshape(-1, 2),
+        domain=domain,
         vehicle_slot=np.array(
             [names.index(n) for n in VEHICLE_STATES] + [inputs.index(n) for n in VEHICLE_INPUTS],
             dtype=np.int64,

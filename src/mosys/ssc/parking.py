@@ -12,54 +12,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mosys.io.car_scene import CarScene, car_scene_attributes, read_car_scene
 from mosys.io.controller_table import ControllerTable
 from mosys.io.start_grid import StartGrid
 from mosys.kernels.geometry import first_colliding_sample, pack_polygons
 from mosys.ssc.controller import Controller
 
 TOLERANCE = {"position_m": 0.15, "heading_deg": 5.0, "speed_m_s": 0.05}
-
-
-@dataclass(frozen=True)
-class Scene:
-    """A car controller's world, from its table's attrs: body outline (V, 2) m in the car's
-    frame; obstacles packed for the kernels; their names; the destination pose (x m, y m,
-    heading deg)."""
-
-    outline: np.ndarray
-    obstacle_vertices: np.ndarray
-    obstacle_start: np.ndarray
-    obstacle_names: tuple[str, ...]
-    destination: dict[str, float]
-    wheelbase: float
-
-    @classmethod
-    def from_table(cls, table: ControllerTable) -> Scene:
-        attrs = table.attrs
-        polygons = [np.array(p, dtype=np.float64) for p in json.loads(attrs["obstacles"])]
-        vertices, start = pack_polygons(polygons)
-        return cls(
-            outline=np.ascontiguousarray(json.loads(attrs["body_outline"]), dtype=np.float64),
-            obstacle_vertices=vertices,
-            obstacle_start=start,
-            obstacle_names=tuple(str(n) for n in attrs["obstacle_names"]),
-            destination={k: table.dest.get(k, 0.0) for k in ("x", "y", "heading")},
-            wheelbase=float(attrs["wheelbase"]),
-        )
-
-    def attributes(self) -> dict:
-        """Trajectory root attrs that let a plot draw the scene from the trajectory alone."""
-        obstacles = [
-            self.obstacle_vertices[self.obstacle_start[k] : self.obstacle_start[k + 1]].tolist()
-            for k in range(len(self.obstacle_names))
-        ]
-        return {
-            "body_outline": json.dumps(self.outline.tolist()),
-            "obstacles": json.dumps(obstacles),
-            "obstacle_names": list(self.obstacle_names),
-            "destination": json.dumps(self.destination),
-            "wheelbase": self.wheelbase,
-        }
 
 
 @dataclass(frozen=True)
@@ -83,8 +42,13 @@ class ParkingOutcome:
         }
 
 
+def table_scene(table: ControllerTable) -> CarScene:
+    """The scene of a car controller table (its destination the table's ``dest``)."""
+    return read_car_scene(table.attrs, f"controller table of {table.figure}", table.dest)
+
+
 def parking_outcome(
-    t: np.ndarray, state: np.ndarray, state_order: tuple[str, ...], scene: Scene
+    t: np.ndarray, state: np.ndarray, state_order: tuple[str, ...], scene: CarScene
 ) -> ParkingOutcome:
     """The outcome of a car run: t (N,) s; state (N, d) spec units in ``state_order`` (x, y m;
     heading deg; speed m/s)."""
@@ -92,9 +56,8 @@ def parking_outcome(
     poses = np.ascontiguousarray(
         np.column_stack([column["x"], column["y"], np.radians(column["heading"])])
     )
-    sample, obstacle = first_colliding_sample(
-        poses, scene.outline, scene.obstacle_vertices, scene.obstacle_start
-    )
+    vertices, start = pack_polygons(list(scene.obstacles))
+    sample, obstacle = first_colliding_sample(poses, scene.body_outline, vertices, start)
     destination = scene.destination
     heading_error = (column["heading"] - destination["heading"] + 180.0) % 360.0 - 180.0
     inside = (
@@ -122,7 +85,7 @@ def evaluate_starts(
 ) -> StartGrid:
     """Run ``controller`` (a car's) from every start (n, d) in its state order, spec units, for
     ``seconds`` with step ``dt``, and judge each run (``parking_outcome``)."""
-    scene = Scene.from_table(controller.table)
+    scene = table_scene(controller.table)
     outcomes = []
     for start in starts:
         run = controller.simulate(controller.figure_state(start), seconds, dt)
@@ -140,6 +103,6 @@ def evaluate_starts(
             "simulated_seconds": float(seconds),
             "dt": float(dt),
             "parking_tolerance": json.dumps(TOLERANCE),
-            **scene.attributes(),
+            **car_scene_attributes(scene),
         },
     )
