@@ -1,16 +1,77 @@
-"""Shared fixtures: the real pendulum compiled from specs/ into a temporary results tree."""
+"""Shared fixtures (the real figures and controllers compiled from specs/ into temporary
+results trees) and the helpers the spec-parser tests share."""
 
 from __future__ import annotations
 
 import shutil
 import textwrap
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypeVar
 
 import pytest
 
+from mosys.parsing.tokens import END_OF_FILE, SpecError
+
 ROOT = Path(__file__).resolve().parents[1]
 SPECS = ROOT / "specs"
+
+
+# --- what the spec-parser tests share -------------------------------------------------------
+
+Parsed = TypeVar("Parsed")
+
+
+def parses_or_spec_error(
+    parse: Callable[[str, str], Parsed], text: str, path: str, check: Callable[[Parsed], None]
+) -> None:
+    """The fuzzing property of every spec grammar: ``parse(text, path)`` returns a value that
+    ``check`` accepts, or raises SpecError with the whole message ``path:line:column: expected
+    ..., found ...`` pointing into the text: at the word it found, at a line of the text for
+    'end of line', just past the last line at most for 'end of file'."""
+    try:
+        parsed = parse(text, path)
+    except SpecError as error:
+        shown = {None: "end of line", END_OF_FILE: "end of file"}
+        found = shown.get(error.found, repr(error.found))
+        assert str(error) == (
+            f"{path}:{error.line}:{error.column}: expected {error.expected}, found {found}"
+        )
+        assert error.expected and error.line >= 1 and error.column >= 1
+        lines = text.split("\n")  # lines end at '\n' only, as the tokenizer counts them
+        if error.found == END_OF_FILE:
+            assert error.line <= len(lines) + 1
+        else:
+            assert error.line <= len(lines)
+            if error.found is not None:
+                assert lines[error.line - 1][error.column - 1 :].startswith(error.found)
+    else:
+        check(parsed)
+
+
+@dataclass(frozen=True)
+class SpecLines:
+    """A valid spec's text, edited a line at a time (lines count from 1) to make an error."""
+
+    text: str
+
+    def replace(self, number: int, line: str) -> str:
+        lines = self.text.splitlines()
+        lines[number - 1] = line
+        return "\n".join(lines) + "\n"
+
+    def drop(self, number: int) -> str:
+        lines = self.text.splitlines()
+        del lines[number - 1]
+        return "\n".join(lines) + "\n"
+
+    def insert(self, number: int, line: str) -> str:
+        """``line`` becomes line ``number``."""
+        lines = self.text.splitlines()
+        lines.insert(number - 1, line)
+        return "\n".join(lines) + "\n"
+
 
 DOUBLE_INTEGRATOR = textwrap.dedent(
     '''
@@ -136,3 +197,29 @@ def composite_workspace(tmp_path_factory) -> CompositeWorkspace:
         budget="test",
     )
     return workspace
+
+
+# --- what the plot tests share --------------------------------------------------------------
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+def assert_png(
+    path: Path, least_bytes: int = 10_000, least_width: int = 500, least_height: int = 300
+) -> tuple[int, int]:
+    """``path`` is a PNG of at least ``least_bytes`` (under 3 MB), at least ``least_width`` x
+    ``least_height`` pixels (under 2500 each), not blank (more than 20 colours), written
+    atomically (no partial file beside it); returns its (width, height)."""
+    from PIL import Image
+
+    data = path.read_bytes()
+    assert data.startswith(PNG_MAGIC)
+    assert least_bytes < len(data) < 3_000_000, len(data)
+    with Image.open(path) as image:
+        assert image.format == "PNG"
+        width, height = image.size
+        colors = image.convert("RGB").getcolors(maxcolors=1 << 20)
+    assert least_width < width < 2500 and least_height < height < 2500, (width, height)
+    assert len(colors) > 20, f"{path} looks blank: {len(colors)} colours"
+    assert not list(path.parent.glob(".*.partial"))  # written atomically
+    return width, height

@@ -1,7 +1,9 @@
 """The BSR plots (learning curves of Figures 7 and 8, the filmstrip of Figures 9-12, the motion
 GIF) from small synthetic search results: a five-rod star (a torso, two arms at its top, two legs
 at its bottom) turning as it moves, written with ``write_bsr_result`` for a sense-based and a
-time-based search of a few seeds each, with made-up non-decreasing learning curves."""
+time-based search of a few seeds each, with made-up non-decreasing learning curves. The
+figures are checked through their matplotlib artists (``learning_figure``,
+``learning_comparison_figure``, ``filmstrip_figure``)."""
 
 from __future__ import annotations
 
@@ -11,6 +13,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import assert_png
+from matplotlib.collections import LineCollection, PolyCollection
 from PIL import Image
 
 import mosys.plots.bsr as bsr
@@ -19,10 +23,12 @@ from mosys.io.bsr_result import BsrController, BsrResult, write_bsr_result
 from mosys.io.trajectory import FigureMotion
 from mosys.plots.bsr import (
     best_result_path,
-    choose_interval,
     curves_on_grid,
+    filmstrip_figure,
     fitness_formula,
     group_by_search,
+    learning_comparison_figure,
+    learning_figure,
     letter_levels,
     plot_filmstrip,
     plot_learning,
@@ -30,12 +36,16 @@ from mosys.plots.bsr import (
     pose_offsets,
     read_result,
     rule_letter,
-    spread_labels,
     write_motion_gif,
 )
-from mosys.plots.pendulum import PlotInputError
+from mosys.plots.style import (
+    PlotInputError,
+    choose_interval,
+    controller_colors,
+    frame_indices,
+    spread_labels,
+)
 
-PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 DT = 0.01  # s between the samples of the motions
 ROD_NAMES = ("torso", "arm_left", "arm_right", "leg_left", "leg_right")
 # the star in its own frame, m: per rod its proximal then distal end; the torso hip to neck
@@ -180,15 +190,8 @@ def searches(tmp_path_factory: pytest.TempPathFactory) -> dict[str, list[Path]]:
     }
 
 
-def assert_png(path: Path) -> tuple[int, int]:
-    data = path.read_bytes()
-    assert data.startswith(PNG_MAGIC)
-    assert 10_000 < len(data) < 2_000_000
-    with Image.open(path) as image:
-        width, height = image.size
-    assert 600 < width < 2500 and 300 < height < 2500
-    assert not list(path.parent.glob(".*.partial"))  # written atomically
-    return width, height
+def legend_labels(legend) -> list[str]:
+    return [text.get_text() for text in legend.get_texts()]
 
 
 def test_the_fixture_writes_readable_results(searches: dict[str, list[Path]]) -> None:
@@ -256,29 +259,109 @@ def test_poses_are_shifted_apart_only_when_the_figure_hardly_travels() -> None:
     assert spacing == 0 and not offsets.any()
 
 
-def test_learning_plot(searches: dict[str, list[Path]], tmp_path: Path) -> None:
+def test_learning_figure(searches: dict[str, list[Path]]) -> None:
+    figure = learning_figure(searches["star_sense"])
+    curves, finals = figure.axes
+    assert figure.get_suptitle() == (
+        "BSR search star_sense: sense-based controller for starman, 3 seeds\n"
+        "best fitness found so far by each seed; fitness = 1·distance − 0.5·rotations"
+    )
+    assert curves.get_xlabel() == "controller evaluations (count)"
+    assert curves.get_ylabel() == "best fitness so far (Σ weight × term)"
+    assert curves.get_title() == "learning curve of each seed"
+    assert finals.get_title() == "final best fitness"
+    steps = [line for line in curves.lines if line.get_label().startswith("seed")]
+    assert [line.get_label() for line in steps] == ["seed 1", "seed 2", "seed 3"]  # by seed
+    colors = controller_colors(["1", "2", "3"])
+    for line, seed in zip(steps, (1, 2, 3), strict=True):
+        result = read_result(searches["star_sense"][0].parent / f"seed{seed}.h5")
+        np.testing.assert_array_equal(line.get_xdata(), [*result.evaluations, 5000])
+        np.testing.assert_array_equal(line.get_ydata()[:-1], result.best_fitness)
+        assert line.get_color() == colors[str(seed)]
+    assert [text.get_text() for text in finals.texts] == [
+        "seed 1: 1.1",
+        "seed 2: 2.5",
+        "seed 3: 2.5",
+    ]
+    marks = [line for line in finals.lines if line.get_marker() == "o"]
+    assert sorted(line.get_ydata()[0] for line in marks) == pytest.approx([1.1, 2.5, 2.5])
+    label_y = sorted(text.get_position()[1] for text in finals.texts)
+    assert label_y[2] - label_y[1] > 0  # the tied seeds' labels moved apart
+    with pytest.raises(PlotInputError, match="more than one search"):
+        learning_figure([*searches["star_sense"], *searches["star_time"]])
+
+
+def test_learning_plot_writes_a_png(searches: dict[str, list[Path]], tmp_path: Path) -> None:
     out = tmp_path / "learning.png"
     plot_learning(searches["star_sense"], out)
-    width, height = assert_png(out)
+    width, height = assert_png(out, least_width=600)
     assert width > height
-    with pytest.raises(PlotInputError, match="more than one search"):
-        plot_learning([*searches["star_sense"], *searches["star_time"]], tmp_path / "x.png")
 
 
-def test_learning_comparison_plot(searches: dict[str, list[Path]], tmp_path: Path) -> None:
+def test_learning_comparison_figure(searches: dict[str, list[Path]]) -> None:
+    figure = learning_comparison_figure(searches)
+    raw, scaled = figure.axes
+    assert figure.get_suptitle().startswith("Learning curves for both kinds of motion controller")
+    medians = [line for line in raw.lines if len(line.get_xdata()) > 1]
+    assert [line.get_linestyle() for line in medians] == ["-", "--"]  # sense solid, time dashed
+    bands = [c for c in raw.collections if isinstance(c, PolyCollection)]
+    assert len(bands) == 2  # min..max over the seeds of each search
+    grid, values = curves_on_grid([read_result(p) for p in searches["star_time"]])
+    np.testing.assert_allclose(medians[1].get_ydata(), np.nanmedian(values, axis=0))
+    scaled_lines = [line for line in scaled.lines if len(line.get_xdata()) > 2]
+    assert [line.get_ydata()[-1] for line in scaled_lines] == pytest.approx([1.0, 1.0])
+    assert raw.get_xlabel() == scaled.get_xlabel() == "controller evaluations (count)"
+    assert scaled.get_ylabel() == "median best fitness / final median (fraction)"
+    (legend,) = figure.legends
+    assert legend_labels(legend) == [
+        "star_sense (sense-based, 3 seeds)",
+        "star_time (time-based, 2 seeds)",
+    ]
+
+
+def test_learning_comparison_writes_a_png(searches: dict[str, list[Path]], tmp_path: Path) -> None:
     out = tmp_path / "comparison.png"
     plot_learning_comparison(searches, out)
-    width, height = assert_png(out)
+    width, height = assert_png(out, least_width=600)
     assert width > 1.5 * height
 
 
 @pytest.mark.parametrize("search", ["star_sense", "star_time"])
-def test_filmstrip(searches: dict[str, list[Path]], tmp_path: Path, search: str) -> None:
-    out = tmp_path / f"{search}.png"
-    plot_filmstrip(searches[search][0], out)
-    assert_png(out)
+def test_filmstrip_figure(searches: dict[str, list[Path]], search: str) -> None:
+    path = searches[search][0]
+    figure = filmstrip_figure(path)
+    *rows, colorbar = figure.axes
+    result = read_result(path)
+    t = result.motion.t
+    interval = choose_interval(float(t[-1] - t[0]))
+    assert interval == 0.25  # 4 s: 17 poses
+    samples = frame_indices(t, interval)
+    seed = int(result.attrs["seed"])
+    kind = "sense-based" if search == "star_sense" else "time-based"
+    assert figure.get_suptitle().startswith(
+        f"BSR search {search} (starman), seed {seed}: {kind} controller, 4 rules"
+    )
+    assert "poses every 0.25 s from 0 s to 4 s" in figure.get_suptitle()
+    assert colorbar.get_ylabel() == "time t (s)"
+    poses = [c for ax in rows for c in ax.collections if isinstance(c, LineCollection)]
+    assert len(poses) == len(samples) == 17  # one stick figure per pose
+    letters = [text.get_text() for ax in rows for text in ax.texts]
+    assert letters == [rule_letter(result.active_rule[s]) for s in samples]
+    assert all(ax.get_ylabel() == "y (m)" and ax.get_aspect() == 1.0 for ax in rows)
+    assert rows[-1].get_xlabel().startswith("x (m)")
+    # both travel less than half a pose width per pose: the poses are shifted apart
+    assert "each pose shifted right by" in figure.get_suptitle()
+    drawn_x = [pose.get_segments()[0][:, 0].mean() for pose in poses]
+    assert np.all(np.diff(drawn_x) > 0)
 
 
+def test_filmstrip_writes_a_png(searches: dict[str, list[Path]], tmp_path: Path) -> None:
+    out = tmp_path / "star_time.png"
+    plot_filmstrip(searches["star_time"][0], out)
+    assert_png(out, least_width=600)
+
+
+@pytest.mark.slow
 def test_motion_gif_is_small_and_real_time(searches: dict[str, list[Path]], tmp_path: Path) -> None:
     out = tmp_path / "motion.gif"
     write_motion_gif(searches["star_time"][0], out)
@@ -294,6 +377,7 @@ def test_motion_gif_is_small_and_real_time(searches: dict[str, list[Path]], tmp_
         assert gif.n_frames == 9 and gif.info["duration"] == 500
 
 
+@pytest.mark.slow
 def test_cli_draws_the_best_seed(
     searches: dict[str, list[Path]], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -313,8 +397,8 @@ def test_cli_draws_the_best_seed(
     )
     assert code == 0
     assert drawn == ["seed2.h5"]
-    assert_png(learning)
-    assert_png(strip)
+    assert_png(learning, least_width=600)
+    assert_png(strip, least_width=600)
     assert gif.stat().st_size > 10_000
 
 
@@ -324,7 +408,7 @@ def test_cli_comparison_groups_files_by_search(
     out = tmp_path / "compare.png"
     files = [str(p) for paths in searches.values() for p in paths]
     assert main(["plot", "bsr-learning", *files, "-o", str(out)]) == 0
-    assert_png(out)
+    assert_png(out, least_width=600)
 
 
 def test_cli_rejects_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:

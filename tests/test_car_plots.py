@@ -1,6 +1,7 @@
 """The car's plots (Figure 19, the parking GIF, the start-grid success map) from small car
 trajectories and a start grid built here: the car's own kinematics (mosys.dynamics.vehicle)
-integrated in numpy, collisions found by the real geometry kernel."""
+integrated in numpy, collisions found by the real geometry kernel. The figures are checked
+through their matplotlib artists (``parking_frames_figure``, ``success_map_figure``)."""
 
 from __future__ import annotations
 
@@ -11,9 +12,12 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from conftest import assert_png
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from matplotlib.collections import PathCollection, PolyCollection
 from matplotlib.colors import same_color
+from matplotlib.patches import Polygon
 from PIL import Image
 
 import mosys.plots.car as car
@@ -21,19 +25,21 @@ from mosys.io.trajectory import Trajectory, write_trajectory
 from mosys.kernels.geometry import first_colliding_sample, pack_polygons
 from mosys.plots.car import (
     FAILURE_COLOR,
-    PlotInputError,
+    OBSTACLE_FACE,
+    TIMEOUT_COLOR,
     drawn_samples,
-    frame_indices,
     outcome_text,
+    parking_frames_figure,
     plot_parking_frames,
     plot_success_map,
     read_car_trajectory,
+    success_map_figure,
     view_limits,
     wheel_segments,
     write_parking_gif,
 )
+from mosys.plots.style import GIF_HOLD_MS, PlotInputError, frame_indices
 
-PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 WHEELBASE = 2.5  # m, as specs/figures/car.fig
 BODY = [[0.8, -0.85], [0.8, 0.85], [-3.2, 0.85], [-3.2, -0.85]]  # m, car frame
 OBSTACLES = {
@@ -178,32 +184,33 @@ def write_start_grid(path: Path, steers=(0.0,)) -> Path:
     return path
 
 
-@pytest.fixture
-def saved_figures(monkeypatch) -> list:
-    """The figures the car plots save, kept for inspection (the PNG is still written)."""
-    figures = []
-    save = car.save_png
-
-    def keep(figure, path):
-        figures.append(figure)
-        save(figure, path)
-
-    monkeypatch.setattr(car, "save_png", keep)
-    return figures
-
-
-def assert_image(path: Path, kind: str, min_size=(300, 200)) -> Image.Image:
+def assert_gif(path: Path) -> None:
+    assert path.read_bytes()[:6] == b"GIF89a"
     with Image.open(path) as image:
-        assert image.format == kind
-        assert image.width >= min_size[0] and image.height >= min_size[1], image.size
+        assert image.format == "GIF"
+        assert image.width >= 300 and image.height >= 200, image.size
         colors = image.convert("RGB").getcolors(maxcolors=1 << 20)
         assert len(colors) > 20, f"{path} looks blank"
-        return image.size
 
 
 def outcome_label(ax):
     (label,) = [text for text in ax.texts if text.get_gid() == "outcome"]
     return label
+
+
+def legend_labels(figure) -> list[str]:
+    (legend,) = figure.legends
+    return [text.get_text() for text in legend.get_texts()]
+
+
+def polygons(ax, **style) -> list[Polygon]:
+    """The axes' Polygon patches whose properties match ``style`` (linestyle, fill...)."""
+    return [
+        patch
+        for patch in ax.patches
+        if isinstance(patch, Polygon)
+        and all(getattr(patch, f"get_{key}")() == value for key, value in style.items())
+    ]
 
 
 # --------------------------------------------------------------------------- the synthetic runs
@@ -319,63 +326,92 @@ def test_view_limits_clip_long_obstacles_to_the_cars_region():
 # --------------------------------------------------------------------------- the plots
 
 
-def test_parking_frames_png(tmp_path, parks, crashes, lost, saved_figures):
-    out = tmp_path / "frames.png"
-    plot_parking_frames([parks, crashes, lost], out, interval=0.3)
-    assert out.read_bytes()[:8] == PNG_MAGIC
-    assert_image(out, "PNG", min_size=(900, 300))
-    assert not [p for p in tmp_path.iterdir() if "partial" in p.name]
-    (figure,) = saved_figures
+def test_parking_frames_figure(parks, crashes, lost):
+    figure = parking_frames_figure([parks, crashes, lost], interval=0.3)
     panels = [ax for ax in figure.axes if ax.get_title()]
+    assert len(panels) == len(figure.axes) == 3
     assert [ax.get_title().split(":")[0] for ax in panels] == ["park_1", "park_2", "park_3"]
-    assert "controller park" in figure.get_suptitle()
+    assert figure.get_suptitle() == "The car parking under controller park"
     assert all(ax.get_xlim() == panels[0].get_xlim() for ax in panels)
     assert all(ax.get_ylim() == panels[0].get_ylim() for ax in panels)
     assert all(ax.get_aspect() == 1.0 for ax in panels)
+    assert [ax.get_ylabel() for ax in panels] == ["y (m)", "", ""]  # the left column only
+    assert all(ax.get_xlabel() == "x (m)" for ax in panels)
+    assert legend_labels(figure) == [
+        "obstacle",
+        "destination (car outline)",
+        "car every 0.3 s, light → dark",
+        "start and final outline",
+        "path of the front-axle midpoint",
+        "first collision",
+    ]
     parked, crashed, wandered = (outcome_label(ax) for ax in panels)
     assert parked.get_text().startswith("parked in") and parked.get_color() == "black"
     assert crashed.get_text().startswith("FAILED: hits front_car")
     assert crashed.get_color() == FAILURE_COLOR
     assert wandered.get_text() == "FAILED: not parked in 6 s"
     assert wandered.get_color() == FAILURE_COLOR
-    # the crash is drawn no further than its first colliding sample
+    for ax, path in zip(panels, (parks, crashes, lost), strict=True):
+        run = read_car_trajectory(path)
+        drawn = drawn_samples(run.t, 0.3, run.collision_index)
+        obstacles = [p for p in ax.patches if same_color(p.get_facecolor(), OBSTACLE_FACE)]
+        assert len(obstacles) == 3
+        assert {text.get_text() for text in ax.texts} & set(OBSTACLES)  # named where they fit
+        (goal,) = polygons(ax, linestyle=":")
+        assert np.ptp(goal.get_xy()[:, 0]) == pytest.approx(4.0)  # the 4 m body at the goal
+        # the outlines between the start and the final one, thin; those two thick
+        (between,) = [c for c in ax.collections if isinstance(c, PolyCollection)]
+        assert len(between.get_paths()) == len(drawn) - 2
+        assert len(polygons(ax, fill=False, linewidth=2.0)) == 2
+        (trace,) = [line for line in ax.lines if len(line.get_xdata()) > 1]
+        np.testing.assert_array_equal(trace.get_xdata(), run.x[: drawn[-1] + 1])
+    # the crash is drawn no further than its first colliding sample, that outline red
     run = read_car_trajectory(crashes)
-    (path,) = [line for line in panels[1].lines if len(line.get_xdata()) > 1]
-    assert len(path.get_xdata()) == run.collision_index + 1
-    assert path.get_xdata()[-1] == run.x[run.collision_index]
+    (trace,) = [line for line in panels[1].lines if len(line.get_xdata()) > 1]
+    assert len(trace.get_xdata()) == run.collision_index + 1
     red = [p for p in panels[1].patches if same_color(p.get_edgecolor(), FAILURE_COLOR)]
-    assert red, "the colliding outline is drawn in red"
+    assert len(red) == 1, "the colliding outline is drawn in red"
+    assert not [p for p in panels[0].patches if same_color(p.get_edgecolor(), FAILURE_COLOR)]
 
 
-def test_six_panels_are_two_rows_of_three(tmp_path, saved_figures):
+def test_parking_frames_png(tmp_path, parks, crashes, lost):
+    out = tmp_path / "frames.png"
+    plot_parking_frames([parks, crashes, lost], out, interval=0.3)
+    width, height = assert_png(out, least_width=900)
+    assert width > height
+
+
+def test_six_panels_are_two_rows_of_three(tmp_path):
     paths = [
         write_car_trajectory(tmp_path / f"park_{k}.h5", parking_states(steer))
         for k, steer in enumerate((-30, -15, 0, 10, 20, 30), start=1)
     ]
-    plot_parking_frames(paths, tmp_path / "six.png")
-    (figure,) = saved_figures
+    figure = parking_frames_figure(paths)
     boxes = [ax.get_position() for ax in figure.axes if ax.get_title()]
+    assert len(boxes) == 6
     assert len({round(b.y0, 6) for b in boxes}) == 2
     assert len({round(b.x0, 6) for b in boxes}) == 3
     assert [ax.get_title() for ax in figure.axes[:2]] == [
         "park_1: steer −30°",
         "park_2: steer −15°",
     ]
+    assert [ax.get_xlabel() for ax in figure.axes] == [""] * 3 + ["x (m)"] * 3  # lower row
 
 
 def test_parking_gif(tmp_path, crashes, parks):
     out = tmp_path / "park.gif"
     write_parking_gif(crashes, out, fps=10)
-    assert out.read_bytes()[:6] == b"GIF89a"
-    assert_image(out, "GIF")
+    assert_gif(out)
     run = read_car_trajectory(crashes)
     hit = run.collision_index
     with Image.open(out) as gif:
         # every 0.1 s up to the collision, both ends included: no frame after it
         expected = np.union1d(frame_indices(run.t[: run.collision_index + 1], 0.1), [hit])
         assert gif.n_frames == len(expected)
+        assert gif.info["duration"] == 100
         first = np.asarray(gif.convert("RGB"))
         gif.seek(gif.n_frames - 1)
+        assert gif.info["duration"] == GIF_HOLD_MS
         last = np.asarray(gif.convert("RGB"))
     assert np.any(first != last)
     write_parking_gif(parks, tmp_path / "parks.gif", fps=4)
@@ -384,25 +420,49 @@ def test_parking_gif(tmp_path, crashes, parks):
     assert not [p for p in tmp_path.iterdir() if "partial" in p.name]
 
 
-def test_success_map_one_panel(tmp_path, saved_figures):
+def test_success_map_one_panel(tmp_path):
+    figure = success_map_figure(write_start_grid(tmp_path / "grid.h5"))
+    assert figure.get_suptitle() == (
+        "Controller park: parks from 3 of 6 starts (50 %)\n"
+        "every start: heading 0°, steer 0°, speed 0.0 m/s; each run simulated for up to 20 s"
+    )
+    panel, colorbar = figure.axes
+    assert colorbar.get_ylabel() == "parking time (s)"
+    assert panel.get_aspect() == 1.0 and panel.get_title() == ""
+    parked, collided, late = (c for c in panel.collections if isinstance(c, PathCollection))
+    np.testing.assert_array_equal(parked.get_offsets(), [[0, 4], [3, 4], [6, 4]])
+    np.testing.assert_array_equal(parked.get_array(), [8.0, 10.0, 12.0])  # s, the colours
+    assert parked.get_clim() == (8.0, 12.0)
+    np.testing.assert_array_equal(collided.get_offsets(), [[0, 6]])
+    assert same_color(collided.get_edgecolor()[0], FAILURE_COLOR)
+    np.testing.assert_array_equal(late.get_offsets(), [[3, 6], [6, 6]])
+    assert same_color(late.get_facecolor()[0], TIMEOUT_COLOR)
+    assert len([p for p in panel.patches if same_color(p.get_facecolor(), OBSTACLE_FACE)]) == 3
+    assert len(polygons(panel, linestyle=":")) == 1  # the destination
+    assert legend_labels(figure) == [
+        "parked",
+        "collision",
+        "not parked in 20 s",
+        "destination (car outline)",
+    ]
+
+
+def test_success_map_one_panel_per_steer(tmp_path):
+    figure = success_map_figure(write_start_grid(tmp_path / "grid.h5", steers=(-30.0, 0.0)))
+    panels = [ax for ax in figure.axes if ax.get_title()]
+    assert [ax.get_title() for ax in panels] == ["start steer δ = −30°", "start steer δ = 0°"]
+    assert figure.get_suptitle().startswith("Controller park: parks from 3 of 12 starts (25 %)")
+    markers = [
+        [len(c.get_offsets()) for c in ax.collections if isinstance(c, PathCollection)]
+        for ax in panels
+    ]
+    assert markers == [[3, 1, 2], [1, 5]]  # no parked marker where none parks
+
+
+def test_success_map_png(tmp_path):
     out = tmp_path / "map.png"
     plot_success_map(write_start_grid(tmp_path / "grid.h5"), out)
-    assert_image(out, "PNG")
-    (figure,) = saved_figures
-    assert figure.get_suptitle().startswith("Controller park: parks from 3 of 6 starts (50 %)")
-    (panel, colorbar) = figure.axes[:2]
-    assert colorbar.get_ylabel() == "parking time (s)"
-    assert panel.get_aspect() == 1.0
-
-
-def test_success_map_one_panel_per_steer(tmp_path, saved_figures):
-    out = tmp_path / "map.png"
-    plot_success_map(write_start_grid(tmp_path / "grid.h5", steers=(-30.0, 0.0)), out)
-    assert_image(out, "PNG")
-    (figure,) = saved_figures
-    titles = [ax.get_title() for ax in figure.axes if ax.get_title()]
-    assert titles == ["start steer δ = −30°", "start steer δ = 0°"]
-    assert "parks from 3 of 12 starts (25 %)" in figure.get_suptitle()
+    assert_png(out)
 
 
 # --------------------------------------------------------------------------- bad inputs

@@ -1,6 +1,7 @@
 """The concatenation editor (the 1995 paper's §3 "manual animation editor"), driven headless
 through its widgets and callbacks on an Agg canvas, with real tiny BSR controllers
-(``composite_workspace``) and the session ``mosys composite`` scores with."""
+(``composite_workspace``: its searches make those tests slow) and the session ``mosys
+composite`` scores with."""
 
 from __future__ import annotations
 
@@ -88,6 +89,7 @@ def slider_click(slider, ticks: int) -> None:
 # --------------------------------------------------------------------------- moving a slider
 
 
+@pytest.mark.slow
 def test_the_editor_starts_from_the_scripts_durations(at_guess):
     editor = at_guess
     expected = editor.session.score([159, 90, 100])
@@ -99,6 +101,7 @@ def test_the_editor_starts_from_the_scripts_durations(at_guess):
     assert editor.status_text.get_text() == f"the durations in {editor.script_path}"
 
 
+@pytest.mark.slow
 def test_moving_a_slider_reruns_the_motion_and_redraws_it(at_guess):
     editor = at_guess
     drawn_before = np.array(editor.poses.get_segments())
@@ -134,6 +137,7 @@ def test_moving_a_slider_reruns_the_motion_and_redraws_it(at_guess):
     assert editor.status_text.get_text().startswith("unsaved")
 
 
+@pytest.mark.slow
 def test_each_phase_is_drawn_in_its_colour(at_guess):
     editor = at_guess
     editor.set_durations([100, 120, 130])
@@ -148,6 +152,7 @@ def test_each_phase_is_drawn_in_its_colour(at_guess):
     np.testing.assert_array_equal(switches, motion.com[[100, 220]])
 
 
+@pytest.mark.slow
 def test_set_duration_moves_the_slider_and_refuses_what_no_slider_gives(at_guess):
     editor = at_guess
     editor.set_duration(2, 150.0)  # a slider gives floats
@@ -167,6 +172,7 @@ def test_set_duration_moves_the_slider_and_refuses_what_no_slider_gives(at_guess
         editor.set_duration(3, 10)
 
 
+@pytest.mark.slow
 def test_reset_returns_to_the_start(at_guess):
     editor = at_guess
     editor.set_durations([10, 20, 30])
@@ -176,6 +182,7 @@ def test_reset_returns_to_the_start(at_guess):
     assert editor.status_text.get_text() == f"the durations in {editor.script_path}"
 
 
+@pytest.mark.slow
 def test_a_move_drawn_over_the_background_shows_what_a_full_draw_shows(at_guess):
     editor = at_guess
     canvas = editor.figure.canvas
@@ -209,6 +216,7 @@ def test_pose_samples_are_regular_and_round():
 # --------------------------------------------------------------------------- saving
 
 
+@pytest.mark.slow
 def test_save_rewrites_only_the_ticks(composite_workspace, tmp_path):
     path = copied_script(composite_workspace, tmp_path)
     original = path.read_bytes()
@@ -239,6 +247,7 @@ def test_save_rewrites_only_the_ticks(composite_workspace, tmp_path):
     assert path.read_bytes() == expected.replace("ticks=7\n", "ticks=90\n").encode()
 
 
+@pytest.mark.slow
 def test_save_leaves_a_script_changed_since_alone(composite_workspace, tmp_path):
     path = copied_script(composite_workspace, tmp_path)
     editor = open_editor(composite_workspace, path)
@@ -257,6 +266,7 @@ def test_save_leaves_a_script_changed_since_alone(composite_workspace, tmp_path)
     assert path.read_text() == changed
 
 
+@pytest.mark.slow
 def test_a_script_without_ticks_starts_equally_spaced_and_gains_them(composite_workspace, tmp_path):
     text = SHOW.read_text()
     for line, _ in PHASE_LINES:

@@ -1,5 +1,7 @@
 """The composite plots (the 1995 paper's Figures 13 and 14, Figure 5's search, the refined
-motion's GIF) from the real small composite result of the ``composite_workspace`` fixture."""
+motion's GIF) from the real small composite result of the ``composite_workspace`` fixture
+(slow: it runs BSR and composite searches), checked through their matplotlib artists
+(``filmstrips_figure``, ``search_figure``); the pose and label placement from made-up motions."""
 
 from __future__ import annotations
 
@@ -9,38 +11,28 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from conftest import assert_png
 from matplotlib.colors import to_rgba
 from PIL import Image
 
 import mosys.plots.composite as composite
 import mosys.plots.style as style
-from mosys.plots.car import frame_indices
 from mosys.plots.composite import (
+    filmstrips_figure,
     phase_colors,
     plot_filmstrips,
     plot_search,
     read_composite,
     search_curve,
+    search_figure,
     shade,
     strip_poses,
     switch_label_places,
+    switch_labels,
     switch_samples,
     write_composite_gif,
 )
-from mosys.plots.pendulum import PlotInputError
-
-PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
-
-
-def assert_png(path: Path) -> tuple[int, int]:
-    data = path.read_bytes()
-    assert data.startswith(PNG_MAGIC)
-    assert 10_000 < len(data) < 3_000_000
-    with Image.open(path) as image:
-        width, height = image.size
-    assert 600 < width < 2500 and 300 < height < 2500
-    assert not list(path.parent.glob(".*.partial"))  # written atomically
-    return width, height
+from mosys.plots.style import PlotInputError, frame_indices
 
 
 @pytest.fixture(scope="module")
@@ -67,6 +59,7 @@ def test_strip_poses_of_a_known_motion() -> None:
     assert poses.fraction[4] == 0 and poses.fraction[8] == 0 and poses.fraction[-1] == 1
 
 
+@pytest.mark.slow
 def test_strip_poses_of_the_real_result(result_path: Path) -> None:
     result = read_composite(result_path)
     interval = 0.25
@@ -102,6 +95,7 @@ def test_switch_labels_keep_apart_inside_the_view() -> None:
     assert x.min() >= gap / 2 - 1e-9 and x.max() <= 2.0 - gap / 2 + 1e-9
 
 
+@pytest.mark.slow
 def test_phase_colours_are_distinct_and_shaded(result_path: Path) -> None:
     phases = read_composite(result_path).phases
     colors = phase_colors(phases)
@@ -112,6 +106,7 @@ def test_phase_colours_are_distinct_and_shaded(result_path: Path) -> None:
     assert sum(shade(color, 0.3)[:3]) > sum(shade(color, 0.7)[:3])
 
 
+@pytest.mark.slow
 def test_filmstrips_draw_both_panels_in_phase_colours(
     result_path: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -123,18 +118,44 @@ def test_filmstrips_draw_both_panels_in_phase_colours(
         real(ax, pose, color, zorder)
 
     monkeypatch.setattr(composite, "draw_pose", recorded)
-    out = tmp_path / "strips.png"
-    plot_filmstrips(result_path, out, interval=0.25)
-    assert_png(out)
+    figure = filmstrips_figure(result_path, interval=0.25)
 
     result = read_composite(result_path)
     colors = phase_colors(result.phases)
     panels = list(dict.fromkeys(ax for ax, _ in drawn))
-    assert len(panels) == 2  # before above after
+    assert panels == figure.axes  # before above after
     assert panels[0].get_position().y0 > panels[1].get_position().y0
-    for ax, stored, phases in zip(
-        panels, (result.before, result.after), (result.phases_before, result.phases), strict=True
+    assert figure.get_suptitle().startswith(
+        "Composite motion starman_show: the trajectory before and after the transition points "
+        "are refined\nthe figure every 0.25 s"
+    )
+    assert (
+        panels[0]
+        .get_title(loc="left")
+        .startswith("Before refinement (Figure 13): the guessed transition points\nscript total ")
+    )
+    assert (
+        panels[1]
+        .get_title(loc="left")
+        .startswith(
+            "After refinement (Figure 14): the transition points found by the search\nscript total "
+        )
+    )
+    for ax, stored, phases, legend in zip(
+        panels,
+        (result.before, result.after),
+        (result.phases_before, result.phases),
+        figure.legends,
+        strict=True,
     ):
+        labels = [text.get_text() for text in legend.get_texts()]
+        assert len(labels) == len(phases) + 1
+        assert [label.split(":")[0] for label in labels[:-1]] == [p["name"] for p in phases]
+        assert labels[-1] == "the pose at a switch (its time above it)"
+        switches = switch_samples(stored.motion.t, phases)
+        notes = [text.get_text() for text in ax.texts]  # the switch labels, arrows to the poses
+        assert notes == switch_labels(phases, switches, stored.motion.t)
+        assert len(notes) == len(phases) - 1
         poses = strip_poses(stored.motion.t, stored.phase, phases, 0.25)
         expected = [
             to_rgba(composite.SWITCH_COLOR) if switch else shade(colors[k], fraction)
@@ -145,8 +166,12 @@ def test_filmstrips_draw_both_panels_in_phase_colours(
         assert ax.get_aspect() == 1.0
         assert sum(c == to_rgba("black") for c in got) == len(phases) - 1
     assert panels[0].get_xlim() == panels[1].get_xlim()  # one view for both
+    out = tmp_path / "strips.png"
+    plot_filmstrips(result_path, out, interval=0.25)
+    assert_png(out, least_width=600)
 
 
+@pytest.mark.slow
 def test_search_plot(result_path: Path, tmp_path: Path) -> None:
     result = read_composite(result_path)
     generations, scores = search_curve(result)
@@ -154,11 +179,30 @@ def test_search_plot(result_path: Path, tmp_path: Path) -> None:
     assert scores[0] == result.attrs["score_before"]
     assert scores[-1] == pytest.approx(result.attrs["score_after"])
     assert np.all(np.diff(scores) >= 0)  # the best so far never falls
+    figure = search_figure(result_path)
+    (ax,) = figure.axes
+    assert ax.get_title().startswith(
+        "Composite motion starman_show: transition-point search (Figure 5)"
+    )
+    assert ax.get_xlabel() == "generation (0: the guessed transition points)"
+    assert ax.get_ylabel() == "best script total so far"
+    guess, curve, points = ax.lines
+    assert list(guess.get_ydata()) == [scores[0], scores[0]]  # the guess's total, dotted
+    assert guess.get_linestyle() == ":"
+    np.testing.assert_array_equal(curve.get_xdata(), generations)
+    np.testing.assert_array_equal(curve.get_ydata(), scores)
+    assert curve.get_drawstyle() == "steps-post"
+    np.testing.assert_array_equal(points.get_ydata(), scores)
+    texts = [text.get_text() for text in ax.texts]
+    assert texts[0].startswith("the guess: ")
+    assert f"{int(result.attrs['simulations']):,} simulations in" in texts[1]
+    assert "Q = 4, G = 3, H = 2" in texts[1]
     out = tmp_path / "search.png"
     plot_search(result_path, out)
-    assert_png(out)
+    assert_png(out, least_width=600)
 
 
+@pytest.mark.slow
 def test_gif_plays_the_refined_motion_in_real_time(result_path: Path, tmp_path: Path) -> None:
     result = read_composite(result_path)
     t = result.after.motion.t
@@ -195,6 +239,7 @@ def _without(source: Path, target: Path, attribute: str) -> Path:
 @pytest.mark.parametrize(
     "write", [plot_filmstrips, plot_search, write_composite_gif], ids=lambda f: f.__name__
 )
+@pytest.mark.slow
 def test_bad_input_raises_and_writes_nothing(result_path: Path, tmp_path: Path, write) -> None:
     out = tmp_path / "out.png"
     not_hdf5 = tmp_path / "bogus.h5"

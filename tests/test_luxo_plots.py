@@ -1,6 +1,8 @@
 """Luxo's plots (the motion strip of Figure 22, the show GIF, torques and ground forces) from a
 short real trajectory: the lamp compiled from specs/figures/luxo.fig, a hop motor program run
-from the standing pose by the real kernel, written with its figure_motion and contacts."""
+from the standing pose by the real kernel, written with its figure_motion and contacts. The
+figures are checked through their matplotlib artists (``motion_strip_figure``,
+``torques_and_forces_figure``)."""
 
 from __future__ import annotations
 
@@ -10,9 +12,13 @@ from types import ModuleType
 
 import numpy as np
 import pytest
+from conftest import assert_png
+from matplotlib.collections import LineCollection
+from matplotlib.colors import same_color
 from PIL import Image
 
 import mosys.plots.luxo as luxo
+import mosys.plots.style as style
 from mosys.animation.motion_measures import motions
 from mosys.animation.motor_program import BoundMotorProgram
 from mosys.dynamics.compile import compile_figure
@@ -21,22 +27,24 @@ from mosys.dynamics.load import load_dynamics
 from mosys.io.trajectory import Trajectory, read_trajectory, write_trajectory
 from mosys.parsing.motor import parse_motor_program_text
 from mosys.plots.luxo import (
+    COM_COLOR,
     HEAD_LENGTH,
     HEAD_MOUTH,
     STILL_DISTANCE,
     contact_labels,
     head_outline,
+    motion_strip_figure,
     net_rotation,
-    pan,
     plot_motion_strip,
     plot_torques_and_forces,
     strip_samples,
+    torques_and_forces_figure,
     write_show_gif,
 )
+from mosys.plots.style import POSE_TIMES, pan
 from mosys.ssc.grid import control_scale, state_unit
 
 LUXO = Path(__file__).resolve().parents[1] / "specs" / "figures" / "luxo.fig"
-PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 DT = 0.001  # s
 HOP = """
 figure luxo
@@ -105,15 +113,8 @@ def landed_path(tmp_path_factory: pytest.TempPathFactory, lamp: ModuleType) -> P
     return path
 
 
-def assert_png(path: Path, least_bytes: int = 20_000) -> tuple[int, int]:
-    data = path.read_bytes()
-    assert data.startswith(PNG_MAGIC)
-    assert least_bytes < len(data) < 2_000_000
-    with Image.open(path) as image:
-        width, height = image.size
-    assert 500 < width < 2500 and 300 < height < 2500
-    assert not list(path.parent.glob(".*.partial"))  # written atomically
-    return width, height
+def legend_labels(legend) -> list[str]:
+    return [text.get_text() for text in legend.get_texts()]
 
 
 def test_the_fixture_is_one_hop(hop_path: Path, landed_path: Path) -> None:
@@ -127,10 +128,49 @@ def test_the_fixture_is_one_hop(hop_path: Path, landed_path: Path) -> None:
 
 
 @pytest.mark.parametrize("fixture", ["hop_path", "landed_path"])
-def test_motion_strip_writes_a_png(fixture: str, request, tmp_path: Path) -> None:
+def test_motion_strip_draws_the_lamp_every_interval(fixture: str, request) -> None:
+    path = request.getfixturevalue(fixture)
+    figure = motion_strip_figure(path, "hop", every=0.04)
+    ax, colorbar = figure.axes
+    trajectory = read_trajectory(path)
+    (hop,) = motions(trajectory)
+    rotation = net_rotation(trajectory, hop)
+    assert ax.get_title() == (
+        f"Luxo: hop (net base rotation {rotation:.0f}°)\n".replace("-", "−")
+        + "poses every 0.04 s from t = 0.00 s to 0.48 s, the landing included"
+    )
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("x (m)", "y (m)")
+    assert ax.get_aspect() == 1.0
+    assert colorbar.get_ylabel() == "time since the motion began (s)"
+    motion = trajectory.motion
+    samples = strip_samples(trajectory.t, motion.endpoints, 0, len(trajectory.t) - 1, 0.04)
+    assert 3 <= len(samples) <= 13
+    lamps = [c for c in ax.collections if isinstance(c, LineCollection)]
+    assert len(lamps) == len(samples)  # one lamp (its rods) per pose drawn
+    for lamp, sample in zip(lamps, samples, strict=True):
+        np.testing.assert_allclose(lamp.get_segments(), motion.endpoints[sample])
+    assert same_color(lamps[0].get_color()[0], POSE_TIMES(0.0))  # light to dark
+    assert same_color(lamps[-1].get_color()[0], POSE_TIMES(1.0))
+    heads = [p for p in ax.patches if p.get_zorder() > 3]
+    assert len(heads) == len(samples)  # a lamp shade on each
+    (com,) = [line for line in ax.lines if same_color(line.get_color(), COM_COLOR)]
+    np.testing.assert_allclose(com.get_xydata(), motion.com)
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()  # every pose in view
+    drawn = motion.endpoints[samples]
+    assert x0 < drawn[..., 0].min() and drawn[..., 0].max() < x1
+    assert y0 < drawn[..., 1].min() and drawn[..., 1].max() < y1
+    (legend,) = figure.legends
+    assert legend_labels(legend) == [
+        "ground",
+        "Luxo every 0.04 s (once when still), light → dark",
+        "centre of mass",
+    ]
+
+
+def test_motion_strip_writes_a_png(hop_path: Path, tmp_path: Path) -> None:
     out = tmp_path / "strip.png"
-    plot_motion_strip(request.getfixturevalue(fixture), out, "hop", every=0.04)
-    width, height = assert_png(out)
+    plot_motion_strip(hop_path, out, "hop", every=0.04)
+    width, height = assert_png(out, least_bytes=20_000)
     assert width > height  # a strip
 
 
@@ -143,10 +183,47 @@ def test_motion_strip_names_the_motions_there_are(hop_path: Path, tmp_path: Path
     assert not out.exists()
 
 
+@pytest.mark.parametrize("fixture", ["hop_path", "landed_path"])
+def test_torques_and_forces_figure(fixture: str, request) -> None:
+    path = request.getfixturevalue(fixture)
+    figure = torques_and_forces_figure(path)
+    timeline, torques, forces = figure.axes
+    trajectory = read_trajectory(path)
+    assert timeline.get_title() == "Luxo's joint torques and ground forces: test_hop.anim"
+    assert [text.get_text() for text in timeline.texts] == ["hop"]  # the motion, named
+    expected = ["motor program driving"]
+    if fixture == "landed_path":
+        expected.append("then controller land")
+    assert legend_labels(timeline.get_legend()) == expected
+    names = list(trajectory.control_names)
+    assert torques.get_legend().get_title().get_text() == "actuator"
+    assert legend_labels(torques.get_legend()) == names
+    for j, name in enumerate(names):
+        (line,) = [line for line in torques.lines if line.get_label() == name]
+        np.testing.assert_array_equal(line.get_ydata(), trajectory.control[:, j])
+    assert torques.get_ylabel() == "joint torque (N·m)"
+    weight = float(np.sum(trajectory.motion.rod_mass) * trajectory.motion.gravity)
+    assert forces.get_legend().get_title().get_text() == "contact point"
+    assert legend_labels(forces.get_legend()) == [
+        "base front edge",
+        "base back edge",
+        "head",
+        f"Luxo's weight, {weight:.1f} N",
+    ]
+    magnitude = np.linalg.norm(trajectory.contacts.force, axis=2)
+    for c, label in enumerate(["base front edge", "base back edge", "head"]):
+        (line,) = [line for line in forces.lines if line.get_label() == label]
+        np.testing.assert_array_equal(line.get_ydata(), magnitude[:, c])
+    assert magnitude.max() > weight  # the push off
+    assert forces.get_yscale() == "symlog"
+    assert forces.get_xlabel() == "time t (s)"
+    assert forces.get_xlim() == pytest.approx((0.0, HOP_SECONDS))
+
+
 def test_torques_and_forces_writes_a_png(landed_path: Path, tmp_path: Path) -> None:
     out = tmp_path / "torques.png"
     plot_torques_and_forces(landed_path, out)
-    assert_png(out)
+    assert_png(out, least_bytes=20_000)
 
 
 @pytest.mark.parametrize("fixture", ["hop_path", "landed_path"])
@@ -176,7 +253,8 @@ def test_show_gif_follows_a_lamp_wider_than_the_view(
 ) -> None:
     # a view 0.3 m wide (narrower than the lamp), the figure up to 1.6 times taller than wide
     monkeypatch.setattr(luxo, "FOLLOW_WIDTH", 0.3)
-    monkeypatch.setattr(luxo, "ASPECT_RANGE", (0.3, 1.6))
+    monkeypatch.setattr(luxo, "ASPECT_RANGE", (0.3, 1.6))  # the window's height / width
+    monkeypatch.setattr(style, "ASPECT_RANGE", (0.3, 1.6))  # the view's (style.fit_aspect)
     views = []
 
     def recorded_pan(view, x):

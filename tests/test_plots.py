@@ -1,6 +1,6 @@
-"""The pendulum plots: the cylindrical path splitting (hypothesis), and every plot kind writing a
-real, non-blank PNG or animated GIF from tables and a trajectory built here, from the real
-specs, with a stand-in for the generated pendulum dynamics."""
+"""The pendulum plots: the cylindrical path splitting (hypothesis), and what each plot draws
+(through its matplotlib Figure) from hand-made tables and a hand-made trajectory, quick; the
+phase portraits and the CLI from controllers generated here by the DP from the real specs, slow."""
 
 from __future__ import annotations
 
@@ -8,77 +8,94 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import assert_png
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from matplotlib.collections import QuadMesh
+from matplotlib.colors import same_color
+from matplotlib.contour import ContourSet
 from PIL import Image
 
 from mosys.cli import main
-from mosys.io.trajectory import FigureMotion, Trajectory, write_trajectory
+from mosys.io.controller_table import ControllerTable, write_controller_table
+from mosys.io.trajectory import FigureMotion, Trajectory, read_trajectory, write_trajectory
 from mosys.parsing.controller import parse_controller_spec
 from mosys.plots.pendulum import (
     StateAxis,
     cylinder_pieces,
-    plot_portrait,
     plot_script,
     plot_torque,
+    portrait_figure,
     portrait_starts,
+    script_path_figure,
     split_at_wraps,
+    torque_figure,
     write_script_gif,
 )
-from mosys.ssc.controller import Controller
+from mosys.plots.style import controller_colors
 from mosys.ssc.generate import generate_controller
 
 ROOT = Path(__file__).resolve().parents[1]
 PENDULUM_SPECS = ROOT / "specs" / "controllers" / "pendulum"
-PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 PENDULUM_AXES = (
     StateAxis("angle", "deg", -180.0, 180.0, 360.0),
     StateAxis("omega", "deg/s", -500.0, 500.0, None),
 )
+ANGLES = np.arange(-180.0, 171.0, 10.0)  # the specs' grid: 36 nodes, wrapped
+RATES = np.linspace(-500.0, 500.0, 21)
+DESTINATIONS = {"A": {"angle": 0.0, "omega": 0.0}, "D": {"angle": 0.0, "omega": 300.0}}
+DT = 0.001  # s between the samples of the hand-made trajectory
 
 
 # --------------------------------------------------------------------------- fixtures
 
 
 @pytest.fixture(scope="module")
-def dynamics(link1):
-    """The real pendulum dynamics, compiled from specs/figures/link1.fig (conftest)."""
-    return link1
-
-
-@pytest.fixture(scope="module")
-def tables(dynamics, tmp_path_factory) -> dict[str, Path]:
-    """Controllers A (rest at 0 deg) and D (periodic: 0 deg at 300 deg/s), from the real specs."""
-    directory = tmp_path_factory.mktemp("controllers")
+def drawn_tables(tmp_path_factory) -> dict[str, Path]:
+    """Hand-made controllers A (rest at 0 deg) and D (periodic: 0 deg at 300 deg/s) on the
+    specs' grid, enough for the plots that only read a table: a PD torque law (N·m, within
+    ±10) and a cost-to-go (s) growing with the distance from the destination."""
+    directory = tmp_path_factory.mktemp("drawn_controllers")
+    angle, rate = np.meshgrid(ANGLES, RATES, indexing="ij")
     paths = {}
-    for name in "AD":
+    for name, dest in DESTINATIONS.items():
+        error = (angle - dest["angle"], rate - dest["omega"])
+        torque = np.clip(-0.05 * error[0] - 0.02 * error[1], -10.0, 10.0)[..., None]
+        value = 2.0 * np.hypot(error[0] / 180.0, error[1] / 500.0)
         paths[name] = directory / f"{name}.h5"
-        spec = parse_controller_spec(PENDULUM_SPECS / f"{name}.ssc")
-        generate_controller(spec, dynamics, paths[name], quiet=True)
+        write_controller_table(
+            paths[name],
+            ControllerTable(
+                state_order=("angle", "omega"),
+                control_names=("torque",),
+                axes=(ANGLES, RATES),
+                axis_units=("deg", "deg/s"),
+                wrap=(True, False),
+                torque=torque,
+                value=value,
+                control_min=np.array([-10.0]),
+                control_max=np.array([10.0]),
+                effort_weight=np.array([0.1]),
+                dest=dest,
+                figure="link1",
+                attrs={"dt": DT},
+            ),
+        )
     return paths
 
 
 @pytest.fixture(scope="module")
-def trajectory(dynamics, tables, tmp_path_factory) -> Path:
-    """A two-controller script: from (-135 deg, 350 deg/s), A for 0.5 s, then D for 0.5 s."""
-    dt = 0.001
-    controllers = [Controller.load(tables[name], dynamics) for name in "AD"]
-    state = controllers[0].figure_state(np.array([-135.0, 350.0]))
-    figure_states, controls, index = [], [], []
-    for k, controller in enumerate(controllers):
-        run = controller.simulate(state, 0.5, dt)
-        figure_states.append(run.states[:-1])
-        controls.append(run.controls)
-        index.append(np.full(len(run.controls), k))
-        state = run.states[-1]
-    figure_states.append(state[None])
-    controls.append(controls[-1][-1:])
-    index.append(index[-1][-1:])
-    figure_states = np.concatenate(figure_states)
-    t = dt * np.arange(len(figure_states))
-    angle = figure_states[:, 0]
-    endpoints = np.zeros((len(t), 1, 2, 2))  # rod pinned at the origin, 1 m long
-    endpoints[:, 0, 1] = np.column_stack([np.cos(angle), np.sin(angle)])
+def trajectory(tmp_path_factory) -> Path:
+    """A hand-made two-controller script, 1 s: A from (-135 deg, 400 deg/s) for 0.5 s, then D;
+    the angle passes +180 deg (wraps to -180) near t = 0.8 s. The rod (1 m, pinned at the
+    origin) at the angle as its figure_motion."""
+    t = DT * np.arange(1001)
+    rate = 400.0 - 60.0 * t
+    unwrapped = -135.0 + 400.0 * t - 30.0 * t**2
+    angle = (unwrapped + 180.0) % 360.0 - 180.0
+    radians = np.radians(angle)
+    endpoints = np.zeros((len(t), 1, 2, 2))
+    endpoints[:, 0, 1] = np.column_stack([np.cos(radians), np.sin(radians)])
     motion = FigureMotion(
         t=t,
         endpoints=endpoints,
@@ -97,9 +114,9 @@ def trajectory(dynamics, tables, tmp_path_factory) -> Path:
         path,
         Trajectory(
             t=t,
-            state=controllers[0].controller_states(figure_states),
-            control=np.concatenate(controls),
-            controller=np.concatenate(index),
+            state=np.column_stack([angle, rate]),
+            control=np.zeros((len(t), 1)),
+            controller=(t >= 0.5 - 1e-9).astype(np.int64),
             state_order=("angle", "omega"),
             control_names=("torque",),
             controllers=("A", "D"),
@@ -115,13 +132,42 @@ def trajectory(dynamics, tables, tmp_path_factory) -> Path:
     return path
 
 
-def assert_real_png(path: Path) -> None:
-    """A PNG file, not blank: many colours."""
-    assert path.read_bytes()[:8] == PNG_MAGIC
-    with Image.open(path) as image:
-        assert image.format == "PNG"
-        colors = image.convert("RGB").getcolors(maxcolors=1 << 20)
-        assert len(colors) > 20, f"{path} looks blank: {len(colors)} colours"
+@pytest.fixture(scope="module")
+def dynamics(link1):
+    """The real pendulum dynamics, compiled from specs/figures/link1.fig (conftest)."""
+    return link1
+
+
+@pytest.fixture(scope="module")
+def tables(dynamics, tmp_path_factory) -> dict[str, Path]:
+    """Controllers A and D generated by the DP from the real specs (slow: a few seconds)."""
+    directory = tmp_path_factory.mktemp("controllers")
+    paths = {}
+    for name in "AD":
+        paths[name] = directory / f"{name}.h5"
+        spec = parse_controller_spec(PENDULUM_SPECS / f"{name}.ssc")
+        generate_controller(spec, dynamics, paths[name], quiet=True)
+    return paths
+
+
+def legend_labels(figure) -> list[str]:
+    (legend,) = figure.legends
+    return [text.get_text() for text in legend.get_texts()]
+
+
+def marker_lines(ax, marker: str) -> list:
+    return [line for line in ax.lines if line.get_marker() == marker]
+
+
+def assert_destination_marked(ax, x: float, y: float) -> None:
+    """mark_destination's encircled X: a white halo under a black circle and cross at (x, y)."""
+    marks = [
+        line for line in ax.lines if line.get_marker() in ("o", "x") and line.get_zorder() >= 5
+    ]
+    marks = [line for line in marks if line.get_markersize() >= 6.8]
+    assert sorted(line.get_marker() for line in marks) == ["o", "o", "x", "x"]
+    for line in marks:
+        assert (line.get_xdata()[0], line.get_ydata()[0]) == (x, y)
 
 
 def assert_no_partials(directory: Path) -> None:
@@ -194,28 +240,90 @@ def test_portrait_starts_are_spread_over_the_domain():
 
 
 @pytest.mark.parametrize("name", ["A", "D"])
-def test_portrait_writes_a_png(dynamics, tables, tmp_path, name):
-    out = tmp_path / f"portrait_{name}.png"
-    plot_portrait(tables[name], dynamics, out)
-    assert_real_png(out)
-    assert_no_partials(tmp_path)
+def test_torque_figure_draws_the_table_as_a_heat_map(drawn_tables, name):
+    figure = torque_figure(drawn_tables[name])
+    ax, colorbar = figure.axes
+    dest = DESTINATIONS[name]
+    assert ax.get_title() == (
+        f"Controller {name}: torque table, 36 × 21 nodes\n"
+        f"destination θ = 0 deg, ω = {dest['omega']:g} deg/s"
+    )
+    assert ax.get_xlabel() == "angle θ (deg) — cylindrical"
+    assert ax.get_ylabel() == "omega ω (deg/s)"
+    assert ax.get_xlim() == (-180.0, 180.0)  # one period of the wrapped angle
+    assert ax.get_ylim() == pytest.approx((-520.0, 520.0))  # the range and a 2 % margin
+    (mesh,) = [c for c in ax.collections if isinstance(c, QuadMesh)]
+    assert mesh.get_array().shape == (21, 37)  # a cell per node, the wrapped edge repeated
+    assert mesh.get_clim() == (-10.0, 10.0)  # centred on 0 N·m
+    assert mesh.get_array().min() < -5 and mesh.get_array().max() > 5
+    assert colorbar.get_ylabel() == "torque (N·m)"
+    (contours,) = [c for c in ax.collections if isinstance(c, ContourSet)]
+    np.testing.assert_allclose(np.diff(contours.levels), contours.levels[0])  # round steps
+    assert 6 <= len(contours.levels) <= 12
+    labels = [text.get_text() for text in ax.texts]
+    assert labels and all(label.endswith(" s") for label in labels)
+    assert_destination_marked(ax, dest["angle"], dest["omega"])
+    assert legend_labels(figure) == ["cost-to-go, contours labelled in s", "destination"]
 
 
-def test_torque_writes_a_png(tables, tmp_path):
+def test_torque_writes_a_png(drawn_tables, tmp_path):
     out = tmp_path / "plots" / "torque_A.png"  # the directory is made as needed
-    plot_torque(tables["A"], out)
-    assert_real_png(out)
+    plot_torque(drawn_tables["A"], out)
+    assert assert_png(out) == (840, 696)  # 7 x 5.8 inches at 120 dpi
     assert_no_partials(out.parent)
 
 
-def test_script_writes_a_png_with_and_without_the_tables(trajectory, tables, tmp_path):
-    with_tables = tmp_path / "script.png"
-    plot_script(trajectory, [tables["A"], tables["D"]], with_tables)
-    assert_real_png(with_tables)
-    without_tables = tmp_path / "script_bare.png"
-    plot_script(trajectory, [], without_tables)
-    assert_real_png(without_tables)
-    assert with_tables.read_bytes() != without_tables.read_bytes()  # dA, dD drawn only with tables
+def test_script_figure_draws_each_controllers_stretch(trajectory, drawn_tables):
+    figure = script_path_figure(trajectory, [drawn_tables["A"], drawn_tables["D"]])
+    (ax,) = figure.axes
+    assert ax.get_title() == (
+        "State-space path of the animation script two_controllers.anim\n"
+        "2 controller invocations over 1.00 s"
+    )
+    assert ax.get_xlabel() == "angle θ (deg) — cylindrical"
+    assert ax.get_xlim() == (-180.0, 180.0)
+    colors = controller_colors(["A", "D"])
+    state = read_trajectory(trajectory).state
+    paths = [line for line in ax.lines if line.get_linewidth() == 1.8]
+    # each stretch cut where the angle wraps: A's one piece, D's two (it passes +180 deg)
+    expected = [("A", piece) for piece in cylinder_pieces(state[:501], PENDULUM_AXES)]
+    expected += [("D", piece) for piece in cylinder_pieces(state[500:], PENDULUM_AXES)]
+    assert len(paths) == len(expected) == 3
+    for line, (name, piece) in zip(paths, expected, strict=True):
+        assert same_color(line.get_color(), colors[name])
+        np.testing.assert_array_equal(line.get_xydata(), piece)
+    starts = marker_lines(ax, "s")
+    assert [(s.get_xdata()[0], s.get_ydata()[0]) for s in starts] == [
+        tuple(state[0]),
+        tuple(state[500]),
+    ]
+    for start, name in zip(starts, "AD", strict=True):
+        assert same_color(start.get_markerfacecolor(), colors[name])
+    (end,) = [line for line in ax.lines if line.get_marker() == "o" and line.get_markersize() == 5]
+    assert (end.get_xdata()[0], end.get_ydata()[0]) == tuple(state[-1])
+    assert sorted(text.get_text() for text in ax.texts) == ["dA", "dD", "sA", "sD"]
+    assert legend_labels(figure) == [
+        "controller A",
+        "controller D",
+        "sX: controller X invoked",
+        "dX: destination of controller X",
+        "end, t = 1.00 s",
+    ]
+
+
+def test_script_figure_without_tables_draws_no_destinations(trajectory):
+    figure = script_path_figure(trajectory, [])
+    (ax,) = figure.axes
+    assert sorted(text.get_text() for text in ax.texts) == ["sA", "sD"]
+    assert "dX: destination of controller X" not in legend_labels(figure)
+    assert ax.get_ylim() == pytest.approx((-520.0, 520.0))  # the pendulum's rates, deg/s
+    assert not [line for line in ax.lines if line.get_marker() == "x"]
+
+
+def test_script_writes_a_png(trajectory, drawn_tables, tmp_path):
+    out = tmp_path / "script.png"
+    plot_script(trajectory, [drawn_tables["A"], drawn_tables["D"]], out)
+    assert assert_png(out) == (912, 768)
 
 
 def test_gif_is_animated(trajectory, tmp_path):
@@ -228,11 +336,45 @@ def test_gif_is_animated(trajectory, tmp_path):
         assert gif.info["duration"] == 40
         first = np.asarray(gif.convert("RGB"))
         gif.seek(gif.n_frames - 1)
+        assert gif.info["duration"] == 40  # the last frame not held
         last = np.asarray(gif.convert("RGB"))
     assert len(np.unique(first.reshape(-1, 3), axis=0)) > 20
     assert np.any(first != last)  # the pendulum moved
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["A", "D"])
+def test_portrait_draws_closed_loop_paths_from_spread_starts(dynamics, tables, name):
+    figure = portrait_figure(tables[name], dynamics)
+    (ax,) = figure.axes
+    dest = DESTINATIONS[name]
+    assert ax.get_title() == (
+        f"Controller {name}: destination θ = 0 deg, ω = {dest['omega']:g} deg/s\n"
+        "closed-loop paths, 3 s from each of 8 start states"
+    )
+    assert ax.get_xlabel() == "angle θ (deg) — cylindrical"
+    assert ax.get_ylabel() == "omega ω (deg/s)"
+    starts = marker_lines(ax, "s")
+    np.testing.assert_allclose(
+        [(s.get_xdata()[0], s.get_ydata()[0]) for s in starts],
+        portrait_starts(PENDULUM_AXES, 8),
+    )
+    paths = [line for line in ax.lines if line.get_linewidth() == 1.3]
+    assert len(paths) >= 8  # a path from each start, more where it wraps
+    assert len({tuple(line.get_color()) for line in paths}) == 8  # a colour each
+    assert all(len(line.get_xdata()) > 100 for line in paths[:1])
+    cycle = [line for line in ax.lines if line.get_linewidth() == 5.0]
+    expected = ["start state (one colour per path)", "destination"]
+    if name == "D":  # a periodic destination: its cycle drawn thick and grey
+        assert cycle
+        expected.insert(0, "cycle through the destination")
+    else:
+        assert not cycle
+    assert legend_labels(figure) == expected
+    assert_destination_marked(ax, dest["angle"], dest["omega"])
+
+
+@pytest.mark.slow
 def test_cli_makes_every_plot_kind(trajectory, tables, dynamics, tmp_path):
     portrait, torque = tmp_path / "portrait.png", tmp_path / "torque.png"
     commands = [
@@ -259,14 +401,16 @@ def test_cli_makes_every_plot_kind(trajectory, tables, dynamics, tmp_path):
     ]
     for command in commands:
         assert main(["plot", *command]) == 0
-    for name in ("portrait.png", "torque.png", "script.png", "script.gif"):
-        assert (tmp_path / name).stat().st_size > 1000
+    for name in ("portrait.png", "torque.png", "script.png"):
+        assert_png(tmp_path / name)
+    with Image.open(tmp_path / "script.gif") as gif:
+        assert gif.n_frames == 26
 
 
-def test_cli_portrait_without_dynamics_exits_2_and_writes_nothing(tables, tmp_path, capsys):
+def test_cli_portrait_without_dynamics_exits_2_and_writes_nothing(drawn_tables, tmp_path, capsys):
     out = tmp_path / "portrait.png"
     with pytest.raises(SystemExit) as exit_:
-        main(["plot", "controller", str(tables["A"]), "--portrait", str(out)])
+        main(["plot", "controller", str(drawn_tables["A"]), "--portrait", str(out)])
     assert exit_.value.code == 2
     assert "--portrait needs --dynamics" in capsys.readouterr().err
     assert not out.exists()

@@ -46,8 +46,17 @@ from mosys.io.atomic import write_text_atomically
 from mosys.parsing.composite import parse_composite_text, render_expression
 from mosys.parsing.composite_script import CompositeScript
 from mosys.parsing.tokens import read_spec_text
-from mosys.plots.bsr import JOINT_SIZE, OUTLINE, ROD_WIDTH, choose_interval
-from mosys.plots.style import TERRAIN_EDGE, TERRAIN_FACE, controller_colors, new_figure, plot_style
+from mosys.plots.style import (
+    JOINT_SIZE,
+    OUTLINE,
+    ROD_WIDTH,
+    TERRAIN_EDGE,
+    TERRAIN_FACE,
+    choose_interval,
+    controller_colors,
+    new_figure,
+    plot_style,
+)
 
 POSES = (15, 25)  # the filmstrip's interval is a round one drawing about this many poses
 SLIDER_SPAN = 3  # a phase's slider runs from 1 tick to this many times its guess (or the total)

@@ -10,6 +10,7 @@ or start grid's root holds ``body_outline``, ``obstacles``, ``obstacle_names``, 
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -25,8 +26,8 @@ DESTINATION_KEYS = ("x", "y", "heading")
 class CarScene:
     """A car's world. body_outline: (V, 2) m in the car's frame (reference point at the origin,
     heading along +x); obstacles: one (V_k, 2) m polygon each, named by obstacle_names;
-    destination: the goal pose, x and y (m), heading (deg); wheelbase: m; domain: (D, 2) m, the
-    polygon the reference point must stay in ((0, 2): none)."""
+    destination: the goal pose, x and y (m), heading (deg); wheelbase: m (NaN where the file
+    records none); domain: (D, 2) m, the polygon the reference point must stay in ((0, 2): none)."""
 
     body_outline: np.ndarray
     obstacles: tuple[np.ndarray, ...]
@@ -72,7 +73,7 @@ def read_car_scene(attrs: Mapping, where: str, destination: Mapping | None = Non
         obstacles=obstacles,
         obstacle_names=names,
         destination=goal,
-        wheelbase=float(attrs["wheelbase"]),
+        wheelbase=float(attrs["wheelbase"]) if "wheelbase" in attrs else math.nan,
         domain=np.ascontiguousarray(domain, dtype=np.float64).reshape(-1, 2),
     )
 

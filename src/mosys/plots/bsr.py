@@ -19,42 +19,50 @@ a line with round ends, metres in the world frame, y up, equal aspect, over the 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import h5py
 import numpy as np
-from matplotlib import patheffects
-from matplotlib.axes import Axes
 from matplotlib.cm import ScalarMappable
-from matplotlib.collections import LineCollection
 from matplotlib.colors import Normalize
+from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 from matplotlib.ticker import FuncFormatter
 
 from mosys.io.bsr_result import BsrResult, read_bsr_result
-from mosys.plots.car import frame_indices
-from mosys.plots.luxo import ASPECT_RANGE, fit_aspect, pan, scene_limits
-from mosys.plots.pendulum import PlotInputError
 from mosys.plots.style import (
+    ASPECT_RANGE,
     GIF_DPI,
+    GIF_FPS,
+    GIF_MAX_FRAMES,
     MARGIN_BOTTOM,
     MARGIN_LEFT,
     MARGIN_RIGHT,
     MARGIN_TOP,
     POSE_TIMES,
+    STRIP_GROUND,
+    STRIP_MARGIN,
     TITLE_LINE,
+    PlotInputError,
     add_legend,
-    animation_frames,
+    animate_stick_figure,
     check_animation_options,
+    choose_interval,
     controller_colors,
+    draw_pose,
     draw_terrain,
+    fit_aspect,
+    frame_indices,
     frame_samples,
+    minus_signs,
     new_figure,
     plot_style,
     save_png,
     scene_figure,
+    scene_limits,
+    spread_labels,
     write_real_time_gif,
 )
 
@@ -77,9 +85,7 @@ COMPARISON_WIDTH, COMPARISON_HEIGHT = 12.5, 5.6  # inches
 BAND_ALPHA = 0.16  # the min..max band of a search's seeds
 SUPTITLE_TOP, AXES_TITLE = 0.1, 0.38  # inches: above the figure's title, for an axes title
 
-# filmstrip
-POSES = (12, 20)  # the interval is chosen so that this many poses are drawn, 16 if it can
-NICE_STEPS = (1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0)  # mantissas of a chosen interval
+# filmstrip (its interval: ``choose_interval``)
 SHIFT_BELOW = 0.5  # poses are shifted apart when they advance less than this many pose widths
 SHIFT_SPACING = 1.05  # pose widths from one shifted pose to the next
 GROUND_GAP = 0.08  # of the spacing: the blank between the ground pieces of shifted poses
@@ -89,19 +95,12 @@ ROW_ASPECT_MIN = 0.14  # height / width of a row: poses wrap onto up to MAX_ROWS
 MAX_ROWS = 4
 ROW_GAP = 0.42  # inches between rows (the upper row's x tick labels)
 STRIP_COLORBAR = 1.05  # inches right of the rows for the time colour bar
-SCENE_MARGIN = 0.06  # inches of blank round the poses (in data units: times the m per inch)
-GROUND_SHOWN = 0.12  # inches of ground shown below the lowest ground point
 LETTER_PAD, LETTER_ROW = 0.06, 0.2  # inches: letters above the highest pose, one row's height
 LETTER_SPACE = 0.24  # inches: letters nearer than this in x go on different rows
 LETTER_SIZE = 11.0  # pt
-ROD_WIDTH = 2.0  # pt
-JOINT_SIZE = 3.4  # pt, the round marker at each rod end
-OUTLINE = "0.2"  # the thin outline that keeps light poses visible on white
 
 # animation
 GIF_WIDTH = 6.0  # inches, the scene's data area
-GIF_FPS = 25  # frames per second of motion time: a frame every 40 ms at most
-GIF_MAX_FRAMES = 150
 FOLLOW_POSES = 3.0  # a figure ranging wider than this many pose widths is followed by the view
 NONE_COLOR = "0.45"  # rods while no rule is active
 
@@ -194,11 +193,6 @@ def rule_letter(rule: int) -> str:
     return letters
 
 
-def minus_signs(text: str) -> str:
-    """A true minus sign for hyphens in numbers."""
-    return text.replace("-", "−")
-
-
 def fitness_formula(weights: Mapping[str, float]) -> str:
     """``fitness = 1·distance + 0.5·max_height − 2·rotations`` from term -> weight (zero
     weights left out)."""
@@ -253,31 +247,18 @@ def curves_on_grid(results: Sequence[BsrResult]) -> tuple[np.ndarray, np.ndarray
     return grid, values
 
 
-def spread_labels(values: np.ndarray, gap: float, low: float, high: float) -> np.ndarray:
-    """Label heights near ``values`` (data units), at least ``gap`` apart, kept in
-    [low, high] where they fit."""
-    values = np.asarray(values, dtype=np.float64)
-    order = np.argsort(values, kind="stable")
-    placed = values[order].copy()
-    for k in range(1, len(placed)):
-        placed[k] = max(placed[k], placed[k - 1] + gap)
-    overflow = placed[-1] - high if len(placed) else 0.0
-    if overflow > 0:
-        placed[-1] -= overflow
-        for k in range(len(placed) - 2, -1, -1):
-            placed[k] = min(placed[k], placed[k + 1] - gap)
-    placed = np.maximum(placed, low + gap * np.arange(len(placed)))
-    out = np.empty_like(placed)
-    out[order] = placed
-    return out
-
-
 def plot_learning(results: Sequence[str | Path], path: str | Path) -> None:
+    """Write ``learning_figure`` as a PNG to ``path``."""
+    with plot_style():
+        save_png(learning_figure(results), path)
+
+
+def learning_figure(results: Sequence[str | Path]) -> Figure:
     """Figure 8 ("Variability in search-algorithm performance") for one search: the best
     fitness so far against the number of controller evaluations, one line per seed, and in a
     narrow panel beside it each seed's final best fitness marked with its seed number. The
-    title names the search, the controller kind and the fitness function. Writes a PNG;
-    PlotInputError if the files are not all of one search."""
+    title names the search, the controller kind and the fitness function. PlotInputError if
+    the files are not all of one search."""
     if not results:
         raise PlotInputError("plot_learning: no BSR result files given")
     loaded = sorted(
@@ -351,7 +332,7 @@ def plot_learning(results: Sequence[str | Path], path: str | Path) -> None:
                 fontsize=8.5,
             )
         finals.set_ylim(low, high)
-        save_png(figure, path)
+    return figure
 
 
 def _layout_learning(figure, title: str) -> None:
@@ -371,13 +352,18 @@ def _layout_learning(figure, title: str) -> None:
 def plot_learning_comparison(
     results_by_search: Mapping[str, Sequence[str | Path]], path: str | Path
 ) -> None:
+    """Write ``learning_comparison_figure`` as a PNG to ``path``."""
+    with plot_style():
+        save_png(learning_comparison_figure(results_by_search), path)
+
+
+def learning_comparison_figure(results_by_search: Mapping[str, Sequence[str | Path]]) -> Figure:
     """Figure 7 ("Learning curves for both kinds of motion controller"): for each search (name
     -> its seeds' result files), the median over seeds of the best fitness so far against the
     number of evaluations, the range over seeds (min..max) shaded; sense-based searches solid,
     time-based dashed. A second panel shows each median as a fraction of the search's final
     median, so that searches of different fitness scales compare in speed (a search whose final
-    median is not positive cannot be so normalised and is left out there, as its note says).
-    Writes a PNG."""
+    median is not positive cannot be so normalised and is left out there, as its note says)."""
     if not results_by_search or not all(results_by_search.values()):
         raise PlotInputError("plot_learning_comparison: give at least one result per search")
     searches = list(results_by_search)
@@ -451,31 +437,10 @@ def plot_learning_comparison(
             left=(MARGIN_LEFT + 0.1) / width,
             wspace=0.24,
         )
-        save_png(figure, path)
+    return figure
 
 
 # --------------------------------------------------------------------------- the filmstrip
-
-
-def choose_interval(duration: float, poses: tuple[int, int] = POSES) -> float:
-    """A round interval, s (1, 1.5, 2, 2.5, 3, 4, 5, 6 or 8 times a power of ten) at which
-    between ``poses`` poses are drawn over ``duration`` s (both ends counted), as near the
-    middle of that range as can be."""
-    if not duration > 0:
-        return 1.0
-    least, most = poses
-    aim = (least + most) / 2
-    best = None
-    scale = 10.0 ** math.floor(math.log10(duration / most))
-    for power in (scale / 10, scale, scale * 10):
-        for mantissa in NICE_STEPS:
-            interval = mantissa * power
-            count = math.floor(duration / interval + 1e-9) + 1
-            if least <= count <= most:
-                score = (abs(count - aim), -interval)
-                if best is None or score < best[0]:
-                    best = (score, interval)
-    return best[1] if best else duration / (aim - 1)
 
 
 def _round_up(value: float) -> float:
@@ -556,27 +521,6 @@ def letter_levels(x: np.ndarray, space: float) -> np.ndarray:
     return levels
 
 
-def draw_pose(ax: Axes, pose: np.ndarray, color, zorder: float) -> None:
-    """One pose (rods, 2, 2) m: rods as lines with round ends, outlined thinly."""
-    outline = [patheffects.withStroke(linewidth=ROD_WIDTH + 1.0, foreground=OUTLINE)]
-    rods = LineCollection(
-        pose, colors=[color], linewidths=ROD_WIDTH, capstyle="round", zorder=zorder
-    )
-    rods.set_path_effects(outline)
-    ax.add_collection(rods, autolim=False)
-    ends = pose.reshape(-1, 2)
-    ax.plot(
-        ends[:, 0],
-        ends[:, 1],
-        "o",
-        markersize=JOINT_SIZE,
-        color=color,
-        markeredgecolor=OUTLINE,
-        markeredgewidth=0.6,
-        zorder=zorder + 0.001,
-    )
-
-
 def _controller_text(result: BsrResult) -> str:
     kind = _kind(result)
     text = f"{KIND_TEXT.get(kind, kind)} controller, {result.controller.rules} rules"
@@ -600,6 +544,12 @@ def _result_title(result: BsrResult, path: str | Path) -> str:
 def plot_filmstrip(
     result_path: str | Path, path: str | Path, interval: float | None = None
 ) -> None:
+    """Write ``filmstrip_figure`` as a PNG to ``path``."""
+    with plot_style():
+        save_png(filmstrip_figure(result_path, interval), path)
+
+
+def filmstrip_figure(result_path: str | Path, interval: float | None = None) -> Figure:
     """Figures 9 to 12: the best motion of a search as the figure's rods (lines with round
     ends) every ``interval`` s from its start to its end (None: a round interval giving 12 to
     20 poses, ``choose_interval``), light to dark with time (colour bar, s), each pose lettered
@@ -608,7 +558,7 @@ def plot_filmstrip(
     advances less than SHIFT_BELOW pose widths per pose: then each is shifted a fixed spacing
     further than the one before (``pose_offsets``), as the subtitle says. A long strip wraps
     onto up to MAX_ROWS rows at one scale. The title gives the search, seed, controller kind,
-    fitness and measured terms. Writes a PNG."""
+    fitness and measured terms."""
     result = read_result(result_path)
     motion = result.motion
     t = motion.t
@@ -639,18 +589,18 @@ def plot_filmstrip(
         if (top - low) / max(span, 1e-9) >= ROW_ASPECT_MIN:
             break
     data_width = STRIP_WIDTH
-    scale = span / (data_width - 2 * SCENE_MARGIN)  # m per inch
+    scale = span / (data_width - 2 * STRIP_MARGIN)  # m per inch
     levels = [letter_levels((left[r] + right[r]) / 2, LETTER_SPACE * scale) for r in rows]
     letter_rows = max(int(level.max()) + 1 for level in levels)
-    y0 = low - GROUND_SHOWN * scale
+    y0 = low - STRIP_GROUND * scale
     letter_base = top + LETTER_PAD * scale
-    y1 = letter_base + (letter_rows * LETTER_ROW + SCENE_MARGIN) * scale
+    y1 = letter_base + (letter_rows * LETTER_ROW + STRIP_MARGIN) * scale
     row_height = (y1 - y0) / scale
     if row_height > ROW_HEIGHT_MAX:  # a tall scene: narrower rows at a larger scale
         data_width *= ROW_HEIGHT_MAX / row_height
         scale *= row_height / ROW_HEIGHT_MAX
         row_height = ROW_HEIGHT_MAX
-    x_span = span + 2 * SCENE_MARGIN * scale
+    x_span = span + 2 * STRIP_MARGIN * scale
 
     kind = _kind(result)
     rule_text = "the rule of that time segment" if kind == "time" else "the rule active then"
@@ -684,7 +634,7 @@ def plot_filmstrip(
                     row_height / fig_height,
                 )
             )
-            x0 = left[row].min() - SCENE_MARGIN * scale
+            x0 = left[row].min() - STRIP_MARGIN * scale
             ax.set_xlim(x0, x0 + x_span)
             ax.set_ylim(y0, y1)
             ax.set_aspect("equal", adjustable="box")
@@ -721,56 +671,10 @@ def plot_filmstrip(
             )
         )
         figure.colorbar(ScalarMappable(norm, POSE_TIMES), cax=bar, label="time t (s)")
-        save_png(figure, path)
+    return figure
 
 
 # --------------------------------------------------------------------------- the animation
-
-
-def animate_stick_figure(
-    figure,
-    ax: Axes,
-    t: np.ndarray,
-    endpoints: np.ndarray,
-    samples: np.ndarray,
-    look: Callable[[int], tuple],
-    label_size: float,
-    follow: np.ndarray | None = None,
-) -> list:
-    """The frames (``animation_frames``) of a stick figure at ``samples`` of its motion (t (N,)
-    s, endpoints (N, rods, 2, 2) m) on ``ax``: the rods as lines with round ends and their
-    joints, the time in the top left corner and a label in the top right. ``look(frame)`` gives
-    that frame's rod colour, label text and label colour; ``follow`` (frames,) m: the x the view
-    keeps in sight, panning (``mosys.plots.luxo.pan``), or None for a fixed view."""
-    rods = LineCollection(
-        np.zeros((endpoints.shape[1], 2, 2)), linewidths=ROD_WIDTH + 1.0, capstyle="round", zorder=3
-    )
-    ax.add_collection(rods, autolim=False)
-    (joints,) = ax.plot([], [], "o", markersize=JOINT_SIZE + 1.5, zorder=3.1)
-    box = {"boxstyle": "round,pad=0.3", "facecolor": "white", "alpha": 0.9}
-    corner = {"transform": ax.transAxes, "va": "top", "bbox": box, "zorder": 10}
-    clock = ax.text(0.02, 0.97, "", ha="left", fontsize=10, family="monospace", **corner)
-    label = ax.text(0.98, 0.97, "", ha="right", fontsize=label_size, fontweight="bold", **corner)
-
-    def update(frame: int) -> bool:
-        sample = int(samples[frame])
-        pose = endpoints[sample]
-        color, text, text_color = look(frame)
-        rods.set_segments(pose)
-        rods.set_color(color)
-        joints.set_data(pose[..., 0].ravel(), pose[..., 1].ravel())
-        joints.set_color(color)
-        joints.set_markeredgecolor(OUTLINE)
-        clock.set_text(f"t = {t[sample]:5.2f} s")
-        label.set_text(text)
-        label.set_color(text_color)
-        view = None if follow is None else pan(ax.get_xlim(), follow[frame])
-        if view is None:
-            return False
-        ax.set_xlim(*view)
-        return True
-
-    return animation_frames(figure, [rods, joints, clock, label], range(len(samples)), update)
 
 
 def write_motion_gif(
@@ -784,7 +688,7 @@ def write_motion_gif(
     rule's letter. One frame per 1/``fps`` s of motion time (at most every 40 ms by default),
     played in real time, the step widened to keep to ``max_frames`` frames; the last frame held
     GIF_HOLD_MS ms; loops. A figure ranging wider than FOLLOW_POSES of its widths is followed by
-    a view that pans (``mosys.plots.luxo.pan``). Written atomically."""
+    a view that pans (``mosys.plots.style.pan``). Written atomically."""
     check_animation_options(fps, max_frames)
     result = read_result(result_path)
     motion = result.motion

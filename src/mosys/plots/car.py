@@ -14,7 +14,6 @@ colliding sample, that outline in red, and its title says FAILED in red.
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -30,32 +29,37 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Polygon
 
 from mosys.errors import InputError
-from mosys.io.attributes import string_tuple
+from mosys.io.car_scene import CarScene, read_car_scene
 from mosys.io.start_grid import DATASETS
 from mosys.io.start_grid import read_start_grid as read_start_grid_file
 from mosys.io.trajectory import read_trajectory
-from mosys.plots.pendulum import PlotInputError
 from mosys.plots.style import (
     DESTINATION_COLOR,
     GIF_DPI,
+    GIF_HOLD_MS,
     LEGEND_ROW,
     MARGIN_BOTTOM,
     MARGIN_RIGHT,
     SYMBOLS,
+    PlotInputError,
     add_legend,
+    animation_frames,
+    fit_aspect,
+    frame_indices,
+    minus_signs,
     new_figure,
     plot_style,
+    samples_to_the_end,
     save_png,
     write_gif,
 )
 
 FRAME_INTERVAL = 0.3  # s between the outlines drawn in a parking panel
-GIF_FPS = 20  # frames per second of motion time in a parking GIF
-GIF_HOLD_MS = 1500  # ms the last GIF frame stays up before the loop restarts
+PARKING_GIF_FPS = 20  # frames per second of motion time in a parking GIF
 COLUMNS = 3  # panels per row
 PANEL_WIDTH = 3.3  # inches of one panel's data area in a multi-panel figure
 SINGLE_PANEL_WIDTH = 6.0  # inches of the data area when there is one panel
-ASPECT_RANGE = (0.35, 1.25)  # height / width of a panel; the limits are widened to stay inside
+PANEL_ASPECT_RANGE = (0.35, 1.25)  # height / width of a panel: its limits widen to stay inside
 VIEW_MARGIN = 1.5  # m: obstacles are shown this far beyond the region the cars use
 EDGE_MARGIN = 0.4  # m: blank border around everything shown
 DEFAULT_WHEEL_RADIUS = 0.3  # m, when a trajectory records no wheel_radius
@@ -93,18 +97,6 @@ OBSTACLE_LABEL_SIZE = 8.0  # pt
 
 
 @dataclass(frozen=True)
-class Scene:
-    """The car's world: body_outline (V, 2) m in the car's frame (reference point at the origin,
-    heading along +x); obstacles: one (V_k, 2) m polygon each, named by obstacle_names;
-    destination: the goal pose, x and y (m), heading (deg)."""
-
-    body_outline: np.ndarray
-    obstacles: tuple[np.ndarray, ...]
-    obstacle_names: tuple[str, ...]
-    destination: dict[str, float]
-
-
-@dataclass(frozen=True)
 class CarTrajectory:
     """One simulated manoeuvre. t: (N,) s; x, y: (N,) m; heading, steer: (N,) deg; speed: (N,)
     m/s or None; collision_index: first sample whose outline meets an obstacle, -1 if none;
@@ -118,7 +110,7 @@ class CarTrajectory:
     heading: np.ndarray
     steer: np.ndarray
     speed: np.ndarray | None
-    scene: Scene
+    scene: CarScene
     controllers: tuple[str, ...]
     wheelbase: float
     track: float
@@ -156,7 +148,7 @@ class StartGrid:
     parked: np.ndarray
     collided: np.ndarray
     parking_seconds: np.ndarray
-    scene: Scene
+    scene: CarScene
     controller: str
     simulated_seconds: float
 
@@ -177,51 +169,12 @@ def _missing(path, kind: str, names: Sequence[str], present) -> None:
         raise PlotInputError(f"{path}: not a {kind}: missing {', '.join(absent)}")
 
 
-def _json_attr(path, attrs, name: str):
-    text = attrs[name]
-    try:
-        return json.loads(_text(text))
-    except json.JSONDecodeError as error:
-        raise PlotInputError(f"{path}: root attribute {name} is not valid JSON ({error})") from None
-
-
-def _polygon(path, name: str, vertices) -> np.ndarray:
-    try:
-        polygon = np.asarray(vertices, dtype=np.float64)
-    except (TypeError, ValueError):
-        polygon = None
-    if polygon is None or polygon.ndim != 2 or polygon.shape[1] != 2 or len(polygon) < 3:
-        raise PlotInputError(
-            f"{path}: {name} must be a list of at least 3 [x, y] vertices, got {vertices!r}"
-        )
-    if not np.all(np.isfinite(polygon)):
-        raise PlotInputError(f"{path}: {name} has a non-finite vertex")
-    return polygon
-
-
-def _read_scene(path, attrs) -> Scene:
+def _read_scene(path, attrs) -> CarScene:
     """The body outline, obstacles and destination from a file's root attributes."""
-    outline = _polygon(path, "body_outline", _json_attr(path, attrs, "body_outline"))
-    polygons = _json_attr(path, attrs, "obstacles")
-    if not isinstance(polygons, list):
-        raise PlotInputError(f"{path}: obstacles must be a list of polygons, got {polygons!r}")
-    names = string_tuple(attrs["obstacle_names"]) if len(polygons) else ()
-    if len(names) != len(polygons):
-        raise PlotInputError(
-            f"{path}: {len(polygons)} obstacles but {len(names)} obstacle_names {list(names)}"
-        )
-    obstacles = tuple(
-        _polygon(path, f"obstacle {name}", vertices)
-        for name, vertices in zip(names, polygons, strict=True)
-    )
-    destination = _json_attr(path, attrs, "destination")
     try:
-        destination = {key: float(destination[key]) for key in ("x", "y", "heading")}
-    except (KeyError, TypeError, ValueError):
-        raise PlotInputError(
-            f'{path}: destination must be {{"x": m, "y": m, "heading": deg}}, got {destination!r}'
-        ) from None
-    return Scene(outline, obstacles, names, destination)
+        return read_car_scene(attrs, str(path))
+    except InputError as error:
+        raise PlotInputError(str(error)) from None
 
 
 def _columns(path, state_order: Sequence[str], required: Sequence[str]) -> dict[str, int]:
@@ -338,23 +291,6 @@ def read_start_grid(path: str | Path) -> StartGrid:
 # --------------------------------------------------------------------------- pure helpers
 
 
-def frame_indices(t: np.ndarray, interval: float) -> np.ndarray:
-    """Sample indices (int64, increasing, no repeats) of the first sample at or after each
-    time t[0] + k·interval (k = 0, 1, ...) up to t[-1]. t: (N,) s, non-decreasing; interval: s.
-    Times within 1e-9 s of a sample count as that sample."""
-    t = np.asarray(t, dtype=np.float64)
-    if t.ndim != 1:
-        raise ValueError(f"t must be 1-D, got shape {t.shape}")
-    if not interval > 0:
-        raise ValueError(f"interval must be positive, got {interval!r}")
-    if len(t) == 0:
-        return np.zeros(0, dtype=np.int64)
-    count = math.floor((t[-1] - t[0]) / interval + 1e-9) + 1
-    times = t[0] + interval * np.arange(count)
-    index = np.minimum(np.searchsorted(t, times - 1e-9), len(t) - 1)
-    return np.unique(index).astype(np.int64)
-
-
 def drawn_samples(t: np.ndarray, interval: float, collision_index: int = -1) -> np.ndarray:
     """The samples whose outline a parking panel draws: every ``interval`` seconds (see
     ``frame_indices``) and the last sample, but nothing after the first colliding sample
@@ -413,7 +349,7 @@ def describe_value(name: str, value: float) -> str:
     whole = unit == "deg" and abs(value - round(value)) < 0.05
     value = round(value, 0 if whole else 1) + 0.0  # + 0.0: no "-0"
     text = f"{value:.0f}°" if whole else f"{value:.1f}°" if unit == "deg" else f"{value:.1f} {unit}"
-    return text.rstrip().replace("-", "−")
+    return minus_signs(text.rstrip())
 
 
 def _start_summary(runs: Sequence[CarTrajectory]) -> list[list[str]]:
@@ -430,7 +366,7 @@ def _start_summary(runs: Sequence[CarTrajectory]) -> list[list[str]]:
         start, parts = run.start(), []
         if varying & {"x", "y"}:
             position = f"from ({start['x']:.1f}, {start['y']:.1f}) m"
-            parts.append(position.replace("-", "−"))
+            parts.append(minus_signs(position))
         for name in ("heading", "steer", "speed"):
             if name in varying:
                 parts.append(f"{name} {describe_value(name, start[name])}")
@@ -469,7 +405,7 @@ def view_limits(car_points: np.ndarray, obstacles: Sequence[np.ndarray]) -> np.n
     """[[xmin, ymin], [xmax, ymax]] m of the view: the region the cars use (``car_points``
     (..., 2) m: outlines, path, destination) united with the obstacles' extents clipped to that
     region widened by VIEW_MARGIN, plus EDGE_MARGIN all round, then widened in x or y to keep
-    the view's height / width within ASPECT_RANGE."""
+    the view's height / width within PANEL_ASPECT_RANGE (``fit_aspect``)."""
     cars = _bounds(car_points)
     window = cars + [[-VIEW_MARGIN], [VIEW_MARGIN]]
     limits = cars.copy()
@@ -479,13 +415,7 @@ def view_limits(car_points: np.ndarray, obstacles: Sequence[np.ndarray]) -> np.n
         if np.all(high >= low):
             limits = np.array([np.minimum(limits[0], low), np.maximum(limits[1], high)])
     limits += [[-EDGE_MARGIN], [EDGE_MARGIN]]
-    width, height = limits[1] - limits[0]
-    low_aspect, high_aspect = ASPECT_RANGE
-    if height < low_aspect * width:
-        limits[:, 1] += np.array([-1, 1]) * (low_aspect * width - height) / 2
-    elif height > high_aspect * width:
-        limits[:, 0] += np.array([-1, 1]) * (height / high_aspect - width) / 2
-    return limits
+    return fit_aspect(limits, PANEL_ASPECT_RANGE)
 
 
 @dataclass(frozen=True)
@@ -578,7 +508,7 @@ def _panel_title(ax: Axes, first_line: str, outcome: str | None = None, failed=F
     )
 
 
-def _draw_scene(ax: Axes, scene: Scene, limits: np.ndarray) -> None:
+def _draw_scene(ax: Axes, scene: CarScene, limits: np.ndarray) -> None:
     """Obstacles as grey polygons, each named where its name fits in the part in view, and the
     destination as the car's outline, dotted, at the destination pose. Call once the axes are
     placed: the name's size in metres comes from the axes' size in inches."""
@@ -699,7 +629,7 @@ def _controller_names(runs: Sequence[CarTrajectory]) -> str:
     return ", ".join(names) if names else "?"
 
 
-def _scene_points(scene: Scene) -> np.ndarray:
+def _scene_points(scene: CarScene) -> np.ndarray:
     d = scene.destination
     return place_outline(scene.body_outline, d["x"], d["y"], d["heading"])
 
@@ -712,13 +642,20 @@ def plot_parking_frames(
     out_path: str | Path,
     interval: float = FRAME_INTERVAL,
 ) -> None:
+    """Write ``parking_frames_figure`` as a PNG to ``out_path``."""
+    with plot_style():
+        save_png(parking_frames_figure(trajectory_paths, interval), out_path)
+
+
+def parking_frames_figure(
+    trajectory_paths: Sequence[str | Path], interval: float = FRAME_INTERVAL
+) -> Figure:
     """Figure 19: one panel per car trajectory (2 rows × 3 columns for six; any count works),
     each to scale in metres over the same x/y limits: the obstacles (grey), the destination
     (the car's outline at the goal, dotted), the car's outline every ``interval`` seconds
     (light to dark with time, the start and final outlines thick) and the reference point's path.
     A run that hits an obstacle is drawn up to its first colliding sample, that outline red. Each
-    panel's title: the file stem, its start state, and the outcome (a failure in red). Writes a
-    PNG to ``out_path``."""
+    panel's title: the file stem, its start state, and the outcome (a failure in red)."""
     if not trajectory_paths:
         raise PlotInputError("plot_parking_frames: no trajectories given")
     runs = [read_car_trajectory(path) for path in trajectory_paths]
@@ -765,27 +702,24 @@ def plot_parking_frames(
             _panel_title(ax, head, outcome_text(run), run.failed)
         _suptitle(layout.figure, f"The car parking under controller {_controller_names(runs)}")
         add_legend(layout.figure, legend, ncols=3)
-        save_png(layout.figure, out_path)
+    return layout.figure
 
 
-def write_parking_gif(trajectory_path: str | Path, out_path: str | Path, fps: int = GIF_FPS):
+def write_parking_gif(
+    trajectory_path: str | Path, out_path: str | Path, fps: int = PARKING_GIF_FPS
+) -> None:
     """An animated GIF of one manoeuvre, to scale in metres: obstacles, the destination outline,
     the car's outline with its four wheels (short thick segments, the front pair turned by the
     steer angle), the path so far, the time and the speed. ``fps`` frames per second of motion time
-    (the sample at or after each frame time, see ``frame_indices``); a run that collides stops
-    at its first colliding sample, drawn red; the last frame is held GIF_HOLD_MS ms; loops.
-
-    Frames are blitted over the static background, and Pillow writes them with one shared
-    palette, as ``mosys.plots.pendulum.write_script_gif`` does."""
-    from PIL import Image
-
+    (the sample at or after each frame time, and the last, see ``samples_to_the_end``), each
+    frame round(1000 / fps) ms; a run that collides stops at its first colliding sample, drawn
+    red; the last frame is held GIF_HOLD_MS ms; loops. Frames are blitted
+    (``animation_frames``) and written with one shared palette (``write_gif``)."""
     if not fps > 0:
         raise ValueError(f"fps must be positive, got {fps!r}")
     run = read_car_trajectory(trajectory_path)
     last = len(run.t) - 1 if run.collision_index < 0 else run.collision_index
-    samples = frame_indices(run.t[: last + 1], 1.0 / fps)
-    if samples[-1] != last:
-        samples = np.append(samples, last)
+    samples = samples_to_the_end(run.t[: last + 1], 1.0 / fps)
     every = np.arange(last + 1)
     limits = view_limits(
         np.concatenate(
@@ -836,15 +770,9 @@ def write_parking_gif(trajectory_path: str | Path, out_path: str | Path, fps: in
             zorder=7,
             bbox={"facecolor": "white", "alpha": 0.85, "edgecolor": "0.6"},
         )
-        moving = [path, body, *wheels, caption]  # in drawing (z) order
-        for artist in moving:
-            artist.set_animated(True)
-        canvas = figure.canvas
-        canvas.draw()
-        background = canvas.copy_from_bbox(figure.bbox)
-        frames = []
-        for s in samples:
-            s = int(s)
+
+        def update(frame: int) -> bool:
+            s = int(samples[frame])
             path.set_data(run.x[: s + 1], run.y[: s + 1])
             body.set_xy(place_outline(run.scene.body_outline, run.x[s], run.y[s], run.heading[s]))
             hit = run.collided and s == run.collision_index
@@ -855,13 +783,11 @@ def write_parking_gif(trajectory_path: str | Path, out_path: str | Path, fps: in
             text = f"t = {run.t[s]:5.2f} s"  # short: text is most of a frame's drawing time
             if run.speed is not None:
                 text += f"  v = {round(float(run.speed[s]), 1) + 0.0:+.1f} m/s"  # + 0.0: no -0
-            caption.set_text(text.replace("-", "−"))
-            canvas.restore_region(background)
-            for artist in moving:
-                figure.draw_artist(artist)
-            rgba = np.asarray(canvas.buffer_rgba())
-            frames.append(Image.fromarray(rgba[..., :3].copy()))
+            caption.set_text(minus_signs(text))
+            return False
 
+        moving = [path, body, *wheels, caption]  # in drawing (z) order
+        frames = animation_frames(figure, moving, range(len(samples)), update)
     write_gif(frames, out_path, [round(1000 / fps)] * (len(frames) - 1) + [GIF_HOLD_MS])
 
 
@@ -896,6 +822,12 @@ def _group_starts(grid: StartGrid) -> tuple[list[str], list[np.ndarray], list[st
 
 
 def plot_success_map(start_grid_path: str | Path, out_path: str | Path) -> None:
+    """Write ``success_map_figure`` as a PNG to ``out_path``."""
+    with plot_style():
+        save_png(success_map_figure(start_grid_path), out_path)
+
+
+def success_map_figure(start_grid_path: str | Path) -> Figure:
     """Which start positions park: the start grid's obstacles and destination outline, and at
     each start's reference point (x, y) a marker: a green disc where it parked (coloured by the
     parking time, colour bar in s), a red × where it hit an obstacle, an orange square where it
@@ -906,7 +838,7 @@ def plot_success_map(start_grid_path: str | Path, out_path: str | Path) -> None:
     root attribute ``state_order``, ``parked`` and ``collided`` (n,) bool, ``parking_seconds``
     (n,) s (NaN where not parked); root attributes ``body_outline``, ``obstacles``,
     ``obstacle_names``, ``destination`` (JSON, as in a car trajectory), ``controller`` and
-    ``simulated_seconds`` (s). Writes a PNG to ``out_path``."""
+    ``simulated_seconds`` (s)."""
     grid = read_start_grid(start_grid_path)
     column = {name: k for k, name in enumerate(grid.state_order)}
     xy = grid.start[:, [column["x"], column["y"]]]
@@ -1029,4 +961,4 @@ def plot_success_map(start_grid_path: str | Path, out_path: str | Path) -> None:
             layout.figure.colorbar(mappable, cax=layout.colorbar, label="parking time (s)")
         _suptitle(layout.figure, f"{headline}\n{details}")
         add_legend(layout.figure, legend, ncols=4)
-        save_png(layout.figure, out_path)
+    return layout.figure

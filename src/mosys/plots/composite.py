@@ -25,41 +25,40 @@ from pathlib import Path
 import numpy as np
 from matplotlib.collections import LineCollection
 from matplotlib.colors import to_rgba
+from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from mosys.io.composite_result import CompositeMotion, CompositeResult, read_composite_result
-from mosys.plots.bsr import (
-    GIF_FPS,
-    GIF_MAX_FRAMES,
-    GROUND_SHOWN,
-    ROD_WIDTH,
-    SCENE_MARGIN,
-    animate_stick_figure,
-    choose_interval,
-    draw_pose,
-    minus_signs,
-    spread_labels,
-)
-from mosys.plots.car import frame_indices
-from mosys.plots.luxo import scene_limits
-from mosys.plots.pendulum import PlotInputError
 from mosys.plots.style import (
     GIF_DPI,
+    GIF_FPS,
+    GIF_MAX_FRAMES,
     LEGEND_ROW,
     MARGIN_BOTTOM,
     MARGIN_LEFT,
     MARGIN_RIGHT,
     MARGIN_TOP,
+    ROD_WIDTH,
+    STRIP_GROUND,
+    STRIP_MARGIN,
     TITLE_LINE,
+    PlotInputError,
     add_legend,
+    animate_stick_figure,
     check_animation_options,
+    choose_interval,
     controller_colors,
+    draw_pose,
     draw_terrain,
+    frame_indices,
     frame_samples,
+    minus_signs,
     new_figure,
     plot_style,
     save_png,
     scene_figure,
+    scene_limits,
+    spread_labels,
     write_real_time_gif,
 )
 
@@ -283,7 +282,13 @@ class _Panel:
 def plot_filmstrips(
     result_path: str | Path, path: str | Path, interval: float | None = None
 ) -> None:
-    """Figures 13 and 14 in one PNG: above, the motion from the guessed transition points
+    """Write ``filmstrips_figure`` as a PNG to ``path``."""
+    with plot_style():
+        save_png(filmstrips_figure(result_path, interval), path)
+
+
+def filmstrips_figure(result_path: str | Path, interval: float | None = None) -> Figure:
+    """Figures 13 and 14 in one figure: above, the motion from the guessed transition points
     (``before/figure_motion``); below, the refined one (``figure_motion``). Each panel draws
     the figure's rods (lines with round ends, m) every ``interval`` s (None: a round interval
     giving 12 to 20 poses over the longer motion, ``choose_interval``) and at its end, each
@@ -292,7 +297,7 @@ def plot_filmstrips(
     phases it goes between. Both panels share one scale and one view (m), equal aspect, over
     the ground; poses are drawn where they are and may overlap. Each panel's title gives the
     script total and each phase's score, its legend each phase's controller (and seed),
-    duration and time span (s). Writes a PNG."""
+    duration and time span (s)."""
     result = read_composite(result_path)
     t_ends = [float(s.motion.t[-1] - s.motion.t[0]) for s in (result.before, result.after)]
     if interval is None:
@@ -342,7 +347,7 @@ def plot_filmstrips(
     low = min(float(drawn[..., 1].min()), ground_low)
     top = float(drawn[..., 1].max())
     data_width = STRIP_WIDTH
-    scale = max((x_high - x_low) / (data_width - 2 * SCENE_MARGIN), 1e-6)  # m per inch
+    scale = max((x_high - x_low) / (data_width - 2 * STRIP_MARGIN), 1e-6)  # m per inch
 
     def layout(data_width: float, scale: float):
         """The view's x and y limits (m), each panel's switch labels' x (m) and rows, and the
@@ -351,9 +356,9 @@ def plot_filmstrips(
         x0, x1 = middle - data_width * scale / 2, middle + data_width * scale / 2
         places = [switch_label_places(p.label_at[:, 0], x0, x1, scale) for p in panels]
         rows = max((int(level.max()) + 1 for _, level in places if level.size), default=0)
-        y0 = low - GROUND_SHOWN * scale
+        y0 = low - STRIP_GROUND * scale
         base = top + SWITCH_LABEL_PAD * scale
-        y1 = base + (rows * SWITCH_LABEL_ROW + SCENE_MARGIN) * scale
+        y1 = base + (rows * SWITCH_LABEL_ROW + STRIP_MARGIN) * scale
         return (x0, x1), (y0, y1), places, base
 
     (x0, x1), (y0, y1), places, label_base = layout(data_width, scale)
@@ -421,7 +426,7 @@ def plot_filmstrips(
                 framealpha=0.9,
             )
             top_edge = bottom - under - PANEL_GAP
-        save_png(figure, path)
+    return figure
 
 
 def switch_label_places(
@@ -504,10 +509,16 @@ def search_curve(result: CompositeResult) -> tuple[np.ndarray, np.ndarray]:
 
 
 def plot_search(result_path: str | Path, path: str | Path) -> None:
+    """Write ``search_figure`` as a PNG to ``path``."""
+    with plot_style():
+        save_png(search_figure(result_path), path)
+
+
+def search_figure(result_path: str | Path) -> Figure:
     """Figure 5's transition-point search: the best script total (the script's ``total``,
     unitless) after each generation 0 to G (0: the guessed transition points), a dotted line at
     the guess's total; annotated with the search's size (Q, G, H), the simulations it ran and
-    its wall time (s), and the gain. Writes a PNG."""
+    its wall time (s), and the gain."""
     result = read_composite(result_path)
     generations, scores = search_curve(result)
     attrs = result.attrs
@@ -566,7 +577,7 @@ def plot_search(result_path: str | Path, path: str | Path) -> None:
             bottom=MARGIN_BOTTOM / SEARCH_HEIGHT,
             top=1 - (MARGIN_TOP + 2 * TITLE_LINE + 0.1) / SEARCH_HEIGHT,
         )
-        save_png(figure, path)
+    return figure
 
 
 # --------------------------------------------------------------------------- the animation

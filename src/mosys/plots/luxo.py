@@ -25,31 +25,38 @@ from matplotlib.axes import Axes
 from matplotlib.cm import ScalarMappable
 from matplotlib.collections import LineCollection
 from matplotlib.colors import Normalize, to_rgba
+from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Polygon
 from matplotlib.transforms import blended_transform_factory
 
 from mosys.animation.motion_measures import Motion, motions
 from mosys.io.trajectory import Trajectory, read_trajectory
-from mosys.plots.car import frame_indices
-from mosys.plots.pendulum import PlotInputError
 from mosys.plots.style import (
+    ASPECT_RANGE,
     GIF_DPI,
+    GIF_FPS,
     MARGIN_LEFT,
     POSE_TIMES,
     TERRAIN_EDGE,
     TERRAIN_FACE,
+    PlotInputError,
     add_legend,
     animation_frames,
     arrange,
     check_animation_options,
     controller_colors,
     draw_terrain,
+    fit_aspect,
+    frame_indices,
     frame_samples,
+    minus_signs,
     new_figure,
+    pan,
     plot_style,
     save_png,
     scene_figure,
+    scene_limits,
     write_real_time_gif,
 )
 
@@ -60,15 +67,11 @@ HEAD_LENGTH = 0.06  # m, the lamp shade from its neck to its mouth, along the up
 HEAD_MOUTH = 0.032  # m, half the shade's mouth
 HEAD_NECK = 0.008  # m, half the shade's neck
 COM_COLOR = "#d62728"  # the centre of mass's path in the strip
-VIEW_MARGIN = 0.08  # m of blank around the lamp
-GROUND_MARGIN = 0.04  # m of ground shown below the lowest ground in view
-ASPECT_RANGE = (0.3, 0.85)  # height / width of a scene; its x or y limits widen to stay inside
 STRIP_EVERY = 0.05  # s between the poses of a strip
 STILL_DISTANCE = 0.005  # m: a strip leaves out a pose no end of which moved this far
 STRIP_WIDTH = 7.5  # inches, the strip's data area
 GIF_WIDTH = 6.0  # inches, the animation's data area
-GIF_FPS = 25  # frames per second of motion time
-GIF_MAX_FRAMES = 600
+SHOW_MAX_FRAMES = 600  # frames of the show GIF at most: a longer show gets a wider step
 FOLLOW_WIDTH = 3.0  # m: a lamp ranging wider in x is followed by a view this wide (at least)
 SERIES_WIDTH = 7.2  # inches, the data area of the time series
 SIDE_LEGEND = 2.0  # inches right of the time series for their legends
@@ -169,7 +172,7 @@ def strip_samples(
     t: np.ndarray, endpoints: np.ndarray, first: int, last: int, every: float
 ) -> np.ndarray:
     """The samples a strip draws between ``first`` and ``last`` (both drawn): one every
-    ``every`` seconds (see ``mosys.plots.car.frame_indices``), leaving out each pose none of
+    ``every`` seconds (see ``frame_indices``), leaving out each pose none of
     whose rod ends moved STILL_DISTANCE m or more from the last pose kept (a lamp at rest is
     drawn once). t: (N,) s; endpoints: (N, rods, 2, 2) m."""
     candidates = np.append(frame_indices(t[first : last + 1], every) + first, last)
@@ -185,11 +188,6 @@ def strip_samples(
 
 def _script_name(trajectory: Trajectory, path: str | Path) -> str:
     return Path(str(trajectory.attrs.get("script", path))).name
-
-
-def _minus(text: str) -> str:
-    """A true minus sign for hyphens in numbers."""
-    return text.replace("-", "−")
 
 
 # --------------------------------------------------------------------------- drawing the lamp
@@ -253,46 +251,6 @@ class _Lamp:
         self.head.set_facecolor(color)
 
 
-def _ground_range(terrain: list, x0: float, x1: float) -> tuple[float, float] | None:
-    """The lowest and highest ground between x0 and x1 (m), None without terrain."""
-    if not terrain:
-        return None
-    ground = np.asarray(terrain, dtype=np.float64)
-    inside = ground[(ground[:, 0] >= x0) & (ground[:, 0] <= x1), 1]
-    ends = np.interp([x0, x1], ground[:, 0], ground[:, 1])
-    heights = np.concatenate([inside, ends])
-    return float(heights.min()), float(heights.max())
-
-
-def scene_limits(points: np.ndarray, terrain: list) -> np.ndarray:
-    """[[xmin, ymin], [xmax, ymax]] m of a view of the lamp: its ``points`` (..., 2) m with
-    VIEW_MARGIN all round and the ground in that range of x with GROUND_MARGIN below, widened
-    by ``fit_aspect``."""
-    points = np.asarray(points, dtype=np.float64).reshape(-1, 2)
-    low, high = points.min(axis=0) - VIEW_MARGIN, points.max(axis=0) + VIEW_MARGIN
-    limits = np.array([low, high])
-    for _ in range(2):  # once more after a widening in x, which may show deeper ground
-        ground = _ground_range(terrain, limits[0, 0], limits[1, 0])
-        if ground is not None:
-            limits[0, 1] = min(limits[0, 1], ground[0] - GROUND_MARGIN)
-            limits[1, 1] = max(limits[1, 1], ground[1] + VIEW_MARGIN)
-        limits = fit_aspect(limits)
-    return limits
-
-
-def fit_aspect(limits: np.ndarray) -> np.ndarray:
-    """``limits`` [[xmin, ymin], [xmax, ymax]] (m) widened about their centre to a height /
-    width within ASPECT_RANGE: in y if too flat, in x if too tall."""
-    limits = np.array(limits, dtype=np.float64)
-    width, height = limits[1] - limits[0]
-    least, most = ASPECT_RANGE
-    if height < least * width:
-        limits[:, 1] += np.array([-1, 1]) * (least * width - height) / 2
-    elif height > most * width:
-        limits[:, 0] += np.array([-1, 1]) * (height / most - width) / 2
-    return limits
-
-
 # --------------------------------------------------------------------------- the plots
 
 
@@ -302,13 +260,21 @@ def plot_motion_strip(
     motion: str,
     every: float = STRIP_EVERY,
 ) -> None:
+    """Write ``motion_strip_figure`` as a PNG to ``out_path``."""
+    with plot_style():
+        save_png(motion_strip_figure(trajectory_path, motion, every), out_path)
+
+
+def motion_strip_figure(
+    trajectory_path: str | Path, motion: str, every: float = STRIP_EVERY
+) -> Figure:
     """Figure 22 ("A Luxo back-flip"): the first motion called ``motion`` in one panel, to
     scale in metres: the terrain (filled grey), the lamp every ``every`` seconds from the
     motion's start to its last sample (the landing included; a pose that hardly moved from the
     last one drawn is left out, see ``strip_samples``), light to dark with the time since the
     motion began (colour bar, s), and the path of its centre of mass. The title gives the
-    base's net rotation (deg, from the state column ``base``). Writes a PNG to ``out_path``;
-    ValueError (PlotInputError) if the trajectory has no such motion."""
+    base's net rotation (deg, from the state column ``base``). ValueError (PlotInputError) if
+    the trajectory has no such motion."""
     if not every > 0:
         raise ValueError(f"every must be a positive number of seconds, got {every!r}")
     trajectory = read_luxo_trajectory(trajectory_path)
@@ -327,7 +293,7 @@ def plot_motion_strip(
         np.concatenate([endpoints[samples].reshape(-1, 2), shades.reshape(-1, 2), com]),
         figure_motion.terrain,
     )
-    rotation = _minus(f"{net_rotation(trajectory, chosen):.0f}")
+    rotation = minus_signs(f"{net_rotation(trajectory, chosen):.0f}")
     title = (
         f"Luxo: {chosen.name} (net base rotation {rotation}°)\n"
         f"poses every {every:g} s from t = {t[first]:.2f} s to {t[last]:.2f} s, "
@@ -354,7 +320,7 @@ def plot_motion_strip(
         )
         ax.set_title(title)
         add_legend(figure, legend, ncols=3)
-        save_png(figure, out_path)
+    return figure
 
 
 def _motion_at(found: Sequence[Motion], samples: np.ndarray) -> np.ndarray:
@@ -365,21 +331,11 @@ def _motion_at(found: Sequence[Motion], samples: np.ndarray) -> np.ndarray:
     return index
 
 
-def pan(view: tuple[float, float], x: float) -> tuple[float, float] | None:
-    """A view (xmin, xmax) m that follows a lamp whose middle is at ``x`` m: None (stay) while
-    ``x`` is in the view's middle half, else the view of the same width centred on ``x``."""
-    x0, x1 = view
-    quarter = (x1 - x0) / 4
-    if x0 + quarter <= x <= x1 - quarter:
-        return None
-    return (x - 2 * quarter, x + 2 * quarter)
-
-
 def write_show_gif(
     trajectory_path: str | Path,
     out_path: str | Path,
     fps: int = GIF_FPS,
-    max_frames: int = GIF_MAX_FRAMES,
+    max_frames: int = SHOW_MAX_FRAMES,
 ) -> None:
     """An animated GIF of the whole trajectory, to scale in metres: the terrain, the lamp
     coloured by what drives it (legend), and in the title the time, the motion (``k of n``) and
@@ -512,13 +468,19 @@ def _mark_motions(
 
 
 def plot_torques_and_forces(trajectory_path: str | Path, out_path: str | Path) -> None:
+    """Write ``torques_and_forces_figure`` as a PNG to ``out_path``."""
+    with plot_style():
+        save_png(torques_and_forces_figure(trajectory_path), out_path)
+
+
+def torques_and_forces_figure(trajectory_path: str | Path) -> Figure:
     """The lamp's actuation and ground contact over the whole trajectory, three panels on one
     time axis (s): a timeline of the motions (a bar each, named, solid while its motor
     program drives, faded while the landing controller does); the joint torques (each
     ``/control`` column, N·m); and the magnitude of the ground's force on each contact point
     (N, on a scale linear to 10 N and logarithmic above, with the lamp's weight for
     reference), labelled base front edge, base back edge and head. The motions' spans are
-    shaded on both data panels. Writes a PNG to ``out_path``."""
+    shaded on both data panels."""
     trajectory = read_luxo_trajectory(trajectory_path, contacts=True)
     t = trajectory.t
     contacts = trajectory.contacts
@@ -589,4 +551,4 @@ def plot_torques_and_forces(trajectory_path: str | Path, out_path: str | Path) -
         figure.subplots_adjust(
             left=(MARGIN_LEFT + 0.3) / width, right=1 - SIDE_LEGEND / width, top=1 - 0.45 / height
         )
-        save_png(figure, out_path)
+    return figure

@@ -22,20 +22,22 @@ import matplotlib
 import numpy as np
 from matplotlib import patheffects
 from matplotlib.axes import Axes
+from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import MultipleLocator
 from matplotlib.transforms import Bbox
 
-from mosys.errors import InputError
-from mosys.io.atomic import write_atomically
 from mosys.io.attributes import string_tuple
 from mosys.io.controller_table import ControllerTable, read_controller_table
 from mosys.io.trajectory import Trajectory, read_trajectory
 from mosys.plots.style import (
     DESTINATION_COLOR,
     GIF_DPI,
+    GIF_FPS,
     SYMBOLS,
+    PlotInputError,
     add_legend,
+    animation_frames,
     axis_label,
     controller_colors,
     destination_handle,
@@ -44,19 +46,14 @@ from mosys.plots.style import (
     new_figure,
     plot_style,
     save_png,
-    shared_palette,
     start_style,
+    write_gif,
 )
 
 PORTRAIT_STARTS = 8  # start states per portrait
 PORTRAIT_SECONDS = 3.0  # s simulated from each start
 CYCLE_SECONDS = (3.0, 5.0)  # s: a periodic destination's cycle is drawn over this window
-GIF_FPS = 25  # frames per second of the animations
 DEFAULT_DT = 0.001  # s: simulator step when a table does not record its own
-
-
-class PlotInputError(InputError):
-    """The inputs cannot make the requested plot (wrong count, wrong kind of file...)."""
 
 
 @dataclass(frozen=True)
@@ -273,10 +270,21 @@ def plot_portrait(
     seconds: float = PORTRAIT_SECONDS,
     starts: int = PORTRAIT_STARTS,
 ) -> None:
+    """Write ``portrait_figure`` as a PNG to ``out_path``."""
+    with plot_style():
+        save_png(portrait_figure(table_path, dynamics, seconds, starts), out_path)
+
+
+def portrait_figure(
+    table_path: str | Path,
+    dynamics: ModuleType,
+    seconds: float = PORTRAIT_SECONDS,
+    starts: int = PORTRAIT_STARTS,
+) -> Figure:
     """Figure 14: closed-loop paths in state space under the controller in ``table_path``, from
     ``starts`` start states (small squares) for ``seconds`` each, to the destination (encircled
     X). A periodic destination's cycle (the path from the destination itself, between
-    ``CYCLE_SECONDS``) is drawn as a thick grey line. Writes a PNG to ``out_path``."""
+    ``CYCLE_SECONDS``) is drawn as a thick grey line."""
     from mosys.ssc.controller import Controller
 
     controller = Controller.load(table_path, dynamics)
@@ -316,14 +324,20 @@ def plot_portrait(
             f"closed-loop paths, {seconds:g} s from each of {starts} start states"
         )
         add_legend(figure, legend)
-        save_png(figure, out_path)
+    return figure
 
 
 def plot_torque(table_path: str | Path, out_path: str | Path, contours: bool = True) -> None:
+    """Write ``torque_figure`` as a PNG to ``out_path``."""
+    with plot_style():
+        save_png(torque_figure(table_path, contours), out_path)
+
+
+def torque_figure(table_path: str | Path, contours: bool = True) -> Figure:
     """A controller's torque table as a heat map over its two state variables: one cell per
     table node (the value the DP stored there; between nodes the controller interpolates),
     a diverging colour scale centred on 0 N·m, the destination marked, and the cost-to-go as
-    labelled contour lines (s). One panel per control. Writes a PNG to ``out_path``."""
+    labelled contour lines (s). One panel per control."""
     table = read_controller_table(table_path)
     axes = table_axes(table, table_path)
     name = Path(table_path).stem
@@ -394,7 +408,7 @@ def plot_torque(table_path: str | Path, out_path: str | Path, contours: bool = T
                 f"destination {describe_state(table.dest, units)}"
             )
         add_legend(figure, legend)
-        save_png(figure, out_path)
+    return figure
 
 
 def _cell_edges(centres: np.ndarray) -> np.ndarray:
@@ -506,11 +520,17 @@ def plot_script(
     table_paths: Sequence[str | Path],
     out_path: str | Path,
 ) -> None:
+    """Write ``script_path_figure`` as a PNG to ``out_path``."""
+    with plot_style():
+        save_png(script_path_figure(trajectory_path, table_paths), out_path)
+
+
+def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | Path]) -> Figure:
     """Figure 16: an animation script's path in state space, each controller's stretch in its
     own colour; ``sX`` marks where controller X is invoked and ``dX`` its destination (read
     from the controller tables in ``table_paths``, matched to the script's controllers by file
     stem; without them no destinations are drawn, and the axes are the pendulum's: see
-    ``trajectory_axes``). Writes a PNG to ``out_path``."""
+    ``trajectory_axes``)."""
     trajectory = read_trajectory(trajectory_path)
     if len(trajectory.t) == 0:
         raise PlotInputError(f"{trajectory_path}: the trajectory has no samples")
@@ -569,7 +589,7 @@ def plot_script(
         )
         add_legend(figure, legend, ncols=4)
         place_labels(figure, ax, labels, obstacles)
-        save_png(figure, out_path)
+    return figure
 
 
 def write_script_gif(trajectory_path: str | Path, out_path: str | Path, fps: int = GIF_FPS):
@@ -577,15 +597,11 @@ def write_script_gif(trajectory_path: str | Path, out_path: str | Path, fps: int
     trajectory's ``figure_motion`` group: rods as thick lines coloured by the active controller,
     the pivot (rod 0's proximal end), the centre of mass and the terrain; fixed, equal-aspect
     limits from the data; a caption with the time and active controller. ``fps`` frames per
-    second of motion time (the sample at or after each frame time); loops forever.
-
-    Frames are blitted: the static figure is drawn once and each frame redraws only the moving
-    artists, many times faster than matplotlib's animation writers, which redraw the whole
-    figure (title, axes, legend) for every frame; Pillow writes the GIF (as PillowWriter
-    does), with one palette for all frames.
+    second of motion time (the sample at or after each frame time, one frame more when the
+    end is nearer the next frame time than the last; every frame round(1000 / fps) ms, the last
+    not held); loops forever. Frames are blitted (``animation_frames``) and written with one
+    palette for all (``write_gif``).
     """
-    from PIL import Image
-
     trajectory = read_trajectory(trajectory_path)
     motion = trajectory.motion
     if motion is None or len(motion.t) == 0:
@@ -648,14 +664,9 @@ def write_script_gif(trajectory_path: str | Path, out_path: str | Path, fps: int
             (Line2D([], [], **com_style), "centre of mass"),
         ]
         add_legend(figure, legend, ncols=3, fontsize=8)
-        moving = [*rods, joints, pivot, centre_of_mass, caption]  # in drawing (z) order
-        for artist in moving:
-            artist.set_animated(True)  # left out of full draws: drawn per frame below
-        canvas = figure.canvas
-        canvas.draw()
-        background = canvas.copy_from_bbox(figure.bbox)
-        frames = []
-        for frame, s in enumerate(samples):
+
+        def update(frame: int) -> bool:
+            s = samples[frame]
             for rod, ends in zip(rods, endpoints[s], strict=True):
                 rod.set_data(ends[:, 0], ends[:, 1])
                 rod.set_color(colors[active[frame]])
@@ -663,25 +674,8 @@ def write_script_gif(trajectory_path: str | Path, out_path: str | Path, fps: int
             pivot.set_data([endpoints[s, 0, 0, 0]], [endpoints[s, 0, 0, 1]])
             centre_of_mass.set_data([com[s, 0]], [com[s, 1]])
             caption.set_text(f"t = {motion.t[s]:5.2f} s   controller {active[frame]}")
-            canvas.restore_region(background)
-            for artist in moving:
-                figure.draw_artist(artist)
-            rgba = np.asarray(canvas.buffer_rgba())
-            frames.append(Image.fromarray(rgba[..., :3].copy()))
+            return False
 
-    frames = shared_palette(frames)
-
-    def write(partial: Path) -> None:
-        frames[0].save(
-            partial,
-            format="GIF",
-            save_all=True,
-            append_images=frames[1:],
-            duration=round(1000 / fps),
-            loop=0,
-        )
-
-    write_atomically(out_path, write)
-
-
-# --------------------------------------------------------------------------- the CLI verb
+        moving = [*rods, joints, pivot, centre_of_mass, caption]  # in drawing (z) order
+        frames = animation_frames(figure, moving, range(len(samples)), update)
+    write_gif(frames, out_path, round(1000 / fps))

@@ -1,5 +1,8 @@
-"""The shared look of mosys plots: figure sizes, fonts, markers, colours, the atomic PNG write and
-the blitted, atomically written animated GIF.
+"""The one base module of the plot families (``pendulum``, ``car``, ``luxo``, ``bsr``,
+``composite``), which import it and nothing of each other: the shared look (figure sizes, fonts,
+markers, colours), the error a bad input raises, the sampling of a motion at regular times, the
+scene views, the stick figure the BSR and composite plots and the concatenation editor draw, the
+atomic PNG write and the blitted, atomically written animated GIF.
 
 Figures are built with matplotlib's object API on an Agg canvas (no pyplot, no global figure
 state), so plotting works headless and in parallel Snakemake jobs.
@@ -14,15 +17,18 @@ from pathlib import Path
 
 import matplotlib
 import numpy as np
+from matplotlib import patheffects
 from matplotlib.artist import Artist
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.collections import LineCollection
 from matplotlib.colors import LinearSegmentedColormap
 from matplotlib.figure import Figure
 from matplotlib.legend_handler import HandlerTuple
 from matplotlib.lines import Line2D
 from matplotlib.patches import Polygon
 
+from mosys.errors import InputError
 from mosys.io.atomic import write_atomically
 
 DPI = 120  # dots per inch of every PNG
@@ -43,6 +49,10 @@ STYLE = {
 SYMBOLS = {"angle": "θ", "omega": "ω", "heading": "φ", "steer": "δ", "speed": "v"}
 DESTINATION_COLOR = "black"
 LEGEND_HANDLERS = {tuple: HandlerTuple(ndivide=1)}  # a tuple handle: its parts overlaid
+
+
+class PlotInputError(InputError):
+    """The inputs cannot make the requested plot (wrong count, wrong kind of file...)."""
 
 
 @contextmanager
@@ -86,6 +96,11 @@ def arrange(figure: Figure, legend_rows: int = 0) -> None:
 def save_png(figure: Figure, path: str | Path) -> None:
     """Write ``figure`` as a PNG to ``path`` atomically (a hidden partial file, then a rename)."""
     write_atomically(path, lambda partial: figure.savefig(partial, format="png", dpi=DPI))
+
+
+def minus_signs(text: str) -> str:
+    """A true minus sign for hyphens in numbers."""
+    return text.replace("-", "−")
 
 
 def axis_label(name: str, unit: str) -> str:
@@ -181,6 +196,37 @@ def add_legend(
     arrange(figure, legend_rows=-(-len(entries) // ncols))
 
 
+# --------------------------------------------------------------------------- sampling a motion
+
+
+def frame_indices(t: np.ndarray, interval: float) -> np.ndarray:
+    """Sample indices (int64, increasing, no repeats) of the first sample at or after each
+    time t[0] + k·interval (k = 0, 1, ...) up to t[-1]. t: (N,) s, non-decreasing; interval: s.
+    Times within 1e-9 s of a sample count as that sample."""
+    t = np.asarray(t, dtype=np.float64)
+    if t.ndim != 1:
+        raise ValueError(f"t must be 1-D, got shape {t.shape}")
+    if not interval > 0:
+        raise ValueError(f"interval must be positive, got {interval!r}")
+    if len(t) == 0:
+        return np.zeros(0, dtype=np.int64)
+    count = math.floor((t[-1] - t[0]) / interval + 1e-9) + 1
+    times = t[0] + interval * np.arange(count)
+    index = np.minimum(np.searchsorted(t, times - 1e-9), len(t) - 1)
+    return np.unique(index).astype(np.int64)
+
+
+def samples_to_the_end(t: np.ndarray, interval: float, max_count: int | None = None) -> np.ndarray:
+    """``frame_indices`` of ``t`` (N,) s every ``interval`` s and the last sample, N - 1,
+    always; if that one is added, only the first ``max_count`` - 1 of the others are kept
+    (None: all)."""
+    samples = frame_indices(t, interval)
+    if samples[-1] != len(t) - 1:
+        keep = len(samples) if max_count is None else max_count - 1
+        samples = np.append(samples[:keep], len(t) - 1)
+    return samples
+
+
 # --------------------------------------------------------------------------- scenes
 
 # Scenes draw an articulated figure (``figure_motion``) to scale in metres, y up, over its terrain.
@@ -241,10 +287,145 @@ def scene_figure(
     return figure, ax, bar
 
 
+# Views of a moving figure (Luxo's, and the BSR and composite animations'), metres.
+VIEW_PADDING = 0.08  # m of blank round the figure
+GROUND_PADDING = 0.04  # m of ground shown below the lowest ground in view
+ASPECT_RANGE = (0.3, 0.85)  # height / width of a view; its x or y limits widen to stay inside
+
+
+def _ground_range(terrain: list, x0: float, x1: float) -> tuple[float, float] | None:
+    """The lowest and highest ground between x0 and x1 (m), None without terrain."""
+    if not terrain:
+        return None
+    ground = np.asarray(terrain, dtype=np.float64)
+    inside = ground[(ground[:, 0] >= x0) & (ground[:, 0] <= x1), 1]
+    ends = np.interp([x0, x1], ground[:, 0], ground[:, 1])
+    heights = np.concatenate([inside, ends])
+    return float(heights.min()), float(heights.max())
+
+
+def scene_limits(points: np.ndarray, terrain: list) -> np.ndarray:
+    """[[xmin, ymin], [xmax, ymax]] m of a view of a figure: its ``points`` (..., 2) m with
+    VIEW_PADDING all round and the ground in that range of x with GROUND_PADDING below, widened
+    by ``fit_aspect``."""
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    low, high = points.min(axis=0) - VIEW_PADDING, points.max(axis=0) + VIEW_PADDING
+    limits = np.array([low, high])
+    for _ in range(2):  # once more after a widening in x, which may show deeper ground
+        ground = _ground_range(terrain, limits[0, 0], limits[1, 0])
+        if ground is not None:
+            limits[0, 1] = min(limits[0, 1], ground[0] - GROUND_PADDING)
+            limits[1, 1] = max(limits[1, 1], ground[1] + VIEW_PADDING)
+        limits = fit_aspect(limits)
+    return limits
+
+
+def fit_aspect(limits: np.ndarray, aspect_range: tuple[float, float] | None = None) -> np.ndarray:
+    """``limits`` [[xmin, ymin], [xmax, ymax]] (m) widened about their centre to a height /
+    width within ``aspect_range`` (None: ASPECT_RANGE): in y if too flat, in x if too tall."""
+    limits = np.array(limits, dtype=np.float64)
+    width, height = limits[1] - limits[0]
+    least, most = ASPECT_RANGE if aspect_range is None else aspect_range
+    if height < least * width:
+        limits[:, 1] += np.array([-1, 1]) * (least * width - height) / 2
+    elif height > most * width:
+        limits[:, 0] += np.array([-1, 1]) * (height / most - width) / 2
+    return limits
+
+
+def pan(view: tuple[float, float], x: float) -> tuple[float, float] | None:
+    """A view (xmin, xmax) m that follows a figure whose middle is at ``x`` m: None (stay) while
+    ``x`` is in the view's middle half, else the view of the same width centred on ``x``."""
+    x0, x1 = view
+    quarter = (x1 - x0) / 4
+    if x0 + quarter <= x <= x1 - quarter:
+        return None
+    return (x - 2 * quarter, x + 2 * quarter)
+
+
+# --------------------------------------------------------------------------- stick figures
+
+# A stick figure (the BSR and composite plots, the concatenation editor): each rod a line with
+# round ends, outlined thinly, a round marker at each rod end.
+ROD_WIDTH = 2.0  # pt
+JOINT_SIZE = 3.4  # pt, the round marker at each rod end
+OUTLINE = "0.2"  # the thin outline that keeps light poses visible on white
+
+
+def draw_pose(ax: Axes, pose: np.ndarray, color, zorder: float) -> None:
+    """One pose (rods, 2, 2) m: rods as lines with round ends, outlined thinly."""
+    outline = [patheffects.withStroke(linewidth=ROD_WIDTH + 1.0, foreground=OUTLINE)]
+    rods = LineCollection(
+        pose, colors=[color], linewidths=ROD_WIDTH, capstyle="round", zorder=zorder
+    )
+    rods.set_path_effects(outline)
+    ax.add_collection(rods, autolim=False)
+    ends = pose.reshape(-1, 2)
+    ax.plot(
+        ends[:, 0],
+        ends[:, 1],
+        "o",
+        markersize=JOINT_SIZE,
+        color=color,
+        markeredgecolor=OUTLINE,
+        markeredgewidth=0.6,
+        zorder=zorder + 0.001,
+    )
+
+
+# Filmstrips (the BSR and composite plots): poses at regular times, to scale.
+POSES = (12, 20)  # the interval is chosen so that this many poses are drawn, 16 if it can
+NICE_STEPS = (1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0)  # mantissas of a chosen interval
+STRIP_MARGIN = 0.06  # inches of blank round the poses (in data units: times the m per inch)
+STRIP_GROUND = 0.12  # inches of ground shown below the lowest ground point
+
+
+def choose_interval(duration: float, poses: tuple[int, int] = POSES) -> float:
+    """A round interval, s (1, 1.5, 2, 2.5, 3, 4, 5, 6 or 8 times a power of ten) at which
+    between ``poses`` poses are drawn over ``duration`` s (both ends counted), as near the
+    middle of that range as can be."""
+    if not duration > 0:
+        return 1.0
+    least, most = poses
+    aim = (least + most) / 2
+    best = None
+    scale = 10.0 ** math.floor(math.log10(duration / most))
+    for power in (scale / 10, scale, scale * 10):
+        for mantissa in NICE_STEPS:
+            interval = mantissa * power
+            count = math.floor(duration / interval + 1e-9) + 1
+            if least <= count <= most:
+                score = (abs(count - aim), -interval)
+                if best is None or score < best[0]:
+                    best = (score, interval)
+    return best[1] if best else duration / (aim - 1)
+
+
+def spread_labels(values: np.ndarray, gap: float, low: float, high: float) -> np.ndarray:
+    """Label heights near ``values`` (data units), at least ``gap`` apart, kept in
+    [low, high] where they fit."""
+    values = np.asarray(values, dtype=np.float64)
+    order = np.argsort(values, kind="stable")
+    placed = values[order].copy()
+    for k in range(1, len(placed)):
+        placed[k] = max(placed[k], placed[k - 1] + gap)
+    overflow = placed[-1] - high if len(placed) else 0.0
+    if overflow > 0:
+        placed[-1] -= overflow
+        for k in range(len(placed) - 2, -1, -1):
+            placed[k] = min(placed[k], placed[k + 1] - gap)
+    placed = np.maximum(placed, low + gap * np.arange(len(placed)))
+    out = np.empty_like(placed)
+    out[order] = placed
+    return out
+
+
 # --------------------------------------------------------------------------- animations
 
 GIF_DPI = 80  # dots per inch of animation frames
 GIF_HOLD_MS = 1500  # ms the last frame of an animation stays up before the loop restarts
+GIF_FPS = 25  # frames per second of motion time: a frame every 40 ms
+GIF_MAX_FRAMES = 150  # a longer motion gets a wider step (``frame_samples``)
 
 
 def check_animation_options(fps, max_frames) -> None:
@@ -260,15 +441,10 @@ def frame_samples(t: np.ndarray, fps: int, max_frames: int) -> tuple[np.ndarray,
     time (the step widened to keep to ``max_frames``, and rounded up to whole hundredths, the
     unit of a GIF's frame durations, so that the animation plays in real time), the last sample
     always included; and the step, s."""
-    from mosys.plots.car import frame_indices  # here: car imports this module
-
     span = float(t[-1] - t[0])
     step = max(1.0 / fps, span / (max_frames - 1)) if span > 0 else 1.0 / fps
     step = math.ceil(step * 100.0 - 1e-9) / 100.0
-    samples = frame_indices(t, step)
-    if samples[-1] != len(t) - 1:
-        samples = np.append(samples[: max_frames - 1], len(t) - 1)
-    return samples, step
+    return samples_to_the_end(t, step, max_frames), step
 
 
 def animation_frames(
@@ -300,6 +476,52 @@ def animation_frames(
         rgba = np.asarray(canvas.buffer_rgba())
         frames.append(Image.fromarray(rgba[..., :3].copy()))
     return frames
+
+
+def animate_stick_figure(
+    figure: Figure,
+    ax: Axes,
+    t: np.ndarray,
+    endpoints: np.ndarray,
+    samples: np.ndarray,
+    look: Callable[[int], tuple],
+    label_size: float,
+    follow: np.ndarray | None = None,
+) -> list:
+    """The frames (``animation_frames``) of a stick figure at ``samples`` of its motion (t (N,)
+    s, endpoints (N, rods, 2, 2) m) on ``ax``: the rods as lines with round ends and their
+    joints, the time in the top left corner and a label in the top right. ``look(frame)`` gives
+    that frame's rod colour, label text and label colour; ``follow`` (frames,) m: the x the view
+    keeps in sight, panning (``pan``), or None for a fixed view."""
+    rods = LineCollection(
+        np.zeros((endpoints.shape[1], 2, 2)), linewidths=ROD_WIDTH + 1.0, capstyle="round", zorder=3
+    )
+    ax.add_collection(rods, autolim=False)
+    (joints,) = ax.plot([], [], "o", markersize=JOINT_SIZE + 1.5, zorder=3.1)
+    box = {"boxstyle": "round,pad=0.3", "facecolor": "white", "alpha": 0.9}
+    corner = {"transform": ax.transAxes, "va": "top", "bbox": box, "zorder": 10}
+    clock = ax.text(0.02, 0.97, "", ha="left", fontsize=10, family="monospace", **corner)
+    label = ax.text(0.98, 0.97, "", ha="right", fontsize=label_size, fontweight="bold", **corner)
+
+    def update(frame: int) -> bool:
+        sample = int(samples[frame])
+        pose = endpoints[sample]
+        color, text, text_color = look(frame)
+        rods.set_segments(pose)
+        rods.set_color(color)
+        joints.set_data(pose[..., 0].ravel(), pose[..., 1].ravel())
+        joints.set_color(color)
+        joints.set_markeredgecolor(OUTLINE)
+        clock.set_text(f"t = {t[sample]:5.2f} s")
+        label.set_text(text)
+        label.set_color(text_color)
+        view = None if follow is None else pan(ax.get_xlim(), follow[frame])
+        if view is None:
+            return False
+        ax.set_xlim(*view)
+        return True
+
+    return animation_frames(figure, [rods, joints, clock, label], range(len(samples)), update)
 
 
 def shared_palette(frames: list, samples: int = 8) -> list:
