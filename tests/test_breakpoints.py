@@ -28,21 +28,31 @@ def dynamics_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return directory
 
 
-def run(tmp_path: Path, dynamics_dir: Path, pendulum_tables: Path, text: str):
+@pytest.fixture(scope="module")
+def a_and_b(tmp_path_factory: pytest.TempPathFactory, link1) -> Path:
+    """Controllers A and B (the two the breakpoint test swaps), built from their specs."""
+    directory = tmp_path_factory.mktemp("controllers")
+    for name in "AB":
+        spec = parse_controller_spec(SPECS / "controllers" / "pendulum" / f"{name}.ssc")
+        generate_controller(spec, link1, directory / f"{name}.h5", quiet=True)
+    return directory
+
+
+def run(tmp_path: Path, dynamics_dir: Path, controllers: Path, text: str):
     script = tmp_path / "breakpoint.anim"
     script.write_text(text)
     out = tmp_path / "breakpoint.h5"
-    run_animation_script(script, pendulum_tables, dynamics_dir, out, DT, SPECS / "motor")
+    run_animation_script(script, controllers, dynamics_dir, out, DT, SPECS / "motor")
     return read_trajectory(out)
 
 
 def test_the_breakpoint_controller_drives_exactly_while_the_state_is_in_its_box(
-    tmp_path, dynamics_dir, pendulum_tables
+    tmp_path, dynamics_dir, a_and_b
 ):
     trajectory = run(
         tmp_path,
         dynamics_dir,
-        pendulum_tables,
+        a_and_b,
         "state link -135,350\n"
         "swapcon link conA.ctab\n"
         "when link angle>-60 angle<-20 swapcon conB.ctab\n"

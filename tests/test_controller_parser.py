@@ -6,6 +6,7 @@ import hashlib
 from pathlib import Path
 
 import pytest
+from conftest import SpecLines, parses_or_spec_error
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from spec_fuzz import token_mutations
@@ -120,8 +121,9 @@ def test_nodes_and_indices():
     assert angle.nodes() == tuple(float(v) for v in range(-180, 171, 10))
     assert spec.dimension("omega").nodes()[-1] == 500.0
     assert {e.name: e.index for e in spec.destination} == {"angle": 18, "omega": 10}
-    with pytest.raises(KeyError):
+    with pytest.raises(KeyError) as error:
         spec.dimension("torque")
+    assert error.value.args == ("torque",)
 
 
 @pytest.mark.parametrize(
@@ -151,8 +153,12 @@ def test_options_and_order_free_lines():
 def test_dest_within_grid_tolerance():
     spec = parse_controller_text(BASE.replace("omega=0", "omega=500.00000001"))
     assert spec.destination[1].index == 20
-    with pytest.raises(SpecError, match="a grid node of ssd omega"):
+    with pytest.raises(SpecError) as error:
         parse_controller_text(BASE.replace("omega=0", "omega=0.0000001"))
+    assert str(error.value) == (
+        "<text>:5:20: expected a grid node of ssd omega (-500 + k * 50) for dest omega, "
+        "found '0.0000001'"
+    )
 
 
 def test_ordered_state_rejects_names_the_figure_lacks():
@@ -171,16 +177,8 @@ def test_ordered_state_rejects_names_the_figure_lacks():
 # --- errors: the whole message --------------------------------------------------------------
 
 
-def replace_line(number: int, text: str) -> str:
-    lines = BASE.splitlines()
-    lines[number - 1] = text
-    return "\n".join(lines) + "\n"
-
-
-def drop_line(number: int) -> str:
-    lines = BASE.splitlines()
-    del lines[number - 1]
-    return "\n".join(lines) + "\n"
+replace_line = SpecLines(BASE).replace
+drop_line = SpecLines(BASE).drop
 
 
 ERRORS = [
@@ -367,15 +365,10 @@ garbage = st.one_of(
 )
 
 
-def parses_or_spec_error(text: str) -> None:
-    try:
-        spec = parse_controller_text(text, "fuzz.ssc")
-    except SpecError as error:
-        assert str(error).startswith("fuzz.ssc:")
-        assert 1 <= error.line <= len(text.splitlines()) + 1 and error.column >= 1
-    else:
-        assert spec.state and spec.controls and spec.destination
-        assert values(parse_controller_text(render_controller_spec(spec))) == values(spec)
+def sound_and_round_trips(spec: ControllerSpec) -> None:
+    """What a spec the parser accepts satisfies, and it reads back from its rendering."""
+    assert spec.state and spec.controls and spec.destination
+    assert values(parse_controller_text(render_controller_spec(spec))) == values(spec)
 
 
 FAST = settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -384,13 +377,13 @@ FAST = settings(max_examples=300, deadline=None, suppress_health_check=[HealthCh
 @FAST
 @given(st.text())
 def test_any_text_parses_or_raises_spec_error(text):
-    parses_or_spec_error(text)
+    parses_or_spec_error(parse_controller_text, text, "fuzz.ssc", sound_and_round_trips)
 
 
 @FAST
 @given(st.lists(st.lists(garbage, max_size=7).map(" ".join), max_size=8).map("\n".join))
 def test_keyword_soup_parses_or_raises_spec_error(text):
-    parses_or_spec_error(text)
+    parses_or_spec_error(parse_controller_text, text, "fuzz.ssc", sound_and_round_trips)
 
 
 mutated_specs = token_mutations(st.sampled_from(SPECS), garbage)
@@ -399,7 +392,7 @@ mutated_specs = token_mutations(st.sampled_from(SPECS), garbage)
 @FAST
 @given(mutated_specs)
 def test_mutated_specs_parse_or_raise_spec_error(text):
-    parses_or_spec_error(text)
+    parses_or_spec_error(parse_controller_text, text, "fuzz.ssc", sound_and_round_trips)
 
 
 NAMES = st.from_regex(r"[a-z][a-z0-9_]{0,6}", fullmatch=True).filter(

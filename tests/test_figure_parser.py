@@ -7,6 +7,7 @@ import math
 from pathlib import Path
 
 import pytest
+from conftest import parses_or_spec_error
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -243,21 +244,16 @@ WORDS = st.one_of(
 LINES = st.lists(st.lists(WORDS, max_size=6).map(" ".join), max_size=10).map("\n".join)
 
 
-def assert_parses_or_spec_error(text: str) -> None:
-    try:
-        figure = parse_figure_text(text, "fuzz.fig")
-    except SpecError as error:
-        assert str(error).startswith(f"fuzz.fig:{error.line}:{error.column}: expected ")
-        assert 1 <= error.line <= len(text.splitlines()) + 1
-    else:
-        assert isinstance(figure, Figure)
-        assert len(figure.joints) == len(figure.rods)
+def sound(figure: Figure) -> None:
+    """What a figure the parser accepts satisfies."""
+    assert isinstance(figure, Figure)
+    assert len(figure.joints) == len(figure.rods)
 
 
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(LINES)
 def test_random_text_parses_or_raises_spec_error(text: str) -> None:
-    assert_parses_or_spec_error(text)
+    parses_or_spec_error(parse_figure_text, text, "fuzz.fig", sound)
 
 
 SHIPPED = [(FIGURES / f"{name}.fig").read_text() for name in ("link1", "double_pendulum", "free3")]
@@ -293,7 +289,7 @@ def mutated(draw: st.DrawFn) -> str:
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(mutated())
 def test_mutated_text_parses_or_raises_spec_error(text: str) -> None:
-    assert_parses_or_spec_error(text)
+    parses_or_spec_error(parse_figure_text, text, "fuzz.fig", sound)
 
 
 POSITIVE = st.floats(0.01, 100.0)

@@ -23,6 +23,8 @@ LUXO = Path(__file__).resolve().parents[1] / "specs" / "figures" / "luxo.fig"
 STANDING = np.array([0.0, 0.0, 0.0, 0.0, math.radians(120.0)])  # x, y, base, hip, elbow
 PENETRATION_TOLERANCE = 0.01  # m: the deepest any contact point may sink in (README)
 
+pytestmark = pytest.mark.slow  # every test compiles the lamp: seconds of numba compiling
+
 
 @pytest.fixture(scope="module")
 def luxo(tmp_path_factory: pytest.TempPathFactory) -> ModuleType:

@@ -26,6 +26,8 @@ DT = 0.0005  # s: config/config.yaml's luxo dt
 PENETRATION_TOLERANCE = 0.01  # m: the deepest a contact point may go on landing (README)
 SHOW = ("hop", "hop", "hop", "long_jump", "backflip", "double_backflip", "backflip_down_step")
 
+pytestmark = pytest.mark.slow  # every test needs the landing controller built
+
 
 @pytest.fixture(scope="module")
 def luxo_results(tmp_path_factory: pytest.TempPathFactory) -> Path:

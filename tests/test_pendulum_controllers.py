@@ -8,6 +8,8 @@ import pytest
 from mosys.ssc.controller import Controller
 from mosys.ssc.quality import PENDULUM_STARTS, arrivals, in_destination_box
 
+pytestmark = pytest.mark.slow  # the six controllers A-F, built as the pipeline builds them
+
 
 @pytest.fixture(scope="module")
 def controllers(pendulum_tables, link1):
