@@ -15,6 +15,6 @@ rule pendulum_table:
     threads: 1
     priority: 1  # a long job: start it before the plots that can fill in around it
     shell:
-        "NUMBA_NUM_THREADS={threads} mosys table {input.tables} --dynamics {input.dynamics}"
+        "NUMBA_NUM_THREADS={threads} mosys pendulum-table {input.tables} --dynamics {input.dynamics}"
         " --budget {params.budget}"
         " --csv {output.csv} --md {output.md} 2> {log} || (cat {log} >&2; exit 1)"

@@ -1,0 +1,118 @@
+"""The ``mosys`` command line: argument parsing and exit codes, nothing else.
+
+Each verb family has its module here (``dynamics``, ``ssc``, ``animation``, ``bsr``,
+``composite``, ``plots``, ``paper_tables``, ``index``), declaring every verb's arguments, checks
+and handler together (``verb.Verb``); this module assembles them into one parser and runs one.
+
+Exit codes: 0 success; 2 a bad spec or input (a ``file:line:column: expected ..., found ...``
+message, no traceback, no output file) or bad arguments; 1 any other failure.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import textwrap
+
+from mosys import __version__
+from mosys.cli import animation, bsr, composite, dynamics, index, paper_tables, plots, ssc
+from mosys.cli.verb import Family
+
+# In `mosys --help` order: the pipeline's steps, then what is drawn and tabulated from them.
+FAMILIES: tuple[Family, ...] = (
+    dynamics.FAMILY,
+    ssc.FAMILY,
+    animation.FAMILY,
+    bsr.FAMILY,
+    composite.FAMILY,
+    plots.FAMILY,
+    paper_tables.FAMILY,
+    index.FAMILY,
+)
+
+_HELP_WIDTH = 78  # argparse's own width on an 80-column terminal
+
+
+def _fill(text: str) -> str:
+    """``text`` wrapped to the help's width, never breaking at a no-break space."""
+    return textwrap.fill(text, _HELP_WIDTH).replace("\xa0", " ")
+
+
+DESCRIPTION = (
+    "Motion synthesis for physically based animation: state-space controllers (van de Panne "
+    "et al. 1990) and BSR controllers (Auslander et al. 1995). Each verb is one step of the "
+    "Snakemake pipeline and works on its own too; `mosys\xa0VERB\xa0--help` gives its arguments. "
+    "Exit codes: 0 done; 2 a bad spec, input file or argument (the message says where; no "
+    "output file is written); 1 anything else."
+)
+
+EPILOG = (
+    "To build everything the 1990 pendulum example makes, from the repository root:\n"
+    "  snakemake results/pendulum_all\n"
+    + _fill(
+        "README.md describes the other targets (results/car_all, results/bsr_all, "
+        "results/composite_all, results/paper_tables, all), the spec formats and the verbs."
+    )
+)
+
+
+def verb_listing(families: tuple[Family, ...] = FAMILIES) -> str:
+    """The verbs of ``mosys --help``: a heading per family, one line per verb (wrapped under
+    its summary when long)."""
+    column = 2 + max(len(verb.name) for family in families for verb in family.verbs) + 2
+    lines = []
+    for family in families:
+        lines.append(f"{family.title}:")
+        for verb in family.verbs:
+            lines += textwrap.wrap(
+                verb.summary,
+                _HELP_WIDTH,
+                initial_indent=f"  {verb.name}".ljust(column),
+                subsequent_indent=" " * column,
+            )
+    return "\n".join(lines)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="mosys",
+        usage="%(prog)s [-h] [--version] VERB ...",
+        description=f"{_fill(DESCRIPTION)}\n\n{verb_listing()}",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument(
+        "--version", action="version", version=f"mosys {__version__}", help="print the version"
+    )
+    # The listing above replaces argparse's; prog="mosys" keeps "usage: mosys VERB ..." per verb.
+    verbs = parser.add_subparsers(dest="verb", required=True, prog="mosys", help=argparse.SUPPRESS)
+    groups: dict[str, argparse._SubParsersAction] = {}
+    for family in FAMILIES:
+        for verb in family.verbs:
+            group, _, name = verb.name.rpartition(" ")
+            if group and group not in groups:  # "plot car": a kind of the verb "plot"
+                groups[group] = verbs.add_parser(group).add_subparsers(dest="kind", required=True)
+            subparser = (groups[group] if group else verbs).add_parser(name, help=verb.summary)
+            verb.add_arguments(subparser)
+            subparser.set_defaults(command=verb)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    problem = args.command.check(args)
+    if problem:
+        parser.error(problem)
+    from mosys.errors import InputError
+    from mosys.parsing.tokens import SpecError
+
+    try:
+        args.command.handler(args)
+    except SpecError as error:
+        print(error, file=sys.stderr)  # file:line:column: first, as compilers do
+        return 2
+    except (OSError, InputError) as error:  # a missing, unreadable or corrupt input file
+        print(f"mosys: {error}", file=sys.stderr)
+        return 2
+    return 0

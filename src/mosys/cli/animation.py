@@ -1,0 +1,39 @@
+"""``mosys run``: animation script -> trajectory."""
+
+from __future__ import annotations
+
+import argparse
+
+from mosys.cli.verb import Family, Verb
+
+
+def _run_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("script")
+    parser.add_argument("--controllers", required=True, help="directory of controller tables")
+    parser.add_argument("--dynamics-dir", default="results/dynamics", help="generated dynamics")
+    parser.add_argument(
+        "--motor-dir", default="specs/motor", help="motor programs: DIR/FIGURE/NAME.mot"
+    )
+    parser.add_argument("--dt", type=float, default=0.001, help="simulator step, s")
+    parser.add_argument("-o", "--output", required=True)
+
+
+def _run(args: argparse.Namespace) -> None:
+    from mosys.animation.trajectory_file import run_animation_script
+
+    run_animation_script(
+        args.script, args.controllers, args.dynamics_dir, args.output, args.dt, args.motor_dir
+    )
+
+
+FAMILY = Family(
+    "animation",
+    (
+        Verb(
+            "run",
+            "animation script (.anim) -> trajectory (.h5)",
+            _run_arguments,
+            _run,
+        ),
+    ),
+)

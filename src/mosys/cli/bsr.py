@@ -1,0 +1,48 @@
+"""``mosys bsr-search``: one seed of a BSR search spec -> result file."""
+
+from __future__ import annotations
+
+import argparse
+
+from mosys.cli.verb import Family, Verb
+
+
+def _bsr_search_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("spec", help="the search spec (.bsr)")
+    parser.add_argument("--seed", type=int, required=True, help="one of the spec's seeds")
+    parser.add_argument("--figures", default="specs/figures", help="where NAME.fig lives")
+    parser.add_argument("--generations", type=int, help="override the spec's G (a budget)")
+    parser.add_argument("--budget", default="paper", help="name of the config that built it")
+    parser.add_argument("--threads", type=int, help="threads that run the population")
+    parser.add_argument("-o", "--output", required=True)
+
+
+def _bsr_search(args: argparse.Namespace) -> None:
+    from mosys.bsr.result_file import search_to_file
+
+    outcome = search_to_file(
+        args.spec,
+        args.figures,
+        args.seed,
+        args.output,
+        args.generations,
+        args.budget,
+        args.threads,
+    )
+    print(
+        f"{args.output}: best fitness {outcome.fitness:.3f} after {outcome.evaluations[-1]} "
+        f"evaluations in {outcome.wall_seconds:.1f} s ({outcome.steps_per_second:.3g} steps/s)"
+    )
+
+
+FAMILY = Family(
+    "BSR controllers (the 1995 paper)",
+    (
+        Verb(
+            "bsr-search",
+            "BSR search spec (.bsr) -> result (.h5)",
+            _bsr_search_arguments,
+            _bsr_search,
+        ),
+    ),
+)

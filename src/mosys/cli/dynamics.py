@@ -1,0 +1,31 @@
+"""``mosys compile``: figure spec -> generated dynamics module."""
+
+from __future__ import annotations
+
+import argparse
+
+from mosys.cli.verb import Family, Verb
+
+
+def _compile_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("spec")
+    parser.add_argument("-o", "--output", required=True)
+
+
+def _compile(args: argparse.Namespace) -> None:
+    from mosys.dynamics.compile import compile_figure
+
+    compile_figure(args.spec, args.output)
+
+
+FAMILY = Family(
+    "equations of motion",
+    (
+        Verb(
+            "compile",
+            "figure spec (.fig) -> generated dynamics module",
+            _compile_arguments,
+            _compile,
+        ),
+    ),
+)

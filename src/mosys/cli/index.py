@@ -1,0 +1,35 @@
+"""``mosys index``: an aggregate target's file, the list of the files it stands for."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from mosys.cli.verb import Family, Verb
+
+
+def _index_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("inputs", nargs="*")
+    parser.add_argument("-o", "--output", required=True)
+
+
+def _index(args: argparse.Namespace) -> None:
+    from mosys.io.atomic import write_text_atomically
+
+    missing = [path for path in args.inputs if not Path(path).exists()]
+    if missing:
+        raise FileNotFoundError(f"cannot index missing files: {', '.join(missing)}")
+    write_text_atomically(args.output, "".join(f"{path}\n" for path in args.inputs))
+
+
+FAMILY = Family(
+    "pipeline",
+    (
+        Verb(
+            "index",
+            "write an aggregate target: the list of its files",
+            _index_arguments,
+            _index,
+        ),
+    ),
+)

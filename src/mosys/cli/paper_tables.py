@@ -1,0 +1,151 @@
+"""The papers' tables: ``pendulum-table`` (Figure 13), ``car-table``, ``luxo-table``, ``bsr-table``,
+``composite-table`` and ``robustness-table``."""
+
+from __future__ import annotations
+
+import argparse
+
+from mosys.cli.verb import Family, Verb
+
+
+def _pendulum_table_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("controllers", nargs="+")
+    parser.add_argument("--dynamics", required=True)
+    parser.add_argument("--csv", required=True)
+    parser.add_argument("--md", required=True)
+    parser.add_argument("--budget", default="paper", help="name of the config that built it")
+
+
+def _pendulum_table(args: argparse.Namespace) -> None:
+    from mosys.paper_tables.pendulum import write_pendulum_table
+
+    write_pendulum_table(args.controllers, args.dynamics, args.csv, args.md, args.budget)
+
+
+def _car_table_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("table", help="controller table (.h5)")
+    parser.add_argument("--starts", required=True, help="start grid (.h5, mosys starts)")
+    parser.add_argument(
+        "--trajectories", nargs="+", required=True, help="the Figure 19 trajectories (.h5)"
+    )
+    parser.add_argument("--csv", required=True)
+    parser.add_argument("--md", required=True)
+    parser.add_argument("--budget", default="paper", help="name of the config that built it")
+
+
+def _car_table(args: argparse.Namespace) -> None:
+    from mosys.paper_tables.car import write_car_table
+
+    write_car_table(args.table, args.starts, args.trajectories, args.csv, args.md, args.budget)
+
+
+def _luxo_table_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("trajectory", help="a trajectory of Luxo's show (.h5)")
+    parser.add_argument(
+        "--landing", required=True, help="the landing controller's table (its dest: standing)"
+    )
+    parser.add_argument("--csv", required=True)
+    parser.add_argument("--md", required=True)
+    parser.add_argument("--budget", default="paper", help="name of the config that built it")
+
+
+def _luxo_table(args: argparse.Namespace) -> None:
+    from mosys.paper_tables.luxo import write_luxo_table
+
+    write_luxo_table(args.trajectory, args.landing, args.csv, args.md, args.budget)
+
+
+def _bsr_table_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("results", nargs="+", help="seed files (.h5) of the searches")
+    parser.add_argument("--csv", required=True)
+    parser.add_argument("--md", required=True)
+
+
+def _bsr_table(args: argparse.Namespace) -> None:
+    from mosys.paper_tables.bsr import write_bsr_table
+
+    write_bsr_table(args.results, args.csv, args.md)
+
+
+def _composite_table_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("results", nargs="+", help="composite results (.h5)")
+    parser.add_argument("--csv", required=True)
+    parser.add_argument("--md", required=True)
+
+
+def _composite_table(args: argparse.Namespace) -> None:
+    from mosys.paper_tables.composite import write_composite_table
+
+    write_composite_table(args.results, args.csv, args.md)
+
+
+def _robustness_table_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("results", nargs="+", help="seed files (SEARCH/seedK.h5) of both")
+    parser.add_argument(
+        "--pair",
+        nargs=2,
+        action="append",
+        required=True,
+        metavar=("ROBUST", "PLAIN"),
+        help="a robust search and its plain twin (search names); repeat for more",
+    )
+    parser.add_argument("--bsr-specs", default="specs/bsr", help="where SEARCH.bsr lives")
+    parser.add_argument("--figures", default="specs/figures", help="where NAME.fig lives")
+    parser.add_argument("--csv", required=True)
+    parser.add_argument("--md", required=True)
+
+
+def _robustness_table(args: argparse.Namespace) -> None:
+    from mosys.paper_tables.robustness import write_robustness_table
+
+    write_robustness_table(
+        [tuple(pair) for pair in args.pair],
+        args.results,
+        args.csv,
+        args.md,
+        args.bsr_specs,
+        args.figures,
+    )
+
+
+FAMILY = Family(
+    "the papers' tables",
+    (
+        Verb(
+            "pendulum-table",
+            "the Figure 13 table of the pendulum controllers",
+            _pendulum_table_arguments,
+            _pendulum_table,
+        ),
+        Verb(
+            "car-table",
+            "the car controller's table",
+            _car_table_arguments,
+            _car_table,
+        ),
+        Verb(
+            "luxo-table",
+            "Luxo's motions table",
+            _luxo_table_arguments,
+            _luxo_table,
+        ),
+        Verb(
+            "bsr-table",
+            "the BSR runs table",
+            _bsr_table_arguments,
+            _bsr_table,
+        ),
+        Verb(
+            "composite-table",
+            "the composite-motion table",
+            _composite_table_arguments,
+            _composite_table,
+        ),
+        Verb(
+            "robustness-table",
+            "robust BSR searches against their plain twins",
+            _robustness_table_arguments,
+            _robustness_table,
+        ),
+    ),
+)

@@ -1,0 +1,217 @@
+"""``mosys plot KIND``: the drawings of controllers and motions, one kind per figure family."""
+
+from __future__ import annotations
+
+import argparse
+
+from mosys.cli.verb import Family, Verb
+
+
+def _controller_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("table", help="controller table (.h5)")
+    parser.add_argument("--dynamics", help="generated dynamics module (for --portrait)")
+    parser.add_argument("--portrait", help="state-space portrait PNG (Figure 14 style)")
+    parser.add_argument("--torque", help="torque-table heat map PNG")
+
+
+def _controller_check(args: argparse.Namespace) -> str | None:
+    if not (args.portrait or args.torque):
+        return "plot controller: give --portrait and/or --torque"
+    if args.portrait and not args.dynamics:
+        return "plot controller: --portrait needs --dynamics"
+    return None
+
+
+def _controller(args: argparse.Namespace) -> None:
+    from mosys.plots.pendulum import plot_portrait, plot_torque
+
+    if args.portrait:
+        from mosys.dynamics.load import load_dynamics
+
+        plot_portrait(args.table, load_dynamics(args.dynamics), args.portrait)
+    if args.torque:
+        plot_torque(args.table, args.torque)
+
+
+def _script_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("trajectory")
+    parser.add_argument("tables", nargs="*", help="the controller tables (their destinations)")
+    parser.add_argument("--path", help="state-space path PNG")
+    parser.add_argument("--gif", help="animated GIF of the trajectory's figure_motion")
+
+
+def _script_check(args: argparse.Namespace) -> str | None:
+    if not (args.path or args.gif):
+        return "plot script: give --path and/or --gif"
+    return None
+
+
+def _script(args: argparse.Namespace) -> None:
+    from mosys.plots.pendulum import plot_script, write_script_gif
+
+    if args.path:
+        plot_script(args.trajectory, args.tables, args.path)
+    if args.gif:
+        write_script_gif(args.trajectory, args.gif)
+
+
+def _car_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("trajectories", nargs="*", help="car trajectories (.h5)")
+    parser.add_argument("--frames", help="PNG: one panel per trajectory, the car every 0.3 s")
+    parser.add_argument("--gif", help="animated GIF of the first trajectory")
+    parser.add_argument("--map", nargs=2, metavar=("START_GRID", "PNG"), help="success map")
+
+
+def _car_check(args: argparse.Namespace) -> str | None:
+    if not (args.frames or args.gif or args.map):
+        return "plot car: give --frames, --gif and/or --map"
+    if (args.frames or args.gif) and not args.trajectories:
+        return "plot car: --frames and --gif need trajectories"
+    return None
+
+
+def _car(args: argparse.Namespace) -> None:
+    from mosys.plots.car import plot_parking_frames, plot_success_map, write_parking_gif
+
+    if args.frames:
+        plot_parking_frames(args.trajectories, args.frames)
+    if args.gif:
+        write_parking_gif(args.trajectories[0], args.gif)
+    if args.map:
+        plot_success_map(args.map[0], args.map[1])
+
+
+def _luxo_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("trajectory", help="a trajectory of Luxo's figure (.h5)")
+    parser.add_argument("--strip", help="PNG: the lamp every few frames of one motion")
+    parser.add_argument("--motion", default="backflip", help="the motion the strip draws")
+    parser.add_argument("--forces", help="PNG: joint torques and contact forces over time")
+    parser.add_argument("--gif", help="animated GIF of the whole trajectory, terrain drawn")
+
+
+def _luxo(args: argparse.Namespace) -> None:
+    from mosys.plots.luxo import plot_motion_strip, plot_torques_and_forces, write_show_gif
+
+    if args.strip:
+        plot_motion_strip(args.trajectory, args.strip, args.motion)
+    if args.forces:
+        plot_torques_and_forces(args.trajectory, args.forces)
+    if args.gif:
+        write_show_gif(args.trajectory, args.gif)
+
+
+def _bsr_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("results", nargs="+", help="all seed files of one search (.h5)")
+    parser.add_argument("--learning", help="PNG: best fitness per seed (Figure 8 style)")
+    parser.add_argument("--filmstrip", help="PNG: the best seed's motion (Figures 9-12 style)")
+    parser.add_argument("--gif", help="animated GIF of the best seed's motion")
+
+
+def _bsr_check(args: argparse.Namespace) -> str | None:
+    if not (args.learning or args.filmstrip or args.gif):
+        return "plot bsr: give --learning, --filmstrip and/or --gif"
+    return None
+
+
+def _bsr(args: argparse.Namespace) -> None:
+    from mosys.plots import bsr
+
+    if args.learning:
+        bsr.plot_learning(args.results, args.learning)
+    if args.filmstrip or args.gif:
+        best = bsr.best_result_path(args.results)  # highest best_fitness, ties to lowest seed
+        if args.filmstrip:
+            bsr.plot_filmstrip(best, args.filmstrip)
+        if args.gif:
+            bsr.write_motion_gif(best, args.gif)
+
+
+def _bsr_learning_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "results", nargs="+", help="seed files (.h5) of one or more searches, grouped by name"
+    )
+    parser.add_argument("-o", "--output", required=True, help="PNG")
+
+
+def _bsr_learning(args: argparse.Namespace) -> None:
+    from mosys.plots import bsr
+
+    bsr.plot_learning_comparison(bsr.group_by_search(args.results), args.output)
+
+
+def _composite_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("result", help="results/composite/NAME.h5")
+    parser.add_argument("--filmstrips", help="PNG: before and after (Figures 13-14 style)")
+    parser.add_argument("--search", help="PNG: the best total after each generation")
+    parser.add_argument("--gif", help="animated GIF of the refined motion")
+
+
+def _composite_check(args: argparse.Namespace) -> str | None:
+    if not (args.filmstrips or args.search or args.gif):
+        return "plot composite: give --filmstrips, --search and/or --gif"
+    return None
+
+
+def _composite(args: argparse.Namespace) -> None:
+    from mosys.plots import composite
+
+    if args.filmstrips:
+        composite.plot_filmstrips(args.result, args.filmstrips)
+    if args.search:
+        composite.plot_search(args.result, args.search)
+    if args.gif:
+        composite.write_composite_gif(args.result, args.gif)
+
+
+FAMILY = Family(
+    "plots (mosys plot KIND)",
+    (
+        Verb(
+            "plot controller",
+            "a controller's portrait and torque map",
+            _controller_arguments,
+            _controller,
+            _controller_check,
+        ),
+        Verb(
+            "plot script",
+            "a script's path (Figure 16 style) and its GIF",
+            _script_arguments,
+            _script,
+            _script_check,
+        ),
+        Verb(
+            "plot car",
+            "car frames (Figure 19 style), a GIF, the success map",
+            _car_arguments,
+            _car,
+            _car_check,
+        ),
+        Verb(
+            "plot luxo",
+            "Luxo: a motion's strip (Figure 22), forces, a GIF",
+            _luxo_arguments,
+            _luxo,
+        ),
+        Verb(
+            "plot bsr",
+            "a BSR search: learning curves, filmstrip, GIF",
+            _bsr_arguments,
+            _bsr,
+            _bsr_check,
+        ),
+        Verb(
+            "plot bsr-learning",
+            "learning curves of BSR searches compared (Figure 7 style)",
+            _bsr_learning_arguments,
+            _bsr_learning,
+        ),
+        Verb(
+            "plot composite",
+            "a composite motion: filmstrips before/after, the search, a GIF",
+            _composite_arguments,
+            _composite,
+            _composite_check,
+        ),
+    ),
+)

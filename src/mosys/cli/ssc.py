@@ -1,0 +1,100 @@
+"""State-space controllers: ``mosys dp`` (spec -> table) and ``mosys starts`` (a car controller
+run from a grid of start states)."""
+
+from __future__ import annotations
+
+import argparse
+
+from mosys.cli.verb import Family, Verb
+
+
+def _dp_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("spec")
+    parser.add_argument("--dynamics-dir", default="results/dynamics", help="generated dynamics")
+    parser.add_argument("-o", "--output", required=True)
+    parser.add_argument("--tol", type=float, default=None, help="override the spec's tolerance, s")
+    parser.add_argument("--max-iterations", type=int, default=None)
+    parser.add_argument("--quiet", action="store_true")
+
+
+def _dp(args: argparse.Namespace) -> None:
+    from mosys.dynamics.load import figure_dynamics
+    from mosys.parsing.controller import parse_controller_spec
+    from mosys.ssc.generate import generate_controller
+
+    spec = parse_controller_spec(args.spec)
+    table = generate_controller(
+        spec,
+        figure_dynamics(spec.figure, args.dynamics_dir, spec.error, spec.figure_token),
+        args.output,
+        tolerance=args.tol,
+        max_iterations=args.max_iterations,
+        quiet=args.quiet,
+    )
+    attrs = table.attrs
+    print(
+        f"{args.output}: {table.value.size} nodes, {attrs['iterations']} sweeps, residual "
+        f"{attrs['residual']:.3g} s, {attrs['unreachable_nodes']} unreachable, "
+        f"{attrs['generation_seconds']:.3f} s"
+    )
+
+
+def _starts_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("table", help="controller table (.h5)")
+    parser.add_argument("--dynamics", required=True, help="generated dynamics module")
+    for axis, unit in (("x", "m"), ("y", "m")):
+        parser.add_argument(
+            f"--{axis}",
+            nargs=3,
+            type=float,
+            required=True,
+            metavar=("MIN", "MAX", "COUNT"),
+            help=f"start {axis} values, {unit}",
+        )
+    parser.add_argument("--heading", nargs="+", type=float, default=[0.0], help="deg")
+    parser.add_argument("--steer", nargs="+", type=float, default=[0.0], help="deg")
+    parser.add_argument("--seconds", type=float, default=20.0, help="simulated time per start")
+    parser.add_argument("--dt", type=float, default=0.01, help="simulator step, s")
+    parser.add_argument("-o", "--output", required=True)
+
+
+def _starts(args: argparse.Namespace) -> None:
+    import itertools
+
+    import numpy as np
+
+    from mosys.dynamics.load import load_dynamics
+    from mosys.io.start_grid import write_start_grid
+    from mosys.ssc.controller import Controller
+    from mosys.ssc.parking import evaluate_starts
+
+    controller = Controller.load(args.table, load_dynamics(args.dynamics))
+    axes = {
+        "x": np.linspace(*args.x[:2], int(args.x[2])),
+        "y": np.linspace(*args.y[:2], int(args.y[2])),
+        "heading": np.array(args.heading),
+        "steer": np.array(args.steer),
+        "speed": np.array([0.0]),
+    }
+    order = controller.state_order
+    starts = np.array(list(itertools.product(*(axes[name] for name in order))))
+    write_start_grid(args.output, evaluate_starts(controller, starts, args.seconds, args.dt))
+
+
+FAMILY = Family(
+    "state-space controllers (the 1990 paper)",
+    (
+        Verb(
+            "dp",
+            "controller spec (.ssc) -> controller table (.h5)",
+            _dp_arguments,
+            _dp,
+        ),
+        Verb(
+            "starts",
+            "a car controller from a grid of start states",
+            _starts_arguments,
+            _starts,
+        ),
+    ),
+)

@@ -1,0 +1,35 @@
+"""One ``mosys`` verb as one declaration: its name, its line in ``mosys --help``, its arguments,
+its checks and its handler, kept together in the module of its family."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable
+from dataclasses import dataclass
+
+
+def no_check(args: argparse.Namespace) -> str | None:
+    return None
+
+
+@dataclass(frozen=True)
+class Verb:
+    """A verb. ``name`` is what the user types after ``mosys``: ``"dp"``, or ``"plot car"`` for a
+    kind of ``plot``. ``add_arguments`` fills the verb's parser; ``check`` returns the usage error
+    of arguments that parse but do not go together (``None`` when they do), which ``mosys``
+    reports as argparse does, exit 2; ``handler`` does the work, importing what it needs inside
+    so that ``mosys --help`` stays fast."""
+
+    name: str
+    summary: str
+    add_arguments: Callable[[argparse.ArgumentParser], None]
+    handler: Callable[[argparse.Namespace], None]
+    check: Callable[[argparse.Namespace], str | None] = no_check
+
+
+@dataclass(frozen=True)
+class Family:
+    """Verbs that belong together, listed under ``title`` in ``mosys --help``."""
+
+    title: str
+    verbs: tuple[Verb, ...]
