@@ -17,10 +17,9 @@ from mosys.parsing.motor import (
     LIMP,
     SERVO,
     TORQUE,
-    Limit,
     MotorProgram,
     Phase,
-    PhaseSetting,
+    Setting,
     bind_motor_program,
     parse_motor_program,
     parse_motor_program_text,
@@ -424,14 +423,14 @@ POSITIVE = st.floats(min_value=1e-9, max_value=1e6)
 def motor_programs(draw) -> MotorProgram:
     token = Token("x", 1, 1)
     limit_names = draw(st.lists(NAMES, max_size=4, unique=True))
-    limits = tuple(Limit(name, draw(POSITIVE), token) for name in limit_names)
+    limits = tuple(Setting(name, draw(POSITIVE), token) for name in limit_names)
     phases = []
     for _ in range(draw(st.integers(1, 5))):
         names = draw(st.lists(SETTING_NAMES, max_size=4, unique=True))
         phases.append(
             Phase(
                 seconds=draw(POSITIVE),
-                settings=tuple(PhaseSetting(name, draw(NUMBERS), token) for name in names),
+                settings=tuple(Setting(name, draw(NUMBERS), token) for name in names),
                 kp=draw(st.none() | GAIN_VALUES),
                 kd=draw(st.none() | GAIN_VALUES),
                 token=token,

@@ -65,30 +65,12 @@ SERVO = 2  # PD servo towards a target angle, rad
 
 
 @dataclass(frozen=True)
-class Limit:
-    """One ``ACTUATOR=VALUE`` of the ``limit`` line: the actuator's torque is clipped to
-    ``[-value, value]`` (N·m, > 0). ``token`` is the whole ``name=value`` token."""
-
-    name: str
-    value: float
-    token: Token
-
-    @property
-    def name_token(self) -> Token:
-        """The name part of ``token``."""
-        return Token(self.name, self.token.line, self.token.column)
-
-    @property
-    def value_token(self) -> Token:
-        """The value part of ``token``."""
-        return value_token(self.token, self.name)
-
-
-@dataclass(frozen=True)
-class PhaseSetting:
-    """One ``NAME=VALUE`` of a ``phase`` line other than ``kp=``/``kd=``: a joint coordinate's
-    target angle (degrees) or an actuator's constant torque (N·m); which of the two is settled
-    by ``bind_motor_program``. ``token`` is the whole ``name=value`` token."""
+class Setting:
+    """One ``NAME=VALUE`` of a program: on the ``limit`` line, an actuator's torque limit (its
+    torque is clipped to ``[-value, value]``, N·m, > 0); on a ``phase`` line (other than
+    ``kp=``/``kd=``), a joint coordinate's target angle (degrees) or an actuator's constant torque
+    (N·m), which of the two being settled by ``bind_motor_program``. ``token`` is the whole
+    ``name=value`` token."""
 
     name: str
     value: float
@@ -112,7 +94,7 @@ class Phase:
     given). ``token`` is the keyword; ``seconds_token`` the duration."""
 
     seconds: float
-    settings: tuple[PhaseSetting, ...]
+    settings: tuple[Setting, ...]
     kp: float | None
     kd: float | None
     token: Token
@@ -132,7 +114,7 @@ class MotorProgram:
     path: str
     figure: str
     figure_token: Token
-    limits: tuple[Limit, ...]
+    limits: tuple[Setting, ...]
     kp: float
     kd: float
     phases: tuple[Phase, ...]
@@ -197,7 +179,7 @@ class _Parser:
     def __init__(self, path: str):
         self.path = path
         self.figure: Token | None = None
-        self.limits: tuple[Limit, ...] = ()
+        self.limits: tuple[Setting, ...] = ()
         self.gains: dict[str, float] = {}
         self.phases: list[Phase] = []
         self.first_line: dict[str, int] = {}  # once-only keyword -> its line number
@@ -267,13 +249,13 @@ class _Parser:
         expected = "a torque limit 'actuator=value' (N m)"
         if len(line.tokens) == 1:
             raise SpecError(self.path, line.number, line.end_column, expected, None)
-        limits: dict[str, Limit] = {}
+        limits: dict[str, Setting] = {}
         for token in line.tokens[1:]:
             name, part = self.assignment(token, expected)
             if name in limits:
                 raise self.error(token, f"'{name}=' only once", token.text)
             value = self.number_at_least(part, f"limit {name}", 0.0, strict=True)
-            limits[name] = Limit(name, value, token)
+            limits[name] = Setting(name, value, token)
         self.limits = tuple(limits.values())
 
     def line_gains(self, line: Line) -> None:
@@ -306,7 +288,7 @@ class _Parser:
         self.total += seconds
         expected = "a setting 'name=value' (joint=degrees, actuator=N m, kp= or kd=)"
         gains: dict[str, float] = {}
-        settings: dict[str, PhaseSetting] = {}
+        settings: dict[str, Setting] = {}
         for token in reader.remaining():
             name, part = self.assignment(token, expected)
             if name in GAINS:
@@ -315,7 +297,7 @@ class _Parser:
             if name in settings:
                 raise self.error(token, f"'{name}=' only once", token.text)
             value = parse_number(part, self.path, name)
-            settings[name] = PhaseSetting(name, value, token)
+            settings[name] = Setting(name, value, token)
         self.phases.append(
             Phase(
                 seconds,
@@ -410,7 +392,7 @@ def bind_motor_program(
     for p, phase in enumerate(program.phases):
         kp[p] = program.kp if phase.kp is None else phase.kp
         kd[p] = program.kd if phase.kd is None else phase.kd
-        driven: dict[int, PhaseSetting] = {}  # actuator -> the setting that drives it
+        driven: dict[int, Setting] = {}  # actuator -> the setting that drives it
         for setting in phase.settings:
             if setting.name in joints:
                 a, kind, amount = joints[setting.name], SERVO, math.radians(setting.value)
