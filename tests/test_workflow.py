@@ -21,16 +21,21 @@ ROOT = Path(__file__).resolve().parents[1]
 PENDULUM_CONTROLLERS = "ABCDEF"
 
 
-@pytest.fixture(scope="module")
-def workflow(tmp_path_factory) -> Path:
-    """A copy of the workflow, its specs and sources (their mtimes are rule inputs), built once."""
-    work = tmp_path_factory.mktemp("workflow")
+def copy_workflow(work: Path) -> Path:
+    """A copy of the workflow, its specs and sources (their mtimes are rule inputs) in work."""
     for name in ("Snakefile", "workflow", "config", "profiles", "specs", "src"):
         source = ROOT / name
         if source.is_dir():
             shutil.copytree(source, work / name, ignore=shutil.ignore_patterns("__pycache__"))
         else:
             shutil.copy2(source, work / name)
+    return work
+
+
+@pytest.fixture(scope="module")
+def workflow(tmp_path_factory) -> Path:
+    """A copy of the workflow, built once."""
+    work = copy_workflow(tmp_path_factory.mktemp("workflow"))
     snakemake(work, "results/pendulum_all")
     return work
 
@@ -78,6 +83,7 @@ def mtimes(work: Path) -> dict[str, int]:
     }
 
 
+@pytest.mark.slow
 def test_pendulum_all_lists_every_output(workflow):
     index = (workflow / "results/pendulum_all").read_text().split()
     for name in PENDULUM_CONTROLLERS:
@@ -95,10 +101,12 @@ def test_pendulum_all_lists_every_output(workflow):
         assert (workflow / path).stat().st_size > 0
 
 
+@pytest.mark.slow
 def test_nothing_runs_when_nothing_changed(workflow):
     assert planned_jobs(workflow) == {}
 
 
+@pytest.mark.slow
 def test_editing_one_controller_rebuilds_only_its_dependents(workflow):
     spec = workflow / "specs/controllers/pendulum/B.ssc"
     spec.write_text(spec.read_text().replace("dest angle=120 omega=0", "dest angle=110 omega=0"))
@@ -124,6 +132,7 @@ def test_editing_one_controller_rebuilds_only_its_dependents(workflow):
     assert planned_jobs(workflow) == {}
 
 
+@pytest.mark.slow
 def test_editing_the_figure_rebuilds_all_six_controllers(workflow):
     figure = workflow / "specs/figures/link1.fig"
     figure.write_text(figure.read_text() + "\n# an edit\n")
@@ -133,6 +142,7 @@ def test_editing_the_figure_rebuilds_all_six_controllers(workflow):
     assert jobs.get("controller_plots") == len(PENDULUM_CONTROLLERS)
 
 
+@pytest.mark.slow
 def test_broken_spec_fails_with_its_location_and_leaves_no_output(workflow):
     spec = workflow / "specs/controllers/pendulum/C.ssc"
     spec.write_text(
@@ -154,6 +164,7 @@ def test_broken_spec_fails_with_its_location_and_leaves_no_output(workflow):
 CAR_SCRIPTS = [f"park_{k}" for k in range(1, 7)]
 
 
+@pytest.mark.slow
 def test_the_car_parks_from_every_figure_19_start(workflow):
     """Issue 4's targets: every Figure 19 case parks (within 0.15 m and 5 deg, at rest, no
     collision at any instant) within 20 s, and some case backs up past the destination and
@@ -179,6 +190,7 @@ def test_the_car_parks_from_every_figure_19_start(workflow):
     assert backed_past
 
 
+@pytest.mark.slow
 def test_editing_an_obstacle_rebuilds_the_car_and_nothing_else(workflow):
     snakemake(workflow, "results/car_all")
     index = (workflow / "results/car_all").read_text().split()
@@ -202,6 +214,7 @@ def test_editing_an_obstacle_rebuilds_the_car_and_nothing_else(workflow):
     assert planned_jobs(workflow) == pendulum_plan  # the pendulum does not depend on the car
 
 
+@pytest.mark.slow
 def test_a_new_luxo_script_reuses_the_controller_and_motor_programs(workflow):
     """Issue 5: a user's own order of Luxo's motions needs only its own run and plots; editing a
     motor program reruns the shows that use it, never the dynamics or the landing controller."""
@@ -251,6 +264,7 @@ def median_terms(work: Path, name: str) -> dict[str, float]:
     return medians
 
 
+@pytest.mark.slow
 def test_the_secondary_terms_steer_star_mans_style(bsr_built):
     shuffle = median_terms(bsr_built, "starman_shuffle")
     cartwheel = median_terms(bsr_built, "starman_cartwheel")
@@ -266,6 +280,7 @@ def test_the_secondary_terms_steer_star_mans_style(bsr_built):
     assert table.count(",ci,") == 5  # every row says which budget made it
 
 
+@pytest.mark.slow
 def test_editing_one_weight_reruns_only_that_search_and_its_plots(bsr_built):
     spec = bsr_built / "specs/bsr/starman_jump.bsr"
     text = spec.read_text()
@@ -313,6 +328,7 @@ JUMP_CLEARANCE = 0.75  # m: the refined jump's own flight lifts every endpoint a
 GROUNDED = 0.1  # m: a jump whose own flight stays below this did not leave the ground
 
 
+@pytest.mark.slow
 def test_the_refined_composite_motion_does_all_three_phases(composite_built):
     from mosys.composite.measures import phase_measures
     from mosys.io.composite_result import read_composite_result
@@ -339,6 +355,7 @@ def test_the_refined_composite_motion_does_all_three_phases(composite_built):
         assert f"results/{made}" in index
 
 
+@pytest.mark.slow
 def test_the_robust_controllers_hold_up_better(composite_built):
     import pandas as pd
 
@@ -354,6 +371,7 @@ def test_the_robust_controllers_hold_up_better(composite_built):
             assert robust[column] > plain[column], (robust["search"], column)
 
 
+@pytest.mark.slow
 def test_editing_the_script_reruns_only_the_transition_search(composite_built):
     script = composite_built / "specs/composite/starman_show.comp"
     text = script.read_text()
@@ -372,3 +390,110 @@ def test_editing_the_script_reruns_only_the_transition_search(composite_built):
         planned_jobs(composite_built, "results/composite_all", "--configfile", "config/ci.yaml")
         == {}
     )
+
+
+CI = ("--configfile", "config/ci.yaml")
+
+
+@pytest.fixture(scope="module")
+def touched(tmp_path_factory) -> Path:
+    """A copy of the workflow where every output of ``all`` (CI's config) is an empty file that
+    ``snakemake --touch`` marked up to date: the whole pipeline's dry runs, and no job run."""
+    work = copy_workflow(tmp_path_factory.mktemp("touched"))
+    for line in re.findall(r"^\s+output: (.+)$", snakemake(work, "--dry-run", "all", *CI), re.M):
+        for path in line.split(", "):
+            (work / path).parent.mkdir(parents=True, exist_ok=True)
+            (work / path).touch()
+    snakemake(work, "--touch", "all", *CI)
+    assert planned_jobs(work, "all", *CI) == {}
+    return work
+
+
+AGGREGATES = {
+    "all",
+    "paper_tables",
+    "pendulum_all",
+    "car_all",
+    "luxo_all",
+    "bsr_all",
+    "composite_all",
+}
+
+
+def planned_stages(work: Path) -> set[str]:
+    """The stage rules (not the aggregates) a dry run of ``all`` plans."""
+    return set(planned_jobs(work, "all", *CI)) - AGGREGATES
+
+
+SIMULATION = {"compile_dynamics", "dp_controller", "run_script", "car_start_grid"}
+SEARCHES = {"bsr_search", "composite_search"}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    ("module", "dependents", "unrelated"),
+    [
+        (  # Luxo's motions as its table and plots measure them, after the simulation
+            "animation/motion_measures.py",
+            {"luxo_plots", "luxo_motions_table"},
+            SIMULATION | SEARCHES | {"pendulum_table", "car_controller_table"},
+        ),
+        (  # the composite result's contract; the robustness table reads BSR results only
+            "io/composite_result.py",
+            {"composite_search", "composite_plots", "composite_table"},
+            SIMULATION | {"bsr_search", "bsr_plots", "composite_robustness_table"},
+        ),
+        (  # a verb family's CLI module: its own verbs' rules (and theirs downstream), not the
+            # modules its handlers import
+            "cli/ssc.py",
+            {"dp_controller", "car_start_grid"},
+            SEARCHES | {"compile_dynamics", "bsr_plots", "composite_table"},
+        ),
+    ],
+)
+def test_editing_a_module_reruns_the_stages_that_import_it(touched, module, dependents, unrelated):
+    """Modules the hand-kept list of stage modules missed (issue 20): each reruns the stages
+    whose verbs import it, directly or not, and not the others."""
+    source = touched / "src/mosys" / module
+    with edited_spec(source, source.read_text() + "\n# an edit\n"):
+        planned = planned_stages(touched)
+    assert dependents <= planned
+    assert not planned & unrelated
+
+
+@pytest.mark.slow
+def test_every_stage_imports_the_atomic_writes(touched):
+    every_stage = set(planned_jobs(touched, "all", "--forceall", *CI)) - AGGREGATES
+    source = touched / "src/mosys/io/atomic.py"
+    with edited_spec(source, source.read_text() + "\n# an edit\n"):
+        assert planned_stages(touched) == every_stage
+
+
+@pytest.mark.slow
+def test_imports_inside_functions_and_relative_ones_are_followed(touched):
+    """A module that motion_measures imports only inside a function, relatively (or as a
+    submodule named by a from-import), reruns what motion_measures does."""
+    package = touched / "src/mosys/animation"
+    measures = package / "motion_measures.py"
+    text = measures.read_text()
+    with edited_spec(measures, text + "\n# an edit\n"):
+        users = planned_stages(touched)
+    assert "luxo_motions_table" in users
+    probes = [package / "relative_probe.py", package / "submodule_probe.py"]
+    try:
+        for probe in probes:
+            probe.write_text('"""A module only the workflow test imports."""\n')
+        measures.write_text(
+            text + "\n\ndef _probes():\n    from . import relative_probe\n"
+            "    from mosys.animation import submodule_probe\n\n"
+            "    return relative_probe, submodule_probe\n"
+        )
+        snakemake(touched, "--touch", "all", *CI)
+        for probe in probes:
+            with edited_spec(probe, probe.read_text() + "# an edit\n"):
+                assert planned_stages(touched) == users, probe.name
+    finally:
+        measures.write_text(text)
+        for probe in probes:
+            probe.unlink(missing_ok=True)
+        snakemake(touched, "--touch", "all", *CI)

@@ -5,7 +5,7 @@ rule bsr_search:
     input:
         spec="specs/bsr/{name}.bsr",
         figure=bsr_figure_spec,
-        code=package_sources("bsr"),
+        code=code_inputs("mosys.cli.bsr", "mosys.bsr.result_file"),  # mosys bsr-search
     output:
         "results/bsr/{name}/seed{seed}.h5",
     log:
@@ -25,7 +25,7 @@ rule bsr_search:
 rule bsr_plots:
     input:
         results=bsr_seed_results,
-        code=package_sources("plots"),
+        code=code_inputs("mosys.cli.plots", "mosys.plots.bsr"),  # mosys plot bsr
     output:
         learning="results/plots/bsr/{name}/learning.png",
         filmstrip="results/plots/bsr/{name}/filmstrip.png",
@@ -41,7 +41,7 @@ rule bsr_plots:
 rule bsr_learning_curves:
     input:
         results=bsr_all_results(),
-        code=package_sources("plots"),
+        code=code_inputs("mosys.cli.plots", "mosys.plots.bsr"),  # mosys plot bsr-learning
     output:
         "results/plots/bsr/learning_curves.png",
     log:
@@ -54,7 +54,7 @@ rule bsr_learning_curves:
 rule bsr_runs_table:
     input:
         results=bsr_all_results(),
-        code=package_sources("tables"),
+        code=code_inputs("mosys.cli.paper_tables", "mosys.paper_tables.bsr"),  # mosys bsr-table
     output:
         csv="results/tables/bsr_runs.csv",
         md="results/tables/bsr_runs.md",

@@ -4,7 +4,13 @@ rule car_start_grid:
     input:
         table=car_table(),
         dynamics=f"results/dynamics/{config['car']['figure']}.py",
-        code=package_sources("ssc", "scripts"),
+        code=code_inputs(
+            "mosys.cli.ssc",
+            "mosys.dynamics.load",
+            "mosys.io.start_grid",
+            "mosys.ssc.controller",
+            "mosys.ssc.parking",
+        ),  # mosys starts
     output:
         "results/car/start_grid.h5",
     log:
@@ -29,7 +35,7 @@ rule car_start_grid:
 rule car_frames:
     input:
         trajectories=car_trajectories(),
-        code=package_sources("plots"),
+        code=code_inputs("mosys.cli.plots", "mosys.plots.car"),  # mosys plot car
     output:
         "results/plots/car/figure19_frames.png",
     log:
@@ -45,7 +51,7 @@ rule car_frames:
 rule car_gif:
     input:
         trajectory=f"results/trajectories/{config['car']['gif_script']}.h5",
-        code=package_sources("plots"),
+        code=code_inputs("mosys.cli.plots", "mosys.plots.car"),  # mosys plot car
     output:
         "results/plots/car/manoeuvre.gif",
     log:
@@ -60,7 +66,7 @@ rule car_gif:
 rule car_start_map:
     input:
         grid="results/car/start_grid.h5",
-        code=package_sources("plots"),
+        code=code_inputs("mosys.cli.plots", "mosys.plots.car"),  # mosys plot car
     output:
         "results/plots/car/start_map.png",
     log:
@@ -77,7 +83,7 @@ rule car_controller_table:
         table=car_table(),
         grid="results/car/start_grid.h5",
         trajectories=car_trajectories(),
-        code=package_sources("tables"),
+        code=code_inputs("mosys.cli.paper_tables", "mosys.paper_tables.car"),  # mosys car-table
     output:
         csv="results/tables/car_controller.csv",
         md="results/tables/car_controller.md",

@@ -1,41 +1,111 @@
 # Config validation and the only helpers of the workflow: target lists, the package modules each
-# stage depends on, and the light look-ups of spec lines that decide a rule's inputs.
+# rule's verb runs, and the light look-ups of spec lines that decide a rule's inputs.
+import ast
+import functools
+import importlib.util
 import re
+from importlib.machinery import PathFinder
 from pathlib import Path
 
+from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
 
 validate(config, "../schemas/config.schema.yaml")
 
-PACKAGE = Path("src/mosys")
-STAGE_MODULES = {
-    "parsing": ["parsing/tokens.py"],
-    "dynamics": ["parsing/figure.py", "parsing/vehicle.py", "dynamics"],
-    "ssc": ["parsing/controller.py", "kernels/dp.py", "kernels/integrate.py",
-            "kernels/figure_state.py", "kernels/interpolate.py", "kernels/geometry.py",
-            "ssc/generate.py", "ssc/grid.py", "ssc/obstacles.py", "io/controller_table.py",
-            "dynamics/load.py"],
-    "scripts": ["parsing/script.py", "parsing/motor.py", "animation", "ssc/controller.py", "ssc/regions.py", "ssc/parking.py",
-                "ssc/lookahead.py", "kernels/simulate.py", "kernels/lookahead.py",
-                "kernels/motor.py", "kernels/figure_motion.py",
-                "io/trajectory.py", "io/start_grid.py", "dynamics/figure_motion.py"],
-    "bsr": ["parsing/bsr.py", "parsing/figure.py", "bsr", "kernels/bsr_simulate.py",
-            "kernels/bsr_controller.py", "io/bsr_result.py", "io/trajectory.py", "io/progress.py"],
-    "composite": ["parsing/composite.py", "parsing/composite_script.py", "composite", "io/composite_result.py"],
-    "plots": ["plots"],
-    "tables": ["paper_tables", "ssc/quality.py"],
-}
+# What the CLI's main imports for every verb (its error types).
+CLI_MODULES = ("mosys.errors", "mosys.parsing.tokens")
 
 
-def package_sources(*stages):
-    """The package files a stage's output depends on (editing one rebuilds that stage)."""
-    files = []
-    for stage in ("parsing",) + stages:
-        for entry in STAGE_MODULES[stage]:
-            path = PACKAGE / entry
-            files += sorted(str(p) for p in path.rglob("*.py")) if path.is_dir() else [str(path)]
-    return files
+@functools.cache
+def package_directory():
+    """The mosys package the workflow's code inputs name: the checkout beside the Snakefile
+    (it, or one of its directories, holds mosys/), else the installed package."""
+    here = Path(workflow.basedir)
+    roots = [here] + sorted(p for p in here.iterdir() if p.is_dir() and not p.name.startswith("."))
+    spec = PathFinder.find_spec("mosys", [str(root) for root in roots])
+    if spec is None or not spec.submodule_search_locations:
+        spec = importlib.util.find_spec("mosys")
+    if spec is None or not spec.submodule_search_locations:
+        raise WorkflowError("cannot find the mosys package: install it (pip install -e .)")
+    return Path(list(spec.submodule_search_locations)[0])
+
+
+def module_file(name):
+    """The source file of the package module name (mosys.a.b), or None if there is none."""
+    parts = name.split(".")
+    if parts[0] != "mosys":
+        return None
+    path = package_directory().joinpath(*parts[1:])
+    for candidate in (path / "__init__.py", path.with_suffix(".py")):
+        if candidate.is_file():
+            return candidate
+    return None
+
+
+@functools.cache
+def imported_modules(name):
+    """The package modules that module name imports anywhere (function bodies too), with the
+    packages along each dotted path; read with ast, nothing is imported."""
+    path = module_file(name)
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    found = []  # (line, dotted name)
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found += [(node.lineno, alias.name) for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            source = node.module or ""
+            if node.level:  # from . import x, from ..a import b
+                parts = package.split(".")[: len(package.split(".")) - node.level + 1]
+                source = ".".join(parts + ([source] if source else []))
+            found.append((node.lineno, source))
+            # from mosys.plots import bsr names a submodule; from mosys.io.atomic import f, not
+            found += [(node.lineno, f"{source}.{alias.name}") for alias in node.names
+                      if module_file(f"{source}.{alias.name}") is not None]
+    modules = set()
+    for line, dotted in found:
+        parts = dotted.split(".")
+        if parts[0] != "mosys":
+            continue
+        if module_file(dotted) is None:
+            raise WorkflowError(f"{path}:{line}: imports {dotted}, which has no source file")
+        modules.update(".".join(parts[:n]) for n in range(1, len(parts) + 1))
+    return frozenset(modules)
+
+
+@functools.cache
+def import_closure(name):
+    """Module name and every package module it imports, directly or not."""
+    if module_file(name) is None:
+        raise WorkflowError(f"code_inputs: no package module {name}")
+    parts = name.split(".")
+    todo = [".".join(parts[:n]) for n in range(1, len(parts) + 1)]
+    closure = set()
+    while todo:
+        dotted = todo.pop()
+        if dotted not in closure:
+            closure.add(dotted)
+            todo += imported_modules(dotted)
+    return frozenset(closure)
+
+
+def code_inputs(*entries):
+    """The package files a rule's output depends on (editing one reruns the rule): the import
+    closure of the entry modules its verb calls and of the CLI's own imports, sorted; paths
+    relative to the working directory when the package lies below it. An entry in mosys.cli
+    (the module of the verb's family) counts as its own file only: the CLI package imports every
+    family, so following its imports would make every rule depend on all the code."""
+    cwd = Path.cwd()
+    files = set()
+    for entry in CLI_MODULES + entries:
+        if module_file(entry) is None:
+            raise WorkflowError(f"code_inputs: no package module {entry}")
+        modules = [entry] if entry.startswith("mosys.cli.") else import_closure(entry)
+        for dotted in modules:
+            path = module_file(dotted)
+            files.add(str(path.relative_to(cwd)) if path.is_relative_to(cwd) else str(path))
+    return sorted(files)
 
 
 def spec_words(path, keyword):

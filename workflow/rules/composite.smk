@@ -5,7 +5,12 @@
 rule composite_search:
     input:
         unpack(composite_inputs),
-        code=package_sources("bsr", "composite"),
+        code=code_inputs(
+            "mosys.cli.composite",
+            "mosys.composite.result_file",
+            "mosys.composite.session",
+            "mosys.parsing.composite",
+        ),  # mosys composite
     output:
         "results/composite/{name}.h5",
     log:
@@ -25,7 +30,7 @@ rule composite_search:
 rule composite_plots:
     input:
         result="results/composite/{name}.h5",
-        code=package_sources("plots"),
+        code=code_inputs("mosys.cli.plots", "mosys.plots.composite"),  # mosys plot composite
     output:
         filmstrips="results/plots/composite/{name}/filmstrips.png",
         search="results/plots/composite/{name}/search.png",
@@ -41,7 +46,7 @@ rule composite_plots:
 rule composite_table:
     input:
         results=expand("results/composite/{name}.h5", name=config["composite"]["scripts"]),
-        code=package_sources("tables"),
+        code=code_inputs("mosys.cli.paper_tables", "mosys.paper_tables.composite"),  # mosys composite-table
     output:
         csv="results/tables/composite.csv",
         md="results/tables/composite.md",
@@ -57,7 +62,7 @@ rule composite_robustness_table:
     input:
         results=robustness_results(),
         specs=[f"specs/bsr/{search}.bsr" for pair in robustness_pairs() for search in pair],
-        code=package_sources("bsr", "composite", "tables"),
+        code=code_inputs("mosys.cli.paper_tables", "mosys.paper_tables.robustness"),  # mosys robustness-table
     output:
         csv="results/tables/composite_robustness.csv",
         md="results/tables/composite_robustness.md",

@@ -1,7 +1,7 @@
 rule compile_dynamics:
     input:
         spec="specs/figures/{figure}.fig",
-        code=package_sources("dynamics"),
+        code=code_inputs("mosys.cli.dynamics", "mosys.dynamics.compile"),  # mosys compile
     output:
         "results/dynamics/{figure}.py",
     log:

@@ -7,7 +7,7 @@ ruleorder: luxo_plots > script_plots
 rule luxo_plots:
     input:
         trajectory="results/trajectories/{script}.h5",
-        code=package_sources("plots"),
+        code=code_inputs("mosys.cli.plots", "mosys.plots.luxo"),  # mosys plot luxo
     output:
         strip="results/plots/luxo/{script}_strip.png",
         gif="results/plots/luxo/{script}.gif",
@@ -28,7 +28,7 @@ rule luxo_motions_table:
     input:
         trajectory=f"results/trajectories/{luxo_script()}.h5",
         landing=f"results/controllers/{config['luxo']['group']}/{config['luxo']['controller']}.h5",
-        code=package_sources("tables"),
+        code=code_inputs("mosys.cli.paper_tables", "mosys.paper_tables.luxo"),  # mosys luxo-table
     output:
         csv="results/tables/luxo_motions.csv",
         md="results/tables/luxo_motions.md",

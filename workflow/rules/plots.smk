@@ -2,7 +2,7 @@ rule controller_plots:
     input:
         table="results/controllers/{group}/{name}.h5",
         dynamics=lambda wildcards: f"results/dynamics/{config['pendulum']['figure']}.py",
-        code=package_sources("ssc", "scripts", "plots"),
+        code=code_inputs("mosys.cli.plots", "mosys.plots.pendulum", "mosys.dynamics.load"),  # mosys plot controller
     output:
         portrait="results/plots/{group}/{name}_portrait.png",
         torque="results/plots/{group}/{name}_torque.png",
@@ -21,7 +21,7 @@ rule script_plots:
     input:
         trajectory="results/trajectories/{script}.h5",
         tables=lambda wildcards: [p for p in script_inputs(wildcards) if p.endswith(".h5")],
-        code=package_sources("plots"),
+        code=code_inputs("mosys.cli.plots", "mosys.plots.pendulum"),  # mosys plot script
     output:
         path="results/plots/{group}/{script}_path.png",
         gif="results/plots/{group}/{script}.gif",

@@ -2,7 +2,7 @@ rule run_script:
     input:
         script="specs/scripts/{script}.anim",
         needs=script_inputs,
-        code=package_sources("ssc", "scripts"),
+        code=code_inputs("mosys.cli.animation", "mosys.animation.trajectory_file"),  # mosys run
     output:
         "results/trajectories/{script}.h5",
     log:

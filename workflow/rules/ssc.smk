@@ -2,7 +2,12 @@ rule dp_controller:
     input:
         spec="specs/controllers/{group}/{name}.ssc",
         dynamics=controller_dynamics,
-        code=package_sources("ssc"),
+        code=code_inputs(
+            "mosys.cli.ssc",
+            "mosys.dynamics.load",
+            "mosys.parsing.controller",
+            "mosys.ssc.generate",
+        ),  # mosys dp
     output:
         "results/controllers/{group}/{name}.h5",
     log:

@@ -2,7 +2,7 @@ rule pendulum_table:
     input:
         tables=pendulum_controller_tables(),
         dynamics=f"results/dynamics/{config['pendulum']['figure']}.py",
-        code=package_sources("ssc", "scripts", "tables"),
+        code=code_inputs("mosys.cli.paper_tables", "mosys.paper_tables.pendulum"),  # mosys pendulum-table
     output:
         csv="results/tables/pendulum_controllers.csv",
         md="results/tables/pendulum_controllers.md",
