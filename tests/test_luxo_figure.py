@@ -1,4 +1,4 @@
-"""Luxo's figure (issue 5, first part): the spec compiles to the paper's five degrees of freedom;
+"""Luxo's figure: the spec compiles to the paper's five degrees of freedom;
 with gravity, contacts and joint stops off and no torques, the free lamp conserves energy and
 momentum; dropped onto the floor without torques it comes to rest without sinking in."""
 

@@ -1,4 +1,4 @@
-"""Luxo's show end to end (issue 5): the landing controller built from the grounded lamp with
+"""Luxo's show end to end: the landing controller built from the grounded lamp with
 the same DP engine, the motor programs, and the scripted sequence; the targets are checked on
 the trajectory file, as a user would."""
 

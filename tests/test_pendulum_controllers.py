@@ -1,4 +1,4 @@
-"""The six controllers of Figure 13 do their job (the issue's quality targets)."""
+"""The six controllers of Figure 13 do their job (the quality targets in the README's Figure 13 table)."""
 
 from __future__ import annotations
 

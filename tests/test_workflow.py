@@ -166,7 +166,7 @@ CAR_SCRIPTS = [f"park_{k}" for k in range(1, 7)]
 
 @pytest.mark.slow
 def test_the_car_parks_from_every_figure_19_start(workflow):
-    """Issue 4's targets: every Figure 19 case parks (within 0.15 m and 5 deg, at rest, no
+    """The car's targets (README): every Figure 19 case parks (within 0.15 m and 5 deg, at rest, no
     collision at any instant) within 20 s, and some case backs up past the destination and
     then pulls forward into it."""
     snakemake(workflow, "results/car_all")
@@ -216,7 +216,7 @@ def test_editing_an_obstacle_rebuilds_the_car_and_nothing_else(workflow):
 
 @pytest.mark.slow
 def test_a_new_luxo_script_reuses_the_controller_and_motor_programs(workflow):
-    """Issue 5: a user's own order of Luxo's motions needs only its own run and plots; editing a
+    """Luxo: a user's own order of Luxo's motions needs only its own run and plots; editing a
     motor program reruns the shows that use it, never the dynamics or the landing controller."""
     snakemake(workflow, "results/luxo_all")
     index = (workflow / "results/luxo_all").read_text().split()
@@ -452,7 +452,7 @@ SEARCHES = {"bsr_search", "composite_search"}
     ],
 )
 def test_editing_a_module_reruns_the_stages_that_import_it(touched, module, dependents, unrelated):
-    """Modules the hand-kept list of stage modules missed (issue 20): each reruns the stages
+    """Modules a hand-kept list of stage modules once missed: each reruns the stages
     whose verbs import it, directly or not, and not the others."""
     source = touched / "src/mosys" / module
     with edited_spec(source, source.read_text() + "\n# an edit\n"):
