@@ -1,4 +1,5 @@
-"""The six controllers of Figure 13 do their job (the quality targets in the README's Figure 13 table)."""
+"""The six controllers of Figure 13 do their job (the quality targets of the README's
+Figure 13 table)."""
 
 from __future__ import annotations
 
