@@ -96,6 +96,10 @@ def exit_transitions(
 ):
     """Simulate every (node, control sample) pair until it leaves the node's cell.
 
+    Long because the explicit signature (one cached kernel for every model) lists each argument
+    and each prange iteration allocates its own scratch in this body; the cell-crossing and
+    exit-weight blocks could move into helpers later.
+
     derivative_into: the model's first-class dynamics (``integrate.DERIVATIVE_INTO``).
     axis_*: (d,) the controller grid, SI; state_slot: (d,) int64 index of each controller axis in
     the model's state (length S); base_state: (S,) values of the uncovered slots.

@@ -366,6 +366,9 @@ def simulate_lookahead(
     """Simulate up to ``record_state.shape[0]`` RK4 steps of dt seconds by lookahead on the
     cost-to-go (module docstring); return how many were taken.
 
+    Long because it threads the grid, table, obstacle and vehicle arrays through to ``_choose``
+    one by one; named tuples for those groups (as the BSR kernels' FigureArrays) would shorten it.
+
     value: (N, 1) cost-to-go at the grid nodes, s; known: (N,) bool, the nodes with a finite
     value (interpolation renormalises over them, as ``interpolate_with``). control_samples:
     (U, m) the DP's control samples, SI, driving ``control_slot`` (m,) of the model's
