@@ -15,10 +15,14 @@ from pathlib import Path
 
 import numpy as np
 
+from mosys.io.trajectory import FigureMotion
 from mosys.kernels.bsr_simulate import FigureArrays
 from mosys.parsing.bsr import ENDPOINT_ENDS
 from mosys.parsing.figure import Figure, parse_figure_spec
 from mosys.parsing.tokens import SpecError, Token
+
+# the figure_motion contract's contact attribute of every BSR motion
+CONTACT_MODEL = "bsr-impulse: rigid-body impulses at <= 2 rod endpoints, paper's friction"
 
 _SAME_POINT = 1e-12  # m: a hinge this close to an end of its parent sits on that endpoint
 
@@ -67,6 +71,25 @@ class BsrFigure:
             self.joint_names
             + tuple(f"force_{name}" for name in self.endpoint_names)
             + ("y_cm", "vy_cm")
+        )
+
+    def motion(self, rod_ends: np.ndarray, com: np.ndarray, dt: float) -> FigureMotion:
+        """A run of the figure as the ``figure_motion`` contract: rod_ends (N, rods, 2, 2) m and
+        com (N, 2) m, one sample every simulator step of dt s from t = 0."""
+        floor = 0.0 if np.isnan(self.floor) else self.floor
+        terrain = [] if np.isnan(self.floor) else [[-1000.0, floor], [1000.0, floor]]
+        return FigureMotion(
+            t=np.arange(com.shape[0]) * dt,
+            endpoints=rod_ends,
+            com=com,
+            rod_names=tuple(rod.name for rod in self.figure.rods),
+            rod_mass=self.mass,
+            rod_length=self.length,
+            rod_com=self.com,
+            rod_inertia=self.inertia,
+            gravity=self.gravity,
+            terrain=terrain,
+            contact=CONTACT_MODEL,
         )
 
     @property

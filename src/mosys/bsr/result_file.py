@@ -6,16 +6,11 @@ import json
 import os
 from pathlib import Path
 
-import numpy as np
-
-from mosys.bsr.figure import BsrFigure, load_bsr_figure
+from mosys.bsr.figure import load_bsr_figure
 from mosys.bsr.search import SearchOutcome, bind_search, run_search
 from mosys.io.bsr_result import BsrResult, write_bsr_result
-from mosys.io.trajectory import FigureMotion
 from mosys.parsing.bsr import parse_bsr_spec
 from mosys.parsing.tokens import SpecError
-
-CONTACT_MODEL = "bsr-impulse: rigid-body impulses at <= 2 rod endpoints, paper's friction"
 
 
 def search_to_file(
@@ -46,7 +41,7 @@ def search_to_file(
         evaluations=outcome.evaluations,
         best_fitness=outcome.best_fitness,
         controller=outcome.controller,
-        motion=figure_motion(figure, outcome.rod_ends, outcome.com, spec.dt),
+        motion=figure.motion(outcome.rod_ends, outcome.com, spec.dt),
         active_rule=outcome.active_rule,
         joint_names=figure.joint_names,
         sense_names=figure.sense_names if spec.kind == "sense" else (),
@@ -79,26 +74,3 @@ def search_to_file(
     )
     write_bsr_result(output, result)
     return outcome
-
-
-def figure_motion(
-    figure: BsrFigure, rod_ends: np.ndarray, com: np.ndarray, dt: float
-) -> FigureMotion:
-    """A run of the figure as the ``figure_motion`` contract: rod_ends (N, rods, 2, 2) m and
-    com (N, 2) m, one sample every simulator step of dt s from t = 0."""
-    parsed = figure.figure
-    floor = 0.0 if np.isnan(figure.floor) else figure.floor
-    terrain = [] if np.isnan(figure.floor) else [[-1000.0, floor], [1000.0, floor]]
-    return FigureMotion(
-        t=np.arange(com.shape[0]) * dt,
-        endpoints=rod_ends,
-        com=com,
-        rod_names=tuple(rod.name for rod in parsed.rods),
-        rod_mass=figure.mass,
-        rod_length=figure.length,
-        rod_com=figure.com,
-        rod_inertia=figure.inertia,
-        gravity=figure.gravity,
-        terrain=terrain,
-        contact=CONTACT_MODEL,
-    )

@@ -11,7 +11,6 @@ from pathlib import Path
 
 import numpy as np
 
-from mosys.bsr.result_file import figure_motion
 from mosys.composite.session import CompositeSession, ScoredMotion, open_session
 from mosys.composite.transitions import TransitionSearch, search_transitions
 from mosys.io.composite_result import CompositeMotion, CompositeResult, write_composite_result
@@ -39,7 +38,7 @@ def phase_table(session: CompositeSession, ticks: np.ndarray) -> list[dict]:
 def stored_motion(session: CompositeSession, scored: ScoredMotion) -> CompositeMotion:
     motion = scored.motion
     return CompositeMotion(
-        motion=figure_motion(session.figure, motion.rod_ends, motion.com, session.dt),
+        motion=session.figure.motion(motion.rod_ends, motion.com, session.dt),
         phase=motion.phase,
         active_rule=motion.active_rule,
     )
