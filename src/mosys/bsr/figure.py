@@ -16,7 +16,6 @@ from pathlib import Path
 import numpy as np
 
 from mosys.io.trajectory import FigureMotion
-from mosys.kernels.bsr_simulate import FigureArrays
 from mosys.parsing.bsr import ENDPOINT_ENDS
 from mosys.parsing.figure import Figure, parse_figure_spec
 from mosys.parsing.tokens import SpecError, Token
@@ -93,23 +92,20 @@ class BsrFigure:
         )
 
     @property
-    def arrays(self) -> FigureArrays:
-        """The figure as the kernels take it."""
-        return FigureArrays(
-            parent=self.parent,
-            hinge=self.hinge,
-            offset=self.offset,
-            length=self.length,
-            mass=self.mass,
-            com=self.com,
-            inertia=self.inertia,
-            joint=self.joint,
-            endpoints=self.endpoints,
-            joint_min=self.joint_min,
-            joint_max=self.joint_max,
-            gravity=self.gravity,
-            floor=self.floor,
-            reach=self.reach,
+    def kernel_arrays(self) -> tuple:
+        """The figure's arrays in the order the kernels take them."""
+        return (
+            self.parent,
+            self.hinge,
+            self.offset,
+            self.length,
+            self.mass,
+            self.com,
+            self.inertia,
+            self.joint,
+            self.endpoints,
+            self.joint_min,
+            self.joint_max,
         )
 
 

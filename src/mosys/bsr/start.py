@@ -35,7 +35,7 @@ def standing_state(
     offsets = np.empty((figure.endpoints.shape[0], 2))
     velocities = np.empty_like(offsets)
     _, inertia, _ = body_frame(
-        figure.arrays,
+        *figure.kernel_arrays[:9],
         theta,
         np.zeros(n_joints),
         rod_ends,

@@ -17,7 +17,6 @@ steps that end with one of the ``fall`` endpoints touching the floor.
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange
@@ -33,7 +32,6 @@ from mosys.kernels.bsr_simulate import (
     endpoint_position,
     place_in_world,
     step,
-    step_work,
 )
 
 # Table 2 of the paper: a rule's hyper-rectangle side 2/lambda lies in [SIDE_MIN, SIDE_MAX], so
@@ -45,40 +43,6 @@ CENTER_MAX = 1.5
 # the columns of terms_out
 DISTANCE, MAX_HEIGHT, CONTACT_DISTANCE, ROTATIONS, FALL = range(5)
 TERM_COUNT = 5
-
-
-class ControllerRules(NamedTuple):
-    """A controller's R rules as ``run_controller`` takes them (``run_population``: a population's,
-    every array with a leading axis C, one row per controller). Sense-based (time_based False):
-    center, side select the rule; time-based: segment_end and period do."""
-
-    time_based: bool
-    target: np.ndarray  # (R, J) rad: each rule's target pose
-    tau: np.ndarray  # (R,) s: each rule's time constant
-    center: np.ndarray  # (R, V): each rule's hyper-rectangle centre in sense space
-    side: np.ndarray  # (R, V): its sides
-    segment_end: np.ndarray  # (R,) s: the cumulative ends of the segments, the last = period
-    period: float  # s
-
-
-class RunSettings(NamedTuple):
-    """How long a run lasts and what counts as a fall."""
-
-    steps: int
-    dt: float  # s
-    fall_endpoints: np.ndarray  # (F,) int64: the endpoints whose touching the floor is a fall
-
-
-class RunOutputs(NamedTuple):
-    """What a run fills; ends and com with 0 rows: not recorded."""
-
-    senses: np.ndarray  # (steps + 1, V): the sense variables at every sample (0: the start)
-    rule: np.ndarray  # (steps + 1,) int64: the rule active after every sample
-    terms: np.ndarray  # (TERM_COUNT,): the fitness terms of the run
-    ends: np.ndarray  # (steps + 1, N, 2, 2) m or (0, N, 2, 2): every rod's ends, world
-    com: np.ndarray  # (steps + 1, 2) m or (0, 2): the centre of mass, world
-    final_state: np.ndarray  # (S,): the state at the end
-    final_force: np.ndarray  # (E,) N: the endpoints' normal forces at the end
 
 
 @njit(cache=True)
@@ -139,91 +103,104 @@ def segment_rule(time, segment_end, period):
 
 
 @njit(cache=True)
-def _first_sample(figure, state, work, weight, end_x, touching, record, out):
-    """The start: fill work (body frame, previous) from the state (S,), each endpoint's x (m)
-    into end_x (E,) and whether it touches the floor into touching (E,), and sample 0 of out
-    (its ends and com if record; no forces but the carried-over ones in work.end_force)."""
-    n_joints = figure.joint_min.shape[0]
+def run_controller(
+    parent,
+    hinge,
+    offset,
+    length,
+    mass,
+    com,
+    inertia,
+    joint,
+    endpoints,
+    joint_min,
+    joint_max,
+    gravity,
+    floor,
+    reach,
+    time_based,
+    target,
+    tau,
+    center,
+    side,
+    segment_end,
+    period,
+    start,
+    steps,
+    dt,
+    fall_endpoints,
+    senses_out,
+    rule_out,
+    terms_out,
+    ends_out,
+    com_out,
+    start_force,
+    carry_over,
+    final_state,
+    final_force,
+):
+    """Run a controller for ``steps`` steps of dt seconds from the state ``start`` (S,).
+
+    Sense-based (time_based False): center, side (R, V) select the rule; time-based:
+    segment_end (R,) and period s do. target (R, J) rad, tau (R,) s. fall_endpoints (F,) int64.
+    Fills senses_out (steps + 1, V) and rule_out (steps + 1,) (sample 0: the start, with rule 0
+    active as Figure 2 begins), terms_out (TERM_COUNT,), and, if ends_out has steps + 1 rows,
+    ends_out (steps + 1, N, 2, 2) and com_out (steps + 1, 2), world metres.
+    start_force (E,): the endpoints' normal forces at the start, N (zeros for a fresh start);
+    carry_over: a controller taking over from another (a composite motion) starts with the rule
+    its score picks from the carried-over senses (rule 0 if none scores positive) instead of
+    rule 0. Fills final_state (S,) and final_force (E,) with the state and forces at the end.
+    """
+    state = start.copy()
+    n_rods = parent.shape[0]
+    n_ends = endpoints.shape[0]
+    rod_ends = np.empty((n_rods, 2, 2))
+    end_offset = np.empty((n_ends, 2))
+    end_velocity = np.empty((n_ends, 2))
+    end_force = start_force.copy()
+    end_x = np.empty(n_ends)
+    touching = np.zeros(n_ends, np.bool_)
+    previous = np.zeros(1)
+    scratch = np.empty((n_rods, 8))
+    contact = np.empty((3, 2, 2))
+    entry_x = np.empty(n_ends)
+    weight = mass.sum() * gravity
+    record = ends_out.shape[0] == steps + 1
+    weights = rule_weights(side)
+    # the start: its pose, no forces yet
+    n_joints = joint_min.shape[0]
     theta = state[JOINTS : JOINTS + n_joints]
     theta_rate = state[JOINTS + n_joints : JOINTS + 2 * n_joints]
     _, total_inertia, deformation_momentum = body_frame(
-        figure, theta, theta_rate, work.rod_ends, work.end_offset, work.end_velocity, work.scratch
+        parent,
+        hinge,
+        offset,
+        length,
+        mass,
+        com,
+        inertia,
+        joint,
+        endpoints,
+        theta,
+        theta_rate,
+        rod_ends,
+        end_offset,
+        end_velocity,
+        scratch,
     )
-    work.previous[0] = deformation_momentum / total_inertia
+    previous[0] = deformation_momentum / total_inertia
     cos_phi = math.cos(state[PHI])
     sin_phi = math.sin(state[PHI])
-    floor = figure.floor
-    end_offset = work.end_offset
-    for e in range(end_x.shape[0]):
+    for e in range(n_ends):
         end_x[e], y = endpoint_position(state, cos_phi, sin_phi, end_offset, e)
         touching[e] = not math.isnan(floor) and y <= floor + CONTACT_TOLERANCE
     if record:
-        place_in_world(state, cos_phi, sin_phi, work.rod_ends, out.ends[0])
-        out.com[0, 0] = state[CX]
-        out.com[0, 1] = state[CY]
+        place_in_world(state, cos_phi, sin_phi, rod_ends, ends_out[0])
+        com_out[0, 0] = state[CX]
+        com_out[0, 1] = state[CY]
     measure_senses(
-        state,
-        figure.joint_min,
-        figure.joint_max,
-        work.end_force,
-        weight,
-        floor,
-        figure.reach,
-        figure.gravity,
-        out.senses[0],
+        state, joint_min, joint_max, end_force, weight, floor, reach, gravity, senses_out[0]
     )
-
-
-@njit(cache=True, inline="always")
-def _track_endpoints(state, end_offset, floor, fall_endpoints, end_x, touching, contact_distance):
-    """After a step: update each endpoint's x (m) in end_x (E,) and whether it touches the
-    floor (m, nan: none) in touching (E,). Returns contact_distance (m) plus the horizontal
-    distance moved by the endpoints that touched the floor before and after the step, and
-    whether one of fall_endpoints (F,) touches it now."""
-    cos_phi = math.cos(state[PHI])
-    sin_phi = math.sin(state[PHI])
-    for e in range(end_x.shape[0]):
-        x, y = endpoint_position(state, cos_phi, sin_phi, end_offset, e)
-        now_touching = not math.isnan(floor) and y <= floor + CONTACT_TOLERANCE
-        if now_touching and touching[e]:
-            contact_distance += abs(x - end_x[e])
-        end_x[e] = x
-        touching[e] = now_touching
-    fallen = False
-    for f in range(fall_endpoints.shape[0]):
-        if touching[fall_endpoints[f]]:
-            fallen = True
-    return contact_distance, fallen
-
-
-@njit(cache=True)
-def run_controller(figure, rules, settings, start, start_force, carry_over, out):
-    """Run a controller (a ControllerRules) on the figure (a FigureArrays) for settings.steps
-    steps of settings.dt seconds from the state ``start`` (S,).
-
-    Fills out (a RunOutputs): senses and rule (sample 0: the start, with rule 0 active as
-    Figure 2 begins), terms, and, if out.ends has steps + 1 rows, ends and com; final_state and
-    final_force: the state and forces at the end. start_force (E,): the endpoints' normal
-    forces at the start, N (zeros for a fresh start); carry_over: a controller taking over from
-    another (a composite motion) starts with the rule its score picks from the carried-over
-    senses (rule 0 if none scores positive) instead of rule 0. The named tuples are unpacked
-    once here, not in the loop: each read of a tuple's array costs a reference count.
-    """
-    steps, dt, fall_endpoints = settings
-    time_based, target, tau, center, side, segment_end, period = rules
-    senses_out, rule_out, terms_out, ends_out, com_out, final_state, final_force = out
-    joint_min, joint_max = figure.joint_min, figure.joint_max
-    gravity, floor, reach = figure.gravity, figure.floor, figure.reach
-    state = start.copy()
-    work = step_work(figure, start_force)
-    rod_ends, end_offset, end_velocity, end_force, previous, scratch, contact, entry_x = work
-    n_ends = figure.endpoints.shape[0]
-    end_x = np.empty(n_ends)
-    touching = np.zeros(n_ends, np.bool_)
-    weight = figure.mass.sum() * gravity
-    record = ends_out.shape[0] == steps + 1
-    weights = rule_weights(side)
-    _first_sample(figure, state, work, weight, end_x, touching, record, out)
     rule = 0
     if carry_over and not time_based:
         rule = active_rule(senses_out[0], center, side, weights, 0)
@@ -235,34 +212,55 @@ def run_controller(figure, rules, settings, start, start_force, carry_over, out)
     fallen_steps = 0
     for n in range(steps):
         step(
-            figure,
+            parent,
+            hinge,
+            offset,
+            length,
+            mass,
+            com,
+            inertia,
+            joint,
+            endpoints,
+            joint_min,
+            joint_max,
+            gravity,
+            floor,
             state,
             target[rule],
             tau[rule],
             dt,
+            previous,
             rod_ends,
             end_offset,
             end_velocity,
             end_force,
-            previous,
             scratch,
             contact,
             entry_x,
         )
-        contact_distance, fallen = _track_endpoints(
-            state, end_offset, floor, fall_endpoints, end_x, touching, contact_distance
-        )
+        cos_phi = math.cos(state[PHI])
+        sin_phi = math.sin(state[PHI])
+        fallen = False
+        for e in range(n_ends):
+            x, y = endpoint_position(state, cos_phi, sin_phi, end_offset, e)
+            now_touching = not math.isnan(floor) and y <= floor + CONTACT_TOLERANCE
+            if now_touching and touching[e]:
+                contact_distance += abs(x - end_x[e])
+            end_x[e] = x
+            touching[e] = now_touching
+        for f in range(fall_endpoints.shape[0]):
+            if touching[fall_endpoints[f]]:
+                fallen = True
         if fallen:
             fallen_steps += 1
         max_height = max(max_height, state[CY])
-        senses = senses_out[n + 1]
         measure_senses(
-            state, joint_min, joint_max, end_force, weight, floor, reach, gravity, senses
+            state, joint_min, joint_max, end_force, weight, floor, reach, gravity, senses_out[n + 1]
         )
         if time_based:
             rule = segment_rule((n + 1) * dt, segment_end, period)
         else:
-            rule = active_rule(senses, center, side, weights, rule)
+            rule = active_rule(senses_out[n + 1], center, side, weights, rule)
         rule_out[n + 1] = rule
         if record:
             ends_out[n + 1] = rod_ends
@@ -278,31 +276,77 @@ def run_controller(figure, rules, settings, start, start_force, carry_over, out)
 
 
 @njit(cache=True, parallel=True)
-def run_population(figure, rules, settings, start, senses_out, rule_out, terms_out):
+def run_population(
+    parent,
+    hinge,
+    offset,
+    length,
+    mass,
+    com,
+    inertia,
+    joint,
+    endpoints,
+    joint_min,
+    joint_max,
+    gravity,
+    floor,
+    reach,
+    time_based,
+    target,
+    tau,
+    center,
+    side,
+    segment_end,
+    period,
+    start,
+    steps,
+    dt,
+    fall_endpoints,
+    senses_out,
+    rule_out,
+    terms_out,
+):
     """``run_controller`` for C controllers at once, in parallel (each run is independent, so
-    the results do not depend on the number of threads), from the states start (C, S): rules
-    (a ControllerRules) with a leading axis C on every array. Fills senses_out
+    the results do not depend on the number of threads). target (C, R, J), tau (C, R),
+    center/side (C, R, V), segment_end (C, R), start (C, S); fills senses_out
     (C, steps + 1, V), rule_out (C, steps + 1), terms_out (C, TERM_COUNT)."""
-    n_ends = figure.endpoints.shape[0]
-    no_ends = np.empty((0, figure.parent.shape[0], 2, 2))
+    no_ends = np.empty((0, parent.shape[0], 2, 2))
     no_com = np.empty((0, 2))
-    for c in prange(rules.target.shape[0]):
-        controller = ControllerRules(
-            rules.time_based,
-            rules.target[c],
-            rules.tau[c],
-            rules.center[c],
-            rules.side[c],
-            rules.segment_end[c],
-            rules.period,
-        )
-        out = RunOutputs(
+    n_ends = endpoints.shape[0]
+    for c in prange(target.shape[0]):
+        run_controller(
+            parent,
+            hinge,
+            offset,
+            length,
+            mass,
+            com,
+            inertia,
+            joint,
+            endpoints,
+            joint_min,
+            joint_max,
+            gravity,
+            floor,
+            reach,
+            time_based,
+            target[c],
+            tau[c],
+            center[c],
+            side[c],
+            segment_end[c],
+            period,
+            start[c],
+            steps,
+            dt,
+            fall_endpoints,
             senses_out[c],
             rule_out[c],
             terms_out[c],
             no_ends,
             no_com,
+            np.zeros(n_ends),
+            False,
             np.empty(start.shape[1]),
             np.empty(n_ends),
         )
-        run_controller(figure, controller, settings, start[c], np.zeros(n_ends), False, out)

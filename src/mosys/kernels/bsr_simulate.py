@@ -12,8 +12,11 @@ impulses in the ratio of their normal impulses, sized so that their normal-impul
 tangential velocity is zero. A contact's force is its impulse over the step. Rods do not collide
 with one another.
 
-A figure travels through the kernels as one ``FigureArrays`` (built by ``mosys.bsr.figure``), the
-simulator's working arrays as one ``StepWork``.
+Layout of a figure (see ``mosys.bsr.figure``): rods in an order where every parent precedes its
+children; per rod ``parent`` (-1: the root), ``hinge`` (m along the parent from its proximal end),
+``offset`` (rad), ``length`` (m), ``mass`` (kg), ``com`` (fraction from proximal to distal),
+``inertia`` (kg m² about its own centre of mass), ``joint`` (its joint's index in θ, -1: the root).
+``endpoints`` (E, 2) int64: the rod and end (0 proximal, 1 distal) of each distinct endpoint.
 
 State vector (S = 6 + 2J): ``c_x, c_y`` (m), ``v_x, v_y`` (m/s), ``phi`` (the root rod's absolute
 angle, rad, unwrapped), ``L`` (kg m²/s), ``θ`` (J, rad), ``θ'`` (J, rad/s).
@@ -22,7 +25,6 @@ angle, rad, unwrapped), ``L`` (kg m²/s), ``θ`` (J, rad), ``θ'`` (J, rad/s).
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -33,63 +35,33 @@ CONTACT_TOLERANCE = 1e-3  # m: an endpoint this close to the floor is touching i
 MAX_CONTACTS = 2
 
 
-class FigureArrays(NamedTuple):
-    """A figure as the kernels take it: N rods in an order where every parent precedes its
-    children, J joints, E distinct endpoints."""
-
-    parent: np.ndarray  # (N,) int64: each rod's parent, -1: the root
-    hinge: np.ndarray  # (N,) m: where the rod hangs on its parent, from the parent's proximal end
-    offset: np.ndarray  # (N,) rad: the rod's angle to its parent at joint angle 0
-    length: np.ndarray  # (N,) m
-    mass: np.ndarray  # (N,) kg
-    com: np.ndarray  # (N,): the rod's centre of mass, a fraction from proximal to distal
-    inertia: np.ndarray  # (N,) kg m² about the rod's own centre of mass
-    joint: np.ndarray  # (N,) int64: the rod's joint's index in θ, -1: the root
-    endpoints: np.ndarray  # (E, 2) int64: rod and end (0 proximal, 1 distal) of each endpoint
-    joint_min: np.ndarray  # (J,) rad
-    joint_max: np.ndarray  # (J,) rad
-    gravity: float  # m/s²
-    floor: float  # m: the floor's height (nan: no floor)
-    reach: float  # m: the sum of the rods' lengths
-
-
-class StepWork(NamedTuple):
-    """What ``step`` carries from one step to the next, and its work space (``step_work``)."""
-
-    rod_ends: np.ndarray  # (N, 2, 2) m: every rod's ends in the world after the last step
-    end_offset: np.ndarray  # (E, 2) m: the endpoints from the centre of mass, body frame
-    end_velocity: np.ndarray  # (E, 2) m/s: the endpoints' velocities from the deformation alone
-    end_force: np.ndarray  # (E,) N: the ground's normal force on each endpoint over the last step
-    previous: np.ndarray  # (1,) rad/s: h / I of the figure after the last step
-    scratch: np.ndarray  # (N, 8) work space of body_frame
-    contact: np.ndarray  # (3, 2, 2) work space of the contacts: velocities, offsets, impulses
-    entry_x: np.ndarray  # (E,) m: the endpoints' x at the start of the step
-
-
 @njit(cache=True)
-def step_work(figure, end_force):
-    """A new StepWork for the figure, its end_force a copy of end_force (E,) N (previous 0;
-    the caller sets it and end_offset with ``body_frame`` before the first step)."""
-    n_rods = figure.parent.shape[0]
-    n_ends = figure.endpoints.shape[0]
-    return StepWork(
-        np.empty((n_rods, 2, 2)),
-        np.empty((n_ends, 2)),
-        np.empty((n_ends, 2)),
-        end_force.copy(),
-        np.zeros(1),
-        np.empty((n_rods, 8)),
-        np.empty((3, 2, 2)),
-        np.empty(n_ends),
-    )
+def body_frame(
+    parent,
+    hinge,
+    offset,
+    length,
+    mass,
+    com,
+    inertia,
+    joint,
+    endpoints,
+    theta,
+    theta_rate,
+    rod_ends,
+    end_offset,
+    end_velocity,
+    scratch,
+):
+    """The deformed figure in its body frame (root angle 0), about its centre of mass.
 
-
-@njit(cache=True, inline="always")
-def _chain_rods(parent, hinge, offset, length, mass, com, joint, theta, theta_rate, scratch):
-    """Walk the tree from the root in the body frame (root angle 0, root's proximal end at 0):
-    fills scratch (N, 8) with each rod's angle (rad), rate (rad/s), proximal end (m) and its
-    velocity (m/s), cosine and sine; returns the total mass (kg) and the centre of mass's
-    position (m) and velocity (m/s). The rod arrays as in FigureArrays."""
+    Fills rod_ends (N, 2, 2): each rod's proximal and distal end relative to the centre of
+    mass, m; end_offset, end_velocity (E, 2): each distinct endpoint's position relative to the
+    centre of mass (m) and its velocity from the deformation alone (m/s). Returns (M, I, h):
+    total mass kg, inertia about the centre of mass kg m², the deformation's angular momentum
+    about the centre of mass kg m²/s. scratch: (N, 8) work space.
+    """
+    n = parent.shape[0]
     angle = scratch[:, 0]
     rate = scratch[:, 1]
     proximal = scratch[:, 2:4]
@@ -101,7 +73,7 @@ def _chain_rods(parent, hinge, offset, length, mass, com, joint, theta, theta_ra
     mass_y = 0.0
     momentum_x = 0.0
     momentum_y = 0.0
-    for k in range(parent.shape[0]):
+    for k in range(n):
         p = parent[k]
         if p < 0:
             angle[k] = 0.0
@@ -129,38 +101,13 @@ def _chain_rods(parent, hinge, offset, length, mass, com, joint, theta, theta_ra
         mass_y += mass[k] * (proximal[k, 1] + arm * sin_k)
         momentum_x += mass[k] * (proximal_velocity[k, 0] - arm * rate[k] * sin_k)
         momentum_y += mass[k] * (proximal_velocity[k, 1] + arm * rate[k] * cos_k)
-    return (
-        total_mass,
-        mass_x / total_mass,
-        mass_y / total_mass,
-        momentum_x / total_mass,
-        momentum_y / total_mass,
-    )
-
-
-@njit(cache=True)
-def body_frame(figure, theta, theta_rate, rod_ends, end_offset, end_velocity, scratch):
-    """The deformed figure (a FigureArrays) in its body frame (root angle 0), about its centre
-    of mass, at joint angles theta (J,) rad and rates theta_rate (J,) rad/s.
-
-    Fills rod_ends (N, 2, 2): each rod's proximal and distal end relative to the centre of
-    mass, m; end_offset, end_velocity (E, 2): each distinct endpoint's position relative to the
-    centre of mass (m) and its velocity from the deformation alone (m/s). Returns (M, I, h):
-    total mass kg, inertia about the centre of mass kg m², the deformation's angular momentum
-    about the centre of mass kg m²/s. scratch: (N, 8) work space.
-    """
-    parent, hinge, offset, length, mass, com, inertia, joint, endpoints = figure[:9]
-    total_mass, centre_x, centre_y, centre_vx, centre_vy = _chain_rods(
-        parent, hinge, offset, length, mass, com, joint, theta, theta_rate, scratch
-    )
-    rate = scratch[:, 1]
-    proximal = scratch[:, 2:4]
-    proximal_velocity = scratch[:, 4:6]
-    cosine = scratch[:, 6]
-    sine = scratch[:, 7]
+    centre_x = mass_x / total_mass
+    centre_y = mass_y / total_mass
+    centre_vx = momentum_x / total_mass
+    centre_vy = momentum_y / total_mass
     total_inertia = 0.0
     deformation_momentum = 0.0
-    for k in range(parent.shape[0]):
+    for k in range(n):
         arm = com[k] * length[k]
         cos_k = cosine[k]
         sin_k = sine[k]
@@ -346,47 +293,64 @@ def contact_impulses(u, r, count, inverse_mass, inverse_inertia, impulse):
 
 @njit(cache=True)
 def step(
-    figure,
+    parent,
+    hinge,
+    offset,
+    length,
+    mass,
+    com,
+    inertia,
+    joint,
+    endpoints,
+    joint_min,
+    joint_max,
+    gravity,
+    floor,
     state,
     target,
     tau,
     dt,
+    previous,
     rod_ends,
     end_offset,
     end_velocity,
     end_force,
-    previous,
     scratch,
     contact,
     entry_x,
 ):
-    """Advance the state (S,) of the figure (a FigureArrays) by dt seconds toward the target
-    pose (J,) rad with time constant tau s.
-
-    The rest are the arrays of a StepWork (``step_work``), one by one: unpacking the named tuple
-    here, once a step, cost a reference count per array (a search ran some 5% slower).
-    end_offset and previous must hold what the previous step (or the start) left; the step
-    leaves in rod_ends (N, 2, 2) the world positions of every rod's ends after it (m), in
-    end_force (E,) the ground's normal force on each endpoint over it (N), and in previous h / I
-    of the figure after it (rad/s). end_velocity, scratch, contact, entry_x: work space.
-
-    One piece (about 110 lines of code), because this is the innermost loop of every search:
-    with the contact phase and the settling in helpers a step measured 17% slower (plain calls)
-    or about 3% slower (``inline="always"``).
+    """Advance the state (S,) by dt seconds toward the target pose (J,) rad with time constant
+    tau s. ``previous`` (2,): h / I of the figure before the step (rad/s), updated to the
+    figure after it. Fills rod_ends (N, 2, 2) with world positions of every rod's ends after the
+    step (m), end_offset/end_velocity (E, 2) scratch, end_force (E,) the ground's normal force on
+    each endpoint over the step, N. gravity m/s², floor: the floor's height, m (nan: no floor).
+    scratch (N, 8), contact (3, 2, 2), entry_x (E,): work space; end_offset must hold the
+    figure's endpoints as the previous step (or the start) left them.
     """
-    n_ends = figure.endpoints.shape[0]
-    gravity = figure.gravity
-    floor = figure.floor
     cos_phi = math.cos(state[PHI])
     sin_phi = math.sin(state[PHI])
-    for e in range(n_ends):
+    for e in range(endpoints.shape[0]):
         entry_x[e] = endpoint_position(state, cos_phi, sin_phi, end_offset, e)[0]
     n_joints = target.shape[0]
     theta = state[JOINTS : JOINTS + n_joints]
     theta_rate = state[JOINTS + n_joints : JOINTS + 2 * n_joints]
-    deform_joints(theta, theta_rate, target, tau, figure.joint_min, figure.joint_max, dt)
+    deform_joints(theta, theta_rate, target, tau, joint_min, joint_max, dt)
     total_mass, total_inertia, deformation_momentum = body_frame(
-        figure, theta, theta_rate, rod_ends, end_offset, end_velocity, scratch
+        parent,
+        hinge,
+        offset,
+        length,
+        mass,
+        com,
+        inertia,
+        joint,
+        endpoints,
+        theta,
+        theta_rate,
+        rod_ends,
+        end_offset,
+        end_velocity,
+        scratch,
     )
     spin_of_deformation = deformation_momentum / total_inertia
     # orientation correction: the deformation leaves the angular momentum unchanged
@@ -408,7 +372,7 @@ def step(
         chosen1 = -1
         lowest0 = np.inf
         lowest1 = np.inf
-        for e in range(n_ends):
+        for e in range(endpoints.shape[0]):
             rx = cos_phi * end_offset[e, 0] - sin_phi * end_offset[e, 1]
             ry = sin_phi * end_offset[e, 0] + cos_phi * end_offset[e, 1]
             uy = (
@@ -478,7 +442,7 @@ def step(
         state[CY] = floor - (sin_phi * end_offset[pinned, 0] + cos_phi * end_offset[pinned, 1])
     if not math.isnan(floor):
         lowest = np.inf
-        for e in range(n_ends):
+        for e in range(endpoints.shape[0]):
             lowest = min(lowest, endpoint_position(state, cos_phi, sin_phi, end_offset, e)[1])
         if lowest < floor:
             state[CY] += floor - lowest  # no sinking: lift the figure out of the floor
