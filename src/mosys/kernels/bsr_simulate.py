@@ -326,6 +326,8 @@ def step(
     each endpoint over the step, N. gravity m/s², floor: the floor's height, m (nan: no floor).
     scratch (N, 8), contact (3, 2, 2), entry_x (E,): work space; end_offset must hold the
     figure's endpoints as the previous step (or the start) left them.
+
+    One piece on purpose: it runs every step, and split into helpers it measured 3-17% slower.
     """
     cos_phi = math.cos(state[PHI])
     sin_phi = math.sin(state[PHI])
