@@ -15,11 +15,11 @@ from mosys.animation.runner import (
 )
 from mosys.dynamics.figure_motion import figure_contacts, figure_motion
 from mosys.dynamics.load import figure_dynamics
-from mosys.io.car_scene import car_scene_attributes
+from mosys.io.car_scene import car_scene_attributes, controller_table_scene
 from mosys.io.controller_table import read_controller_table
 from mosys.io.trajectory import Trajectory, write_trajectory
 from mosys.parsing.script import SwapController, parse_script
-from mosys.ssc.parking import parking_outcome, table_scene
+from mosys.ssc.parking import parking_outcome
 
 
 def run_animation_script(
@@ -54,7 +54,7 @@ def run_animation_script(
     if getattr(dynamics, "MODEL_KIND", "figure") == "vehicle":
         motion = None  # not an articulated figure: no figure_motion (DESIGN.md)
         first_table = next(iter(sources.controllers.values())).table
-        scene = table_scene(first_table)
+        scene = controller_table_scene(first_table)
         outcome = parking_outcome(run.t, run.state, run.state_order, scene)
         extra = car_scene_attributes(scene) | outcome.attributes()
     else:

@@ -17,7 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from mosys.errors import InputError
-from mosys.io.attributes import string_tuple
+from mosys.io.attributes import string_attr, string_tuple
+from mosys.io.controller_table import ControllerTable
 
 DESTINATION_KEYS = ("x", "y", "heading")
 
@@ -67,7 +68,7 @@ def read_car_scene(attrs: Mapping, where: str, destination: Mapping | None = Non
         raise InputError(
             f'{where}: destination must be {{"x": m, "y": m, "heading": deg}}, got {destination!r}'
         ) from None
-    domain = json.loads(_text(attrs["domain"])) if "domain" in attrs else []
+    domain = json.loads(string_attr(attrs["domain"])) if "domain" in attrs else []
     return CarScene(
         body_outline=outline,
         obstacles=obstacles,
@@ -76,6 +77,11 @@ def read_car_scene(attrs: Mapping, where: str, destination: Mapping | None = Non
         wheelbase=float(attrs["wheelbase"]) if "wheelbase" in attrs else math.nan,
         domain=np.ascontiguousarray(domain, dtype=np.float64).reshape(-1, 2),
     )
+
+
+def controller_table_scene(table: ControllerTable) -> CarScene:
+    """The scene of a car controller table, its destination the table's ``dest``."""
+    return read_car_scene(table.attrs, f"controller table of {table.figure}", table.dest)
 
 
 def car_scene_attributes(scene: CarScene) -> dict:
@@ -89,15 +95,11 @@ def car_scene_attributes(scene: CarScene) -> dict:
     }
 
 
-def _text(value) -> str:
-    return value.decode() if isinstance(value, bytes) else str(value)
-
-
 def _json_attr(attrs: Mapping, where: str, name: str):
     if name not in attrs:
         raise InputError(f"{where}: not a car scene (root attributes): missing {name}")
     try:
-        return json.loads(_text(attrs[name]))
+        return json.loads(string_attr(attrs[name]))
     except json.JSONDecodeError as error:
         raise InputError(f"{where}: root attribute {name} is not valid JSON ({error})") from None
 

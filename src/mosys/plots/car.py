@@ -29,6 +29,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Polygon
 
 from mosys.errors import InputError
+from mosys.io.attributes import string_attr
 from mosys.io.car_scene import CarScene, read_car_scene
 from mosys.io.start_grid import DATASETS
 from mosys.io.start_grid import read_start_grid as read_start_grid_file
@@ -158,11 +159,6 @@ class StartGrid:
         return self.parked & ~self.collided
 
 
-def _text(value) -> str:
-    """A string attribute as read by h5py (str or bytes)."""
-    return value.decode() if isinstance(value, bytes) else str(value)
-
-
 def _missing(path, kind: str, names: Sequence[str], present) -> None:
     absent = [name for name in names if name not in present]
     if absent:
@@ -239,7 +235,7 @@ def read_car_trajectory(path: str | Path) -> CarTrajectory:
         track=float(attrs.get("track", TRACK_FRACTION * 2 * half_width)),
         wheel_radius=float(attrs.get("wheel_radius", DEFAULT_WHEEL_RADIUS)),
         collision_index=collision_index,
-        collided_with=_text(attrs["collided_with"]),
+        collided_with=string_attr(attrs["collided_with"]),
         parked=parked,
         parking_seconds=parking_seconds,
         simulated_seconds=float(attrs["simulated_seconds"]),
@@ -283,7 +279,7 @@ def read_start_grid(path: str | Path) -> StartGrid:
         collided=flags["collided"].astype(bool),
         parking_seconds=flags["parking_seconds"].astype(np.float64),
         scene=_read_scene(path, attrs),
-        controller=_text(attrs["controller"]),
+        controller=string_attr(attrs["controller"]),
         simulated_seconds=float(attrs["simulated_seconds"]),
     )
 

@@ -10,7 +10,7 @@ from types import ModuleType
 
 import numpy as np
 
-from mosys.io.car_scene import has_car_scene, read_car_scene
+from mosys.io.car_scene import controller_table_scene, has_car_scene
 from mosys.io.controller_table import ControllerTable
 from mosys.kernels.geometry import pack_polygons
 from mosys.ssc.grid import FigureGrid, control_scale, figure_state_names
@@ -64,7 +64,7 @@ def lookahead_runtime(table: ControllerTable, dynamics: ModuleType, grid: Figure
     samples = np.array(list(itertools.product(*axes)), dtype=np.float64) * scale
     pose_slot = np.array([names.index(n) for n in ("x", "y", "heading")], dtype=np.int64)
     if has_car_scene(attrs):
-        scene = read_car_scene(attrs, f"controller table of {table.figure}", table.dest)
+        scene = controller_table_scene(table)
         outline, domain = scene.body_outline, scene.domain
         vertices, start = pack_polygons(list(scene.obstacles))
     else:  # no obstacles and no domain polygon: every pose is free

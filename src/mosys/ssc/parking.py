@@ -12,8 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mosys.io.car_scene import CarScene, car_scene_attributes, read_car_scene
-from mosys.io.controller_table import ControllerTable
+from mosys.io.car_scene import CarScene, car_scene_attributes, controller_table_scene
 from mosys.io.start_grid import StartGrid
 from mosys.kernels.geometry import first_colliding_sample, pack_polygons
 from mosys.ssc.controller import Controller
@@ -40,11 +39,6 @@ class ParkingOutcome:
             "parking_seconds": self.parking_seconds,
             "parking_tolerance": json.dumps(TOLERANCE),
         }
-
-
-def table_scene(table: ControllerTable) -> CarScene:
-    """The scene of a car controller table (its destination the table's ``dest``)."""
-    return read_car_scene(table.attrs, f"controller table of {table.figure}", table.dest)
 
 
 def parking_outcome(
@@ -85,7 +79,7 @@ def evaluate_starts(
 ) -> StartGrid:
     """Run ``controller`` (a car's) from every start (n, d) in its state order, spec units, for
     ``seconds`` with step ``dt``, and judge each run (``parking_outcome``)."""
-    scene = table_scene(controller.table)
+    scene = controller_table_scene(controller.table)
     outcomes = []
     for start in starts:
         run = controller.simulate(controller.figure_state(start), seconds, dt)
