@@ -449,6 +449,11 @@ SEARCHES = {"bsr_search", "composite_search"}
             {"dp_controller", "car_start_grid"},
             SEARCHES | {"compile_dynamics", "bsr_plots", "composite_table"},
         ),
+        (  # the verb declarations every family builds on (shared options such as --budget)
+            "cli/verb.py",
+            SIMULATION | SEARCHES | {"pendulum_table", "bsr_runs_table", "composite_plots"},
+            set(),
+        ),
     ],
 )
 def test_editing_a_module_reruns_the_stages_that_import_it(touched, module, dependents, unrelated):

@@ -15,6 +15,8 @@ validate(config, "../schemas/config.schema.yaml")
 
 # What the CLI's main imports for every verb (its error types).
 CLI_MODULES = ("mosys.errors", "mosys.parsing.tokens")
+# What every verb family's module builds its arguments with (shared options such as --budget).
+CLI_VERBS = "mosys.cli.verb"
 
 
 @functools.cache
@@ -94,14 +96,16 @@ def code_inputs(*entries):
     """The package files a rule's output depends on (editing one reruns the rule): the import
     closure of the entry modules its verb calls and of the CLI's own imports, sorted; paths
     relative to the working directory when the package lies below it. An entry in mosys.cli
-    (the module of the verb's family) counts as its own file only: the CLI package imports every
-    family, so following its imports would make every rule depend on all the code."""
+    (the module of the verb's family) counts as its own file and the verb declarations it builds
+    on (CLI_VERBS) only: the CLI package imports every family, so following its imports would
+    make every rule depend on all the code."""
     cwd = Path.cwd()
     files = set()
     for entry in CLI_MODULES + entries:
         if module_file(entry) is None:
             raise WorkflowError(f"code_inputs: no package module {entry}")
-        modules = [entry] if entry.startswith("mosys.cli.") else import_closure(entry)
+        cli = entry.startswith("mosys.cli.")
+        modules = [entry, CLI_VERBS] if cli else import_closure(entry)
         for dotted in modules:
             path = module_file(dotted)
             files.add(str(path.relative_to(cwd)) if path.is_relative_to(cwd) else str(path))

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from mosys.cli.verb import Family, Verb
+from mosys.cli.verb import Family, Verb, add_budget
 
 
 def _bsr_search_arguments(parser: argparse.ArgumentParser) -> None:
@@ -12,7 +12,7 @@ def _bsr_search_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, required=True, help="one of the spec's seeds")
     parser.add_argument("--figures", default="specs/figures", help="where NAME.fig lives")
     parser.add_argument("--generations", type=int, help="override the spec's G (a budget)")
-    parser.add_argument("--budget", default="paper", help="name of the config that built it")
+    add_budget(parser)
     parser.add_argument("--threads", type=int, help="threads that run the population")
     parser.add_argument("-o", "--output", required=True)
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from mosys.cli.verb import Family, Verb
+from mosys.cli.verb import Family, Verb, add_budget
 
 
 def _composite_arguments(parser: argparse.ArgumentParser) -> None:
@@ -22,7 +22,7 @@ def _composite_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--bsr-specs", default="specs/bsr", help="where SEARCH.bsr lives")
     for key, what in (("q", "Q arrays"), ("g", "G generations"), ("h", "H mutations")):
         parser.add_argument(f"--{key}", type=int, help=f"override the script's {what}")
-    parser.add_argument("--budget", default="paper", help="name of the config that built it")
+    add_budget(parser)
     parser.add_argument("-o", "--output", required=True)
 
 

@@ -5,15 +5,14 @@ from __future__ import annotations
 
 import argparse
 
-from mosys.cli.verb import Family, Verb
+from mosys.cli.verb import Family, Verb, add_budget, add_table_outputs
 
 
 def _pendulum_table_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("controllers", nargs="+")
     parser.add_argument("--dynamics", required=True)
-    parser.add_argument("--csv", required=True)
-    parser.add_argument("--md", required=True)
-    parser.add_argument("--budget", default="paper", help="name of the config that built it")
+    add_table_outputs(parser)
+    add_budget(parser)
 
 
 def _pendulum_table(args: argparse.Namespace) -> None:
@@ -28,9 +27,8 @@ def _car_table_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--trajectories", nargs="+", required=True, help="the Figure 19 trajectories (.h5)"
     )
-    parser.add_argument("--csv", required=True)
-    parser.add_argument("--md", required=True)
-    parser.add_argument("--budget", default="paper", help="name of the config that built it")
+    add_table_outputs(parser)
+    add_budget(parser)
 
 
 def _car_table(args: argparse.Namespace) -> None:
@@ -44,9 +42,8 @@ def _luxo_table_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--landing", required=True, help="the landing controller's table (its dest: standing)"
     )
-    parser.add_argument("--csv", required=True)
-    parser.add_argument("--md", required=True)
-    parser.add_argument("--budget", default="paper", help="name of the config that built it")
+    add_table_outputs(parser)
+    add_budget(parser)
 
 
 def _luxo_table(args: argparse.Namespace) -> None:
@@ -57,8 +54,7 @@ def _luxo_table(args: argparse.Namespace) -> None:
 
 def _bsr_table_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("results", nargs="+", help="seed files (.h5) of the searches")
-    parser.add_argument("--csv", required=True)
-    parser.add_argument("--md", required=True)
+    add_table_outputs(parser)
 
 
 def _bsr_table(args: argparse.Namespace) -> None:
@@ -69,8 +65,7 @@ def _bsr_table(args: argparse.Namespace) -> None:
 
 def _composite_table_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("results", nargs="+", help="composite results (.h5)")
-    parser.add_argument("--csv", required=True)
-    parser.add_argument("--md", required=True)
+    add_table_outputs(parser)
 
 
 def _composite_table(args: argparse.Namespace) -> None:
@@ -91,8 +86,7 @@ def _robustness_table_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--bsr-specs", default="specs/bsr", help="where SEARCH.bsr lives")
     parser.add_argument("--figures", default="specs/figures", help="where NAME.fig lives")
-    parser.add_argument("--csv", required=True)
-    parser.add_argument("--md", required=True)
+    add_table_outputs(parser)
 
 
 def _robustness_table(args: argparse.Namespace) -> None:

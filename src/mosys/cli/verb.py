@@ -12,6 +12,17 @@ def no_check(args: argparse.Namespace) -> str | None:
     return None
 
 
+def add_budget(parser: argparse.ArgumentParser) -> None:
+    """``--budget``: the name of the config that built an output (it is written into it)."""
+    parser.add_argument("--budget", default="paper", help="name of the config that built it")
+
+
+def add_table_outputs(parser: argparse.ArgumentParser) -> None:
+    """``--csv`` and ``--md``: the two files every paper table is written to."""
+    parser.add_argument("--csv", required=True)
+    parser.add_argument("--md", required=True)
+
+
 @dataclass(frozen=True)
 class Verb:
     """A verb. ``name`` is what the user types after ``mosys``: ``"dp"``, or ``"plot car"`` for a
