@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from mosys.io.trajectory import FigureMotion
+from mosys.kernels.bsr_simulate import FigureArrays
 from mosys.parsing.bsr import ENDPOINT_ENDS
 from mosys.parsing.figure import Figure, parse_figure_spec
 from mosys.parsing.tokens import SpecError, Token
@@ -92,9 +93,9 @@ class BsrFigure:
         )
 
     @property
-    def kernel_arrays(self) -> tuple:
-        """The figure's arrays in the order the kernels take them."""
-        return (
+    def arrays(self) -> FigureArrays:
+        """The figure as the kernels take it."""
+        return FigureArrays(
             self.parent,
             self.hinge,
             self.offset,
@@ -106,6 +107,9 @@ class BsrFigure:
             self.endpoints,
             self.joint_min,
             self.joint_max,
+            self.gravity,
+            self.floor,
+            self.reach,
         )
 
 

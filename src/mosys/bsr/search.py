@@ -34,6 +34,8 @@ from mosys.kernels.bsr_controller import (
     CENTER_MIN,
     SIDE_MAX,
     SIDE_MIN,
+    ControllerArrays,
+    RunRecord,
     run_controller,
     run_population,
 )
@@ -268,11 +270,7 @@ def _evaluate(setup: SearchSetup, population: _Population, rng: np.random.Genera
         starts = np.repeat(start[None, :], c, axis=0)
     rules = np.zeros((c, spec.steps + 1), np.int64)
     terms = np.zeros((c, len(FITNESS_TERMS)))
-    run_population(
-        *figure.kernel_arrays,
-        figure.gravity,
-        figure.floor,
-        figure.reach,
+    controllers = ControllerArrays(
         spec.kind == "time",
         population.target,
         population.tau,
@@ -280,6 +278,10 @@ def _evaluate(setup: SearchSetup, population: _Population, rng: np.random.Genera
         population.side,
         population.segment_end(),
         setup.period,
+    )
+    run_population(
+        figure.arrays,
+        controllers,
         starts,
         spec.steps,
         spec.dt,
@@ -403,11 +405,7 @@ def record_run(
         final_state=np.empty_like(start),
         final_force=np.empty(n_ends),
     )
-    run_controller(
-        *figure.kernel_arrays,
-        figure.gravity,
-        figure.floor,
-        figure.reach,
+    arrays = ControllerArrays(
         time_based,
         controller.target,
         controller.tau,
@@ -415,18 +413,25 @@ def record_run(
         controller.side,
         segment_end,
         controller.period if time_based else 1.0,
-        np.asarray(start, np.float64),
-        steps,
-        dt,
-        np.zeros(0, np.int64) if fall_endpoints is None else fall_endpoints,
+    )
+    record = RunRecord(
         np.zeros((steps + 1, len(figure.sense_names))),
         run.active_rule,
         run.terms,
         run.rod_ends,
         run.com,
-        np.zeros(n_ends) if start_force is None else np.asarray(start_force, np.float64),
-        carry_over,
         run.final_state,
         run.final_force,
+    )
+    run_controller(
+        figure.arrays,
+        arrays,
+        np.asarray(start, np.float64),
+        np.zeros(n_ends) if start_force is None else np.asarray(start_force, np.float64),
+        carry_over,
+        steps,
+        dt,
+        np.zeros(0, np.int64) if fall_endpoints is None else fall_endpoints,
+        record,
     )
     return run

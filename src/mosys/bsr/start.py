@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from mosys.bsr.figure import BsrFigure
-from mosys.kernels.bsr_simulate import CX, CY, JOINTS, MOMENTUM, PHI, VX, VY, body_frame
+from mosys.kernels.bsr_simulate import CX, CY, JOINTS, MOMENTUM, PHI, VX, VY, figure_body_frame
 from mosys.parsing.bsr import Perturbation
 
 
@@ -34,8 +34,8 @@ def standing_state(
     rod_ends = np.empty((figure.parent.shape[0], 2, 2))
     offsets = np.empty((figure.endpoints.shape[0], 2))
     velocities = np.empty_like(offsets)
-    _, inertia, _ = body_frame(
-        *figure.kernel_arrays[:9],
+    _, inertia, _ = figure_body_frame(
+        figure.arrays,
         theta,
         np.zeros(n_joints),
         rod_ends,

@@ -17,6 +17,7 @@ steps that end with one of the ``fall`` endpoints touching the floor.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange
@@ -28,8 +29,8 @@ from mosys.kernels.bsr_simulate import (
     JOINTS,
     PHI,
     VY,
-    body_frame,
     endpoint_position,
+    figure_body_frame,
     place_in_world,
     step,
 )
@@ -102,59 +103,52 @@ def segment_rule(time, segment_end, period):
     return segment_end.shape[0] - 1
 
 
+class ControllerArrays(NamedTuple):
+    """A controller as the kernels take it (R rules, J joints, V senses): sense-based
+    (time_based False), center and side select the rule; time-based, segment_end and period
+    do. In ``run_population`` every array has a leading axis C, one controller each."""
+
+    time_based: bool
+    target: np.ndarray  # (R, J) rad: each rule's target pose
+    tau: np.ndarray  # (R,) s: each rule's time constant
+    center: np.ndarray  # (R, V): each rule's hyper-rectangle centre
+    side: np.ndarray  # (R, V): each rule's hyper-rectangle side
+    segment_end: np.ndarray  # (R,) s: cumulative ends of a time-based controller's segments
+    period: float  # s: a time-based controller's period
+
+
+class RunRecord(NamedTuple):
+    """What ``run_controller`` fills: senses_out (steps + 1, V) and rule_out (steps + 1,)
+    (sample 0: the start), terms_out (TERM_COUNT,); ends_out (steps + 1, N, 2, 2) and com_out
+    (steps + 1, 2), world metres, if ends_out has steps + 1 rows (else nothing is recorded);
+    final_state (S,) and final_force (E,) N: the state and the endpoints' forces at the end."""
+
+    senses_out: np.ndarray
+    rule_out: np.ndarray
+    terms_out: np.ndarray
+    ends_out: np.ndarray
+    com_out: np.ndarray
+    final_state: np.ndarray
+    final_force: np.ndarray
+
+
 @njit(cache=True)
-def run_controller(
-    parent,
-    hinge,
-    offset,
-    length,
-    mass,
-    com,
-    inertia,
-    joint,
-    endpoints,
-    joint_min,
-    joint_max,
-    gravity,
-    floor,
-    reach,
-    time_based,
-    target,
-    tau,
-    center,
-    side,
-    segment_end,
-    period,
-    start,
-    steps,
-    dt,
-    fall_endpoints,
-    senses_out,
-    rule_out,
-    terms_out,
-    ends_out,
-    com_out,
-    start_force,
-    carry_over,
-    final_state,
-    final_force,
-):
-    """Run a controller for ``steps`` steps of dt seconds from the state ``start`` (S,).
+def run_controller(figure, controller, start, start_force, carry_over, steps, dt, falls, record):
+    """Run a controller (a ControllerArrays) of the figure (a FigureArrays) for ``steps`` steps
+    of dt seconds from the state ``start`` (S,), filling ``record`` (a RunRecord).
 
-    Long, with the figure's arrays one by one: a version taking them as one named tuple and
-    passing it to ``step`` measured 10-16% slower per step on recorded runs; grouping them
-    without that cost is open work (README, "Layout").
+    Long on purpose: the tuples are unpacked once, before the step loop, and the loop is one
+    piece (the module docstring of ``mosys.kernels.bsr_simulate`` says why).
 
-    Sense-based (time_based False): center, side (R, V) select the rule; time-based:
-    segment_end (R,) and period s do. target (R, J) rad, tau (R,) s. fall_endpoints (F,) int64.
-    Fills senses_out (steps + 1, V) and rule_out (steps + 1,) (sample 0: the start, with rule 0
-    active as Figure 2 begins), terms_out (TERM_COUNT,), and, if ends_out has steps + 1 rows,
-    ends_out (steps + 1, N, 2, 2) and com_out (steps + 1, 2), world metres.
     start_force (E,): the endpoints' normal forces at the start, N (zeros for a fresh start);
     carry_over: a controller taking over from another (a composite motion) starts with the rule
     its score picks from the carried-over senses (rule 0 if none scores positive) instead of
-    rule 0. Fills final_state (S,) and final_force (E,) with the state and forces at the end.
+    rule 0, as Figure 2 begins. falls (F,) int64: the endpoints that count as a fall.
     """
+    parent, hinge, offset, length, mass, com, inertia, joint, endpoints = figure[:9]
+    joint_min, joint_max, gravity, floor, reach = figure[9:]
+    time_based, target, tau, center, side, segment_end, period = controller
+    senses_out, rule_out, terms_out, ends_out, com_out, final_state, final_force = record
     state = start.copy()
     n_rods = parent.shape[0]
     n_ends = endpoints.shape[0]
@@ -169,28 +163,14 @@ def run_controller(
     contact = np.empty((3, 2, 2))
     entry_x = np.empty(n_ends)
     weight = mass.sum() * gravity
-    record = ends_out.shape[0] == steps + 1
+    recording = ends_out.shape[0] == steps + 1
     weights = rule_weights(side)
     # the start: its pose, no forces yet
     n_joints = joint_min.shape[0]
     theta = state[JOINTS : JOINTS + n_joints]
     theta_rate = state[JOINTS + n_joints : JOINTS + 2 * n_joints]
-    _, total_inertia, deformation_momentum = body_frame(
-        parent,
-        hinge,
-        offset,
-        length,
-        mass,
-        com,
-        inertia,
-        joint,
-        endpoints,
-        theta,
-        theta_rate,
-        rod_ends,
-        end_offset,
-        end_velocity,
-        scratch,
+    _, total_inertia, deformation_momentum = figure_body_frame(
+        figure, theta, theta_rate, rod_ends, end_offset, end_velocity, scratch
     )
     previous[0] = deformation_momentum / total_inertia
     cos_phi = math.cos(state[PHI])
@@ -198,7 +178,7 @@ def run_controller(
     for e in range(n_ends):
         end_x[e], y = endpoint_position(state, cos_phi, sin_phi, end_offset, e)
         touching[e] = not math.isnan(floor) and y <= floor + CONTACT_TOLERANCE
-    if record:
+    if recording:
         place_in_world(state, cos_phi, sin_phi, rod_ends, ends_out[0])
         com_out[0, 0] = state[CX]
         com_out[0, 1] = state[CY]
@@ -252,8 +232,8 @@ def run_controller(
                 contact_distance += abs(x - end_x[e])
             end_x[e] = x
             touching[e] = now_touching
-        for f in range(fall_endpoints.shape[0]):
-            if touching[fall_endpoints[f]]:
+        for f in range(falls.shape[0]):
+            if touching[falls[f]]:
                 fallen = True
         if fallen:
             fallen_steps += 1
@@ -266,7 +246,7 @@ def run_controller(
         else:
             rule = active_rule(senses_out[n + 1], center, side, weights, rule)
         rule_out[n + 1] = rule
-        if record:
+        if recording:
             ends_out[n + 1] = rod_ends
             com_out[n + 1, 0] = state[CX]
             com_out[n + 1, 1] = state[CY]
@@ -280,77 +260,32 @@ def run_controller(
 
 
 @njit(cache=True, parallel=True)
-def run_population(
-    parent,
-    hinge,
-    offset,
-    length,
-    mass,
-    com,
-    inertia,
-    joint,
-    endpoints,
-    joint_min,
-    joint_max,
-    gravity,
-    floor,
-    reach,
-    time_based,
-    target,
-    tau,
-    center,
-    side,
-    segment_end,
-    period,
-    start,
-    steps,
-    dt,
-    fall_endpoints,
-    senses_out,
-    rule_out,
-    terms_out,
-):
+def run_population(figure, controllers, starts, steps, dt, falls, senses_out, rule_out, terms_out):
     """``run_controller`` for C controllers at once, in parallel (each run is independent, so
-    the results do not depend on the number of threads). target (C, R, J), tau (C, R),
-    center/side (C, R, V), segment_end (C, R), start (C, S); fills senses_out
-    (C, steps + 1, V), rule_out (C, steps + 1), terms_out (C, TERM_COUNT)."""
-    no_ends = np.empty((0, parent.shape[0], 2, 2))
-    no_com = np.empty((0, 2))
-    n_ends = endpoints.shape[0]
-    for c in prange(target.shape[0]):
-        run_controller(
-            parent,
-            hinge,
-            offset,
-            length,
-            mass,
-            com,
-            inertia,
-            joint,
-            endpoints,
-            joint_min,
-            joint_max,
-            gravity,
-            floor,
-            reach,
-            time_based,
-            target[c],
-            tau[c],
-            center[c],
-            side[c],
-            segment_end[c],
-            period,
-            start[c],
-            steps,
-            dt,
-            fall_endpoints,
+    the results do not depend on the number of threads): controllers a ControllerArrays whose
+    arrays have a leading axis C, starts (C, S); fills senses_out (C, steps + 1, V), rule_out
+    (C, steps + 1), terms_out (C, TERM_COUNT)."""
+    n_rods = figure.parent.shape[0]
+    n_ends = figure.endpoints.shape[0]
+    for c in prange(starts.shape[0]):
+        controller = ControllerArrays(
+            controllers.time_based,
+            controllers.target[c],
+            controllers.tau[c],
+            controllers.center[c],
+            controllers.side[c],
+            controllers.segment_end[c],
+            controllers.period,
+        )
+        record = RunRecord(
             senses_out[c],
             rule_out[c],
             terms_out[c],
-            no_ends,
-            no_com,
-            np.zeros(n_ends),
-            False,
-            np.empty(start.shape[1]),
+            np.empty((0, n_rods, 2, 2)),
+            np.empty((0, 2)),
+            np.empty(starts.shape[1]),
             np.empty(n_ends),
+        )
+        run_controller(
+            figure, controller, starts[c], np.zeros(n_ends), False, steps, dt, falls, record
         )
