@@ -106,6 +106,34 @@ def test_a_single_contact_does_not_slide():
     assert abs(math.degrees(math.atan2(torso[-1, 1], torso[-1, 0])) - 90.0) > 20.0  # it fell
 
 
+@pytest.mark.parametrize("dt", [0.01, 0.001])
+def test_a_lone_foot_stays_put_while_the_figure_kicks_and_swings_its_arms(dt):
+    # standing on leg_a's foot alone for a second while leg_b kicks and both arms swing (the
+    # figure sways and turns above the foot: a lone endpoint of a deforming figure, not only of
+    # a rigid one)
+    poses = np.radians(
+        [[60, -60, 0, -40], [160, -20, 0, -100], [20, -160, 0, -10], [100, -100, 0, -70]]
+    )
+    swinging = BsrController(
+        kind="time",
+        target=poses,
+        tau=np.full(4, 0.1),
+        center=np.zeros((4, 0)),
+        side=np.zeros((4, 0)),
+        segment=np.full(4, 0.125),
+        period=0.5,
+    )
+    start = standing_state(STARMAN, math.pi / 2, poses[0])
+    steps = round(1.0 / dt)
+    ends = record_run(STARMAN, swinging, start, steps, dt).rod_ends
+    foot = ends[:, 3, 1, :]
+    np.testing.assert_allclose(foot[:, 1], 0.0, atol=1e-9)  # down the whole second
+    others = np.delete(ends[..., 1].reshape(steps + 1, -1), 7, axis=1)  # all but the foot
+    assert others.min() > 0.01  # alone on the floor
+    assert np.ptp(ends[:, 4, 1, 0]) > 0.2 and np.ptp(ends[:, 1, 1, 0]) > 0.2  # kicks, swings
+    assert np.ptp(foot[:, 0]) < 1e-3
+
+
 def test_two_contacts_share_friction_in_the_ratio_of_their_normal_impulses():
     u = np.array([[0.05, -0.5], [-0.1, -0.4]])  # sinking, sliding towards each other
     r = np.array([[-0.4, -0.9], [0.5, -0.9]])

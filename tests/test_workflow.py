@@ -372,6 +372,29 @@ def test_the_robust_controllers_hold_up_better(composite_built):
 
 
 @pytest.mark.slow
+def test_no_lone_contact_slides_in_any_motion_the_pipeline_built(composite_built):
+    # the 1995 paper's friction rule, on the files: every search's best motion (bsr_all's and
+    # the composite's robust searches) and both concatenations of the composite file
+    from mosys.bsr.lone_contact import lone_contacts, sliding
+    from mosys.io.bsr_result import read_bsr_result
+    from mosys.io.composite_result import read_composite_result
+
+    results = composite_built / "results"
+    motions = {
+        str(path.relative_to(results)): read_bsr_result(path).motion
+        for path in sorted(results.glob("bsr/*/seed*.h5"))
+    }
+    assert len(motions) == 5 * 5 + 3 * 3
+    composite = read_composite_result(results / "composite/starman_show.h5")
+    motions["starman_show after"] = composite.after.motion
+    motions["starman_show before"] = composite.before.motion
+    found = {name: lone_contacts(m.t, m.endpoints) for name, m in motions.items()}
+    assert sum(len(contacts) for contacts in found.values()) > 50  # the rule is exercised
+    slid = {name: sliding(contacts) for name, contacts in found.items() if sliding(contacts)}
+    assert slid == {}
+
+
+@pytest.mark.slow
 def test_editing_the_script_reruns_only_the_transition_search(composite_built):
     script = composite_built / "specs/composite/starman_show.comp"
     text = script.read_text()

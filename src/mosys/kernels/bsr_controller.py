@@ -161,7 +161,7 @@ def run_controller(figure, controller, start, start_force, carry_over, steps, dt
     previous = np.zeros(1)
     scratch = np.empty((n_rods, 8))
     contact = np.empty((3, 2, 2))
-    entry_x = np.empty(n_ends)
+    entry = np.empty((n_ends, 2))
     weight = mass.sum() * gravity
     recording = ends_out.shape[0] == steps + 1
     weights = rule_weights(side)
@@ -220,7 +220,7 @@ def run_controller(figure, controller, start, start_force, carry_over, steps, dt
             end_force,
             scratch,
             contact,
-            entry_x,
+            entry,
         )
         cos_phi = math.cos(state[PHI])
         sin_phi = math.sin(state[PHI])

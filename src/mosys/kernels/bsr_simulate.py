@@ -9,8 +9,12 @@ the deformation itself). Then gravity and ground contact act on the rigid figure
 (at most two) lowest rod endpoints on the floor, solved so that no contact point moves into the
 floor, with the paper's friction: one endpoint down does not slide; two down take tangential
 impulses in the ratio of their normal impulses, sized so that their normal-impulse-weighted
-tangential velocity is zero. A contact's force is its impulse over the step. Rods do not collide
-with one another.
+tangential velocity is zero. An endpoint that still ends the step below the floor lifts the figure
+out of it. An endpoint alone within ``GRIP_HEIGHT`` of the floor at the end of a step (every other
+one beyond ``CONTACT_TOLERANCE``) does not slide, however it got there: the floor stops it
+horizontally (dead, if it touches and that pushes) and, if it was that close before the step
+too, holds it where it stood. A contact's force is its impulse over the step. Rods do not
+collide with one another.
 
 A figure travels to the kernels as one ``FigureArrays`` (``mosys.bsr.figure`` builds it). The
 kernels that run every step (``step``, ``body_frame``) take its arrays one by one, unpacked once
@@ -32,6 +36,7 @@ from numba import njit
 CX, CY, VX, VY, PHI, MOMENTUM = 0, 1, 2, 3, 4, 5
 JOINTS = 6  # θ starts here, θ' follows it
 CONTACT_TOLERANCE = 1e-3  # m: an endpoint this close to the floor is touching it
+GRIP_HEIGHT = 3e-3  # m: an endpoint alone this close to the floor does not slide on it
 MAX_CONTACTS = 2
 
 
@@ -359,15 +364,15 @@ def step(
     end_force,
     scratch,
     contact,
-    entry_x,
+    entry,
 ):
     """Advance the state (S,) of a figure (its arrays as in FigureArrays) by dt seconds toward
     the target pose (J,) rad with time constant tau s. ``previous`` (1,): h / I of the figure
     before the step (rad/s), updated to the figure after it. Fills rod_ends (N, 2, 2) with world
     positions of every rod's ends after the step (m), end_offset/end_velocity (E, 2) scratch,
     end_force (E,) the ground's normal force on each endpoint over the step, N. gravity m/s²,
-    floor: the floor's height, m (nan: no floor). scratch (N, 8), contact (3, 2, 2), entry_x
-    (E,): work space; end_offset must hold the figure's endpoints as the previous step (or the
+    floor: the floor's height, m (nan: no floor). scratch (N, 8), contact (3, 2, 2), entry
+    (E, 2): work space; end_offset must hold the figure's endpoints as the previous step (or the
     start) left them.
 
     One piece on purpose, and its arrays one by one (the module docstring says why): it runs
@@ -376,7 +381,7 @@ def step(
     cos_phi = math.cos(state[PHI])
     sin_phi = math.sin(state[PHI])
     for e in range(endpoints.shape[0]):
-        entry_x[e] = endpoint_position(state, cos_phi, sin_phi, end_offset, e)[0]
+        entry[e, 0], entry[e, 1] = endpoint_position(state, cos_phi, sin_phi, end_offset, e)
     n_joints = target.shape[0]
     theta = state[JOINTS : JOINTS + n_joints]
     theta_rate = state[JOINTS + n_joints : JOINTS + 2 * n_joints]
@@ -469,7 +474,7 @@ def step(
             if impulse[i, 1] > 0.0:
                 pushing += 1
                 pinned = chosen0 if i == 0 else chosen1
-                pinned_x = entry_x[pinned]
+                pinned_x = entry[pinned, 0]
         for i in range(count):
             state[VX] += impulse[i, 0] / total_mass
             state[VY] += impulse[i, 1] / total_mass
@@ -488,8 +493,55 @@ def step(
         state[CY] = floor - (sin_phi * end_offset[pinned, 0] + cos_phi * end_offset[pinned, 1])
     if not math.isnan(floor):
         lowest = np.inf
+        next_lowest = np.inf
+        bottom = -1
         for e in range(endpoints.shape[0]):
-            lowest = min(lowest, endpoint_position(state, cos_phi, sin_phi, end_offset, e)[1])
+            y = endpoint_position(state, cos_phi, sin_phi, end_offset, e)[1]
+            if y < lowest:
+                next_lowest = lowest
+                lowest = y
+                bottom = e
+            elif y < next_lowest:
+                next_lowest = y
         if lowest < floor:
             state[CY] += floor - lowest  # no sinking: lift the figure out of the floor
+            next_lowest += floor - lowest
+            lowest = floor
+        alone = lowest - floor <= GRIP_HEIGHT and next_lowest - floor > CONTACT_TOLERANCE
+        if alone and not (pushing == 1 and pinned == bottom):
+            # one endpoint down does not slide, however it came to be alone at the floor (the
+            # lift above, a stop that would have pulled it down, a deformation that lifts it
+            # as the figure moves, a foot skimming just above the floor): the floor stops it
+            # horizontally, and dead if it touches and that pushes; if it was at the floor
+            # before the step too, it stays where it stood
+            rx = cos_phi * end_offset[bottom, 0] - sin_phi * end_offset[bottom, 1]
+            ry = sin_phi * end_offset[bottom, 0] + cos_phi * end_offset[bottom, 1]
+            body_rate = (state[MOMENTUM] - deformation_momentum) / total_inertia
+            ux = (
+                state[VX]
+                - body_rate * ry
+                + cos_phi * end_velocity[bottom, 0]
+                - sin_phi * end_velocity[bottom, 1]
+            )
+            uy = (
+                state[VY]
+                + body_rate * rx
+                + sin_phi * end_velocity[bottom, 0]
+                + cos_phi * end_velocity[bottom, 1]
+            )
+            inverse_mass = 1.0 / total_mass
+            inverse_inertia = 1.0 / total_inertia
+            px = -ux / _response(rx, ry, rx, ry, inverse_mass, inverse_inertia)[0]
+            py = 0.0
+            if lowest - floor <= CONTACT_TOLERANCE:
+                dead_x, dead_y = _single_contact(ux, uy, rx, ry, inverse_mass, inverse_inertia)
+                if dead_y > 0.0:
+                    px = dead_x
+                    py = dead_y
+            state[VX] += px * inverse_mass
+            state[VY] += py * inverse_mass
+            state[MOMENTUM] += rx * py - ry * px
+            end_force[bottom] += py / dt
+            if entry[bottom, 1] - floor <= GRIP_HEIGHT:
+                state[CX] = entry[bottom, 0] - rx
     place_in_world(state, cos_phi, sin_phi, rod_ends, rod_ends)
