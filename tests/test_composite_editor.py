@@ -31,8 +31,8 @@ ROOT = Path(__file__).resolve().parents[1]
 SPECS = ROOT / "specs"
 SHOW = SPECS / "composite" / "starman_show.comp"
 PHASE_LINES = (  # the phase lines of starman_show.comp as written, and their durations
-    ("phase cartwheel controller=starman_cartwheel_robust ticks=159", 159),
-    ("phase jump      controller=starman_jump_robust      ticks=90", 90),
+    ("phase cartwheel controller=starman_cartwheel_robust ticks=215", 215),
+    ("phase jump      controller=starman_jump_robust      ticks=100", 100),
     ("phase shuffle   controller=starman_shuffle_robust   ticks=100", 100),
 )
 
@@ -92,10 +92,10 @@ def slider_click(slider, ticks: int) -> None:
 @pytest.mark.slow
 def test_the_editor_starts_from_the_scripts_durations(at_guess):
     editor = at_guess
-    expected = editor.session.score([159, 90, 100])
-    assert editor.ticks.tolist() == [159, 90, 100]
-    assert [slider.val for slider in editor.sliders] == [159, 90, 100]
-    assert [slider.valmax for slider in editor.sliders] == [477, 349, 349]  # 3x, or the total
+    expected = editor.session.score([215, 100, 100])
+    assert editor.ticks.tolist() == [215, 100, 100]
+    assert [slider.val for slider in editor.sliders] == [215, 100, 100]
+    assert [slider.valmax for slider in editor.sliders] == [645, 415, 415]  # 3x, or the total
     assert editor.scored.total == expected.total
     assert editor.total_text.get_text() == f"total {score_text(expected.total)}"
     assert editor.status_text.get_text() == f"the durations in {editor.script_path}"
@@ -107,11 +107,11 @@ def test_moving_a_slider_reruns_the_motion_and_redraws_it(at_guess):
     drawn_before = np.array(editor.poses.get_segments())
     text_before = editor.total_text.get_text()
 
-    slider_click(editor.sliders[0], 120)  # the cartwheel stops after 1.2 s instead of 1.59 s
+    slider_click(editor.sliders[0], 120)  # the cartwheel stops after 1.2 s instead of 2.15 s
 
-    assert editor.ticks.tolist() == [120, 90, 100]
+    assert editor.ticks.tolist() == [120, 100, 100]
     assert editor.sliders[0].val == 120
-    expected = editor.session.score([120, 90, 100])  # what the pipeline's session makes of it
+    expected = editor.session.score([120, 100, 100])  # what the pipeline's session makes of it
     motion = expected.motion
     assert editor.scored.total == expected.total
     assert editor.scored.scores == expected.scores
@@ -130,7 +130,7 @@ def test_moving_a_slider_reruns_the_motion_and_redraws_it(at_guess):
     # the scores shown are the session's for these durations
     assert editor.total_text.get_text() == f"total {score_text(expected.total)}" != text_before
     for k, name in enumerate(("cartwheel", "jump", "shuffle")):
-        seconds = f"{[1.2, 0.9, 1.0][k]:.2f} s"
+        seconds = f"{[1.2, 1.0, 1.0][k]:.2f} s"
         assert editor.phase_texts[k].get_text() == (
             f"{seconds}   score {score_text(expected.scores[name])}"
         )
@@ -156,18 +156,18 @@ def test_each_phase_is_drawn_in_its_colour(at_guess):
 def test_set_duration_moves_the_slider_and_refuses_what_no_slider_gives(at_guess):
     editor = at_guess
     editor.set_duration(2, 150.0)  # a slider gives floats
-    assert editor.ticks.tolist() == [159, 90, 150]
+    assert editor.ticks.tolist() == [215, 100, 150]
     assert editor.sliders[2].val == 150
-    assert editor.scored.total == editor.session.total([159, 90, 150])
+    assert editor.scored.total == editor.session.total([215, 100, 150])
     for k, ticks, message in (
         (0, 0, "phase cartwheel: a duration is a whole number of ticks >= 1, got 0"),
         (1, 12.5, "phase jump: a duration is a whole number of ticks >= 1, got 12.5"),
-        (2, 350, "phase shuffle: at most 349 ticks (its slider's end), got 350"),
+        (2, 416, "phase shuffle: at most 415 ticks (its slider's end), got 416"),
     ):
         with pytest.raises(ValueError) as error:
             editor.set_duration(k, ticks)
         assert str(error.value) == message
-    assert editor.ticks.tolist() == [159, 90, 150]  # unchanged
+    assert editor.ticks.tolist() == [215, 100, 150]  # unchanged
     with pytest.raises(IndexError):
         editor.set_duration(3, 10)
 
@@ -177,8 +177,8 @@ def test_reset_returns_to_the_start(at_guess):
     editor = at_guess
     editor.set_durations([10, 20, 30])
     click(editor.reset_button.ax)
-    assert editor.ticks.tolist() == [159, 90, 100]
-    assert [slider.val for slider in editor.sliders] == [159, 90, 100]
+    assert editor.ticks.tolist() == [215, 100, 100]
+    assert [slider.val for slider in editor.sliders] == [215, 100, 100]
     assert editor.status_text.get_text() == f"the durations in {editor.script_path}"
 
 
