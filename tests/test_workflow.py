@@ -246,7 +246,7 @@ def test_a_new_luxo_script_reuses_the_controller_and_motor_programs(workflow):
 
 @pytest.fixture(scope="module")
 def bsr_built(workflow) -> Path:
-    """results/bsr_all at CI's reduced budget (config/ci.yaml: G = 600, five seeds)."""
+    """results/bsr_all at CI's reduced budget (config/ci.yaml: G = 1500, five seeds)."""
     snakemake(workflow, "results/bsr_all", "--configfile", "config/ci.yaml")
     return workflow
 
@@ -366,7 +366,7 @@ def test_the_robust_controllers_hold_up_better(composite_built):
         assert robust["starts"] == plain["starts"] == 50
         # the table says what each twin ran at: CI exempts the robust searches from its cap
         assert (robust["budget"], str(robust["generations"])) == ("paper", "4000")
-        assert (plain["budget"], str(plain["generations"])) == ("ci", "600")
+        assert (plain["budget"], str(plain["generations"])) == ("ci", "1500")
         for column in ("mean perturbed fitness (seed average)", "chosen perturbed mean"):
             assert robust[column] > plain[column], (robust["search"], column)
 

@@ -10,11 +10,8 @@ the deformation itself). Then gravity and ground contact act on the rigid figure
 floor, with the paper's friction: one endpoint down does not slide; two down take tangential
 impulses in the ratio of their normal impulses, sized so that their normal-impulse-weighted
 tangential velocity is zero. An endpoint that still ends the step below the floor lifts the figure
-out of it. An endpoint alone within ``GRIP_HEIGHT`` of the floor at the end of a step (every other
-one beyond ``CONTACT_TOLERANCE``) does not slide, however it got there: the floor stops it
-horizontally (dead, if it touches and that pushes) and, if it was that close before the step
-too, holds it where it stood. A contact's force is its impulse over the step. Rods do not
-collide with one another.
+out of it; if that leaves it alone on the floor, the floor stops it as one contact (it does not
+slide). A contact's force is its impulse over the step. Rods do not collide with one another.
 
 A figure travels to the kernels as one ``FigureArrays`` (``mosys.bsr.figure`` builds it). The
 kernels that run every step (``step``, ``body_frame``) take its arrays one by one, unpacked once
@@ -36,7 +33,6 @@ from numba import njit
 CX, CY, VX, VY, PHI, MOMENTUM = 0, 1, 2, 3, 4, 5
 JOINTS = 6  # θ starts here, θ' follows it
 CONTACT_TOLERANCE = 1e-3  # m: an endpoint this close to the floor is touching it
-GRIP_HEIGHT = 3e-3  # m: an endpoint alone this close to the floor does not slide on it
 MAX_CONTACTS = 2
 
 
@@ -507,13 +503,13 @@ def step(
             state[CY] += floor - lowest  # no sinking: lift the figure out of the floor
             next_lowest += floor - lowest
             lowest = floor
-        alone = lowest - floor <= GRIP_HEIGHT and next_lowest - floor > CONTACT_TOLERANCE
+        alone = lowest - floor <= CONTACT_TOLERANCE < next_lowest - floor
         if alone and not (pushing == 1 and pinned == bottom):
-            # one endpoint down does not slide, however it came to be alone at the floor (the
+            # one endpoint down does not slide, however it came to be alone on the floor (the
             # lift above, a stop that would have pulled it down, a deformation that lifts it
-            # as the figure moves, a foot skimming just above the floor): the floor stops it
-            # horizontally, and dead if it touches and that pushes; if it was at the floor
-            # before the step too, it stays where it stood
+            # as the figure moves): the floor stops it, dead if that pushes, else by a
+            # horizontal impulse alone (after which it does not sink), and if it stood on the
+            # floor before the step it stays where it stood
             rx = cos_phi * end_offset[bottom, 0] - sin_phi * end_offset[bottom, 1]
             ry = sin_phi * end_offset[bottom, 0] + cos_phi * end_offset[bottom, 1]
             body_rate = (state[MOMENTUM] - deformation_momentum) / total_inertia
@@ -531,17 +527,14 @@ def step(
             )
             inverse_mass = 1.0 / total_mass
             inverse_inertia = 1.0 / total_inertia
-            px = -ux / _response(rx, ry, rx, ry, inverse_mass, inverse_inertia)[0]
-            py = 0.0
-            if lowest - floor <= CONTACT_TOLERANCE:
-                dead_x, dead_y = _single_contact(ux, uy, rx, ry, inverse_mass, inverse_inertia)
-                if dead_y > 0.0:
-                    px = dead_x
-                    py = dead_y
+            px, py = _single_contact(ux, uy, rx, ry, inverse_mass, inverse_inertia)
+            if py <= 0.0:
+                px = -ux / _response(rx, ry, rx, ry, inverse_mass, inverse_inertia)[0]
+                py = 0.0
             state[VX] += px * inverse_mass
             state[VY] += py * inverse_mass
             state[MOMENTUM] += rx * py - ry * px
             end_force[bottom] += py / dt
-            if entry[bottom, 1] - floor <= GRIP_HEIGHT:
+            if entry[bottom, 1] - floor <= CONTACT_TOLERANCE:
                 state[CX] = entry[bottom, 0] - rx
     place_in_world(state, cos_phi, sin_phi, rod_ends, rod_ends)
