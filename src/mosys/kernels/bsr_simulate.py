@@ -10,8 +10,10 @@ the deformation itself). Then gravity and ground contact act on the rigid figure
 floor, with the paper's friction: one endpoint down does not slide; two down take tangential
 impulses in the ratio of their normal impulses, sized so that their normal-impulse-weighted
 tangential velocity is zero. An endpoint that still ends the step below the floor lifts the figure
-out of it; if that leaves it alone on the floor, the floor stops it as one contact (it does not
-slide). A contact's force is its impulse over the step. Rods do not collide with one another.
+out of it. An endpoint that ends the step alone on the floor (within ``CONTACT_TOLERANCE``, every
+other one beyond it) does not slide, however it got there: the floor stops it (dead if that
+pushes, else horizontally) and, if it was on the floor before the step too, holds it where it
+stood. A contact's force is its impulse over the step. Rods do not collide with one another.
 
 A figure travels to the kernels as one ``FigureArrays`` (``mosys.bsr.figure`` builds it). The
 kernels that run every step (``step``, ``body_frame``) take its arrays one by one, unpacked once
