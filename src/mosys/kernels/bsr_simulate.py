@@ -188,6 +188,18 @@ def endpoint_position(state, cos_phi, sin_phi, end_offset, e):
 
 
 @njit(cache=True, inline="always")
+def endpoint_motion(state, cos_phi, sin_phi, body_rate, end_offset, end_velocity, e):
+    """Endpoint e's offset (rx, ry) from the centre of mass in the world, m, and its velocity
+    (ux, uy), m/s: the body's motion (velocity of the centre of mass, rotation at body_rate
+    rad/s) plus the deformation's own (end_velocity (E, 2), body frame)."""
+    rx = cos_phi * end_offset[e, 0] - sin_phi * end_offset[e, 1]
+    ry = sin_phi * end_offset[e, 0] + cos_phi * end_offset[e, 1]
+    ux = state[VX] - body_rate * ry + cos_phi * end_velocity[e, 0] - sin_phi * end_velocity[e, 1]
+    uy = state[VY] + body_rate * rx + sin_phi * end_velocity[e, 0] + cos_phi * end_velocity[e, 1]
+    return rx, ry, ux, uy
+
+
+@njit(cache=True, inline="always")
 def place_in_world(state, cos_phi, sin_phi, body_ends, out):
     """Every rod's ends in the world, m: body_ends (N, 2, 2) relative to the centre of mass in
     the body frame, turned by the body's orientation and moved to the state's centre of mass;
@@ -422,13 +434,8 @@ def step(
         lowest0 = np.inf
         lowest1 = np.inf
         for e in range(endpoints.shape[0]):
-            rx = cos_phi * end_offset[e, 0] - sin_phi * end_offset[e, 1]
-            ry = sin_phi * end_offset[e, 0] + cos_phi * end_offset[e, 1]
-            uy = (
-                state[VY]
-                + body_rate * rx
-                + sin_phi * end_velocity[e, 0]
-                + cos_phi * end_velocity[e, 1]
+            _, ry, _, uy = endpoint_motion(
+                state, cos_phi, sin_phi, body_rate, end_offset, end_velocity, e
             )
             predicted = state[CY] + ry - floor + min(uy, 0.0) * dt
             if predicted <= CONTACT_TOLERANCE:
@@ -447,25 +454,15 @@ def step(
         for e in (chosen0, chosen1):
             if e < 0:
                 continue
-            rx = cos_phi * end_offset[e, 0] - sin_phi * end_offset[e, 1]
-            ry = sin_phi * end_offset[e, 0] + cos_phi * end_offset[e, 1]
+            rx, ry, ux, uy = endpoint_motion(
+                state, cos_phi, sin_phi, body_rate, end_offset, end_velocity, e
+            )
             r[count, 0] = rx
             r[count, 1] = ry
-            u[count, 0] = (
-                state[VX]
-                - body_rate * ry
-                + cos_phi * end_velocity[e, 0]
-                - sin_phi * end_velocity[e, 1]
-            )
+            u[count, 0] = ux
             # the velocity that would take the point exactly to the floor counts as zero
             gap = max(state[CY] + ry - floor, 0.0)
-            u[count, 1] = (
-                state[VY]
-                + body_rate * rx
-                + sin_phi * end_velocity[e, 0]
-                + cos_phi * end_velocity[e, 1]
-                + gap / dt
-            )
+            u[count, 1] = uy + gap / dt
             count += 1
         contact_impulses(u, r, count, 1.0 / total_mass, 1.0 / total_inertia, impulse)
         for i in range(count):
@@ -512,20 +509,9 @@ def step(
             # as the figure moves): the floor stops it, dead if that pushes, else by a
             # horizontal impulse alone (after which it does not sink), and if it stood on the
             # floor before the step it stays where it stood
-            rx = cos_phi * end_offset[bottom, 0] - sin_phi * end_offset[bottom, 1]
-            ry = sin_phi * end_offset[bottom, 0] + cos_phi * end_offset[bottom, 1]
             body_rate = (state[MOMENTUM] - deformation_momentum) / total_inertia
-            ux = (
-                state[VX]
-                - body_rate * ry
-                + cos_phi * end_velocity[bottom, 0]
-                - sin_phi * end_velocity[bottom, 1]
-            )
-            uy = (
-                state[VY]
-                + body_rate * rx
-                + sin_phi * end_velocity[bottom, 0]
-                + cos_phi * end_velocity[bottom, 1]
+            rx, ry, ux, uy = endpoint_motion(
+                state, cos_phi, sin_phi, body_rate, end_offset, end_velocity, bottom
             )
             inverse_mass = 1.0 / total_mass
             inverse_inertia = 1.0 / total_inertia
