@@ -14,7 +14,10 @@ from hypothesis import strategies as st
 from spec_fuzz import token_mutations
 
 from mosys.parsing.bsr import (
+    DEFAULT_FALL_BELOW,
+    DEFAULT_SENSE_FILTER,
     FITNESS_TERMS,
+    FITNESS_TERMS_3D,
     BsrSpec,
     Endpoint,
     Perturbation,
@@ -85,6 +88,7 @@ def test_example():
         "fitness.fall": Token("fall=-10", 9, 35),
         "fall.0": Token("upper.distal", 10, 6),
         "fall.1": Token("lower.distal", 10, 19),
+        "perturb": Token("perturb", 8, 1),
     }
     assert spec.fall[1].token == Token("lower.distal", 10, 19)
 
@@ -155,9 +159,13 @@ def test_render_example():
 # --- errors: the whole message --------------------------------------------------------------
 
 KEYWORDS = (
-    "'figure', 'controller', 'simulate', 'search', 'seeds', 'start', 'perturb', 'fitness', 'fall'"
+    "'figure', 'controller', 'simulate', 'search', 'seeds', 'start', 'perturb', 'fitness', 'fall', "
+    "'chain'"
 )
-TERMS = "'distance=', 'max_height=', 'contact_distance=', 'rotations=', 'fall='"
+TERMS = (
+    "'distance=', 'max_height=', 'contact_distance=', 'rotations=', 'fall=', 'sideways=', "
+    "'heading_change=', 'heading_deviation=', 'feet_distance=', 'foot_steps=', 'min_height='"
+)
 FALL_LINE = (
     "a 'fall' line naming the endpoints whose ground contact the fall term measures "
     "(e.g. 'fall upper.distal')"
@@ -230,7 +238,7 @@ ERRORS = [
     ),
     (
         replace_line(3, "controller time rules=8 tper=1"),
-        "x.bsr:3:25: expected one of 'rules=', 'period=', found 'tper=1'",
+        "x.bsr:3:25: expected one of 'rules=', 'period=', 'filter=', found 'tper=1'",
     ),
     # simulate
     (
@@ -359,11 +367,13 @@ ERRORS = [
     ),
     (
         replace_line(10, "fall torso"),
-        "x.bsr:10:6: expected an endpoint 'rod.proximal' or 'rod.distal', found 'torso'",
+        "x.bsr:10:6: expected an endpoint 'rod.proximal' or 'rod.distal' (or below=FRACTION, "
+        "3-D), found 'torso'",
     ),
     (
         replace_line(10, "fall"),
-        "x.bsr:10:5: expected an endpoint 'rod.proximal' or 'rod.distal', found end of line",
+        "x.bsr:10:5: expected an endpoint 'rod.proximal' or 'rod.distal' (or below=FRACTION, "
+        "3-D), found end of line",
     ),
     (replace_line(10, "fall .distal"), "x.bsr:10:6: expected a rod name before '.', found ''"),
     (
@@ -446,9 +456,12 @@ def bsr_specs(draw) -> BsrSpec:
     kind = draw(st.sampled_from(["sense", "time"]))
     dt = draw(st.floats(min_value=1e-6, max_value=1.0))
     duration = draw(st.integers(9, 10**6)) * dt
-    terms = draw(st.lists(st.sampled_from(FITNESS_TERMS), min_size=1, unique=True))
+    terms = draw(
+        st.lists(st.sampled_from(FITNESS_TERMS + FITNESS_TERMS_3D), min_size=1, unique=True)
+    )
     endpoints = st.builds(Endpoint, IDENTIFIERS, st.sampled_from(["proximal", "distal"]))
     fall = draw(st.lists(endpoints, min_size=1 if "fall" in terms else 0, max_size=4, unique=True))
+    chain = draw(st.just("") | IDENTIFIERS)
     return BsrSpec(
         path="generated.bsr",
         figure=draw(IDENTIFIERS),
@@ -462,11 +475,16 @@ def bsr_specs(draw) -> BsrSpec:
         reseed=draw(WHOLE),
         reinitialize=draw(st.just(0.5) | st.floats(0, 1)),
         seeds=tuple(draw(st.lists(st.integers(0, 2**64), min_size=1, max_size=5, unique=True))),
-        start=draw(st.dictionaries(IDENTIFIERS, NUMBERS, max_size=5)),
+        start={} if chain else draw(st.dictionaries(IDENTIFIERS, NUMBERS, max_size=5)),
         perturbation=Perturbation(*(draw(st.just(0.0) | NON_NEGATIVE) for _ in range(4))),
         weights={term: draw(NUMBERS) for term in terms},
         fall=tuple(fall),
         tau_min=draw(st.none() | st.floats(2 * dt, duration / 4, exclude_max=True)),
+        fall_below=draw(st.just(DEFAULT_FALL_BELOW) | st.floats(0, 1)),
+        sense_filter=draw(st.just(DEFAULT_SENSE_FILTER) | NON_NEGATIVE)
+        if kind == "sense"
+        else DEFAULT_SENSE_FILTER,
+        chain=chain,
     )
 
 
@@ -483,6 +501,10 @@ def test_render_then_parse_round_trips(spec):
         | {f"start.{name}" for name in spec.start}
         | {f"fitness.{term}" for term in spec.weights}
         | {f"fall.{i}" for i in range(len(spec.fall))}
+        | ({"perturb"} if spec.perturbation.any else set())
+        | ({"chain"} if spec.chain else set())
+        | ({"filter"} if spec.sense_filter != DEFAULT_SENSE_FILTER else set())
+        | ({"fall.below"} if spec.fall_below != DEFAULT_FALL_BELOW else set())
     )
     for i, endpoint in enumerate(parsed.fall):
         assert parsed.tokens[f"fall.{i}"] == endpoint.token

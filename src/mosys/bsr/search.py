@@ -14,6 +14,13 @@ sides by a factor exp N(0, 0.1), a time segment's weight by exp N(0, 0.2)), each
 Table 2) on the sense vector at a random step of the parent's run (just outside it, at 0.98 of
 the half-side from the centre, so that the rule fires there); a time-based rule's segment
 length is its weight over the sum of weights times t_per, weights drawn uniformly in [0.2, 1].
+
+The same search drives 2-D and 3-D figures: a ``SearchSetup`` carries the simulation that
+evaluates a population and records a run (``PlanarSimulation`` here, the 3-D one in
+``mosys.bsr.search3d``), and how new sense rules are made relevant: 2-D shares a corner with
+the sense trajectory; 3-D (§4.2) contains a point of it (the point uniformly inside the box, at
+most 0.98 of the half-side from the centre), and the first population is enriched by three
+rounds of that mutation before the search begins.
 """
 
 from __future__ import annotations
@@ -22,6 +29,7 @@ import json
 import math
 import time
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 
@@ -43,6 +51,7 @@ from mosys.parsing.bsr import FITNESS_TERMS, BsrSpec
 from mosys.parsing.tokens import SpecError
 
 CORNER_INSIDE = 0.98  # a re-initialised box's corner: this fraction of the half-side out
+RELEVANCE = ("corner", "contain")
 SEGMENT_WEIGHT_MIN = 0.2
 SEGMENT_WEIGHT_MAX = 1.0
 CREEP_TARGET = 0.1  # of the joint's range
@@ -52,10 +61,27 @@ CREEP_LOG_SIDE = 0.1
 CREEP_LOG_SEGMENT = 0.2
 
 
+class Simulation(Protocol):
+    """How a search runs its figure: ``evaluate`` runs every controller of a population once
+    and returns their fitness (C,), filling the population's senses; ``record`` runs one
+    controller from the nominal start, every step recorded. ``term_names``: the fitness terms
+    its runs measure, in their order."""
+
+    term_names: tuple[str, ...]
+
+    def evaluate(
+        self, setup: SearchSetup, population: _Population, rng: np.random.Generator
+    ) -> np.ndarray: ...
+
+    def record(self, setup: SearchSetup, controller: BsrController) -> RecordedRun: ...
+
+
 @dataclass(frozen=True)
 class SearchSetup:
     """A spec bound to its figure: the nominal start pose (root angle rad, joints (J,) rad, x
-    m), the fall endpoints' indices, the term weights in ``FITNESS_TERMS`` order, and the budget."""
+    m), the fall endpoints' indices, the term weights in the order of the simulation's terms,
+    the budget, the simulation, the relevance heuristic (``RELEVANCE``) and how many rounds of
+    it enrich the first population."""
 
     spec: BsrSpec
     figure: BsrFigure
@@ -65,6 +91,9 @@ class SearchSetup:
     fall_endpoints: np.ndarray
     weights: np.ndarray
     generations: int
+    simulation: Simulation
+    relevance: str = "corner"
+    enrich_rounds: int = 0
 
     @property
     def tau_range(self) -> tuple[float, float]:
@@ -80,9 +109,10 @@ class SearchSetup:
 @dataclass(frozen=True)
 class SearchOutcome:
     """What a search found: the learning curve (evaluations (M,), best fitness (M,)), the best
-    controller, its fitness during the search, and its run from the nominal start (terms as
-    ``FITNESS_TERMS``, the active rule (steps + 1,), rod ends (steps + 1, N, 2, 2) m, com
-    (steps + 1, 2) m), the wall time s and the simulated steps per second."""
+    controller, its fitness during the search, and its run from the nominal start (terms named
+    by ``term_names``, the active rule (steps + 1,), rod ends (steps + 1, N, 2, D) m, com (steps
+    + 1, D) m, the state it ends in (S,) and its endpoints' forces (E,) N), the wall time s and
+    the simulated steps per second."""
 
     evaluations: np.ndarray
     best_fitness: np.ndarray
@@ -95,9 +125,12 @@ class SearchOutcome:
     com: np.ndarray
     wall_seconds: float
     steps_per_second: float
+    term_names: tuple[str, ...] = FITNESS_TERMS
+    final_state: np.ndarray | None = None
+    final_force: np.ndarray | None = None
 
     def terms_json(self) -> str:
-        terms = zip(FITNESS_TERMS, self.terms, strict=True)
+        terms = zip(self.term_names, self.terms, strict=True)
         return json.dumps({name: float(value) for name, value in terms})
 
 
@@ -144,7 +177,19 @@ def bind_search(spec: BsrSpec, figure: BsrFigure, generations: int | None = None
         fall_endpoints=np.array(fall, np.int64),
         weights=np.array([spec.weights.get(term, 0.0) for term in FITNESS_TERMS]),
         generations=spec.generations if generations is None else generations,
+        simulation=PlanarSimulation(),
     )
+
+
+def searched_variables(setup: SearchSetup) -> int:
+    """The variables the search varies: per rule the free (not fixed) angles' targets and tau,
+    plus the sense-based rules' boxes (centre and side per sense) or the time-based segments
+    (R - 1 independent lengths)."""
+    spec = setup.spec
+    free = int(np.count_nonzero(setup.figure.joint_max > setup.figure.joint_min))
+    if spec.kind == "sense":
+        return spec.rules * (free + 1 + 2 * len(setup.figure.sense_names))
+    return spec.rules * (free + 1) + spec.rules - 1
 
 
 class _Population:
@@ -171,8 +216,9 @@ class _Population:
         self.senses = np.zeros((c, spec.steps + 1, len(figure.sense_names)))
 
     def draw_rule(self, k: int, i: int, rng: np.random.Generator, senses: np.ndarray | None):
-        """Rule i of controller k from Table 2; with senses (steps + 1, V), a corner of its
-        hyper-rectangle on a random one of them (the relevance heuristic)."""
+        """Rule i of controller k from Table 2; with senses (steps + 1, V), its
+        hyper-rectangle on a random one of them (the relevance heuristic: a corner there, or
+        containing it)."""
         figure = self.setup.figure
         low, high = self.setup.tau_range
         self.target[k, i] = rng.uniform(figure.joint_min, figure.joint_max)
@@ -182,6 +228,10 @@ class _Population:
             self.side[k, i] = np.exp(rng.uniform(math.log(SIDE_MIN), math.log(SIDE_MAX), v))
             if senses is None:
                 self.center[k, i] = rng.uniform(CENTER_MIN, CENTER_MAX, v)
+            elif self.setup.relevance == "contain":
+                point = senses[rng.integers(senses.shape[0])]
+                where = rng.uniform(-1.0, 1.0, v)
+                self.center[k, i] = point + where * self.side[k, i] / 2.0 * CORNER_INSIDE
             else:
                 corner = senses[rng.integers(senses.shape[0])]
                 sign = rng.choice(np.array([-1.0, 1.0]), v)
@@ -251,9 +301,45 @@ class _Population:
         )
 
 
+def population_arrays(setup: SearchSetup, population: _Population) -> ControllerArrays:
+    """The population as the kernels take it (arrays with a leading axis C)."""
+    return ControllerArrays(
+        setup.spec.kind == "time",
+        population.target,
+        population.tau,
+        population.center,
+        population.side,
+        population.segment_end(),
+        setup.period,
+    )
+
+
+class PlanarSimulation:
+    """The 2-D simulator of ``mosys.kernels.bsr_simulate`` (Simulation)."""
+
+    term_names = FITNESS_TERMS
+
+    def evaluate(
+        self, setup: SearchSetup, population: _Population, rng: np.random.Generator
+    ) -> np.ndarray:
+        """Run every controller once (from the nominal start, or a perturbed one per
+        controller); returns the fitness (C,), and fills population.senses."""
+        return _evaluate(setup, population, rng)
+
+    def record(self, setup: SearchSetup, controller: BsrController) -> RecordedRun:
+        """Run one controller from the nominal start, recording every step."""
+        return record_run(
+            setup.figure,
+            controller,
+            standing_state(setup.figure, setup.root_angle, setup.joints, setup.x),
+            setup.spec.steps,
+            setup.spec.dt,
+            setup.fall_endpoints,
+        )
+
+
 def _evaluate(setup: SearchSetup, population: _Population, rng: np.random.Generator):
-    """Run every controller of the population once (from the nominal start, or a perturbed
-    one per controller); returns the fitness (C,), and fills population.senses."""
+    """PlanarSimulation.evaluate."""
     spec, figure = setup.spec, setup.figure
     c = spec.controllers
     if spec.perturbation.any:
@@ -270,18 +356,9 @@ def _evaluate(setup: SearchSetup, population: _Population, rng: np.random.Genera
         starts = np.repeat(start[None, :], c, axis=0)
     rules = np.zeros((c, spec.steps + 1), np.int64)
     terms = np.zeros((c, len(FITNESS_TERMS)))
-    controllers = ControllerArrays(
-        spec.kind == "time",
-        population.target,
-        population.tau,
-        population.center,
-        population.side,
-        population.segment_end(),
-        setup.period,
-    )
     run_population(
         figure.arrays,
-        controllers,
+        population_arrays(setup, population),
         starts,
         spec.steps,
         spec.dt,
@@ -301,12 +378,17 @@ def run_search(setup: SearchSetup, seed: int, label: str = "search") -> SearchOu
     rng = np.random.default_rng(seed)
     began = time.perf_counter()
     current = _Population(setup, rng)
-    current.fitness[:] = _evaluate(setup, current, rng)
+    current.fitness[:] = setup.simulation.evaluate(setup, current, rng)
+    for _ in range(setup.enrich_rounds):
+        # §4.2: rounds of the relevance-heuristic mutation enrich the first population
+        for k in range(c):
+            current.draw_rule(k, int(rng.integers(spec.rules)), rng, current.senses[k])
+        current.fitness[:] = setup.simulation.evaluate(setup, current, rng)
     mutant = current.copy()
     best_k = int(np.argmax(current.fitness))
     best = current.controller(best_k)
     best_fitness = float(current.fitness[best_k])
-    evaluations = [c]
+    evaluations = [c * (1 + setup.enrich_rounds)]
     curve = [best_fitness]
     progress = Progress(label, setup.generations, "generations")
     for generation in range(1, setup.generations + 1):
@@ -317,7 +399,7 @@ def run_search(setup: SearchSetup, seed: int, label: str = "search") -> SearchOu
                 mutant.draw_rule(k, i, rng, current.senses[k] if spec.kind == "sense" else None)
             else:
                 mutant.creep_rule(k, i, rng)
-        fitness = _evaluate(setup, mutant, rng)
+        fitness = setup.simulation.evaluate(setup, mutant, rng)
         for k in range(c):
             if fitness[k] > current.fitness[k]:
                 current.copy_from(mutant, k, k)
@@ -331,12 +413,12 @@ def run_search(setup: SearchSetup, seed: int, label: str = "search") -> SearchOu
             half = c // 2
             for worse, better in zip(order[c - half :], order[:half], strict=True):
                 current.copy_from(current, int(worse), int(better))
-        evaluations.append(c * (generation + 1))
+        evaluations.append(c * (generation + 1 + setup.enrich_rounds))
         curve.append(best_fitness)
         progress.update(generation, f"best fitness {best_fitness:.3f}")
     progress.finish(f"best fitness {best_fitness:.3f}")
     wall = time.perf_counter() - began
-    run = nominal_run(setup, best)
+    run = setup.simulation.record(setup, best)
     return SearchOutcome(
         evaluations=np.array(evaluations, np.int64),
         best_fitness=np.array(curve),
@@ -349,26 +431,22 @@ def run_search(setup: SearchSetup, seed: int, label: str = "search") -> SearchOu
         com=run.com,
         wall_seconds=wall,
         steps_per_second=evaluations[-1] * spec.steps / wall,
+        term_names=setup.simulation.term_names,
+        final_state=run.final_state,
+        final_force=run.final_force,
     )
 
 
 def nominal_run(setup: SearchSetup, controller: BsrController) -> RecordedRun:
     """Run one controller from the nominal start, recording every step."""
-    return record_run(
-        setup.figure,
-        controller,
-        standing_state(setup.figure, setup.root_angle, setup.joints, setup.x),
-        setup.spec.steps,
-        setup.spec.dt,
-        setup.fall_endpoints,
-    )
+    return setup.simulation.record(setup, controller)
 
 
 @dataclass(frozen=True)
 class RecordedRun:
-    """One controller's run, every step: terms (len(FITNESS_TERMS),), active_rule (steps + 1,),
-    rod_ends (steps + 1, N, 2, 2) m, com (steps + 1, 2) m, and where it ended: final_state (S,)
-    and the endpoints' normal forces final_force (E,) N."""
+    """One controller's run, every step: terms (the simulation's terms), active_rule (steps +
+    1,), rod_ends (steps + 1, N, 2, D) m, com (steps + 1, D) m (D = 2 or 3), and where it
+    ended: final_state (S,) and the endpoints' normal forces final_force (E,) N."""
 
     terms: np.ndarray
     active_rule: np.ndarray

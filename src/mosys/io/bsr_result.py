@@ -69,7 +69,9 @@ class BsrResult:
     ``active_rule``: (N,) int64, the rule active at each sample of ``motion.t`` (-1: none);
     ``joint_names`` (J) and ``sense_names`` (V, empty for time-based); ``attrs``: the root
     attributes of the contract plus ours (``name``, ``budget``, ``generations``,
-    ``controllers``, ``reseed``, ``rules``, ``period``, ``steps_per_second``, ...)."""
+    ``controllers``, ``reseed``, ``rules``, ``period``, ``steps_per_second``, ...);
+    ``final_state`` (S,) and ``final_force`` (E,) N: where the best motion ends (simulator
+    state and endpoint forces; what a search that continues this one starts from)."""
 
     evaluations: np.ndarray
     best_fitness: np.ndarray
@@ -79,6 +81,8 @@ class BsrResult:
     joint_names: tuple[str, ...]
     sense_names: tuple[str, ...]
     attrs: dict = field(default_factory=dict)
+    final_state: np.ndarray | None = None
+    final_force: np.ndarray | None = None
 
     @property
     def fitness_terms(self) -> dict[str, float]:
@@ -104,6 +108,9 @@ def write_bsr_result(path: str | Path, result: BsrResult) -> None:
             controller.attrs["sense_names"] = list(result.sense_names)
             write_figure_motion(best.create_group("figure_motion"), result.motion)
             best.create_dataset("active_rule", data=np.asarray(result.active_rule, np.int64))
+            if result.final_state is not None:
+                best.create_dataset("final_state", data=np.asarray(result.final_state, np.float64))
+                best.create_dataset("final_force", data=np.asarray(result.final_force, np.float64))
             h5.attrs["format_version"] = FORMAT_VERSION
             for key, value in result.attrs.items():
                 h5.attrs[key] = value
@@ -149,4 +156,6 @@ def read_bsr_result(path: str | Path) -> BsrResult:
             joint_names=string_tuple(group.attrs["joint_names"]),
             sense_names=string_tuple(group.attrs["sense_names"]),
             attrs={key: h5.attrs[key] for key in h5.attrs},
+            final_state=h5["best/final_state"][()] if "best/final_state" in h5 else None,
+            final_force=h5["best/final_force"][()] if "best/final_force" in h5 else None,
         )

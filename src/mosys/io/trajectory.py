@@ -18,9 +18,11 @@ FORMAT_VERSION = 1
 
 @dataclass(frozen=True)
 class FigureMotion:
-    """An articulated figure moving. t: (N,) s, non-decreasing; endpoints: (N, n_rods, 2, 2) m,
-    per rod its proximal then distal end (x, y), y up; com: (N, 2) m. The rod and world
-    properties are the group attributes of the contract."""
+    """An articulated figure moving. t: (N,) s, non-decreasing; endpoints: (N, n_rods, 2, D) m,
+    per rod its proximal then distal end (x, y) or, for a 3-D figure (D = ``dimensions`` = 3),
+    (x, y, z), y up; com: (N, D) m. The rod and world properties are the group attributes of the
+    contract; a 3-D figure also has ``heading_rod``, ``heading_offset`` (deg) and ``feet`` (pairs
+    of rod index and end, 0 proximal, 1 distal)."""
 
     t: np.ndarray
     endpoints: np.ndarray
@@ -33,6 +35,10 @@ class FigureMotion:
     gravity: float
     terrain: list
     contact: str
+    dimensions: int = 2
+    heading_rod: str = ""
+    heading_offset: float = 0.0
+    feet: tuple[tuple[int, int], ...] = ()
 
 
 def write_figure_motion(group: h5py.Group, motion: FigureMotion) -> None:
@@ -48,6 +54,11 @@ def write_figure_motion(group: h5py.Group, motion: FigureMotion) -> None:
     group.attrs["gravity"] = float(motion.gravity)
     group.attrs["terrain"] = json.dumps(motion.terrain)
     group.attrs["contact"] = motion.contact
+    if motion.dimensions == 3:
+        group.attrs["dimensions"] = 3
+        group.attrs["heading_rod"] = motion.heading_rod
+        group.attrs["heading_offset"] = float(motion.heading_offset)
+        group.attrs["feet"] = json.dumps([list(foot) for foot in motion.feet])
 
 
 def read_figure_motion(group: h5py.Group) -> FigureMotion:
@@ -65,6 +76,10 @@ def read_figure_motion(group: h5py.Group) -> FigureMotion:
         gravity=float(group.attrs["gravity"]),
         terrain=json.loads(group.attrs["terrain"]),
         contact=str(group.attrs["contact"]),
+        dimensions=int(group.attrs.get("dimensions", 2)),
+        heading_rod=str(group.attrs.get("heading_rod", "")),
+        heading_offset=float(group.attrs.get("heading_offset", 0.0)),
+        feet=tuple(tuple(foot) for foot in json.loads(group.attrs.get("feet", "[]"))),
     )
 
 

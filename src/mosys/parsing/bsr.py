@@ -37,6 +37,20 @@ _NO_TOKEN = Token("", 0, 0)
 CONTROLLER_KINDS = ("sense", "time")
 # fitness terms: the primary term and Table 3's secondary terms, plus the fall penalty
 FITNESS_TERMS = ("distance", "max_height", "contact_distance", "rotations", "fall")
+# the fitness terms of a 3-D figure (§4), in the order of the 3-D kernel's terms_out columns
+FITNESS_TERMS_3D = (
+    "distance",
+    "sideways",
+    "heading_change",
+    "max_height",
+    "fall",
+    "heading_deviation",
+    "feet_distance",
+    "foot_steps",
+    "min_height",
+)
+DEFAULT_FALL_BELOW = 0.5  # 3-D: fallen below this fraction of the standing com height
+DEFAULT_SENSE_FILTER = 0.05  # s: 3-D sense-based: the physical senses' low-pass time constant
 ENDPOINT_ENDS = ("proximal", "distal")
 
 
@@ -78,9 +92,12 @@ class BsrSpec:
     coordinate name -> value as written (angles in degrees, ``x`` in m); ``perturbation``: random
     start perturbation; ``weights``: fitness term -> weight; ``fall``: the endpoints whose ground
     contact the ``fall`` term measures; ``tau_min``: the smallest time constant, s (None: Table 2's
-    2 Δt). ``tokens`` keeps the token of each setting (keyed like
-    ``figure``, ``start.NAME``, ``fitness.TERM``) so that binding to the figure can point at the
-    offending word."""
+    2 Δt). 3-D figures only: ``fall_below`` the fraction of the standing centre-of-mass height
+    below which the figure counts as fallen; ``sense_filter`` s, the low-pass time constant of a
+    sense-based controller's physical senses; ``chain`` the search whose final state this one
+    starts from (``""``: none; then the spec has no ``start`` line). ``tokens`` keeps the token
+    of each setting (keyed like ``figure``, ``start.NAME``, ``fitness.TERM``) so that binding to
+    the figure can point at the offending word."""
 
     path: str
     figure: str
@@ -99,6 +116,9 @@ class BsrSpec:
     weights: dict[str, float]
     fall: tuple[Endpoint, ...]
     tau_min: float | None = None
+    fall_below: float = DEFAULT_FALL_BELOW
+    sense_filter: float = DEFAULT_SENSE_FILTER
+    chain: str = ""
     spec_sha256: str = field(default="", compare=False)
     tokens: dict[str, Token] = field(default_factory=dict, compare=False, repr=False)
 
@@ -115,7 +135,7 @@ class BsrSpec:
 
 KEYWORDS = (
     *("figure", "controller", "simulate", "search", "seeds"),
-    *("start", "perturb", "fitness", "fall"),
+    *("start", "perturb", "fitness", "fall", "chain"),
 )
 REQUIRED = ("figure", "controller", "simulate", "search", "seeds", "fitness")
 DEFAULT_REINITIALIZE = 0.5
@@ -124,7 +144,11 @@ STEPS_TOLERANCE = 1e-9
 
 # key -> (minimum, what) for whole numbers; (check, what) for numbers, check one of
 # '>0', '>=0', '0..1', None
-_CONTROLLER_KEYS = {"rules": (1, "rules="), "period": (">0", "period= (s)")}
+_CONTROLLER_KEYS = {
+    "rules": (1, "rules="),
+    "period": (">0", "period= (s)"),
+    "filter": (">=0", "filter= (s)"),
+}
 _SIMULATE_KEYS = {
     "duration": (">0", "duration= (s)"),
     "dt": (">0", "dt= (s)"),
@@ -142,7 +166,9 @@ _PERTURB_KEYS = {
     "speed": (">=0", "speed= (m/s)"),
     "spin": (">=0", "spin= (deg/s)"),
 }
-_FITNESS_KEYS = {term: (None, f"{term}= (weight)") for term in FITNESS_TERMS}
+_FITNESS_KEYS = {
+    term: (None, f"{term}= (weight)") for term in dict.fromkeys(FITNESS_TERMS + FITNESS_TERMS_3D)
+}
 
 
 def _expected(check: int | str | None, what: str) -> str:
@@ -190,6 +216,9 @@ class _Parser:
         self.perturbation = Perturbation()
         self.weights: dict[str, float] = {}
         self.fall: tuple[Endpoint, ...] = ()
+        self.fall_below = DEFAULT_FALL_BELOW
+        self.sense_filter = DEFAULT_SENSE_FILTER
+        self.chain = ""
         self.fall_weight: Token | None = None  # the fitness line's 'fall=' token
 
     def error(self, token: Token, expected: str) -> SpecError:
@@ -205,6 +234,15 @@ class _Parser:
         for keyword in REQUIRED:
             if keyword not in self.first_line:
                 raise missing_line(self.path, lines, keyword)
+        if self.chain and "start" in self.first_line:
+            raise SpecError(
+                self.path,
+                self.first_line["start"],
+                1,
+                f"no 'start' line in a search that continues '{self.chain}' (it starts where "
+                "that search's best motion ends)",
+                None,
+            )
         if self.fall_weight is not None and "fall" not in self.first_line:
             raise self.error(
                 self.fall_weight,
@@ -229,6 +267,9 @@ class _Parser:
             weights=self.weights,
             fall=self.fall,
             tau_min=self.tau_min,
+            fall_below=self.fall_below,
+            sense_filter=self.sense_filter,
+            chain=self.chain,
             spec_sha256=spec_sha256,
             tokens=self.tokens,
         )
@@ -295,8 +336,15 @@ class _Parser:
             raise self.error(
                 found["period"], "end of line (period= is for a 'time' controller only)"
             )
+        if kind.text == "time" and "filter" in found:
+            raise self.error(
+                found["filter"], "end of line (filter= is for a 'sense' controller only)"
+            )
         values = self.values(found, _CONTROLLER_KEYS)
         self.kind = kind.text
+        if "filter" in values:
+            self.sense_filter = float(values["filter"])
+            self.tokens["filter"] = found["filter"]
         self.rules = int(values["rules"])
         self.period = float(values["period"]) if "period" in values else None
 
@@ -372,6 +420,7 @@ class _Parser:
         self.at_least_one(line, _PERTURB_KEYS)
         found = self.settings(line, line.reader(), _PERTURB_KEYS, ())
         values = self.values(found, _PERTURB_KEYS)
+        self.tokens["perturb"] = line.keyword
         self.perturbation = Perturbation(**{key: float(value) for key, value in values.items()})
 
     def line_fitness(self, line: Line) -> None:
@@ -382,12 +431,29 @@ class _Parser:
             self.tokens[f"fitness.{term}"] = token
         self.fall_weight = found.get("fall")
 
+    def line_chain(self, line: Line) -> None:
+        reader = line.reader()
+        token = reader.word("the name of the search this one continues (its .bsr stem)")
+        if NAME.fullmatch(token.text) is None:
+            raise self.error(token, "a search name (letters, digits, '_')")
+        reader.end()
+        self.chain = token.text
+        self.tokens["chain"] = token
+
     def line_fall(self, line: Line) -> None:
-        expected = "an endpoint 'rod.proximal' or 'rod.distal'"
+        expected = "an endpoint 'rod.proximal' or 'rod.distal' (or below=FRACTION, 3-D)"
         if len(line.tokens) == 1:
             raise SpecError(self.path, line.number, line.end_column, expected, None)
         endpoints: list[Endpoint] = []
         for token in line.tokens[1:]:
+            if token.text.startswith("below="):
+                if "fall.below" in self.tokens:
+                    raise self.error(token, "'below=' only once")
+                self.fall_below = float(
+                    self.value(token, "below", "0..1", "below= (a fraction of the standing height)")
+                )
+                self.tokens["fall.below"] = token
+                continue
             rod, sep, end = token.text.partition(".")
             if not sep:
                 raise self.error(token, expected)
@@ -420,6 +486,8 @@ def render_bsr_spec(spec: BsrSpec) -> str:
     controller = f"controller {spec.kind} rules={spec.rules}"
     if spec.period is not None:
         controller += f" period={number(spec.period)}"
+    if spec.sense_filter != DEFAULT_SENSE_FILTER:
+        controller += f" filter={number(spec.sense_filter)}"
     search = (
         f"search controllers={spec.controllers} generations={spec.generations} reseed={spec.reseed}"
     )
@@ -450,6 +518,11 @@ def render_bsr_spec(spec: BsrSpec) -> str:
     lines.append(
         "fitness " + " ".join(f"{term}={number(weight)}" for term, weight in spec.weights.items())
     )
-    if spec.fall:
-        lines.append("fall " + " ".join(f"{point.rod}.{point.end}" for point in spec.fall))
+    fall = [f"{point.rod}.{point.end}" for point in spec.fall]
+    if spec.fall_below != DEFAULT_FALL_BELOW:
+        fall.append(f"below={number(spec.fall_below)}")
+    if fall:
+        lines.append("fall " + " ".join(fall))
+    if spec.chain:
+        lines.append(f"chain {spec.chain}")
     return "\n".join(lines) + "\n"

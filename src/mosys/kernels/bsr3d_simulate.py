@@ -1,0 +1,853 @@
+"""The BSR simulator of the 1995 paper carried to 3-D (§4 on §2.1.1), one step at a time.
+
+Frames: world x forward (a figure faces +x at t = 0), y up, z completing a right-handed frame;
+the floor is the plane y = ``floor``. Every rod has a frame whose x axis runs along the rod,
+proximal to distal. The root rod's frame is the body frame; a child rod's frame is
+``R_child = R_parent @ rest @ Rz(θ) @ Ry(ψ)``, where ``rest = Rz(offset) @ Ry(splay)`` is the
+joint's fixed orientation and (θ, ψ) its two angles (the 1995 paper's Figure 6): θ turns the rod
+about its rest frame's z axis, in the plane of a 2-D figure; ψ then turns it about its own y axis,
+out of that plane. ``Rz(a) = [[c, -s, 0], [s, c, 0], [0, 0, 1]]``, ``Ry(b) = [[c, 0, s], [0, 1,
+0], [-s, 0, c]]``. With every ψ and splay 0 a figure stays in its x-y plane and moves as the 2-D
+simulator moves it.
+
+The figure is otherwise a rigid body, as in 2-D: a deformation leaves its centre of mass, linear
+momentum and angular momentum ``L`` (about the centre of mass, world frame) unchanged, and the
+body frame turns at ``I⁻¹ (L - h)``, where ``I`` is the deformed figure's inertia tensor and ``h``
+the angular momentum of the deformation itself (the 2-D step's correction, split the same way:
+the deformation's own spin, averaged over the step, then the rigid spin ``I⁻¹ L`` at the half
+step). The orientation is a unit quaternion (body to world), renormalised every step. Gravity
+and ground contact act on the rigid figure: impulses at every rod endpoint that would end the
+step on the floor (up to ``MAX_CONTACTS``, the lowest first), with the paper's friction carried
+to 3-D: a lone contact does not slide; several take horizontal impulses in the ratio of their
+normal impulses, sized so that their normal-impulse-weighted horizontal velocity is zero (a
+fixed point over the weights). Contacts whose normal impulse would pull are dropped one at a
+time. An endpoint that still ends the step below the floor lifts the figure out of it, and an
+endpoint alone on the floor is stopped and held where it stood, as in 2-D.
+
+State vector (S = 13 + 2J): ``c`` (3, m), ``v`` (3, m/s), the orientation quaternion ``q`` (w,
+x, y, z), ``L`` (3, kg m²/s, world), ``θ`` (J, rad), ``θ'`` (J, rad/s).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from mosys.kernels.bsr_simulate import CONTACT_TOLERANCE, deform_joints
+
+CX, CY, CZ, VX, VY, VZ = 0, 1, 2, 3, 4, 5
+QW = 6  # quaternion w, x, y, z
+LX = 10  # angular momentum x, y, z
+JOINTS = 13  # θ starts here, θ' follows it
+MAX_CONTACTS = 8
+COMPLIANCE = 1e-6  # of a contact's own response: splits loads the rigid body leaves undecided
+
+
+class FigureArrays3D(NamedTuple):
+    """A 3-D figure as the kernels take it: N rods in an order where every parent precedes its
+    children, J = 2 (N - 1) joint angles (θ then ψ of each non-root rod's joint, in rod order),
+    E distinct endpoints, and the world it moves in. A fixed angle has joint_min == joint_max; a
+    one-angle ``hinge`` in a 3-D figure is a joint whose ψ is fixed at 0."""
+
+    parent: np.ndarray  # (N,) int64: each rod's parent, -1: the root
+    hinge: np.ndarray  # (N,) m: where the rod hangs on its parent, from the parent's proximal end
+    rest: np.ndarray  # (N, 3, 3): the joint's fixed rotation Rz(offset) @ Ry(splay); root: identity
+    length: np.ndarray  # (N,) m
+    mass: np.ndarray  # (N,) kg
+    com: np.ndarray  # (N,): the rod's centre of mass, a fraction from proximal to distal
+    inertia: np.ndarray  # (N,) kg m² about a transverse axis through the rod's centre of mass
+    joint: np.ndarray  # (N,) int64: index of the rod's θ in the angle vector (ψ follows), -1: root
+    endpoints: np.ndarray  # (E, 2) int64: rod and end (0 proximal, 1 distal) of each endpoint
+    joint_min: np.ndarray  # (J,) rad
+    joint_max: np.ndarray  # (J,) rad
+    gravity: float  # m/s², positive
+    floor: float  # m: the floor's height (nan: no floor)
+    reach: float  # m: the sum of the rods' lengths
+
+
+@njit(cache=True, inline="always")
+def _cross(ax, ay, az, bx, by, bz):
+    return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+
+
+@njit(cache=True)
+def body_frame(
+    parent,
+    hinge,
+    rest,
+    length,
+    mass,
+    com,
+    inertia,
+    joint,
+    endpoints,
+    theta,
+    theta_rate,
+    rod_ends,
+    end_offset,
+    end_velocity,
+    frames,
+    scratch,
+    tensor,
+    spin,
+):
+    """The deformed figure in its body frame, about its centre of mass.
+
+    Fills frames (N, 3, 3): each rod's frame in the body frame (columns: its axes, the first
+    along the rod); rod_ends (N, 2, 3): each rod's proximal and distal end relative to the
+    centre of mass, m; end_offset, end_velocity (E, 3): each distinct endpoint's position relative
+    to the centre of mass (m) and its velocity from the deformation alone (m/s); tensor (3, 3):
+    the inertia tensor about the centre of mass, kg m²; spin (3,): the deformation's angular
+    momentum about the centre of mass, kg m²/s. scratch: (N, 5, 3) work space. Returns the total
+    mass, kg. theta, theta_rate (J,): rad, rad/s.
+    """
+    n = parent.shape[0]
+    omega = scratch[:, 0]
+    proximal = scratch[:, 1]
+    proximal_velocity = scratch[:, 2]
+    centre = scratch[:, 3]
+    centre_velocity = scratch[:, 4]
+    total_mass = 0.0
+    mass_x = mass_y = mass_z = 0.0
+    momentum_x = momentum_y = momentum_z = 0.0
+    for k in range(n):
+        p = parent[k]
+        if p < 0:
+            for a in range(3):
+                for b in range(3):
+                    frames[k, a, b] = rest[k, a, b]
+                omega[k, a] = 0.0
+                proximal[k, a] = 0.0
+                proximal_velocity[k, a] = 0.0
+        else:
+            j = joint[k]
+            ct = math.cos(theta[j])
+            st = math.sin(theta[j])
+            cp = math.cos(theta[j + 1])
+            sp = math.sin(theta[j + 1])
+            wx = omega[p, 0]
+            wy = omega[p, 1]
+            wz = omega[p, 2]
+            hx = hinge[k] * frames[p, 0, 0]
+            hy = hinge[k] * frames[p, 1, 0]
+            hz = hinge[k] * frames[p, 2, 0]
+            vx, vy, vz = _cross(wx, wy, wz, hx, hy, hz)
+            proximal[k, 0] = proximal[p, 0] + hx
+            proximal[k, 1] = proximal[p, 1] + hy
+            proximal[k, 2] = proximal[p, 2] + hz
+            proximal_velocity[k, 0] = proximal_velocity[p, 0] + vx
+            proximal_velocity[k, 1] = proximal_velocity[p, 1] + vy
+            proximal_velocity[k, 2] = proximal_velocity[p, 2] + vz
+            for a in range(3):
+                # row a of A = frames[p] @ rest[k], then of A @ Rz(θ) @ Ry(ψ)
+                a0 = frames[p, a, 0] * rest[k, 0, 0]
+                a1 = frames[p, a, 0] * rest[k, 0, 1]
+                a2 = frames[p, a, 0] * rest[k, 0, 2]
+                for c in range(1, 3):
+                    a0 += frames[p, a, c] * rest[k, c, 0]
+                    a1 += frames[p, a, c] * rest[k, c, 1]
+                    a2 += frames[p, a, c] * rest[k, c, 2]
+                b0 = ct * a0 + st * a1
+                b1 = ct * a1 - st * a0
+                frames[k, a, 0] = cp * b0 - sp * a2
+                frames[k, a, 1] = b1
+                frames[k, a, 2] = sp * b0 + cp * a2
+                omega[k, a] = omega[p, a] + a2 * theta_rate[j] + b1 * theta_rate[j + 1]
+        arm = com[k] * length[k]
+        ux = frames[k, 0, 0]
+        uy = frames[k, 1, 0]
+        uz = frames[k, 2, 0]
+        vx, vy, vz = _cross(omega[k, 0], omega[k, 1], omega[k, 2], arm * ux, arm * uy, arm * uz)
+        gx = proximal[k, 0] + arm * ux
+        gy = proximal[k, 1] + arm * uy
+        gz = proximal[k, 2] + arm * uz
+        centre[k, 0] = gx
+        centre[k, 1] = gy
+        centre[k, 2] = gz
+        centre_velocity[k, 0] = proximal_velocity[k, 0] + vx
+        centre_velocity[k, 1] = proximal_velocity[k, 1] + vy
+        centre_velocity[k, 2] = proximal_velocity[k, 2] + vz
+        total_mass += mass[k]
+        mass_x += mass[k] * gx
+        mass_y += mass[k] * gy
+        mass_z += mass[k] * gz
+        momentum_x += mass[k] * centre_velocity[k, 0]
+        momentum_y += mass[k] * centre_velocity[k, 1]
+        momentum_z += mass[k] * centre_velocity[k, 2]
+    cx = mass_x / total_mass
+    cy = mass_y / total_mass
+    cz = mass_z / total_mass
+    cvx = momentum_x / total_mass
+    cvy = momentum_y / total_mass
+    cvz = momentum_z / total_mass
+    tensor[:, :] = 0.0
+    spin[:] = 0.0
+    for k in range(n):
+        m = mass[k]
+        rx = centre[k, 0] - cx
+        ry = centre[k, 1] - cy
+        rz = centre[k, 2] - cz
+        ux = frames[k, 0, 0]
+        uy = frames[k, 1, 0]
+        uz = frames[k, 2, 0]
+        i_rod = inertia[k]
+        squared = m * (rx * rx + ry * ry + rz * rz) + i_rod
+        tensor[0, 0] += squared - m * rx * rx - i_rod * ux * ux
+        tensor[1, 1] += squared - m * ry * ry - i_rod * uy * uy
+        tensor[2, 2] += squared - m * rz * rz - i_rod * uz * uz
+        tensor[0, 1] -= m * rx * ry + i_rod * ux * uy
+        tensor[0, 2] -= m * rx * rz + i_rod * ux * uz
+        tensor[1, 2] -= m * ry * rz + i_rod * uy * uz
+        hx, hy, hz = _cross(
+            rx,
+            ry,
+            rz,
+            centre_velocity[k, 0] - cvx,
+            centre_velocity[k, 1] - cvy,
+            centre_velocity[k, 2] - cvz,
+        )
+        wx = omega[k, 0]
+        wy = omega[k, 1]
+        wz = omega[k, 2]
+        along = ux * wx + uy * wy + uz * wz
+        spin[0] += m * hx + i_rod * (wx - along * ux)
+        spin[1] += m * hy + i_rod * (wy - along * uy)
+        spin[2] += m * hz + i_rod * (wz - along * uz)
+        rod_ends[k, 0, 0] = proximal[k, 0] - cx
+        rod_ends[k, 0, 1] = proximal[k, 1] - cy
+        rod_ends[k, 0, 2] = proximal[k, 2] - cz
+        for a in range(3):
+            rod_ends[k, 1, a] = rod_ends[k, 0, a] + length[k] * frames[k, a, 0]
+    tensor[1, 0] = tensor[0, 1]
+    tensor[2, 0] = tensor[0, 2]
+    tensor[2, 1] = tensor[1, 2]
+    for e in range(endpoints.shape[0]):
+        k = endpoints[e, 0]
+        end = endpoints[e, 1]
+        reach = length[k] * end
+        vx, vy, vz = _cross(
+            omega[k, 0],
+            omega[k, 1],
+            omega[k, 2],
+            reach * frames[k, 0, 0],
+            reach * frames[k, 1, 0],
+            reach * frames[k, 2, 0],
+        )
+        end_offset[e, 0] = rod_ends[k, end, 0]
+        end_offset[e, 1] = rod_ends[k, end, 1]
+        end_offset[e, 2] = rod_ends[k, end, 2]
+        end_velocity[e, 0] = proximal_velocity[k, 0] + vx - cvx
+        end_velocity[e, 1] = proximal_velocity[k, 1] + vy - cvy
+        end_velocity[e, 2] = proximal_velocity[k, 2] + vz - cvz
+    return total_mass
+
+
+@njit(cache=True, inline="always")
+def rotation_of(quaternion, out):
+    """The rotation matrix (3, 3) of a unit quaternion (w, x, y, z), into out."""
+    w = quaternion[0]
+    x = quaternion[1]
+    y = quaternion[2]
+    z = quaternion[3]
+    out[0, 0] = 1.0 - 2.0 * (y * y + z * z)
+    out[0, 1] = 2.0 * (x * y - w * z)
+    out[0, 2] = 2.0 * (x * z + w * y)
+    out[1, 0] = 2.0 * (x * y + w * z)
+    out[1, 1] = 1.0 - 2.0 * (x * x + z * z)
+    out[1, 2] = 2.0 * (y * z - w * x)
+    out[2, 0] = 2.0 * (x * z - w * y)
+    out[2, 1] = 2.0 * (y * z + w * x)
+    out[2, 2] = 1.0 - 2.0 * (x * x + y * y)
+
+
+@njit(cache=True, inline="always")
+def turn(quaternion, ax, ay, az):
+    """Turn the unit quaternion (4,) in place by the world rotation vector (ax, ay, az), rad,
+    and renormalise it (the drift correction)."""
+    angle = math.sqrt(ax * ax + ay * ay + az * az)
+    if angle > 0.0:
+        scale = math.sin(0.5 * angle) / angle
+        dw = math.cos(0.5 * angle)
+        dx = ax * scale
+        dy = ay * scale
+        dz = az * scale
+        w = quaternion[0]
+        x = quaternion[1]
+        y = quaternion[2]
+        z = quaternion[3]
+        quaternion[0] = dw * w - dx * x - dy * y - dz * z
+        quaternion[1] = dw * x + w * dx + dy * z - dz * y
+        quaternion[2] = dw * y + w * dy + dz * x - dx * z
+        quaternion[3] = dw * z + w * dz + dx * y - dy * x
+    norm = math.sqrt(
+        quaternion[0] ** 2 + quaternion[1] ** 2 + quaternion[2] ** 2 + quaternion[3] ** 2
+    )
+    for a in range(4):
+        quaternion[a] /= norm
+
+
+@njit(cache=True, inline="always")
+def invert_symmetric(matrix, out):
+    """The inverse (3, 3) of a symmetric positive definite matrix, into out."""
+    a = matrix[0, 0]
+    b = matrix[0, 1]
+    c = matrix[0, 2]
+    d = matrix[1, 1]
+    e = matrix[1, 2]
+    f = matrix[2, 2]
+    c00 = d * f - e * e
+    c01 = c * e - b * f
+    c02 = b * e - c * d
+    det = a * c00 + b * c01 + c * c02
+    out[0, 0] = c00 / det
+    out[0, 1] = out[1, 0] = c01 / det
+    out[0, 2] = out[2, 0] = c02 / det
+    out[1, 1] = (a * f - c * c) / det
+    out[1, 2] = out[2, 1] = (b * c - a * e) / det
+    out[2, 2] = (a * d - b * b) / det
+
+
+@njit(cache=True, inline="always")
+def conjugate(rotation, matrix, out):
+    """out = rotation @ matrix @ rotation.T, all (3, 3)."""
+    for a in range(3):
+        for b in range(3):
+            total = 0.0
+            for c in range(3):
+                inner = 0.0
+                for d in range(3):
+                    inner += matrix[c, d] * rotation[b, d]
+                total += rotation[a, c] * inner
+            out[a, b] = total
+
+
+@njit(cache=True, inline="always")
+def apply(matrix, x, y, z):
+    """matrix (3, 3) @ (x, y, z)."""
+    return (
+        matrix[0, 0] * x + matrix[0, 1] * y + matrix[0, 2] * z,
+        matrix[1, 0] * x + matrix[1, 1] * y + matrix[1, 2] * z,
+        matrix[2, 0] * x + matrix[2, 1] * y + matrix[2, 2] * z,
+    )
+
+
+@njit(cache=True, inline="always")
+def endpoint_position(state, rotation, end_offset, e):
+    """World (x, y, z) of endpoint e, m, from its offset from the centre of mass in the body
+    frame (end_offset (E, 3)) and the body's orientation (rotation (3, 3))."""
+    x, y, z = apply(rotation, end_offset[e, 0], end_offset[e, 1], end_offset[e, 2])
+    return state[CX] + x, state[CY] + y, state[CZ] + z
+
+
+@njit(cache=True, inline="always")
+def endpoint_motion(state, rotation, body_rate, end_offset, end_velocity, e):
+    """Endpoint e's offset (rx, ry, rz) from the centre of mass in the world, m, and its
+    velocity (ux, uy, uz), m/s: the body's motion (velocity of the centre of mass, rotation at
+    body_rate (3,) rad/s, world) plus the deformation's own (end_velocity (E, 3), body frame)."""
+    rx, ry, rz = apply(rotation, end_offset[e, 0], end_offset[e, 1], end_offset[e, 2])
+    dx, dy, dz = apply(rotation, end_velocity[e, 0], end_velocity[e, 1], end_velocity[e, 2])
+    wx, wy, wz = _cross(body_rate[0], body_rate[1], body_rate[2], rx, ry, rz)
+    return rx, ry, rz, state[VX] + wx + dx, state[VY] + wy + dy, state[VZ] + wz + dz
+
+
+@njit(cache=True)
+def response(ri, rj, inverse_mass, world_inverse, out):
+    """out (3, 3): the velocity change at a point with offset ri (3,) from the centre of mass
+    per unit impulse at a point with offset rj (3,), for a rigid body of inverse mass
+    inverse_mass and inverse inertia world_inverse (3, 3): E/M - [ri]x I⁻¹ [rj]x."""
+    for b in range(3):
+        # column b: impulse along axis b at rj -> angular impulse rj x e_b
+        ex = 1.0 if b == 0 else 0.0
+        ey = 1.0 if b == 1 else 0.0
+        ez = 1.0 if b == 2 else 0.0
+        tx, ty, tz = _cross(rj[0], rj[1], rj[2], ex, ey, ez)
+        wx, wy, wz = apply(world_inverse, tx, ty, tz)
+        vx, vy, vz = _cross(wx, wy, wz, ri[0], ri[1], ri[2])
+        out[0, b] = vx + inverse_mass * ex
+        out[1, b] = vy + inverse_mass * ey
+        out[2, b] = vz + inverse_mass * ez
+
+
+@njit(cache=True)
+def _solve(system, size):
+    """Solve the linear system in system[:size, :size + 1] (augmented) in place by Gaussian
+    elimination with partial pivoting; the solution ends in column ``size``. False if singular."""
+    scale = 0.0
+    for i in range(size):
+        for j in range(size):
+            scale = max(scale, abs(system[i, j]))
+    if scale == 0.0:
+        return False
+    for col in range(size):
+        pivot = col
+        for row in range(col + 1, size):
+            if abs(system[row, col]) > abs(system[pivot, col]):
+                pivot = row
+        if abs(system[pivot, col]) <= 1e-12 * scale:
+            return False
+        if pivot != col:
+            for j in range(col, size + 1):
+                system[col, j], system[pivot, j] = system[pivot, j], system[col, j]
+        for row in range(size):
+            if row != col:
+                factor = system[row, col] / system[col, col]
+                if factor != 0.0:
+                    for j in range(col, size + 1):
+                        system[row, j] -= factor * system[col, j]
+    for row in range(size):
+        system[row, size] /= system[row, row]
+    return True
+
+
+@njit(cache=True)
+def _shared_friction(u, r, active, count, responses, impulse, system, weight, compliance):
+    """Impulses at the active contacts (at least two), the paper's friction carried to 3-D: no
+    active point sinks; each point's horizontal impulse is its share (its normal impulse over
+    their sum) of a common one, a slide (T_x, T_z) plus a twist Γ about the vertical (at offset
+    r from the centre of mass: (T_x + Γ r_z, T_z - Γ r_x)); and the normal-weighted horizontal
+    velocity and twist (r_z u_x - r_x u_z) of the points vanish after it, so that together they
+    neither slide nor spin on the floor (in a vertical plane the twist is 0 and this is the 2-D
+    rule). A fixed point over the shares, iterated to 1e-12. ``compliance`` (s/kg, 0: none) is
+    added to each contact's own normal response: it splits the load of contacts that a rigid
+    body leaves undecided (more than three on a plane, several in a line). u, r (count, 3).
+    Returns the index of the contact whose normal impulse pulls most (-1: none pulls; -2: the
+    system is singular)."""
+    n = 0
+    for i in range(count):
+        if active[i]:
+            n += 1
+    for i in range(count):
+        weight[i] = 1.0 / n if active[i] else 0.0
+    size = n + 3
+    for _ in range(50):
+        system[:size, : size + 1] = 0.0
+        row = 0
+        for i in range(count):
+            if not active[i]:
+                continue
+            for a in range(3):
+                # the velocity u'_ia after the impulses: u_ia + sum over the unknowns
+                if a == 1:
+                    target = row  # this point's normal row: u'_iy = 0
+                    scale_x = 1.0
+                else:
+                    target = -1
+                    scale_x = weight[i]
+                column = 0
+                slide_x = 0.0
+                slide_z = 0.0
+                twist = 0.0
+                for j in range(count):
+                    if not active[j]:
+                        continue
+                    k = responses[i, j]
+                    normal = k[a, 1] + (compliance if (i == j and a == 1) else 0.0)
+                    slide_x += weight[j] * k[a, 0]
+                    slide_z += weight[j] * k[a, 2]
+                    twist += weight[j] * (k[a, 0] * r[j, 2] - k[a, 2] * r[j, 0])
+                    if a == 1:
+                        system[target, column] += normal
+                    else:
+                        system[n, column] += scale_x * normal if a == 0 else 0.0
+                        system[n + 1, column] += scale_x * normal if a == 2 else 0.0
+                        lever = r[i, 2] if a == 0 else -r[i, 0]
+                        system[n + 2, column] += weight[i] * lever * normal
+                    column += 1
+                if a == 1:
+                    system[target, n] += slide_x
+                    system[target, n + 1] += slide_z
+                    system[target, n + 2] += twist
+                    system[target, size] = -u[i, 1]
+                else:
+                    axis_row = n if a == 0 else n + 1
+                    lever = r[i, 2] if a == 0 else -r[i, 0]
+                    system[axis_row, n] += weight[i] * slide_x
+                    system[axis_row, n + 1] += weight[i] * slide_z
+                    system[axis_row, n + 2] += weight[i] * twist
+                    system[axis_row, size] -= weight[i] * u[i, a]
+                    system[n + 2, n] += weight[i] * lever * slide_x
+                    system[n + 2, n + 1] += weight[i] * lever * slide_z
+                    system[n + 2, n + 2] += weight[i] * lever * twist
+                    system[n + 2, size] -= weight[i] * lever * u[i, a]
+            row += 1
+        if not _solve(system, size):
+            return -2
+        total = 0.0
+        worst = -1
+        worst_value = 0.0
+        row = 0
+        for i in range(count):
+            if not active[i]:
+                continue
+            normal = system[row, size]
+            if normal <= worst_value:
+                worst_value = normal
+                worst = i
+            total += normal
+            row += 1
+        if worst >= 0:
+            return worst
+        change = 0.0
+        row = 0
+        for i in range(count):
+            if not active[i]:
+                continue
+            updated = system[row, size] / total
+            change = max(change, abs(updated - weight[i]))
+            weight[i] = updated
+            row += 1
+        if change <= 1e-12:
+            break
+    slide_x = system[n, size]
+    slide_z = system[n + 1, size]
+    twist = system[n + 2, size]
+    row = 0
+    for i in range(count):
+        if active[i]:
+            impulse[i, 0] = weight[i] * (slide_x + twist * r[i, 2])
+            impulse[i, 1] = system[row, size]
+            impulse[i, 2] = weight[i] * (slide_z - twist * r[i, 0])
+            row += 1
+    return -1
+
+
+@njit(cache=True)
+def stop_dead(u, responses, i, system):
+    """The impulse (x, y, z) that stops contact i (velocity u[i] (3,)) dead, from its own
+    response responses[i, i] (3, 3); its y is <= 0 if that would pull the point down."""
+    for a in range(3):
+        for b in range(3):
+            system[a, b] = responses[i, i, a, b]
+        system[a, 3] = -u[i, a]
+    if not _solve(system, 3):
+        return 0.0, 0.0, 0.0
+    return system[0, 3], system[1, 3], system[2, 3]
+
+
+@njit(cache=True)
+def _others_hold(u, count, responses, impulse, members):
+    """True if no touching point outside ``members`` ((count,) 1.0 for a member) sinks after
+    the impulses (count, 3)."""
+    for i in range(count):
+        if members[i]:
+            continue
+        uy = u[i, 1]
+        for j in range(count):
+            for b in range(3):
+                uy += responses[i, j, 1, b] * impulse[j, b]
+        if uy < -1e-9:
+            return False
+    return True
+
+
+@njit(cache=True)
+def contact_impulses(u, r, count, inverse_mass, world_inverse, impulse, responses, system, work):
+    """The ground's impulses (count, 3) N s on ``count`` touching endpoints: u (count, 3) their
+    velocities m/s, r (count, 3) their offsets from the centre of mass m. First the sinking ones
+    together, with shared friction, dropping the one whose normal impulse would pull most and
+    trying again while two or more are left; then each sinking one alone, the fastest first,
+    stopped dead. The first set whose normal impulses push and after which no other touching
+    point sinks is kept; none, no impulse (the 2-D rule for two, carried to any number).
+    responses (M, M, 3, 3), system (M + 3, M + 4), work (2, M): work space."""
+    impulse[:count, :] = 0.0
+    active = work[0]
+    weight = work[1]
+    n = 0
+    for i in range(count):
+        active[i] = 1.0 if u[i, 1] < 0.0 else 0.0
+        n += int(active[i])
+    if n == 0:
+        return
+    for i in range(count):
+        for j in range(count):
+            response(r[i], r[j], inverse_mass, world_inverse, responses[i, j])
+    compliance = 0.0
+    while n >= 2:
+        worst = _shared_friction(
+            u, r, active, count, responses, impulse, system, weight, compliance
+        )
+        if worst == -2 and compliance == 0.0:
+            # the rigid body leaves the split undecided: a little compliance decides it
+            compliance = COMPLIANCE * (responses[0, 0, 0, 0] + responses[0, 0, 1, 1])
+            continue
+        if worst == -1 and _others_hold(u, count, responses, impulse, active):
+            return
+        if worst < 0:
+            # still singular, or another point would sink: drop the one sinking slowest
+            for i in range(count):
+                if active[i] and (worst < 0 or u[i, 1] > u[worst, 1]):
+                    worst = i
+        active[worst] = 0.0
+        n -= 1
+        impulse[:count, :] = 0.0
+    tried = work[1]
+    tried[:count] = 0.0
+    for _ in range(count):
+        first = -1
+        for i in range(count):
+            if u[i, 1] < 0.0 and not tried[i] and (first < 0 or u[i, 1] < u[first, 1]):
+                first = i
+        if first < 0:
+            return
+        tried[first] = 1.0
+        px, py, pz = stop_dead(u, responses, first, system)
+        if py <= 0.0:
+            continue
+        impulse[first, 0] = px
+        impulse[first, 1] = py
+        impulse[first, 2] = pz
+        active[:count] = 0.0
+        active[first] = 1.0
+        if _others_hold(u, count, responses, impulse, active):
+            return
+        impulse[first, :] = 0.0
+
+
+@njit(cache=True)
+def step(
+    parent,
+    hinge,
+    rest,
+    length,
+    mass,
+    com,
+    inertia,
+    joint,
+    endpoints,
+    joint_min,
+    joint_max,
+    gravity,
+    floor,
+    state,
+    target,
+    tau,
+    dt,
+    previous,
+    rod_ends,
+    end_offset,
+    end_velocity,
+    end_force,
+    frames,
+    scratch,
+    matrices,
+    vectors,
+    contact,
+    responses,
+    system,
+    work,
+    chosen,
+    entry,
+):
+    """Advance the state (S,) of a figure (its arrays as in FigureArrays3D) by dt seconds toward
+    the target pose (J,) rad with time constant tau s. ``previous`` (3,): the deformation's own
+    spin I⁻¹ h in the world before the step (rad/s), updated to the one after it. Fills rod_ends
+    (N, 2, 3) with world positions of every rod's ends after the step (m), end_force (E,) the
+    ground's normal force on each endpoint over the step, N. Work space: end_offset and
+    end_velocity (E, 3) (end_offset must hold the endpoints as the previous step or the start
+    left them), frames (N, 3, 3), scratch (N, 5, 3), matrices (5, 3, 3), vectors (3, 4),
+    contact (3, M, 3), responses (M, M, 3, 3), system (M + 3, M + 4), work (2, M), chosen (M,)
+    int64, entry (E, 3); M = MAX_CONTACTS.
+
+    One piece on purpose, its arrays one by one, as the 2-D step (that module's docstring says
+    why).
+    """
+    rotation = matrices[0]
+    tensor = matrices[1]
+    tensor_inverse = matrices[2]
+    world_inverse = matrices[3]
+    half_rotation = matrices[4]
+    spin = vectors[0, :3]
+    body_rate = vectors[1, :3]
+    quaternion = state[QW : QW + 4]
+    half = vectors[2]
+    rotation_of(quaternion, rotation)
+    n_ends = endpoints.shape[0]
+    for e in range(n_ends):
+        entry[e, 0], entry[e, 1], entry[e, 2] = endpoint_position(state, rotation, end_offset, e)
+    n_joints = target.shape[0]
+    theta = state[JOINTS : JOINTS + n_joints]
+    theta_rate = state[JOINTS + n_joints : JOINTS + 2 * n_joints]
+    deform_joints(theta, theta_rate, target, tau, joint_min, joint_max, dt)
+    total_mass = body_frame(
+        parent,
+        hinge,
+        rest,
+        length,
+        mass,
+        com,
+        inertia,
+        joint,
+        endpoints,
+        theta,
+        theta_rate,
+        rod_ends,
+        end_offset,
+        end_velocity,
+        frames,
+        scratch,
+        tensor,
+        spin,
+    )
+    invert_symmetric(tensor, tensor_inverse)
+    # orientation correction: the deformation leaves the angular momentum unchanged
+    sx, sy, sz = apply(tensor_inverse, spin[0], spin[1], spin[2])
+    sx, sy, sz = apply(rotation, sx, sy, sz)
+    turn(
+        quaternion,
+        -0.5 * (previous[0] + sx) * dt,
+        -0.5 * (previous[1] + sy) * dt,
+        -0.5 * (previous[2] + sz) * dt,
+    )
+    previous[0] = sx
+    previous[1] = sy
+    previous[2] = sz
+    rotation_of(quaternion, rotation)
+    conjugate(rotation, tensor_inverse, world_inverse)
+    state[VY] -= gravity * dt
+    hx, hy, hz = apply(rotation, spin[0], spin[1], spin[2])
+    body_rate[0], body_rate[1], body_rate[2] = apply(
+        world_inverse, state[LX] - hx, state[LX + 1] - hy, state[LX + 2] - hz
+    )
+    end_force[:] = 0.0
+    pushing = 0
+    pinned = -1
+    if not math.isnan(floor):
+        # the endpoints (at most M, the lowest) that would end the step within the contact
+        # tolerance of the floor (speculative contacts, as in 2-D)
+        lowest = work[1]
+        count = 0
+        for e in range(n_ends):
+            _, ry, _, _, uy, _ = endpoint_motion(
+                state, rotation, body_rate, end_offset, end_velocity, e
+            )
+            predicted = state[CY] + ry - floor + min(uy, 0.0) * dt
+            if predicted > CONTACT_TOLERANCE:
+                continue
+            if count == MAX_CONTACTS and predicted >= lowest[count - 1]:
+                continue
+            place = min(count, MAX_CONTACTS - 1)
+            while place > 0 and lowest[place - 1] > predicted:
+                lowest[place] = lowest[place - 1]
+                chosen[place] = chosen[place - 1]
+                place -= 1
+            lowest[place] = predicted
+            chosen[place] = e
+            count = min(count + 1, MAX_CONTACTS)
+        u = contact[0]
+        r = contact[1]
+        impulse = contact[2]
+        for i in range(count):
+            rx, ry, rz, ux, uy, uz = endpoint_motion(
+                state, rotation, body_rate, end_offset, end_velocity, chosen[i]
+            )
+            r[i, 0] = rx
+            r[i, 1] = ry
+            r[i, 2] = rz
+            u[i, 0] = ux
+            # the velocity that would take the point exactly to the floor counts as zero
+            u[i, 1] = uy + max(state[CY] + ry - floor, 0.0) / dt
+            u[i, 2] = uz
+        contact_impulses(
+            u, r, count, 1.0 / total_mass, world_inverse, impulse, responses, system, work
+        )
+        for i in range(count):
+            if impulse[i, 1] > 0.0:
+                pushing += 1
+                pinned = chosen[i]
+            state[VX] += impulse[i, 0] / total_mass
+            state[VY] += impulse[i, 1] / total_mass
+            state[VZ] += impulse[i, 2] / total_mass
+            tx, ty, tz = _cross(
+                r[i, 0], r[i, 1], r[i, 2], impulse[i, 0], impulse[i, 1], impulse[i, 2]
+            )
+            state[LX] += tx
+            state[LX + 1] += ty
+            state[LX + 2] += tz
+            end_force[chosen[i]] = impulse[i, 1] / dt
+    state[CX] += state[VX] * dt
+    state[CY] += state[VY] * dt
+    state[CZ] += state[VZ] * dt
+    # the rigid spin I⁻¹ L, taken at the half step (the midpoint rule)
+    wx, wy, wz = apply(world_inverse, state[LX], state[LX + 1], state[LX + 2])
+    for a in range(4):
+        half[a] = quaternion[a]
+    turn(half, 0.5 * wx * dt, 0.5 * wy * dt, 0.5 * wz * dt)
+    rotation_of(half, half_rotation)
+    conjugate(half_rotation, tensor_inverse, world_inverse)
+    wx, wy, wz = apply(world_inverse, state[LX], state[LX + 1], state[LX + 2])
+    turn(quaternion, wx * dt, wy * dt, wz * dt)
+    rotation_of(quaternion, rotation)
+    if pushing == 1:
+        # one endpoint down does not slide: hold it where it stood before the step, on the floor
+        x, y, z = apply(
+            rotation, end_offset[pinned, 0], end_offset[pinned, 1], end_offset[pinned, 2]
+        )
+        state[CX] = entry[pinned, 0] - x
+        state[CY] = floor - y
+        state[CZ] = entry[pinned, 2] - z
+    if not math.isnan(floor):
+        lowest_y = np.inf
+        next_lowest = np.inf
+        bottom = -1
+        for e in range(n_ends):
+            y = endpoint_position(state, rotation, end_offset, e)[1]
+            if y < lowest_y:
+                next_lowest = lowest_y
+                lowest_y = y
+                bottom = e
+            elif y < next_lowest:
+                next_lowest = y
+        if lowest_y < floor:
+            state[CY] += floor - lowest_y  # no sinking: lift the figure out of the floor
+            next_lowest += floor - lowest_y
+            lowest_y = floor
+        alone = lowest_y - floor <= CONTACT_TOLERANCE < next_lowest - floor
+        if alone and not (pushing == 1 and pinned == bottom):
+            # one endpoint down does not slide, however it came to be alone on the floor (as in
+            # 2-D): stopped dead if that pushes, else horizontally, and held where it stood
+            conjugate(rotation, tensor_inverse, world_inverse)
+            hx, hy, hz = apply(rotation, spin[0], spin[1], spin[2])
+            body_rate[0], body_rate[1], body_rate[2] = apply(
+                world_inverse, state[LX] - hx, state[LX + 1] - hy, state[LX + 2] - hz
+            )
+            u = contact[0]
+            r = contact[1]
+            rx, ry, rz, ux, uy, uz = endpoint_motion(
+                state, rotation, body_rate, end_offset, end_velocity, bottom
+            )
+            r[0, 0] = rx
+            r[0, 1] = ry
+            r[0, 2] = rz
+            u[0, 0] = ux
+            u[0, 1] = uy
+            u[0, 2] = uz
+            inverse_mass = 1.0 / total_mass
+            response(r[0], r[0], inverse_mass, world_inverse, responses[0, 0])
+            px, py, pz = stop_dead(u, responses, 0, system)
+            if py <= 0.0:
+                # horizontal only: solve the x-z block for zero horizontal velocity
+                k = responses[0, 0]
+                det = k[0, 0] * k[2, 2] - k[0, 2] * k[2, 0]
+                px = (-ux * k[2, 2] + uz * k[0, 2]) / det
+                pz = (-uz * k[0, 0] + ux * k[2, 0]) / det
+                py = 0.0
+            state[VX] += px * inverse_mass
+            state[VY] += py * inverse_mass
+            state[VZ] += pz * inverse_mass
+            tx, ty, tz = _cross(rx, ry, rz, px, py, pz)
+            state[LX] += tx
+            state[LX + 1] += ty
+            state[LX + 2] += tz
+            end_force[bottom] += py / dt
+            if entry[bottom, 1] - floor <= CONTACT_TOLERANCE:
+                state[CX] = entry[bottom, 0] - rx
+                state[CZ] = entry[bottom, 2] - rz
+    for k in range(rod_ends.shape[0]):
+        for end in range(2):
+            x, y, z = apply(rotation, rod_ends[k, end, 0], rod_ends[k, end, 1], rod_ends[k, end, 2])
+            rod_ends[k, end, 0] = state[CX] + x
+            rod_ends[k, end, 1] = state[CY] + y
+            rod_ends[k, end, 2] = state[CZ] + z

@@ -1,0 +1,383 @@
+"""The 3-D BSR simulator (``mosys.kernels.bsr3d_simulate``): momentum through deformations,
+free rigid-body motion (conservation, the intermediate-axis instability), contact with the floor
+(coming to rest without sinking, the paper's friction), and agreement with the 2-D simulator for
+a figure that stays in a vertical plane."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from mosys.bsr.figure import load_bsr_figure
+from mosys.bsr.start import standing_state as standing_state_2d
+from mosys.kernels import bsr3d_simulate as sim
+from mosys.kernels import bsr_simulate as planar
+from mosys.parsing.tokens import Token
+
+NAN = float("nan")
+
+
+def rz(angle: float) -> np.ndarray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def ry(angle: float) -> np.ndarray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def figure_arrays(rods, floor=0.0, gravity=9.81) -> sim.FigureArrays3D:
+    """A figure from rods (parent, hinge m, offset deg, splay deg, length m, mass kg, (θ range),
+    (ψ range) deg); each rod's endpoints its own (distal ends; and proximal of the root)."""
+    n = len(rods)
+    parent = np.array([r[0] for r in rods], np.int64)
+    joint = np.array([-1 if r[0] < 0 else 2 * (i - 1) for i, r in enumerate(rods)], np.int64)
+    rest = np.array([rz(math.radians(r[2])) @ ry(math.radians(r[3])) for r in rods])
+    length = np.array([r[4] for r in rods], float)
+    mass = np.array([r[5] for r in rods], float)
+    limits = [angle for r in rods[1:] for angle in (r[6], r[7])]
+    ends = [(0, 0)] + [(k, 1) for k in range(n)]
+    return sim.FigureArrays3D(
+        parent,
+        np.array([r[1] for r in rods], float),
+        rest,
+        length,
+        mass,
+        np.full(n, 0.5),
+        mass * length**2 / 12.0,
+        joint,
+        np.array(ends, np.int64),
+        np.radians([low for low, _ in limits]),
+        np.radians([high for _, high in limits]),
+        gravity,
+        floor,
+        float(length.sum()),
+    )
+
+
+# a dog-like figure out of its plane: a spine and four splayed legs, a tail up and to the side
+DOG = [
+    (-1, 0.0, 0.0, 0.0, 1.0, 20.0, None, None),
+    (0, 1.0, -90.0, 15.0, 0.6, 3.0, (-60, 60), (-30, 30)),
+    (0, 1.0, -90.0, -15.0, 0.6, 3.0, (-60, 60), (-30, 30)),
+    (0, 0.0, -90.0, 15.0, 0.6, 3.0, (-60, 60), (-30, 30)),
+    (0, 0.0, -90.0, -15.0, 0.6, 3.0, (-60, 60), (-30, 30)),
+    (0, 0.0, 150.0, 30.0, 0.5, 2.0, (-45, 45), (-45, 45)),
+]
+
+
+class Stepper:
+    """A figure stepped from Python, one kernel step at a time, with its work space."""
+
+    def __init__(self, figure: sim.FigureArrays3D, state: np.ndarray):
+        self.figure = figure
+        self.state = np.asarray(state, float).copy()
+        n, e, m = figure.parent.shape[0], figure.endpoints.shape[0], sim.MAX_CONTACTS
+        self.rod_ends = np.empty((n, 2, 3))
+        self.end_offset = np.empty((e, 3))
+        self.end_velocity = np.empty((e, 3))
+        self.end_force = np.zeros(e)
+        self.frames = np.empty((n, 3, 3))
+        self.scratch = np.empty((n, 5, 3))
+        self.matrices = np.empty((5, 3, 3))
+        self.vectors = np.zeros((3, 4))
+        self.contact = np.empty((3, m, 3))
+        self.responses = np.empty((m, m, 3, 3))
+        self.system = np.empty((m + 3, m + 4))
+        self.work = np.empty((2, m))
+        self.chosen = np.empty(m, np.int64)
+        self.entry = np.empty((e, 3))
+        self.previous = np.zeros(3)
+        tensor = self.body()
+        self.previous[:] = self.rotation() @ np.linalg.solve(tensor, self.vectors[0, :3])
+
+    @property
+    def angles(self) -> np.ndarray:
+        j = self.figure.joint_min.shape[0]
+        return self.state[sim.JOINTS : sim.JOINTS + j]
+
+    def body(self) -> np.ndarray:
+        """Refresh the body-frame quantities of the current pose; its inertia tensor (3, 3)."""
+        j = self.figure.joint_min.shape[0]
+        sim.body_frame(
+            *self.figure[:9],
+            self.state[sim.JOINTS : sim.JOINTS + j],
+            self.state[sim.JOINTS + j :],
+            self.rod_ends,
+            self.end_offset,
+            self.end_velocity,
+            self.frames,
+            self.scratch,
+            self.matrices[1],
+            self.vectors[0, :3],
+        )
+        return self.matrices[1].copy()
+
+    def rotation(self) -> np.ndarray:
+        out = np.empty((3, 3))
+        sim.rotation_of(self.state[sim.QW : sim.QW + 4], out)
+        return out
+
+    def step(self, target: np.ndarray, tau: float, dt: float) -> None:
+        f = self.figure
+        sim.step(
+            *f[:11],
+            f.gravity,
+            f.floor,
+            self.state,
+            target,
+            tau,
+            dt,
+            self.previous,
+            self.rod_ends,
+            self.end_offset,
+            self.end_velocity,
+            self.end_force,
+            self.frames,
+            self.scratch,
+            self.matrices,
+            self.vectors,
+            self.contact,
+            self.responses,
+            self.system,
+            self.work,
+            self.chosen,
+            self.entry,
+        )
+
+    def world_ends(self) -> np.ndarray:
+        """(N, 2, 3) every rod's ends in the world now, m."""
+        return self.rod_ends.copy()
+
+
+def state_of(
+    figure,
+    centre=(0.0, 1.0, 0.0),
+    angles=None,
+    quaternion=(1.0, 0, 0, 0),
+    momentum=(0, 0, 0),
+    velocity=(0, 0, 0),
+):
+    j = figure.joint_min.shape[0]
+    state = np.zeros(sim.JOINTS + 2 * j)
+    state[0:3] = centre
+    state[3:6] = velocity
+    state[sim.QW : sim.QW + 4] = np.asarray(quaternion, float) / np.linalg.norm(quaternion)
+    state[sim.LX : sim.LX + 3] = momentum
+    if angles is not None:
+        state[sim.JOINTS : sim.JOINTS + j] = angles
+    return state
+
+
+def rod_momenta(figure, ends, dt):
+    """Linear momentum (3,) and angular momentum about the centre of mass (3,) of the figure
+    from its rod ends at three consecutive samples (N, 2, 3) each (central differences)."""
+    before, now, after = ends
+    mass = figure.mass[:, None]
+    com_frac = figure.com[:, None]
+
+    def centres(e):
+        return e[:, 0] + com_frac * (e[:, 1] - e[:, 0])
+
+    centre = centres(now)
+    velocity = (centres(after) - centres(before)) / (2 * dt)
+    total = figure.mass.sum()
+    c = (mass * centre).sum(axis=0) / total
+    v = (mass * velocity).sum(axis=0) / total
+    linear = total * v
+    angular = (mass * np.cross(centre - c, velocity - v)).sum(axis=0)
+    for k in range(figure.parent.shape[0]):
+        u_now = (now[k, 1] - now[k, 0]) / figure.length[k]
+        u_rate = ((after[k, 1] - after[k, 0]) - (before[k, 1] - before[k, 0])) / (
+            2 * dt * figure.length[k]
+        )
+        angular += figure.inertia[k] * np.cross(u_now, u_rate)
+    return linear, angular
+
+
+def test_a_deformation_in_the_air_leaves_linear_and_angular_momentum_unchanged():
+    figure = figure_arrays(DOG, floor=NAN, gravity=0.0)
+    stepper = Stepper(
+        figure, state_of(figure, momentum=(1.0, -2.0, 3.0), velocity=(0.5, 0.2, -0.1))
+    )
+    rng = np.random.default_rng(3)
+    dt = 1e-4
+    momenta = []
+    for phase in range(4):
+        target = rng.uniform(figure.joint_min, figure.joint_max)
+        ends = []
+        for n in range(400):
+            stepper.step(target, 0.05, dt)
+            ends.append(stepper.world_ends())
+            if n % 100 == 50:
+                momenta.append(rod_momenta(figure, ends[-3:], dt))
+    linear = np.array([m[0] for m in momenta])
+    angular = np.array([m[1] for m in momenta])
+    expected = figure.mass.sum() * np.array([0.5, 0.2, -0.1])
+    np.testing.assert_allclose(linear, np.tile(expected, (len(momenta), 1)), atol=2e-3)
+    np.testing.assert_allclose(angular, np.tile([1.0, -2.0, 3.0], (len(momenta), 1)), atol=2e-3)
+    # and the pose really changed (the test is not vacuous)
+    assert np.ptp(stepper.angles) > 0.3
+
+
+def rigid_run(figure, state, seconds, dt):
+    """Step a figure that holds its pose (its target is its pose) in free flight; the body-frame
+    angular velocity (steps, 3) rad/s and the kinetic energy of rotation (steps,) J."""
+    stepper = Stepper(figure, state)
+    target = stepper.angles.copy()
+    tensor = stepper.body()
+    spins, energies, momenta = [], [], []
+    for _ in range(int(round(seconds / dt))):
+        stepper.step(target, 0.1, dt)
+        rotation = stepper.rotation()
+        momentum = stepper.state[sim.LX : sim.LX + 3]
+        spin = np.linalg.solve(tensor, rotation.T @ momentum)
+        spins.append(spin)
+        energies.append(0.5 * spin @ tensor @ spin)
+        momenta.append(momentum.copy())
+    return np.array(spins), np.array(energies), np.array(momenta), tensor
+
+
+def principal(figure):
+    """The principal axes (columns, ascending moments) of the figure at rest."""
+    stepper = Stepper(figure, state_of(figure))
+    moments, axes = np.linalg.eigh(stepper.body())
+    return moments, axes
+
+
+def test_a_tumbling_rigid_figure_conserves_angular_momentum_and_energy():
+    figure = figure_arrays(DOG, floor=NAN, gravity=9.81)
+    moments, axes = principal(figure)
+    spin = axes @ np.array([2.0, 0.5, 1.0])
+    momentum = (
+        np.linalg.inv(np.linalg.inv(axes.T) @ np.diag(1 / moments) @ np.linalg.inv(axes)) @ spin
+    )
+    spins, energies, momenta, _ = rigid_run(figure, state_of(figure, momentum=momentum), 5.0, 1e-3)
+    np.testing.assert_allclose(momenta, np.tile(momentum, (len(momenta), 1)), rtol=0, atol=1e-12)
+    assert np.ptp(energies) / energies[0] < 1e-4
+    # it does tumble: the body-frame spin changes direction
+    assert np.ptp(spins, axis=0).max() > 0.5
+
+
+@pytest.mark.parametrize("axis, stable", [(0, True), (1, False), (2, True)])
+def test_rotation_about_the_intermediate_axis_is_unstable(axis, stable):
+    figure = figure_arrays(DOG, floor=NAN, gravity=0.0)
+    moments, axes = principal(figure)
+    assert moments[0] < moments[1] < moments[2]
+    body_spin = np.full(3, 0.01)
+    body_spin[axis] = 3.0
+    momentum = axes @ (moments * body_spin)  # body frame = world at the start
+    spins, _, _, tensor = rigid_run(figure, state_of(figure, momentum=momentum), 20.0, 2e-3)
+    along = spins @ axes[:, axis]
+    if stable:
+        assert along.min() > 0.95 * 3.0
+    else:
+        assert along.min() < -0.9 * 3.0  # it turned over
+
+
+def test_a_dropped_figure_comes_to_rest_on_the_floor_without_sinking():
+    figure = figure_arrays(DOG)
+    tilt = (math.cos(0.2), 0.1, 0.05, 0.15)
+    stepper = Stepper(
+        figure, state_of(figure, centre=(0.0, 1.5, 0.0), quaternion=tilt, momentum=(2, 1, -3))
+    )
+    target = stepper.angles.copy()
+    lowest = []
+    for _ in range(3000):
+        stepper.step(target, 0.05, 1e-3)
+        lowest.append(stepper.world_ends()[:, :, 1].min())
+    assert min(lowest) >= -1e-9
+    before = stepper.world_ends()
+    speed = np.linalg.norm(stepper.state[3:6])
+    for _ in range(500):
+        stepper.step(target, 0.05, 1e-3)
+    assert speed < 1e-3
+    assert np.abs(stepper.world_ends() - before).max() < 1e-3
+    assert stepper.world_ends()[:, :, 1].min() == pytest.approx(0.0, abs=1e-6)
+
+
+def planar_copy(figure2d) -> sim.FigureArrays3D:
+    """The 3-D arrays of a 2-D BSR figure: every joint's ψ fixed at 0, rest = Rz(offset)."""
+    j = figure2d.joint_min.shape[0]
+    rest = np.array(
+        [rz(o) if p >= 0 else np.eye(3) for o, p in zip(figure2d.offset, figure2d.parent)]
+    )
+    joint_min = np.zeros(2 * j)
+    joint_max = np.zeros(2 * j)
+    joint_min[0::2] = figure2d.joint_min
+    joint_max[0::2] = figure2d.joint_max
+    return sim.FigureArrays3D(
+        figure2d.parent,
+        figure2d.hinge,
+        rest,
+        figure2d.length,
+        figure2d.mass,
+        figure2d.com,
+        figure2d.inertia,
+        np.where(figure2d.joint >= 0, 2 * figure2d.joint, -1),
+        figure2d.endpoints,
+        joint_min,
+        joint_max,
+        figure2d.gravity,
+        figure2d.floor,
+        figure2d.reach,
+    )
+
+
+def test_a_figure_in_a_vertical_plane_moves_as_the_2d_simulator_moves_it():
+    """Star-Man (2-D) kicking and waving on the floor for 4 s, stepped by both simulators."""
+    figure = load_bsr_figure("specs/figures", "x.bsr", Token("starman", 1, 1))
+    arrays = figure.arrays
+    spatial = planar_copy(arrays)
+    j = len(figure.joint_names)
+    start = standing_state_2d(figure, math.pi / 2, np.radians([45, -45, 20, -20]))
+    state3 = np.zeros(sim.JOINTS + 4 * j)
+    state3[[0, 1, 3, 4]] = start[[0, 1, 2, 3]]
+    state3[sim.QW] = math.cos(start[4] / 2)
+    state3[sim.QW + 3] = math.sin(start[4] / 2)
+    state3[sim.LX + 2] = start[5]
+    state3[sim.JOINTS : sim.JOINTS + 2 * j : 2] = start[6 : 6 + j]
+    stepper = Stepper(spatial, state3)
+    n, e = arrays.parent.shape[0], arrays.endpoints.shape[0]
+    rod_ends = np.empty((n, 2, 2))
+    offsets, velocities = np.empty((e, 2)), np.empty((e, 2))
+    scratch = np.empty((n, 8))
+    _, inertia, spin = planar.figure_body_frame(
+        arrays, start[6 : 6 + j], start[6 + j :], rod_ends, offsets, velocities, scratch
+    )
+    previous = np.array([spin / inertia])
+    state2 = start.copy()
+    rng = np.random.default_rng(1)
+    targets = rng.uniform(arrays.joint_min, arrays.joint_max, (8, j))
+    taus = rng.uniform(0.1, 0.3, 8)
+    worst = 0.0
+    for step in range(400):
+        k = step // 50
+        planar.step(
+            *arrays[:11],
+            arrays.gravity,
+            arrays.floor,
+            state2,
+            targets[k],
+            taus[k],
+            0.01,
+            previous,
+            rod_ends,
+            offsets,
+            velocities,
+            np.zeros(e),
+            scratch,
+            np.empty((3, 2, 2)),
+            np.empty((e, 2)),
+        )
+        target3 = np.zeros(2 * j)
+        target3[0::2] = targets[k]
+        stepper.step(target3, taus[k], 0.01)
+        worst = max(worst, np.abs(stepper.world_ends()[:, :, :2] - rod_ends).max())
+        assert np.abs(stepper.world_ends()[:, :, 2]).max() == 0.0
+    assert worst < 1e-9
+    assert np.ptp(state2[0]) >= 0  # ran
+    assert abs(state2[0] - start[0]) > 0.05  # the figure really moved along the floor
