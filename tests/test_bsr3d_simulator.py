@@ -81,13 +81,14 @@ class Stepper:
         self.end_velocity = np.empty((e, 3))
         self.end_force = np.zeros(e)
         self.frames = np.empty((n, 3, 3))
-        self.scratch = np.empty((n, 5, 3))
+        self.scratch = sim.new_scratch(n)
         self.matrices = np.empty((5, 3, 3))
         self.vectors = np.zeros((3, 4))
         self.contact = np.empty((3, m, 3))
         self.responses = np.empty((m, m, 3, 3))
         self.system = np.empty((m + 3, m + 4))
-        self.work = np.empty((2, m))
+        self.work = np.empty((3, m))
+        self.end_share = np.zeros(e)
         self.chosen = np.empty(m, np.int64)
         self.entry = np.empty((e, 3))
         self.previous = np.zeros(3)
@@ -146,6 +147,7 @@ class Stepper:
             self.work,
             self.chosen,
             self.entry,
+            self.end_share,
         )
 
     def world_ends(self) -> np.ndarray:

@@ -114,7 +114,7 @@ class RunRecord(NamedTuple):
     final_force: np.ndarray
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def heading_of(frames, rotation, rod, offset):
     """The figure's heading, rad: the direction of rod ``rod``'s horizontal projection (its
     frame's first column, body frame, turned to the world by rotation), counter-clockwise seen
@@ -123,7 +123,7 @@ def heading_of(frames, rotation, rod, offset):
     return math.atan2(-z, x) + offset
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def measure_senses(
     state, rotation, world_inverse, spin, end_force, weight, floor, task, joint_min, joint_max, out
 ):
@@ -158,7 +158,7 @@ def measure_senses(
         out[PHYSICAL_SENSES + n_ends + f] = min(max(value, 0.0), 1.0)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def run_controller(figure, controller, task, start, start_force, carry_over, steps, dt, record):
     """Run a controller (a ControllerArrays) of the 3-D figure (a FigureArrays3D) for ``steps``
     steps of dt seconds from the state ``start`` (S,), measuring as ``task`` (a Task) says,
@@ -178,13 +178,14 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
     end_velocity = np.empty((n_ends, 3))
     end_force = start_force.copy()
     frames = np.empty((n_rods, 3, 3))
-    scratch = np.empty((n_rods, 5, 3))
+    scratch = np.full((n_rods, 7, 3), np.nan)  # as new_scratch
     matrices = np.empty((5, 3, 3))
     vectors = np.zeros((3, 4))
     contact = np.empty((3, m, 3))
     responses = np.empty((m, m, 3, 3))
     system = np.empty((m + 3, m + 4))
-    work = np.empty((2, m))
+    work = np.empty((3, m))
+    end_share = np.zeros(n_ends)
     chosen = np.empty(m, np.int64)
     entry = np.empty((n_ends, 3))
     previous = np.zeros(3)
@@ -312,6 +313,7 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
             work,
             chosen,
             entry,
+            end_share,
         )
         rotation = matrices[0]
         fallen = state[CY] < task.fall_height

@@ -54,7 +54,7 @@ class FigureArrays3D(NamedTuple):
 
     parent: np.ndarray  # (N,) int64: each rod's parent, -1: the root
     hinge: np.ndarray  # (N,) m: where the rod hangs on its parent, from the parent's proximal end
-    rest: np.ndarray  # (N, 3, 3): the joint's fixed rotation Rz(offset) @ Ry(splay); root: identity
+    rest: np.ndarray  # (N, 3, 3): fixed rotation Rz(offset) @ Ry(splay) (root: in the body frame)
     length: np.ndarray  # (N,) m
     mass: np.ndarray  # (N,) kg
     com: np.ndarray  # (N,): the rod's centre of mass, a fraction from proximal to distal
@@ -68,12 +68,17 @@ class FigureArrays3D(NamedTuple):
     reach: float  # m: the sum of the rods' lengths
 
 
-@njit(cache=True, inline="always")
+def new_scratch(n_rods: int) -> np.ndarray:
+    """The (N, 7, 3) scratch of ``body_frame``, its angle memory empty (NaN: never seen)."""
+    return np.full((n_rods, 7, 3), np.nan)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def _cross(ax, ay, az, bx, by, bz):
     return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def body_frame(
     parent,
     hinge,
@@ -101,8 +106,9 @@ def body_frame(
     centre of mass, m; end_offset, end_velocity (E, 3): each distinct endpoint's position relative
     to the centre of mass (m) and its velocity from the deformation alone (m/s); tensor (3, 3):
     the inertia tensor about the centre of mass, kg m²; spin (3,): the deformation's angular
-    momentum about the centre of mass, kg m²/s. scratch: (N, 5, 3) work space. Returns the total
-    mass, kg. theta, theta_rate (J,): rad, rad/s.
+    momentum about the centre of mass, kg m²/s. scratch: (N, 7, 3) work space from
+    ``new_scratch`` (its last two rows keep each rod's angles' cosines and sines between calls).
+    Returns the total mass, kg. theta, theta_rate (J,): rad, rad/s.
     """
     n = parent.shape[0]
     omega = scratch[:, 0]
@@ -110,6 +116,8 @@ def body_frame(
     proximal_velocity = scratch[:, 2]
     centre = scratch[:, 3]
     centre_velocity = scratch[:, 4]
+    trig_theta = scratch[:, 5]
+    trig_psi = scratch[:, 6]
     total_mass = 0.0
     mass_x = mass_y = mass_z = 0.0
     momentum_x = momentum_y = momentum_z = 0.0
@@ -124,10 +132,19 @@ def body_frame(
                 proximal_velocity[k, a] = 0.0
         else:
             j = joint[k]
-            ct = math.cos(theta[j])
-            st = math.sin(theta[j])
-            cp = math.cos(theta[j + 1])
-            sp = math.sin(theta[j + 1])
+            # cosines and sines only of angles that moved (fixed ones never do)
+            if theta[j] != trig_theta[k, 0]:
+                trig_theta[k, 0] = theta[j]
+                trig_theta[k, 1] = math.cos(theta[j])
+                trig_theta[k, 2] = math.sin(theta[j])
+            if theta[j + 1] != trig_psi[k, 0]:
+                trig_psi[k, 0] = theta[j + 1]
+                trig_psi[k, 1] = math.cos(theta[j + 1])
+                trig_psi[k, 2] = math.sin(theta[j + 1])
+            ct = trig_theta[k, 1]
+            st = trig_theta[k, 2]
+            cp = trig_psi[k, 1]
+            sp = trig_psi[k, 2]
             wx = omega[p, 0]
             wy = omega[p, 1]
             wz = omega[p, 2]
@@ -245,7 +262,7 @@ def body_frame(
     return total_mass
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def rotation_of(quaternion, out):
     """The rotation matrix (3, 3) of a unit quaternion (w, x, y, z), into out."""
     w = quaternion[0]
@@ -263,7 +280,7 @@ def rotation_of(quaternion, out):
     out[2, 2] = 1.0 - 2.0 * (x * x + y * y)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def turn(quaternion, ax, ay, az):
     """Turn the unit quaternion (4,) in place by the world rotation vector (ax, ay, az), rad,
     and renormalise it (the drift correction)."""
@@ -289,7 +306,7 @@ def turn(quaternion, ax, ay, az):
         quaternion[a] /= norm
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def invert_symmetric(matrix, out):
     """The inverse (3, 3) of a symmetric positive definite matrix, into out."""
     a = matrix[0, 0]
@@ -310,7 +327,7 @@ def invert_symmetric(matrix, out):
     out[2, 2] = (a * d - b * b) / det
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def conjugate(rotation, matrix, out):
     """out = rotation @ matrix @ rotation.T, all (3, 3)."""
     for a in range(3):
@@ -324,7 +341,7 @@ def conjugate(rotation, matrix, out):
             out[a, b] = total
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def apply(matrix, x, y, z):
     """matrix (3, 3) @ (x, y, z)."""
     return (
@@ -334,7 +351,7 @@ def apply(matrix, x, y, z):
     )
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def endpoint_position(state, rotation, end_offset, e):
     """World (x, y, z) of endpoint e, m, from its offset from the centre of mass in the body
     frame (end_offset (E, 3)) and the body's orientation (rotation (3, 3))."""
@@ -342,7 +359,7 @@ def endpoint_position(state, rotation, end_offset, e):
     return state[CX] + x, state[CY] + y, state[CZ] + z
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def endpoint_motion(state, rotation, body_rate, end_offset, end_velocity, e):
     """Endpoint e's offset (rx, ry, rz) from the centre of mass in the world, m, and its
     velocity (ux, uy, uz), m/s: the body's motion (velocity of the centre of mass, rotation at
@@ -353,7 +370,7 @@ def endpoint_motion(state, rotation, body_rate, end_offset, end_velocity, e):
     return rx, ry, rz, state[VX] + wx + dx, state[VY] + wy + dy, state[VZ] + wz + dz
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def response(ri, rj, inverse_mass, world_inverse, out):
     """out (3, 3): the velocity change at a point with offset ri (3,) from the centre of mass
     per unit impulse at a point with offset rj (3,), for a rigid body of inverse mass
@@ -371,7 +388,7 @@ def response(ri, rj, inverse_mass, world_inverse, out):
         out[2, b] = vz + inverse_mass * ez
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _solve(system, size):
     """Solve the linear system in system[:size, :size + 1] (augmented) in place by Gaussian
     elimination with partial pivoting; the solution ends in column ``size``. False if singular."""
@@ -402,8 +419,8 @@ def _solve(system, size):
     return True
 
 
-@njit(cache=True)
-def _shared_friction(u, r, active, count, responses, impulse, system, weight, compliance):
+@njit(cache=True, error_model="numpy")
+def _shared_friction(u, r, active, count, responses, impulse, system, weight, compliance, share):
     """Impulses at the active contacts (at least two), the paper's friction carried to 3-D: no
     active point sinks; each point's horizontal impulse is its share (its normal impulse over
     their sum) of a common one, a slide (T_x, T_z) plus a twist Γ about the vertical (at offset
@@ -414,13 +431,23 @@ def _shared_friction(u, r, active, count, responses, impulse, system, weight, co
     added to each contact's own normal response: it splits the load of contacts that a rigid
     body leaves undecided (more than three on a plane, several in a line). u, r (count, 3).
     Returns the index of the contact whose normal impulse pulls most (-1: none pulls; -2: the
-    system is singular)."""
+    system is singular). ``share`` (count,): the shares the points had the step before (0: not in
+    contact then), where the iteration starts if every active point had one and there are three
+    or more (which the 2-D rule never has: two start at even shares, as in 2-D, since where the
+    iteration starts can decide whether a normal impulse is found to pull)."""
     n = 0
+    known = 0.0
     for i in range(count):
         if active[i]:
             n += 1
+            known = known + share[i] if share[i] > 0.0 and known >= 0.0 else -1.0
     for i in range(count):
-        weight[i] = 1.0 / n if active[i] else 0.0
+        if not active[i]:
+            weight[i] = 0.0
+        elif known > 0.0 and n >= 3:  # two start even, as the 2-D rule does
+            weight[i] = share[i] / known
+        else:
+            weight[i] = 1.0 / n
     size = n + 3
     for _ in range(50):
         system[:size, : size + 1] = 0.0
@@ -514,7 +541,7 @@ def _shared_friction(u, r, active, count, responses, impulse, system, weight, co
     return -1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def stop_dead(u, responses, i, system):
     """The impulse (x, y, z) that stops contact i (velocity u[i] (3,)) dead, from its own
     response responses[i, i] (3, 3); its y is <= 0 if that would pull the point down."""
@@ -527,7 +554,7 @@ def stop_dead(u, responses, i, system):
     return system[0, 3], system[1, 3], system[2, 3]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _others_hold(u, count, responses, impulse, members):
     """True if no touching point outside ``members`` ((count,) 1.0 for a member) sinks after
     the impulses (count, 3)."""
@@ -543,18 +570,26 @@ def _others_hold(u, count, responses, impulse, members):
     return True
 
 
-@njit(cache=True)
-def contact_impulses(u, r, count, inverse_mass, world_inverse, impulse, responses, system, work):
+@njit(cache=True, error_model="numpy")
+def contact_impulses(
+    u, r, count, inverse_mass, world_inverse, impulse, responses, system, work, chosen, end_share
+):
     """The ground's impulses (count, 3) N s on ``count`` touching endpoints: u (count, 3) their
     velocities m/s, r (count, 3) their offsets from the centre of mass m. First the sinking ones
     together, with shared friction, dropping the one whose normal impulse would pull most and
     trying again while two or more are left; then each sinking one alone, the fastest first,
     stopped dead. The first set whose normal impulses push and after which no other touching
     point sinks is kept; none, no impulse (the 2-D rule for two, carried to any number).
-    responses (M, M, 3, 3), system (M + 3, M + 4), work (2, M): work space."""
+    responses (M, M, 3, 3), system (M + 3, M + 4), work (3, M): work space. chosen (count,):
+    the points' endpoint numbers; end_share (E,): each endpoint's share of the horizontal impulse
+    the step before, updated (the shared-friction iteration starts from it)."""
     impulse[:count, :] = 0.0
     active = work[0]
     weight = work[1]
+    share = work[2]
+    for i in range(count):
+        share[i] = end_share[chosen[i]]
+    end_share[:] = 0.0
     n = 0
     for i in range(count):
         active[i] = 1.0 if u[i, 1] < 0.0 else 0.0
@@ -564,16 +599,19 @@ def contact_impulses(u, r, count, inverse_mass, world_inverse, impulse, response
     for i in range(count):
         for j in range(count):
             response(r[i], r[j], inverse_mass, world_inverse, responses[i, j])
-    compliance = 0.0
+    # three or more points: a rigid body often leaves their split undecided
+    compliance = 0.0 if n < 3 else COMPLIANCE * (responses[0, 0, 0, 0] + responses[0, 0, 1, 1])
     while n >= 2:
         worst = _shared_friction(
-            u, r, active, count, responses, impulse, system, weight, compliance
+            u, r, active, count, responses, impulse, system, weight, compliance, share
         )
         if worst == -2 and compliance == 0.0:
             # the rigid body leaves the split undecided: a little compliance decides it
             compliance = COMPLIANCE * (responses[0, 0, 0, 0] + responses[0, 0, 1, 1])
             continue
         if worst == -1 and _others_hold(u, count, responses, impulse, active):
+            for i in range(count):
+                end_share[chosen[i]] = weight[i]
             return
         if worst < 0:
             # still singular, or another point would sink: drop the one sinking slowest
@@ -606,7 +644,7 @@ def contact_impulses(u, r, count, inverse_mass, world_inverse, impulse, response
         impulse[first, :] = 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def step(
     parent,
     hinge,
@@ -640,6 +678,7 @@ def step(
     work,
     chosen,
     entry,
+    end_share,
 ):
     """Advance the state (S,) of a figure (its arrays as in FigureArrays3D) by dt seconds toward
     the target pose (J,) rad with time constant tau s. ``previous`` (3,): the deformation's own
@@ -647,9 +686,10 @@ def step(
     (N, 2, 3) with world positions of every rod's ends after the step (m), end_force (E,) the
     ground's normal force on each endpoint over the step, N. Work space: end_offset and
     end_velocity (E, 3) (end_offset must hold the endpoints as the previous step or the start
-    left them), frames (N, 3, 3), scratch (N, 5, 3), matrices (5, 3, 3), vectors (3, 4),
-    contact (3, M, 3), responses (M, M, 3, 3), system (M + 3, M + 4), work (2, M), chosen (M,)
-    int64, entry (E, 3); M = MAX_CONTACTS.
+    left them), frames (N, 3, 3), scratch (N, 7, 3) (``new_scratch``), matrices (5, 3, 3),
+    vectors (3, 4), contact (3, M, 3), responses (M, M, 3, 3), system (M + 3, M + 4), work
+    (3, M), chosen (M,) int64, entry (E, 3), end_share (E,) (zeros at the start); M =
+    MAX_CONTACTS.
 
     One piece on purpose, its arrays one by one, as the 2-D step (that module's docstring says
     why).
@@ -751,7 +791,17 @@ def step(
             u[i, 1] = uy + max(state[CY] + ry - floor, 0.0) / dt
             u[i, 2] = uz
         contact_impulses(
-            u, r, count, 1.0 / total_mass, world_inverse, impulse, responses, system, work
+            u,
+            r,
+            count,
+            1.0 / total_mass,
+            world_inverse,
+            impulse,
+            responses,
+            system,
+            work,
+            chosen,
+            end_share,
         )
         for i in range(count):
             if impulse[i, 1] > 0.0:
