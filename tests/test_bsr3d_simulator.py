@@ -208,7 +208,7 @@ def test_a_deformation_in_the_air_leaves_linear_and_angular_momentum_unchanged()
     rng = np.random.default_rng(3)
     dt = 1e-4
     momenta = []
-    for phase in range(4):
+    for _ in range(4):
         target = rng.uniform(figure.joint_min, figure.joint_max)
         ends = []
         for n in range(400):
@@ -305,7 +305,10 @@ def planar_copy(figure2d) -> sim.FigureArrays3D:
     """The 3-D arrays of a 2-D BSR figure: every joint's ψ fixed at 0, rest = Rz(offset)."""
     j = figure2d.joint_min.shape[0]
     rest = np.array(
-        [rz(o) if p >= 0 else np.eye(3) for o, p in zip(figure2d.offset, figure2d.parent)]
+        [
+            rz(o) if p >= 0 else np.eye(3)
+            for o, p in zip(figure2d.offset, figure2d.parent, strict=True)
+        ]
     )
     joint_min = np.zeros(2 * j)
     joint_max = np.zeros(2 * j)

@@ -211,6 +211,9 @@ TOP_LEVEL_HELP = (
     "  plot luxo          Luxo: a motion's strip (Figure 22), forces, a GIF\n"
     "  plot bsr           a BSR search: learning curves, filmstrip, GIF\n"
     "  plot bsr-learning  learning curves of BSR searches compared (Figure 7 style)\n"
+    "  plot bsr3d         3-D BSR searches: filmstrip (Figures 15-17), GIF, figure\n"
+    "  plot bsr3d-kinds   time- vs sense-based learning curves (Figure 7 style)\n"
+    "  plot bsr3d-seeds   each seed's learning curve (Figure 8 style)\n"
     "  plot composite     a composite motion: filmstrips before/after, the search,\n"
     "                     a GIF\n"
     "the papers' tables:\n"
@@ -218,6 +221,7 @@ TOP_LEVEL_HELP = (
     "  car-table          the car controller's table\n"
     "  luxo-table         Luxo's motions table\n"
     "  bsr-table          the BSR runs table\n"
+    "  bsr3d-table        the 3-D BSR runs table\n"
     "  composite-table    the composite-motion table\n"
     "  robustness-table   robust BSR searches against their plain twins\n"
     "pipeline:\n"
@@ -258,11 +262,15 @@ VERBS = [
     "plot luxo",
     "plot bsr",
     "plot bsr-learning",
+    "plot bsr3d",
+    "plot bsr3d-kinds",
+    "plot bsr3d-seeds",
     "plot composite",
     "pendulum-table",
     "car-table",
     "luxo-table",
     "bsr-table",
+    "bsr3d-table",
     "composite-table",
     "robustness-table",
     "index",

@@ -115,8 +115,15 @@ class BsrFigure:
 
 def bsr_figure(figure: Figure) -> BsrFigure:
     """Lay out ``figure`` for the BSR simulator; a figure it cannot simulate raises SpecError
-    at the offending line (a pinned root, a hinge out of order or without a limit, terrain that
-    is not a flat floor)."""
+    at the offending line (a 3-D figure, a pinned root, a hinge out of order or without a
+    limit, terrain that is not a flat floor)."""
+    ball = next((joint for joint in figure.joints if joint.kind == "ball"), None)
+    if ball is not None:
+        raise SpecError.at(
+            figure.path,
+            ball.token,
+            "a planar figure (ball joints are for the 3-D BSR search: bsr.figure3d)",
+        )
     root = figure.root
     if root.kind != "free":
         raise SpecError.at(figure.path, root.token, "a 'free' root (BSR figures fly and fall)")
@@ -156,7 +163,7 @@ def bsr_figure(figure: Figure) -> BsrFigure:
     if terrain.kind not in ("none", "floor"):
         raise SpecError(figure.path, 1, 1, "a flat 'terrain floor' for a BSR figure", None)
     length = np.array([rod.length for rod in figure.rods])
-    endpoints = _distinct_endpoints(parent, hinge, length)
+    endpoints = distinct_endpoints(parent, hinge, length)
     return BsrFigure(
         figure=figure,
         parent=parent,
@@ -191,7 +198,7 @@ def load_bsr_figure(figures_dir: str | Path, spec_path: str, token: Token) -> Bs
     return bsr_figure(parsed)
 
 
-def _distinct_endpoints(parent: np.ndarray, hinge: np.ndarray, length: np.ndarray) -> np.ndarray:
+def distinct_endpoints(parent: np.ndarray, hinge: np.ndarray, length: np.ndarray) -> np.ndarray:
     """(E, 2) rod and end of every distinct endpoint: a child's proximal end that sits on an
     end of its parent is that end, not a new point."""
     owner: dict[tuple[int, int], tuple[int, int]] = {}

@@ -1,4 +1,5 @@
-"""One BSR search end to end: spec and figure in, ``results/bsr/NAME/seedK.h5`` out."""
+"""One BSR search end to end: spec and figure (2-D or 3-D) in, ``results/bsr/NAME/seedK.h5``
+out; a 3-D search that continues another also takes that search's result files."""
 
 from __future__ import annotations
 
@@ -7,9 +8,12 @@ import os
 from pathlib import Path
 
 from mosys.bsr.figure import load_bsr_figure
-from mosys.bsr.search import SearchOutcome, bind_search, run_search
+from mosys.bsr.figure3d import load_bsr_figure3d
+from mosys.bsr.search import SearchOutcome, SearchSetup, bind_search, run_search, searched_variables
+from mosys.bsr.search3d import bind_search3d, chain_start, standing_height
 from mosys.io.bsr_result import BsrResult, write_bsr_result
-from mosys.parsing.bsr import parse_bsr_spec
+from mosys.parsing.bsr import BsrSpec, parse_bsr_spec
+from mosys.parsing.figure import parse_figure_spec
 from mosys.parsing.tokens import SpecError
 
 
@@ -21,17 +25,19 @@ def search_to_file(
     generations: int | None = None,
     budget: str = "paper",
     threads: int | None = None,
+    chain_results: list[str | Path] | None = None,
 ) -> SearchOutcome:
     """Parse the spec and its figure, run the search with ``seed`` (which must be one of the
     spec's seeds), write the result atomically. ``generations`` overrides the spec's G;
-    ``budget`` names the config that chose it; ``threads``: numba threads for the population."""
+    ``budget`` names the config that chose it; ``threads``: numba threads for the population;
+    ``chain_results``: the result files of the search a ``chain`` line continues."""
     spec = parse_bsr_spec(spec_path)
     if seed not in spec.seeds:
         raise SpecError(
             spec.path, 1, 1, f"seed {seed} among the spec's seeds {list(spec.seeds)}", None
         )
-    figure = load_bsr_figure(figures_dir, spec.path, spec.tokens["figure"])
-    setup = bind_search(spec, figure, generations)
+    setup, extra = _bind(spec, figures_dir, generations, chain_results or [])
+    figure = setup.figure
     if threads:
         import numba
 
@@ -70,7 +76,41 @@ def search_to_file(
             "perturbed": spec.perturbation.any,
             "steps_per_second": outcome.steps_per_second,
             "threads": threads or int(os.environ.get("NUMBA_NUM_THREADS", "0") or 0),
+            "searched_variables": searched_variables(setup),
+            "min_com_height": float(outcome.com[:, 1].min()),
+            **extra,
         },
+        final_state=outcome.final_state,
+        final_force=outcome.final_force,
     )
     write_bsr_result(output, result)
     return outcome
+
+
+def _bind(
+    spec: BsrSpec, figures_dir: str | Path, generations: int | None, chain_results: list
+) -> tuple[SearchSetup, dict]:
+    """The search set-up of a 2-D or 3-D figure (as its .fig says), and the root attrs only
+    3-D results have."""
+    token = spec.tokens["figure"]
+    figure_path = Path(figures_dir) / f"{token.text}.fig"
+    parsed = parse_figure_spec(figure_path) if figure_path.is_file() else None
+    if getattr(parsed, "dimensions", 2) != 3:
+        if spec.chain:
+            raise SpecError.at(spec.path, spec.tokens["chain"], "a 3-D figure to continue")
+        return bind_search(spec, load_bsr_figure(figures_dir, spec.path, token), generations), {}
+    figure = load_bsr_figure3d(figures_dir, spec.path, token)
+    chain = None
+    if spec.chain:
+        if not chain_results:
+            raise SpecError.at(
+                spec.path, spec.tokens["chain"], f"the result files of '{spec.chain}' (--chain)"
+            )
+        chain = chain_start(spec.chain, chain_results)
+    setup = bind_search3d(spec, figure, generations, chain)
+    standing = standing_height(figure)
+    return setup, {
+        "chain": spec.chain,
+        "chain_seed": 0 if chain is None else chain.seed,
+        "standing_com_height": standing,
+    }

@@ -14,6 +14,12 @@ def _bsr_search_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--generations", type=int, help="override the spec's G (a budget)")
     add_budget(parser)
     parser.add_argument("--threads", type=int, help="threads that run the population")
+    parser.add_argument(
+        "--chain",
+        nargs="+",
+        metavar="RESULT",
+        help="3-D: the result files of the search the spec's 'chain' line continues",
+    )
     parser.add_argument("-o", "--output", required=True)
 
 
@@ -28,6 +34,7 @@ def _bsr_search(args: argparse.Namespace) -> None:
         args.generations,
         args.budget,
         args.threads,
+        args.chain,
     )
     print(
         f"{args.output}: best fitness {outcome.fitness:.3f} after {outcome.evaluations[-1]} "

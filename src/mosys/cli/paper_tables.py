@@ -1,5 +1,5 @@
 """The papers' tables: ``pendulum-table`` (Figure 13), ``car-table``, ``luxo-table``, ``bsr-table``,
-``composite-table`` and ``robustness-table``."""
+``bsr3d-table``, ``composite-table`` and ``robustness-table``."""
 
 from __future__ import annotations
 
@@ -61,6 +61,17 @@ def _bsr_table(args: argparse.Namespace) -> None:
     from mosys.paper_tables.bsr import write_bsr_table
 
     write_bsr_table(args.results, args.csv, args.md)
+
+
+def _bsr3d_table_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("results", nargs="+", help="seed files (.h5) of the 3-D searches")
+    add_table_outputs(parser)
+
+
+def _bsr3d_table(args: argparse.Namespace) -> None:
+    from mosys.paper_tables.bsr3d import write_bsr3d_table
+
+    write_bsr3d_table(args.results, args.csv, args.md)
 
 
 def _composite_table_arguments(parser: argparse.ArgumentParser) -> None:
@@ -128,6 +139,12 @@ FAMILY = Family(
             "the BSR runs table",
             _bsr_table_arguments,
             _bsr_table,
+        ),
+        Verb(
+            "bsr3d-table",
+            "the 3-D BSR runs table",
+            _bsr3d_table_arguments,
+            _bsr3d_table,
         ),
         Verb(
             "composite-table",

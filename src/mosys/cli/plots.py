@@ -139,6 +139,77 @@ def _bsr_learning(args: argparse.Namespace) -> None:
     bsr.plot_learning_comparison(bsr.group_by_search(args.results), args.output)
 
 
+def _bsr3d_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "results",
+        nargs="+",
+        help="seed files (.h5) of one 3-D search, or of a chain's searches in order",
+    )
+    parser.add_argument("--filmstrip", help="PNG: the best motion (Figures 15-17 style)")
+    parser.add_argument("--gif", help="animated GIF of that motion")
+    parser.add_argument("--rest", help="PNG: the figure at rest, seen from four sides")
+    parser.add_argument(
+        "--interval", type=float, help="seconds between the filmstrip's poses (default: chosen)"
+    )
+
+
+def _bsr3d_check(args: argparse.Namespace) -> str | None:
+    if not (args.filmstrip or args.gif or args.rest):
+        return "plot bsr3d: give --filmstrip, --gif and/or --rest"
+    if args.interval is not None and not args.interval > 0:
+        return f"plot bsr3d: --interval must be a positive number of seconds, got {args.interval}"
+    return None
+
+
+def _bsr3d(args: argparse.Namespace) -> None:
+    from mosys.plots import bsr3d
+
+    # one file per search: the last search's best seed, before it the seeds it continues
+    chain = bsr3d.chain_paths(args.results)
+    if args.filmstrip:
+        bsr3d.plot_filmstrip(chain, args.filmstrip, args.interval)
+    if args.gif:
+        bsr3d.write_motion_gif(chain, args.gif)
+    if args.rest:
+        bsr3d.plot_result_at_rest(chain[0], args.rest)
+
+
+def _bsr3d_kinds_arguments(parser: argparse.ArgumentParser) -> None:
+    for kind in ("time", "sense"):
+        parser.add_argument(
+            f"--{kind}",
+            nargs="+",
+            default=[],
+            metavar="RESULT",
+            help=f"seed files (.h5) of the {kind}-based search",
+        )
+    parser.add_argument("-o", "--output", required=True, help="PNG")
+    parser.add_argument("--log-x", action="store_true", help="evaluations on a log axis")
+
+
+def _bsr3d_kinds_check(args: argparse.Namespace) -> str | None:
+    if not (args.time or args.sense):
+        return "plot bsr3d-kinds: give --time and/or --sense result files"
+    return None
+
+
+def _bsr3d_kinds(args: argparse.Namespace) -> None:
+    from mosys.plots import bsr3d
+
+    bsr3d.plot_learning_kinds(args.time, args.sense, args.output, log_x=args.log_x)
+
+
+def _bsr3d_seeds_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("results", nargs="+", help="all seed files of one search (.h5)")
+    parser.add_argument("-o", "--output", required=True, help="PNG")
+
+
+def _bsr3d_seeds(args: argparse.Namespace) -> None:
+    from mosys.plots import bsr3d
+
+    bsr3d.plot_seeds(args.results, args.output)
+
+
 def _composite_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("result", help="results/composite/NAME.h5")
     parser.add_argument("--filmstrips", help="PNG: before and after (Figures 13-14 style)")
@@ -205,6 +276,26 @@ FAMILY = Family(
             "learning curves of BSR searches compared (Figure 7 style)",
             _bsr_learning_arguments,
             _bsr_learning,
+        ),
+        Verb(
+            "plot bsr3d",
+            "3-D BSR searches: filmstrip (Figures 15-17), GIF, figure",
+            _bsr3d_arguments,
+            _bsr3d,
+            _bsr3d_check,
+        ),
+        Verb(
+            "plot bsr3d-kinds",
+            "time- vs sense-based learning curves (Figure 7 style)",
+            _bsr3d_kinds_arguments,
+            _bsr3d_kinds,
+            _bsr3d_kinds_check,
+        ),
+        Verb(
+            "plot bsr3d-seeds",
+            "each seed's learning curve (Figure 8 style)",
+            _bsr3d_seeds_arguments,
+            _bsr3d_seeds,
         ),
         Verb(
             "plot composite",

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from mosys.parsing.figure import Figure
+from mosys.parsing.tokens import SpecError
 
 
 @dataclass(frozen=True)
@@ -124,7 +125,13 @@ def constant_name(kind: str, rod: str) -> str:
 
 
 def build_model(figure: Figure) -> KinematicModel:
-    """The kinematics of ``figure``; rods are placed root first, each after its parent."""
+    """The kinematics of ``figure``; rods are placed root first, each after its parent. A 3-D
+    figure raises SpecError at its first ball line (only the 3-D BSR simulator moves those)."""
+    ball = next((joint for joint in figure.joints if joint.kind == "ball"), None)
+    if ball is not None:
+        raise SpecError.at(
+            figure.path, ball.token, "a planar figure (ball joints are for 3-D BSR figures)"
+        )
     n = len(figure.coordinates)
     q = tuple(sp.Symbol(f"q_{k}", real=True) for k in range(n))
     qd = tuple(sp.Symbol(f"qd_{k}", real=True) for k in range(n))

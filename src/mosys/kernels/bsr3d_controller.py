@@ -13,12 +13,13 @@ centre-of-mass height, ``v0 = sqrt(g h0)`` and ``ω0 = v0 / h0`` (``SenseScales`
 senses (all but the joint angles) pass through a first-order low-pass filter of time constant
 ``filter_time`` s (§4.2: "to remove noise and high-frequency variation").
 
-Fitness terms (the columns of terms_out, ``TERM_NAMES``): ``distance`` the com's displacement
-along the heading at t = 0, m; ``sideways`` |the displacement across it|, m; ``heading_change``
-the unwrapped change of heading, deg (counter-clockwise seen from above positive);
+Fitness terms (the columns of terms_out, named by ``parsing.bsr.FITNESS_TERMS_3D``):
+``distance`` the com's displacement along the heading at t = 0, m; ``sideways`` |the
+displacement across it|, m; ``heading_change`` the unwrapped change of heading, deg
+(counter-clockwise seen from above positive);
 ``max_height`` the largest com height, m; ``fall`` the fraction of steps that end fallen (com
 below ``fall_height`` or a ``fall`` endpoint on the floor); ``heading_deviation`` the mean of
-|heading - heading at t = 0| over the steps, / 180°; ``feet_distance`` the mean displacement
+|heading - heading at t = 0| over the steps, deg; ``feet_distance`` the mean displacement
 of the feet along the heading at t = 0, m; ``foot_steps`` the touch-downs of a foot other than
 the one that touched down last; ``min_height`` the lowest com height, m.
 """
@@ -55,17 +56,7 @@ from mosys.kernels.bsr_controller import (
 )
 from mosys.kernels.bsr_simulate import CONTACT_TOLERANCE
 
-TERM_NAMES = (
-    "distance",
-    "sideways",
-    "heading_change",
-    "max_height",
-    "fall",
-    "heading_deviation",
-    "feet_distance",
-    "foot_steps",
-    "min_height",
-)
+# the columns of terms_out (``parsing.bsr.FITNESS_TERMS_3D`` names them in this order)
 (
     DISTANCE,
     SIDEWAYS,
@@ -76,8 +67,8 @@ TERM_NAMES = (
     FEET_DISTANCE,
     FOOT_STEPS,
     MIN_HEIGHT,
-) = range(len(TERM_NAMES))
-TERM_COUNT = len(TERM_NAMES)
+) = range(9)
+TERM_COUNT = 9
 PHYSICAL_SENSES = 10  # height, velocity (3), angular velocity (3), up (3)
 
 
@@ -380,7 +371,7 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
     terms_out[HEADING_CHANGE] = math.degrees(heading - heading_start)
     terms_out[MAX_HEIGHT] = max_height
     terms_out[FALL] = fallen_steps / steps
-    terms_out[HEADING_DEVIATION] = math.degrees(deviation / steps) / 180.0
+    terms_out[HEADING_DEVIATION] = math.degrees(deviation / steps)
     feet_distance = 0.0
     rotation = matrices[0]
     for f in range(n_feet):

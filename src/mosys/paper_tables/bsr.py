@@ -1,16 +1,19 @@
 """The BSR runs table: per search, how it ran (budget, evaluations, speed against the 1995
-paper's figures) and what it found over its seeds (best and median fitness, the measured terms)."""
+paper's figures) and what it found over its seeds (best and median fitness, the measured terms).
+
+The helpers that read, group and summarise a search's seed files are shared with the 3-D runs
+table (``mosys.paper_tables.bsr3d``)."""
 
 from __future__ import annotations
 
-from collections import defaultdict
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from mosys.io.atomic import write_text_atomically
-from mosys.io.bsr_result import read_bsr_result
+from mosys.io.bsr_result import BsrResult, read_bsr_result
 from mosys.parsing.bsr import FITNESS_TERMS
 
 PAPER_EVALUATIONS = 40_000
@@ -23,42 +26,83 @@ PAPER_FIGURE = {
 }
 
 
+def group_by_search(results: Iterable[BsrResult]) -> dict[str, list[BsrResult]]:
+    """The seed results grouped by their ``name`` attribute (the search), searches in the order
+    first met and seeds in the order given."""
+    by_search: dict[str, list[BsrResult]] = {}
+    for result in results:
+        by_search.setdefault(str(result.attrs["name"]), []).append(result)
+    return by_search
+
+
+def median_ms_per_evaluation(results: Sequence[BsrResult]) -> float:
+    """The median over a search's seeds of wall time per evaluation, ms (unrounded)."""
+    evaluations = np.array([result.attrs["evaluations"] for result in results], np.int64)
+    wall = np.array([result.attrs["wall_seconds"] for result in results])
+    return float(np.median(wall / evaluations * 1000.0))
+
+
+def setup_columns(results: Sequence[BsrResult]) -> dict[str, object]:
+    """How a search was set up, from its first seed file: figure, controller kind, rules, T (s),
+    dt (s), budget (the config's name) and generations."""
+    first = results[0].attrs
+    return {
+        "figure": str(first["figure"]),
+        "kind": str(first["controller_kind"]),
+        "rules": int(first["rules"]),
+        "T (s)": float(first["duration"]),
+        "dt (s)": float(first["dt"]),
+        "budget": str(first["budget"]),
+        "generations": int(first["generations"]),
+    }
+
+
+def cost_columns(results: Sequence[BsrResult]) -> dict[str, object]:
+    """What a search's seeds cost: their number, the median evaluations and wall time (s) per
+    seed and the median ms per evaluation (``median_ms_per_evaluation``, rounded)."""
+    evaluations = np.array([result.attrs["evaluations"] for result in results], np.int64)
+    wall = np.array([result.attrs["wall_seconds"] for result in results])
+    return {
+        "seeds": len(results),
+        "evaluations per seed": int(np.median(evaluations)),
+        "wall per seed (s)": round(float(np.median(wall)), 2),
+        "ms per evaluation": round(median_ms_per_evaluation(results), 3),
+    }
+
+
+def fitness_columns(results: Sequence[BsrResult]) -> dict[str, float]:
+    """The best and the median over a search's seeds of their best fitness."""
+    fitness = np.array([result.attrs["best_fitness"] for result in results])
+    return {
+        "best fitness": round(float(fitness.max()), 3),
+        "median fitness": round(float(np.median(fitness)), 3),
+    }
+
+
+def write_table(frame: pd.DataFrame, caption: str, csv_path: str, md_path: str) -> None:
+    """Write ``frame`` as CSV and as Markdown under ``caption`` (each file atomically)."""
+    write_text_atomically(csv_path, frame.to_csv(index=False))
+    write_text_atomically(md_path, caption + frame.to_markdown(index=False) + "\n")
+
+
 def runs_frame(result_paths: list[str | Path]) -> pd.DataFrame:
     """One row per search (the seed files grouped by their ``name`` attribute, in order)."""
-    by_search: dict[str, list] = defaultdict(list)
-    for path in result_paths:
-        result = read_bsr_result(path)
-        by_search[str(result.attrs["name"])].append(result)
     rows = []
-    for name, results in by_search.items():
-        attrs = [result.attrs for result in results]
-        first = attrs[0]
-        kind = str(first["controller_kind"])
-        evaluations = np.array([a["evaluations"] for a in attrs], np.int64)
-        wall = np.array([a["wall_seconds"] for a in attrs])
-        fitness = np.array([a["best_fitness"] for a in attrs])
-        ms_per_evaluation = float(np.median(wall / evaluations * 1000.0))
-        seconds_40k = ms_per_evaluation * PAPER_EVALUATIONS / 1000.0
+    for name, results in group_by_search(map(read_bsr_result, result_paths)).items():
+        setup = setup_columns(results)
+        kind = str(setup["kind"])
+        seconds_40k = median_ms_per_evaluation(results) * PAPER_EVALUATIONS / 1000.0
         paper_low, paper_high = PAPER_SECONDS[kind]
+        steps_per_second = np.median([result.attrs["steps_per_second"] for result in results])
         row = {
             "search": name,
-            "figure": str(first["figure"]),
-            "kind": kind,
-            "rules": int(first["rules"]),
-            "T (s)": float(first["duration"]),
-            "dt (s)": float(first["dt"]),
-            "budget": str(first["budget"]),
-            "generations": int(first["generations"]),
-            "seeds": len(results),
-            "evaluations per seed": int(np.median(evaluations)),
-            "wall per seed (s)": round(float(np.median(wall)), 2),
-            "ms per evaluation": round(ms_per_evaluation, 3),
-            "steps per second": f"{np.median([a['steps_per_second'] for a in attrs]):.3g}",
+            **setup,
+            **cost_columns(results),
+            "steps per second": f"{steps_per_second:.3g}",
             "40k evaluations (s)": round(seconds_40k, 1),
             "paper": PAPER_FIGURE[kind],
             "speed-up vs paper": f"{paper_low / seconds_40k:.0f}-{paper_high / seconds_40k:.0f}x",
-            "best fitness": round(float(fitness.max()), 3),
-            "median fitness": round(float(np.median(fitness)), 3),
+            **fitness_columns(results),
         }
         for term in FITNESS_TERMS:
             values = [result.fitness_terms[term] for result in results]
@@ -70,7 +114,6 @@ def runs_frame(result_paths: list[str | Path]) -> pd.DataFrame:
 def write_bsr_table(result_paths: list[str | Path], csv_path: str, md_path: str) -> pd.DataFrame:
     """Write the runs table as CSV and Markdown (each atomically)."""
     frame = runs_frame(result_paths)
-    write_text_atomically(csv_path, frame.to_csv(index=False))
     caption = (
         "BSR searches after Auslander et al. (1995), §2: one row per search spec over its seeds "
         "(each seed a separate job). budget: the config that set the generations (paper: the "
@@ -81,5 +124,5 @@ def write_bsr_table(result_paths: list[str | Path], csv_path: str, md_path: str)
         "seeds. contact_distance counts endpoints within 1 mm of the floor at both ends of a "
         "step.\n\n"
     )
-    write_text_atomically(md_path, caption + frame.to_markdown(index=False) + "\n")
+    write_table(frame, caption, csv_path, md_path)
     return frame

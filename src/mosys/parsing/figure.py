@@ -1,4 +1,5 @@
-"""The figure spec (``.fig``): a planar tree of rigid rods joined by hinges.
+"""The figure spec (``.fig``): a tree of rigid rods joined by hinges, planar or (with ``ball``
+joints) 3-D.
 
 ::
 
@@ -10,6 +11,23 @@ Keywords: ``gravity``, ``rod``, ``pin`` or ``free`` (the root), ``hinge``, ``lim
 ``contact``, ``terrain``; or a single ``vehicle`` line for the built-in car (``parsing.vehicle``).
 Lengths in metres, masses in kg, angles in degrees (radians in the parsed ``Figure``).
 The full grammar, with every default and convention, is in ``docs/figure-spec.md``.
+
+A figure with any ``ball`` line is 3-D (the 3-D BSR figures of the 1995 paper's §4; frames as in
+``kernels.bsr3d_simulate``: a child's frame is ``R_parent @ Rz(offset) @ Ry(splay) @ Rz(θ) @
+Ry(ψ)``) and may use three more keywords and two more ``free`` options::
+
+    free spine offset=0 splay=0        # the root rod's rest turn in the body frame (degrees)
+    ball leg on=spine at=0.6 offset=-90 splay=10 angle=leg rate=leg_rate swing=leg_swing
+    limit leg lower=-15 upper=15 swing_lower=-5 swing_upper=5   # lower == upper: a fixed angle
+    heading spine offset=0             # required: the rod whose (x, z) direction is the heading
+    feet leg.distal arm.distal         # the endpoints the figure walks on (optional)
+
+A ball joint sits where a hinge would (``at=`` defaults to the parent's length) and has two
+angles, θ (``angle=``, default name the rod's) and ψ (``swing=``, default ``ROD_swing``), their
+rates (``rate=``, ``swing_rate=``) named ``NAME_rate`` by default, ``offset``/``splay`` 0 by
+default, no actuator; its ``limit`` may fix an angle (lower == upper) and needs no
+``stiffness``. A ``hinge`` in a 3-D figure is a joint whose ψ is fixed at 0 (named
+``ROD_swing``, a name no other coordinate may take); its ``limit`` is a planar one.
 """
 
 from __future__ import annotations
@@ -21,11 +39,13 @@ from pathlib import Path
 
 from mosys.parsing.tokens import (
     END_OF_FILE,
+    NAME,
     Line,
     LineReader,
     SpecError,
     Token,
     format_number,
+    missing_line,
     parse_name,
     parse_number,
     read_spec,
@@ -37,6 +57,10 @@ from mosys.parsing.tokens import (
 from mosys.parsing.vehicle import Vehicle, is_vehicle_spec, parse_vehicle
 
 KEYWORDS = ("gravity", "rod", "pin", "free", "hinge", "limit", "contact", "terrain", "vehicle")
+KEYWORDS_3D = ("ball", "heading", "feet")  # only in a 3-D figure: one with a 'ball' line
+ROOT_KINDS = ("pin", "free")
+CHILD_KINDS = ("hinge", "ball")
+ENDPOINT_ENDS = ("proximal", "distal")  # a rod's ends, as 'feet' names them: ROD.END
 DEFAULT_GRAVITY = 9.81  # m/s²
 DEFAULT_COM = 0.5  # fraction of the rod from its proximal end
 DEFAULT_SLIP = 0.01  # m/s: tangential speed at which contact friction reaches friction * normal
@@ -44,6 +68,14 @@ TERRAIN_HALF_WIDTH = 1000.0  # m: 'floor' and 'steps' run from x = -1000 to x = 
 TERRAIN_KINDS = ("floor", "steps", "polyline")
 
 _NO_TOKEN = Token("", 0, 0)
+# the options of a hinge or ball line
+_PLACEMENT_KEYS = {
+    "on": "the parent rod's name",
+    "at": "the hinge's distance along the parent in metres",
+    "offset": "the fixed angle offset in degrees",
+}
+_ANGLE_KEYS = {"angle": "a name for the angle coordinate", "rate": "a name for the angle's rate"}
+_ACTUATOR_KEY = "a name for the hinge's actuator"
 
 
 @dataclass(frozen=True)
@@ -63,9 +95,9 @@ class Rod:
 @dataclass(frozen=True)
 class Coordinate:
     """One generalized coordinate: ``kind`` is ``x`` or ``y`` (metres, the free root's proximal
-    end) or ``angle`` (radians: absolute, CCW from +x, for the root; relative to the parent for a
-    hinge). ``rate`` names its time derivative; ``actuator`` names the control that drives it
-    (``""``: unactuated)."""
+    end), ``angle`` (radians: absolute, CCW from +x, for the root; relative to the parent for a
+    hinge; θ of a ball joint) or ``swing`` (radians: ψ of a ball joint). ``rate`` names its time
+    derivative; ``actuator`` names the control that drives it (``""``: unactuated)."""
 
     name: str
     rate: str
@@ -75,16 +107,24 @@ class Coordinate:
 
     @property
     def is_angle(self) -> bool:
-        return self.kind == "angle"
+        return self.kind in ("angle", "swing")
+
+
+def default_swing_name(rod: str) -> str:
+    """The name of the swing ψ of rod ``rod``'s joint when the spec gives none (a ball line
+    without ``swing=``, any hinge of a 3-D figure)."""
+    return f"{rod}_swing"
 
 
 @dataclass(frozen=True)
 class Joint:
     """How one rod hangs in the tree: a ``pin`` (root hinged to a fixed ``pivot`` (x, y), m;
     absolute angle = ``offset`` + coordinate), a ``free`` root (floating base: coordinates x,
-    y, angle) or a ``hinge`` on ``parent`` at ``position`` metres along the parent from its
+    y, angle; in a 3-D figure its rod's rest frame in the body frame is Rz(``offset``) @
+    Ry(``splay``)), a ``hinge`` on ``parent`` at ``position`` metres along the parent from its
     proximal end, with a fixed ``offset`` (rad): child absolute angle = parent absolute angle +
-    offset + coordinate."""
+    offset + coordinate; or a ``ball`` (3-D) placed as a hinge, with coordinates θ and ψ: child
+    frame = parent frame @ Rz(offset) @ Ry(``splay``) @ Rz(θ) @ Ry(ψ) (``splay`` rad)."""
 
     kind: str
     rod: str
@@ -93,14 +133,28 @@ class Joint:
     position: float = 0.0
     offset: float = 0.0
     pivot: tuple[float, float] = (0.0, 0.0)
+    splay: float = 0.0
     token: Token = field(default=_NO_TOKEN, compare=False, repr=False)
+
+    @property
+    def angle(self) -> Coordinate:
+        """The joint's angle coordinate (θ of a ball joint, the free root's angle)."""
+        return next(coordinate for coordinate in self.coordinates if coordinate.kind == "angle")
+
+    @property
+    def swing(self) -> Coordinate | None:
+        """A ball joint's swing coordinate ψ; None for other joints."""
+        return next((c for c in self.coordinates if c.kind == "swing"), None)
 
 
 @dataclass(frozen=True)
 class JointLimit:
     """One ``limit`` line: a one-sided spring-damper on the angle coordinate ``coordinate`` of
     rod ``rod``'s joint, active below ``lower`` or above ``upper`` (radians, ±inf: no limit).
-    ``stiffness`` N·m/rad, ``damping`` N·m·s/rad."""
+    ``stiffness`` N·m/rad (0: none, only for a ball joint, whose limit may be a bare range for
+    the kinematic BSR simulator), ``damping`` N·m·s/rad. A ball joint's limit also bounds its
+    swing ψ by ``swing_lower``, ``swing_upper`` (radians, ±inf: no limit); its bounds may be
+    equal (a fixed angle)."""
 
     rod: str
     coordinate: str
@@ -108,6 +162,8 @@ class JointLimit:
     upper: float
     stiffness: float
     damping: float
+    swing_lower: float = -math.inf
+    swing_upper: float = math.inf
     token: Token = field(default=_NO_TOKEN, compare=False, repr=False)
 
 
@@ -163,7 +219,10 @@ class Figure:
 
     ``rods`` are in file order (the order of ``endpoints``); ``joints`` in file order, one per rod,
     exactly one of them the root (``pin`` or ``free``); ``coordinates`` follow the joints' order
-    (a free root gives x, y, angle). ``spec_sha256`` is the hex SHA-256 of the file's bytes.
+    (a free root gives x, y, angle; a ball joint θ, ψ). ``spec_sha256`` is the hex SHA-256 of the
+    file's bytes. A 3-D figure (one with a ball joint) names ``heading_rod``, the rod whose
+    horizontal direction plus ``heading_offset`` (rad) is its heading, and its ``feet``: (rod,
+    ``proximal``|``distal``) endpoints, in file order.
     """
 
     path: str = field(compare=False)
@@ -173,6 +232,9 @@ class Figure:
     limits: tuple[JointLimit, ...] = ()
     contacts: tuple[ContactPoint, ...] = ()
     terrain: Terrain = Terrain()
+    heading_rod: str = ""
+    heading_offset: float = 0.0
+    feet: tuple[tuple[str, str], ...] = ()
     spec_sha256: str = field(default="", compare=False)
 
     @property
@@ -181,8 +243,13 @@ class Figure:
         return Path(self.path).stem
 
     @property
+    def dimensions(self) -> int:
+        """3 for a figure with a ball joint, else 2 (planar)."""
+        return 3 if any(joint.kind == "ball" for joint in self.joints) else 2
+
+    @property
     def root(self) -> Joint:
-        return next(joint for joint in self.joints if joint.kind != "hinge")
+        return next(joint for joint in self.joints if joint.kind in ROOT_KINDS)
 
     @property
     def coordinates(self) -> tuple[Coordinate, ...]:
@@ -261,7 +328,7 @@ def render_figure_spec(figure: Figure) -> str:
             f"com={format_number(rod.com)} inertia={format_number(rod.inertia)}"
         )
     for joint in figure.joints:
-        angle = joint.coordinates[-1]
+        angle = joint.angle
         names = f"angle={angle.name} rate={angle.rate}"
         actuator = f" actuator={angle.actuator}" if angle.actuator else ""
         if joint.kind == "pin":
@@ -270,24 +337,42 @@ def render_figure_spec(figure: Figure) -> str:
             out.append(f"pin {joint.rod} at={at}{offset} {names}{actuator}")
         elif joint.kind == "free":
             x, y = joint.coordinates[0], joint.coordinates[1]
+            rest = "".join(
+                f" {key}={format_number(math.degrees(value))}"
+                for key, value in (("offset", joint.offset), ("splay", joint.splay))
+                if value
+            )
             out.append(
                 f"free {joint.rod} x={x.name} y={y.name} {names} x_rate={x.rate} y_rate={y.rate}"
+                + rest
             )
-        else:
+        elif joint.kind == "hinge":
             out.append(
                 f"hinge {joint.rod} on={joint.parent} at={format_number(joint.position)} "
                 f"offset={format_number(math.degrees(joint.offset))} {names}{actuator}"
             )
+        else:
+            swing = joint.swing
+            assert swing is not None
+            out.append(
+                f"ball {joint.rod} on={joint.parent} at={format_number(joint.position)} "
+                f"offset={format_number(math.degrees(joint.offset))} "
+                f"splay={format_number(math.degrees(joint.splay))} {names} "
+                f"swing={swing.name} swing_rate={swing.rate}"
+            )
     for limit in figure.limits:
         bounds = "".join(
             f" {key}={format_number(math.degrees(value))}"
-            for key, value in (("lower", limit.lower), ("upper", limit.upper))
+            for key, value in (
+                ("lower", limit.lower),
+                ("upper", limit.upper),
+                ("swing_lower", limit.swing_lower),
+                ("swing_upper", limit.swing_upper),
+            )
             if math.isfinite(value)
         )
-        out.append(
-            f"limit {limit.rod}{bounds} stiffness={format_number(limit.stiffness)} "
-            f"damping={format_number(limit.damping)}"
-        )
+        stiffness = f" stiffness={format_number(limit.stiffness)}" if limit.stiffness else ""
+        out.append(f"limit {limit.rod}{bounds}{stiffness} damping={format_number(limit.damping)}")
     for contact in figure.contacts:
         out.append(
             f"contact {contact.rod} fraction={format_number(contact.fraction)} "
@@ -303,6 +388,11 @@ def render_figure_spec(figure: Figure) -> str:
         out.append(f"terrain steps {points} height={format_number(terrain.height)}")
     elif terrain.kind == "polyline":
         out.append(f"terrain polyline {points}")
+    if figure.heading_rod:
+        offset = format_number(math.degrees(figure.heading_offset))
+        out.append(f"heading {figure.heading_rod} offset={offset}")
+    if figure.feet:
+        out.append("feet " + " ".join(f"{rod}.{end}" for rod, end in figure.feet))
     return "\n".join(out) + "\n"
 
 
@@ -322,6 +412,7 @@ class _RawJoint:
     position: tuple[float, Token] | None = None
     offset: float = 0.0
     pivot: tuple[float, float] = (0.0, 0.0)
+    splay: float = 0.0
 
 
 @dataclass
@@ -331,6 +422,8 @@ class _RawLimit:
     upper: float
     stiffness: float
     damping: float
+    swing_lower: float
+    swing_upper: float
 
 
 @dataclass
@@ -352,17 +445,33 @@ class _Parser:
         self.limits: list[_RawLimit] = []
         self.contacts: list[_RawContact] = []
         self.terrain = Terrain()
+        self.heading: tuple[Token, float] | None = None  # the heading rod, the offset (rad)
+        self.feet: list[tuple[Token, str]] = []  # each foot's rod (its part of ROD.END), end
         self.first_line: dict[str, int] = {}  # once-only keyword -> its line number
+        self.dimensions = 2
+        self.ball_rods: set[str] = set()  # the rods the file's ball lines name
 
     def error(self, token: Token, expected: str) -> SpecError:
         return SpecError.at(self.path, token, expected)
 
     def parse(self, lines: list[Line], spec_sha256: str) -> Figure:
+        # a 'ball' line anywhere makes the figure 3-D, which other lines' grammar depends on
+        balls = [line for line in lines if line.keyword.text == "ball"]
+        self.dimensions = 3 if balls else 2
+        self.ball_rods = {line.tokens[1].text for line in balls if len(line.tokens) > 1}
+        keywords = KEYWORDS + KEYWORDS_3D if balls else KEYWORDS
+        once = ("gravity", "terrain", "heading", "feet")
         for line in lines:
             keyword = line.keyword.text
-            if keyword not in KEYWORDS:
-                raise unknown_keyword(line, KEYWORDS)
-            if keyword in ("gravity", "terrain"):
+            if keyword in KEYWORDS_3D and not balls:
+                raise self.error(
+                    line.keyword,
+                    f"a planar figure's keyword ('{keyword}' needs a 3-D figure: one with 'ball' "
+                    "joints)",
+                )
+            if keyword not in keywords:
+                raise unknown_keyword(line, keywords)
+            if keyword in once:
                 record_once(line, self.first_line)
             getattr(self, f"line_{keyword}")(line)
         end = Token(END_OF_FILE, lines[-1].number + 1 if lines else 1, 1)
@@ -372,6 +481,12 @@ class _Parser:
         joints = self.resolve_joints(rods, end)
         self.check_names()
         by_rod = {joint.rod: joint for joint in joints}
+        heading_rod, heading_offset = "", 0.0
+        if balls:
+            if self.heading is None:
+                raise missing_line(self.path, lines, "heading")
+            heading_rod = self.rod_reference(self.heading[0], rods, "a heading rod").name
+            heading_offset = self.heading[1]
         return Figure(
             path=self.path,
             gravity=self.gravity,
@@ -380,6 +495,11 @@ class _Parser:
             limits=tuple(self.resolve_limit(limit, rods, by_rod) for limit in self.limits),
             contacts=tuple(self.resolve_contact(contact, rods) for contact in self.contacts),
             terrain=self.terrain,
+            heading_rod=heading_rod,
+            heading_offset=heading_offset,
+            feet=tuple(
+                (self.rod_reference(rod, rods, "a rod").name, end) for rod, end in self.feet
+            ),
             spec_sha256=spec_sha256,
         )
 
@@ -488,14 +608,13 @@ class _Parser:
             reader,
             {
                 "at": "the pivot 'x,y' in metres",
-                "offset": "the fixed angle offset in degrees",
-                "angle": "a name for the angle coordinate",
-                "rate": "a name for the angle's rate",
-                "actuator": "a name for the hinge's actuator",
+                "offset": _PLACEMENT_KEYS["offset"],
+                **_ANGLE_KEYS,
+                "actuator": _ACTUATOR_KEY,
             },
         )
         pivot = self.point(found["at"], "at", "at") if "at" in found else (0.0, 0.0)
-        offset = self.offset(found)
+        offset = self.degrees(found, "offset")
         angle, names = self.angle_coordinate(found, rod)
         self.joints.append(
             _RawJoint("pin", line.keyword, rod, [angle], names, pivot=pivot, offset=offset)
@@ -513,8 +632,16 @@ class _Parser:
                 "x_rate": "a name for x's rate",
                 "y_rate": "a name for y's rate",
                 "rate": "a name for the angle's rate",
+                "offset": "the rest turn about z in degrees",
+                "splay": "the rest turn about y in degrees",
             },
         )
+        for key in ("offset", "splay"):
+            if key in found and self.dimensions == 2:
+                raise self.error(
+                    found[key],
+                    f"a planar root's option ('{key}=' needs a 3-D figure: one with 'ball' joints)",
+                )
         coordinates = []
         names = []
         for axis in ("x", "y"):
@@ -526,36 +653,62 @@ class _Parser:
             names += [("coordinate", name, name_token), ("rate", rate, rate_token)]
         angle, angle_names = self.angle_coordinate(found, rod)
         coordinates.append(angle)
-        self.joints.append(_RawJoint("free", line.keyword, rod, coordinates, names + angle_names))
+        self.joints.append(
+            _RawJoint(
+                "free",
+                line.keyword,
+                rod,
+                coordinates,
+                names + angle_names,
+                offset=self.degrees(found, "offset"),
+                splay=self.degrees(found, "splay"),
+            )
+        )
 
     def angle_coordinate(
-        self, found: dict[str, Token], rod: Token
+        self, found: dict[str, Token], rod: Token, kind: str = "angle"
     ) -> tuple[Coordinate, list[tuple[str, str, Token]]]:
-        """The angle coordinate of a joint line (its rate and actuator inside), and its names
-        with the tokens that gave them (the rod's token for a default name)."""
-        name, name_token = self.coordinate(found, "angle", rod.text, rod, "the angle coordinate")
-        rate, rate_token = self.coordinate(found, "rate", f"{name}_rate", rod, "the angle's rate")
+        """The ``angle`` coordinate of a joint line (keys ``angle=``, ``rate=``, ``actuator=``)
+        or a ball line's ``swing`` ψ (keys ``swing=``, ``swing_rate=``), and its names with the
+        tokens that gave them (the rod's token for a default name)."""
+        if kind == "angle":
+            rate_key, default = "rate", rod.text
+        else:
+            rate_key, default = "swing_rate", default_swing_name(rod.text)
+        name, name_token = self.coordinate(found, kind, default, rod, f"the {kind} coordinate")
+        rate, rate_token = self.coordinate(
+            found, rate_key, f"{name}_rate", rod, f"the {kind}'s rate"
+        )
         names = [("coordinate", name, name_token), ("rate", rate, rate_token)]
         actuator = ""
         if "actuator" in found:
             actuator, actuator_token = self.coordinate(found, "actuator", "", rod, "the actuator")
             names.append(("actuator", actuator, actuator_token))
-        return Coordinate(name, rate, "angle", rod.text, actuator), names
+        return Coordinate(name, rate, kind, rod.text, actuator), names
 
     def line_hinge(self, line: Line) -> None:
-        reader = line.reader()
-        rod = self.name_token(reader, "the child rod")
-        found = self.options(
-            reader,
+        self.child_joint(
+            line, "hinge", {**_PLACEMENT_KEYS, **_ANGLE_KEYS, "actuator": _ACTUATOR_KEY}
+        )
+
+    def line_ball(self, line: Line) -> None:
+        self.child_joint(
+            line,
+            "ball",
             {
-                "on": "the parent rod's name",
-                "at": "the hinge's distance along the parent in metres",
-                "offset": "the fixed angle offset in degrees",
-                "angle": "a name for the angle coordinate",
-                "rate": "a name for the angle's rate",
-                "actuator": "a name for the hinge's actuator",
+                **_PLACEMENT_KEYS,
+                "splay": "the fixed splay in degrees",
+                **_ANGLE_KEYS,
+                "swing": "a name for the swing coordinate",
+                "swing_rate": "a name for the swing's rate",
             },
         )
+
+    def child_joint(self, line: Line, kind: str, keys: dict[str, str]) -> None:
+        """A ``hinge`` or ``ball`` line, whose options are ``keys`` (key -> what it gives)."""
+        reader = line.reader()
+        rod = self.name_token(reader, "the child rod")
+        found = self.options(reader, keys)
         on = self.required(line, found, "on", "the parent rod")
         parent = value_token(on, "on")
         parse_name(parent, self.path, "the parent rod")
@@ -563,60 +716,117 @@ class _Parser:
         if "at" in found:
             at = found["at"]
             position = (self.number(at, "at", "at (m along the parent)"), value_token(at, "at"))
-        offset = self.offset(found)
+        offset = self.degrees(found, "offset")
         angle, names = self.angle_coordinate(found, rod)
+        coordinates = [angle]
+        if kind == "ball":
+            swing, swing_names = self.angle_coordinate(found, rod, "swing")
+            coordinates.append(swing)
+            names += swing_names
+        elif self.dimensions == 3:  # the hinge's ψ, fixed at 0, still has its name
+            names.append(("coordinate", default_swing_name(rod.text), rod))
         self.joints.append(
             _RawJoint(
-                "hinge",
+                kind,
                 line.keyword,
                 rod,
-                [angle],
+                coordinates,
                 names,
                 parent=parent,
                 position=position,
                 offset=offset,
+                splay=self.degrees(found, "splay"),
             )
         )
 
-    def offset(self, found: dict[str, Token]) -> float:
-        """A joint line's ``offset=`` in radians (0 without one)."""
-        if "offset" not in found:
+    def degrees(self, found: dict[str, Token], key: str) -> float:
+        """A line's angle option ``key=`` (degrees) in radians; 0 without one."""
+        if key not in found:
             return 0.0
-        return math.radians(self.number(found["offset"], "offset", "offset (degrees)"))
+        return math.radians(self.number(found[key], key, f"{key} (degrees)"))
 
     def line_limit(self, line: Line) -> None:
         reader = line.reader()
         rod = self.name_token(reader, "the limited joint's rod")
-        found = self.options(
-            reader,
-            {
-                "lower": "the lower limit in degrees",
-                "upper": "the upper limit in degrees",
-                "stiffness": "the spring stiffness in N·m/rad",
-                "damping": "the damping in N·m·s/rad",
-            },
-        )
-        if "lower" not in found and "upper" not in found:
-            raise SpecError(
-                self.path, line.number, line.end_column, "'lower=' or 'upper=' (degrees)", None
+        ball = rod.text in self.ball_rods
+        keys = {"lower": "the lower limit in degrees", "upper": "the upper limit in degrees"}
+        if ball:
+            keys["swing_lower"] = "the swing's lower limit in degrees"
+            keys["swing_upper"] = "the swing's upper limit in degrees"
+        keys["stiffness"] = "the spring stiffness in N·m/rad"
+        keys["damping"] = "the damping in N·m·s/rad"
+        found = self.options(reader, keys)
+        bound_keys = [key for key in keys if key.endswith(("lower", "upper"))]
+        if not any(key in found for key in bound_keys):
+            expected = " or ".join(
+                [", ".join(f"'{key}='" for key in bound_keys[:-1]), f"'{bound_keys[-1]}='"]
             )
-        stiffness_token = self.required(line, found, "stiffness", "N·m/rad")
-        lower, upper = -math.inf, math.inf
-        if "lower" in found:
-            lower = math.radians(self.number(found["lower"], "lower", "lower (degrees)"))
-        if "upper" in found:
-            upper_degrees = self.number(found["upper"], "upper", "upper (degrees)")
-            upper = math.radians(upper_degrees)
-            if not upper > lower:
-                raise self.error(
-                    value_token(found["upper"], "upper"),
-                    f"a number > lower ({math.degrees(lower):g}) for upper (degrees)",
-                )
-        stiffness = self.number(stiffness_token, "stiffness", "stiffness (N·m/rad)", ">0")
+            raise SpecError(self.path, line.number, line.end_column, f"{expected} (degrees)", None)
+        if not ball:  # a ball joint's limit may be a bare range (the BSR simulator's)
+            self.required(line, found, "stiffness", "N·m/rad")
+        lower, upper = self.bounds(found, "lower", "upper", ball)
+        swing_lower, swing_upper = self.bounds(found, "swing_lower", "swing_upper", ball)
+        stiffness = 0.0
+        if "stiffness" in found:
+            stiffness = self.number(found["stiffness"], "stiffness", "stiffness (N·m/rad)", ">0")
         damping = 0.0
         if "damping" in found:
             damping = self.number(found["damping"], "damping", "damping (N·m·s/rad)", ">=0")
-        self.limits.append(_RawLimit(rod, lower, upper, stiffness, damping))
+        self.limits.append(
+            _RawLimit(rod, lower, upper, stiffness, damping, swing_lower, swing_upper)
+        )
+
+    def bounds(
+        self, found: dict[str, Token], lower_key: str, upper_key: str, closed: bool
+    ) -> tuple[float, float]:
+        """A limit's range from ``lower_key=``, ``upper_key=`` (degrees) in radians, ±inf where
+        absent; upper > lower, or upper >= lower if ``closed`` (a ball joint may fix an angle)."""
+        lower, upper = -math.inf, math.inf
+        if lower_key in found:
+            lower = math.radians(self.number(found[lower_key], lower_key, f"{lower_key} (degrees)"))
+        if upper_key in found:
+            upper_degrees = self.number(found[upper_key], upper_key, f"{upper_key} (degrees)")
+            upper = math.radians(upper_degrees)
+            if not (upper >= lower if closed else upper > lower):
+                raise self.error(
+                    value_token(found[upper_key], upper_key),
+                    f"a number {'>=' if closed else '>'} {lower_key} ({math.degrees(lower):g}) "
+                    f"for {upper_key} (degrees)",
+                )
+        return lower, upper
+
+    def line_heading(self, line: Line) -> None:
+        reader = line.reader()
+        rod = self.name_token(reader, "the heading rod")
+        found = self.options(reader, {"offset": "the heading's offset in degrees"})
+        self.heading = (rod, self.degrees(found, "offset"))
+
+    def line_feet(self, line: Line) -> None:
+        expected = "an endpoint 'rod.proximal' or 'rod.distal'"
+        if len(line.tokens) == 1:
+            raise SpecError(self.path, line.number, line.end_column, expected, None)
+        firsts: dict[str, Token] = {}
+        for token in line.tokens[1:]:
+            rod, sep, end = token.text.partition(".")
+            if not sep:
+                raise self.error(token, expected)
+            if NAME.fullmatch(rod) is None:
+                raise SpecError(self.path, token.line, token.column, "a rod name before '.'", rod)
+            if end not in ENDPOINT_ENDS:
+                raise SpecError(
+                    self.path,
+                    token.line,
+                    token.column + len(rod) + 1,
+                    f"'proximal' or 'distal' after '{rod}.'",
+                    end,
+                )
+            if token.text in firsts:
+                raise self.error(
+                    token,
+                    f"each endpoint once ('{token.text}' is at column {firsts[token.text].column})",
+                )
+            firsts[token.text] = token
+            self.feet.append((Token(rod, token.line, token.column), end))
 
     def line_contact(self, line: Line) -> None:
         reader = line.reader()
@@ -725,7 +935,7 @@ class _Parser:
                     f"{joint_line[raw.rod.text]})",
                 )
             joint_line[raw.rod.text] = raw.rod.line
-            if raw.kind != "hinge":
+            if raw.kind in ROOT_KINDS:
                 if root is not None:
                     raise self.error(
                         raw.keyword,
@@ -747,11 +957,11 @@ class _Parser:
                     f"{rod.token.line})",
                     END_OF_FILE,
                 )
-        parents = {raw.rod.text: raw for raw in self.joints if raw.kind == "hinge"}
+        parents = {raw.rod.text: raw for raw in self.joints if raw.kind in CHILD_KINDS}
         for raw in self.joints:
             chain = [raw.rod.text]
             current = raw
-            while current.kind == "hinge":
+            while current.kind in CHILD_KINDS:
                 assert current.parent is not None
                 parent = current.parent.text
                 if parent in chain:
@@ -766,7 +976,7 @@ class _Parser:
         joints = []
         for raw in self.joints:
             position = 0.0
-            if raw.kind == "hinge":
+            if raw.kind in CHILD_KINDS:
                 assert raw.parent is not None
                 parent_rod = rods[raw.parent.text]
                 position = parent_rod.length
@@ -787,6 +997,7 @@ class _Parser:
                     position=position,
                     offset=raw.offset,
                     pivot=raw.pivot,
+                    splay=raw.splay,
                     token=raw.rod,
                 )
             )
@@ -826,11 +1037,13 @@ class _Parser:
                 )
         return JointLimit(
             rod.name,
-            joint.coordinates[-1].name,
+            joint.angle.name,
             raw.lower,
             raw.upper,
             raw.stiffness,
             raw.damping,
+            raw.swing_lower,
+            raw.swing_upper,
             raw.rod,
         )
 

@@ -108,9 +108,10 @@ NONE_COLOR = "0.45"  # rods while no rule is active
 # --------------------------------------------------------------------------- reading the inputs
 
 
-def read_result(path: str | Path) -> BsrResult:
+def read_result(path: str | Path, dimensions: int | None = 2) -> BsrResult:
     """Read a BSR result file and check that its parts agree: PlotInputError naming the file
-    and what is missing or malformed."""
+    and what is missing or malformed. ``dimensions``: those of the figure the plot draws (2:
+    endpoints (N, rods, 2, 2); 3: (N, rods, 2, 3)); None: either."""
     try:
         result = read_bsr_result(path)
     except KeyError as error:  # h5py: a dataset or attribute the contract requires is absent
@@ -126,11 +127,17 @@ def read_result(path: str | Path) -> BsrResult:
     samples = len(result.motion.t)
     if samples == 0:
         raise PlotInputError(f"{path}: best/figure_motion has no samples")
+    drawn = result.motion.dimensions
+    if dimensions is not None and drawn != dimensions:
+        raise PlotInputError(
+            f"{path}: best/figure_motion is the motion of a {drawn}-D figure; this plot draws "
+            f"{dimensions}-D figures"
+        )
     endpoints = result.motion.endpoints
-    if endpoints.ndim != 4 or endpoints.shape[0] != samples or endpoints.shape[2:] != (2, 2):
+    if endpoints.ndim != 4 or endpoints.shape[0] != samples or endpoints.shape[2:] != (2, drawn):
         raise PlotInputError(
             f"{path}: best/figure_motion/endpoints has shape {endpoints.shape}, expected "
-            f"({samples}, rods, 2, 2): one row per sample of t"
+            f"({samples}, rods, 2, {drawn}): one row per sample of t"
         )
     if result.active_rule.shape != (samples,):
         raise PlotInputError(
@@ -143,7 +150,8 @@ def read_result(path: str | Path) -> BsrResult:
     return result
 
 
-def _root_attrs(path: str | Path) -> dict:
+def root_attrs(path: str | Path) -> dict:
+    """A result file's root attributes, without reading its datasets."""
     try:
         with h5py.File(path, "r") as h5:
             return {key: h5.attrs[key] for key in h5.attrs}
@@ -163,7 +171,7 @@ def best_result_path(paths: Sequence[str | Path]) -> Path:
         raise PlotInputError("no BSR result files given")
     ranked = []
     for path in paths:
-        attrs = _root_attrs(path)
+        attrs = root_attrs(path)
         for key in ("best_fitness", "seed"):
             if key not in attrs:
                 raise PlotInputError(f"{path}: not a BSR result file: no root attribute {key!r}")
@@ -175,7 +183,7 @@ def group_by_search(paths: Sequence[str | Path]) -> dict[str, list[Path]]:
     """The result files grouped by search (``search_name``), in the order first met."""
     groups: dict[str, list[Path]] = {}
     for path in paths:
-        groups.setdefault(search_name(_root_attrs(path), path), []).append(Path(path))
+        groups.setdefault(search_name(root_attrs(path), path), []).append(Path(path))
     return groups
 
 
@@ -209,13 +217,16 @@ def fitness_formula(weights: Mapping[str, float]) -> str:
     return f"fitness = {text}"
 
 
-def terms_text(terms: Mapping[str, float]) -> str:
-    """The measured fitness terms with their units, the four of the contract first."""
-    shown = [name for name in TERMS if name in terms]
-    shown += [name for name in terms if name not in TERMS]
+def terms_text(
+    terms: Mapping[str, float], known: Mapping[str, tuple[str, str, str]] = TERMS
+) -> str:
+    """The measured fitness terms with their units, those ``known`` (term -> label, unit,
+    format; default the four of the 2-D contract) first, in its order."""
+    shown = [name for name in known if name in terms]
+    shown += [name for name in terms if name not in known]
     parts = []
     for name in shown:
-        label, unit, fmt = TERMS.get(name, (name.replace("_", " "), "", ".3g"))
+        label, unit, fmt = known.get(name, (name.replace("_", " "), "", ".3g"))
         value = minus_signs(format(float(terms[name]), fmt))
         parts.append(f"{label} {value}{' ' + unit if unit else ''}")
     return ", ".join(parts)
@@ -257,12 +268,13 @@ def learning_figure(results: Sequence[str | Path]) -> Figure:
     """Figure 8 ("Variability in search-algorithm performance") for one search: the best
     fitness so far against the number of controller evaluations, one line per seed, and in a
     narrow panel beside it each seed's final best fitness marked with its seed number. The
-    title names the search, the controller kind and the fitness function. PlotInputError if
-    the files are not all of one search."""
+    title names the search, the controller kind and the fitness function. The figure may be
+    2-D or 3-D. PlotInputError if the files are not all of one search."""
     if not results:
         raise PlotInputError("plot_learning: no BSR result files given")
-    loaded = sorted(
-        ((read_result(p), p) for p in results), key=lambda pair: int(pair[0].attrs["seed"])
+    loaded = sorted(  # the curves do not depend on the figure's dimensions: 2-D or 3-D
+        ((read_result(p, dimensions=None), p) for p in results),
+        key=lambda pair: int(pair[0].attrs["seed"]),
     )
     names = {search_name(r.attrs, p) for r, p in loaded}
     kinds = {_kind(r) for r, _ in loaded}

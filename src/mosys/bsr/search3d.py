@@ -1,0 +1,236 @@
+"""The 1995 paper's search (Figure 3, with §4's changes) for a 3-D figure: binding a spec to a
+3-D figure and the simulation that runs it (``mosys.kernels.bsr3d_controller``).
+
+A search that continues another (``chain NAME``) starts exactly where the best motion of that
+search's best seed (highest ``best_fitness``) ends: its final state and contact forces, in the
+same world frame.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from mosys.bsr.figure3d import BsrFigure3D
+from mosys.bsr.search import RecordedRun, SearchSetup, population_arrays
+from mosys.bsr.start3d import standing_state
+from mosys.io.bsr_result import BsrController
+from mosys.kernels.bsr3d_controller import RunRecord, Task, run_controller, run_population
+from mosys.kernels.bsr3d_simulate import CY
+from mosys.kernels.bsr_controller import ControllerArrays
+from mosys.parsing.bsr import FITNESS_TERMS_3D, BsrSpec
+from mosys.parsing.tokens import SpecError
+
+ENRICH_ROUNDS = 3  # §4.2: rounds of the relevance mutation that enrich the first population
+
+
+@dataclass(frozen=True)
+class ChainStart:
+    """Where a continued search starts: the ``state`` (S,) and endpoint forces ``force`` (E,) N
+    at the end of the best motion of seed ``seed`` of search ``name``."""
+
+    name: str
+    seed: int
+    state: np.ndarray
+    force: np.ndarray
+
+
+def chain_start(name: str, result_paths: list[str | Path]) -> ChainStart:
+    """The final state of the best seed (highest ``best_fitness``, the lowest seed on a tie)
+    among a search's result files."""
+    best: tuple[float, int, Path] | None = None
+    for path in map(Path, result_paths):
+        with h5py.File(path, "r") as h5:
+            key = (float(h5.attrs["best_fitness"]), -int(h5.attrs["seed"]), path)
+        if best is None or key[:2] > best[:2]:
+            best = key
+    if best is None:
+        raise ValueError(f"no result files of search '{name}' to continue")
+    with h5py.File(best[2], "r") as h5:
+        return ChainStart(name, -best[1], h5["best/final_state"][()], h5["best/final_force"][()])
+
+
+class SpatialSimulation:
+    """The 3-D simulator (Simulation of ``mosys.bsr.search``): every controller from the same
+    start (the nominal pose, or the chain's final state) measured as ``task`` says."""
+
+    term_names = FITNESS_TERMS_3D
+
+    def __init__(self, task: Task, start: np.ndarray, start_force: np.ndarray):
+        self.task = task
+        self.start = start
+        self.start_force = start_force
+
+    def evaluate(self, setup: SearchSetup, population, rng: np.random.Generator) -> np.ndarray:
+        spec = setup.spec
+        c = spec.controllers
+        starts = np.repeat(self.start[None, :], c, axis=0)
+        rules = np.zeros((c, spec.steps + 1), np.int64)
+        terms = np.zeros((c, len(FITNESS_TERMS_3D)))
+        senses = population.senses if spec.kind == "sense" else np.zeros((c, spec.steps + 1, 0))
+        run_population(
+            setup.figure.arrays,
+            population_arrays(setup, population),
+            self.task,
+            starts,
+            spec.steps,
+            spec.dt,
+            senses,
+            rules,
+            terms,
+        )
+        return terms @ setup.weights
+
+    def record(self, setup: SearchSetup, controller: BsrController) -> RecordedRun:
+        return record_run(
+            setup.figure, controller, self.task, self.start, self.start_force, setup.spec
+        )
+
+
+def record_run(
+    figure: BsrFigure3D,
+    controller: BsrController,
+    task: Task,
+    start: np.ndarray,
+    start_force: np.ndarray,
+    spec: BsrSpec,
+) -> RecordedRun:
+    """Run ``controller`` for the spec's steps from the state ``start`` (S,) with the endpoint
+    forces ``start_force`` (E,) N, recording every step."""
+    steps = spec.steps
+    time_based = controller.kind == "time"
+    segment_end = np.cumsum(controller.segment) if time_based else np.zeros(controller.rules)
+    if time_based:
+        segment_end[-1] = controller.period
+    n_ends = figure.endpoints.shape[0]
+    run = RecordedRun(
+        terms=np.zeros(len(FITNESS_TERMS_3D)),
+        active_rule=np.zeros(steps + 1, np.int64),
+        rod_ends=np.zeros((steps + 1, figure.parent.shape[0], 2, 3)),
+        com=np.zeros((steps + 1, 3)),
+        final_state=np.empty_like(start),
+        final_force=np.empty(n_ends),
+    )
+    senses = len(figure.sense_names) if not time_based else 0
+    run_controller(
+        figure.arrays,
+        ControllerArrays(
+            time_based,
+            controller.target,
+            controller.tau,
+            controller.center,
+            controller.side,
+            segment_end,
+            controller.period if time_based else 1.0,
+        ),
+        task,
+        np.asarray(start, np.float64),
+        np.asarray(start_force, np.float64),
+        False,
+        steps,
+        spec.dt,
+        RunRecord(
+            np.zeros((steps + 1, senses)),
+            run.active_rule,
+            run.terms,
+            run.rod_ends,
+            run.com,
+            run.final_state,
+            run.final_force,
+        ),
+    )
+    return run
+
+
+def standing_height(figure: BsrFigure3D, root_angle: float = 0.0) -> float:
+    """The centre of mass's height, m, of the figure stood on the floor at rest with every
+    angle at 0 (held in its range): the scale of the height sense and of a fall."""
+    return float(standing_state(figure, root_angle, np.zeros(len(figure.joint_names)))[CY])
+
+
+def bind_search3d(
+    spec: BsrSpec,
+    figure: BsrFigure3D,
+    generations: int | None = None,
+    chain: ChainStart | None = None,
+) -> SearchSetup:
+    """Check the spec's names against the 3-D figure (start coordinates, fall endpoints, terms)
+    and lay out its numbers; a mistake raises SpecError at its word. ``chain``: where a
+    continued search starts (required exactly when the spec has a ``chain`` line)."""
+    if spec.perturbation.any:
+        raise SpecError.at(
+            spec.path, spec.tokens["perturb"], "no 'perturb' line for a 3-D figure (not built)"
+        )
+    for term in spec.weights:
+        if term not in FITNESS_TERMS_3D:
+            raise SpecError.at(
+                spec.path,
+                spec.tokens[f"fitness.{term}"],
+                f"a fitness term of a 3-D figure ({', '.join(FITNESS_TERMS_3D)})",
+            )
+    known = {figure.root_angle: "angle", figure.root_x: "x"}
+    known.update({name: "joint" for name in figure.joint_names})
+    angles = np.zeros(len(figure.joint_names))
+    root_angle = 0.0
+    x = 0.0
+    for name, value in spec.start.items():
+        kind = known.get(name)
+        if kind is None:
+            raise SpecError.at(
+                spec.path,
+                spec.tokens[f"start.{name}"],
+                f"a coordinate of figure '{figure.figure.name}' ({', '.join(known)})",
+            )
+        if kind == "x":
+            x = value
+        elif kind == "angle":
+            root_angle = math.radians(value)
+        else:
+            angles[figure.joint_names.index(name)] = math.radians(value)
+    fall = []
+    for i, endpoint in enumerate(spec.fall):
+        name = f"{endpoint.rod}.{endpoint.end}"
+        if name not in figure.endpoint_names:
+            raise SpecError.at(
+                spec.path,
+                spec.tokens[f"fall.{i}"],
+                f"an endpoint of figure '{figure.figure.name}' "
+                f"({', '.join(figure.endpoint_names)})",
+            )
+        fall.append(figure.endpoint_names.index(name))
+    endpoints = [tuple(row) for row in figure.endpoints.tolist()]
+    feet = np.array([endpoints.index(tuple(foot)) for foot in figure.feet], np.int64)
+    height = standing_height(figure)
+    speed = math.sqrt(figure.gravity * height)
+    task = Task(
+        falls=np.array(fall, np.int64),
+        fall_height=spec.fall_below * height,
+        feet=feet,
+        heading_rod=int(figure.heading_rod),
+        heading_offset=float(figure.heading_offset),
+        free=np.flatnonzero(figure.free).astype(np.int64),
+        scales=np.array([height, speed, speed / height]),
+        filter_time=spec.sense_filter,
+    )
+    if chain is None:
+        start = standing_state(figure, root_angle, angles, x)
+        start_force = np.zeros(figure.endpoints.shape[0])
+    else:
+        start, start_force = chain.state, chain.force
+    return SearchSetup(
+        spec=spec,
+        figure=figure,
+        root_angle=root_angle,
+        joints=angles,
+        x=x,
+        fall_endpoints=task.falls,
+        weights=np.array([spec.weights.get(term, 0.0) for term in FITNESS_TERMS_3D]),
+        generations=spec.generations if generations is None else generations,
+        simulation=SpatialSimulation(task, start, start_force),
+        relevance="contain",
+        enrich_rounds=ENRICH_ROUNDS if spec.kind == "sense" else 0,
+    )

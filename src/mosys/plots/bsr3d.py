@@ -1,0 +1,1085 @@
+"""3-D BSR searches' plots (Auslander et al. 1995, §4 "Initial Experiments with 3D Articulated
+Figures": Figures 15 to 17, and Figures 7 and 8 for 3-D searches), drawn from search results
+``results/bsr/NAME/seedK.h5`` whose ``best/figure_motion`` is 3-D (DESIGN.md, "Figure motion"):
+
+- ``plot_filmstrip``: Figures 15 to 17 (Cujo bounding, Rex's walk-turn-walk, Bob walking), the
+  best motion of one search, or of a chain of searches drawn as one motion, as stick figures at
+  regular times over a checkered floor, seen by one fixed camera (``VIEW``).
+- ``write_motion_gif``: the same motion animated, the same camera.
+- ``plot_learning_kinds``: Figure 7 ("Learning curves for both kinds of motion controller"),
+  a time-based and a sense-based search of one problem, every seed and the median of each.
+- ``plot_seeds``: Figure 8 ("Variability in search-algorithm performance"), the seeds of one
+  search (``mosys.plots.bsr.learning_figure``).
+- ``plot_figure_at_rest``: a figure's first pose from four sides, its rods named (for the
+  README; ``plot_result_at_rest`` draws a result file's).
+
+It builds on ``mosys.plots.bsr``, the 2-D family (reading and checking result files, choosing
+seeds, the learning curves, the fitness terms' text), and on ``mosys.plots.style``.
+
+The camera is orthographic: a point (x, y, z) m (y up, the floor y = 0, the figure facing +x at
+t = 0) is drawn at its distances along the picture plane's right and up axes (``project``), so
+that one metre is as long wherever it is, the floor's squares all alike and the view can pan.
+``VIEW`` looks from the figure's right (+z) side, turned CAMERA_AZIMUTH towards its front
+(+x) and CAMERA_ELEVATION above the floor: walking forward runs left to right, a left turn heads
+away from the camera, a right turn towards it.
+
+A chain (Rex's walk, then his turn from where the walk ends, then his walk again) is given as
+its files in order, one per search, each search's ``chain`` attribute naming the one before it
+and ``chain_seed`` that one's seed; they must join up (``join_chain``). ``chain_paths`` picks a
+chain's files from all the seeds of its searches.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.cm import ScalarMappable
+from matplotlib.collections import LineCollection, PolyCollection
+from matplotlib.colors import ListedColormap, Normalize, to_rgba
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.ticker import StrMethodFormatter
+
+from mosys.io.bsr_result import BsrResult
+from mosys.io.trajectory import FigureMotion
+from mosys.plots.bsr import (
+    CURVE_WIDTH,
+    FOLLOW_POSES,
+    KIND_LINESTYLE,
+    KIND_TEXT,
+    LEARNING_HEIGHT,
+    LEARNING_WIDTH,
+    TERMS,
+    best_result_path,
+    curves_on_grid,
+    fitness_formula,
+    group_by_search,
+    learning_figure,
+    read_result,
+    root_attrs,
+    search_name,
+    terms_text,
+)
+from mosys.plots.style import (
+    GIF_DPI,
+    GIF_FPS,
+    GIF_MAX_FRAMES,
+    JOINT_SIZE,
+    MARGIN_BOTTOM,
+    MARGIN_LEFT,
+    MARGIN_RIGHT,
+    MARGIN_TOP,
+    OUTLINE,
+    ROD_WIDTH,
+    TITLE_LINE,
+    VIEW_PADDING,
+    PlotInputError,
+    add_legend,
+    animation_frames,
+    check_animation_options,
+    choose_interval,
+    controller_colors,
+    draw_pose,
+    fit_aspect,
+    frame_samples,
+    mark_start,
+    minus_signs,
+    new_figure,
+    pan,
+    plot_style,
+    samples_to_the_end,
+    save_png,
+    scene_figure,
+    spread_labels,
+    write_real_time_gif,
+)
+
+# fitness terms of the 3-D searches: (label, unit, format), in the order the captions give them
+TERMS_3D = {
+    "distance": ("distance", "m", "+.2f"),
+    "sideways": ("sideways", "m", ".2f"),
+    "heading_change": ("heading change", "deg", "+.1f"),
+    "max_height": ("max height", "m", ".2f"),
+    "heading_deviation": ("heading deviation", "deg", ".1f"),
+    "feet_distance": ("feet distance", "m", "+.2f"),
+    "foot_steps": ("foot steps", "", ".0f"),
+    **TERMS,
+}
+CHAIN_TOLERANCE = 1e-3  # m: a continuing search's first pose is its predecessor's last pose
+
+# the camera
+CAMERA_AZIMUTH = 30.0  # deg from the figure's right side (+z) towards its front (+x)
+CAMERA_ELEVATION = 30.0  # deg above the floor
+
+
+@dataclass(frozen=True)
+class Camera:
+    """An orthographic camera looking at the world from ``azimuth`` deg round from +z towards
+    +x (0: from the figure's right side, +x to the right; 90: from its front) and
+    ``elevation`` deg above the floor (90: from straight above, +x to the right and -z up).
+    The picture plane's right axis stays level."""
+
+    azimuth: float = CAMERA_AZIMUTH
+    elevation: float = CAMERA_ELEVATION
+
+    def basis(self) -> np.ndarray:
+        """(3, 3): rows the picture's right and up axes and the direction towards the
+        camera, unit vectors in world (x, y, z)."""
+        a, e = math.radians(self.azimuth), math.radians(self.elevation)
+        toward = np.array([math.sin(a) * math.cos(e), math.sin(e), math.cos(a) * math.cos(e)])
+        right = np.array([math.cos(a), 0.0, -math.sin(a)])
+        return np.array([right, np.cross(toward, right), toward])
+
+
+VIEW = Camera()  # the filmstrips' and animations' camera
+SIDE, FRONT, TOP = Camera(0.0, 0.0), Camera(90.0, 0.0), Camera(0.0, 90.0)
+
+
+def project(points: np.ndarray, camera: Camera = VIEW) -> np.ndarray:
+    """Points (..., 3) world (x, y, z) m as the ``camera`` sees them: (..., 3), the distance
+    along the picture's right axis (u, m), along its up axis (v, m) and towards the camera
+    (depth, m; nearer is larger)."""
+    return np.asarray(points, dtype=np.float64) @ camera.basis().T
+
+
+# --------------------------------------------------------------------------- reading a chain
+
+
+@dataclass(frozen=True)
+class ChainMotion:
+    """The best motions of a chain of searches (or of one search) joined into one: ``motion``
+    the joined ``figure_motion`` (t (N,) s from 0, endpoints (N, rods, 2, 3) m, com (N, 3) m;
+    the rest the first file's); ``segment`` (N,) int64 the search each sample belongs to (a
+    sample where one search hands over to the next: the earlier); ``starts`` (S,) int64 the
+    sample each search starts at; and per search its result, file and name."""
+
+    motion: FigureMotion
+    segment: np.ndarray
+    starts: np.ndarray
+    results: tuple[BsrResult, ...]
+    paths: tuple[Path, ...]
+    names: tuple[str, ...]
+
+
+def join_chain(paths: Sequence[str | Path]) -> ChainMotion:
+    """Read the best motions of a chain of searches, one file per search in order (a single
+    file: one search), and join them. PlotInputError unless every file is a 3-D BSR result of
+    the same figure, with a heading rod among its rods, each after the first continuing the one
+    before it: its ``chain`` is that one's search name, its ``chain_seed`` that one's seed, and
+    its first pose is that one's last (within CHAIN_TOLERANCE m at every rod end)."""
+    if not paths:
+        raise PlotInputError("no BSR result files given")
+    results = [read_result(path, dimensions=3) for path in paths]
+    names = [search_name(result.attrs, path) for result, path in zip(results, paths, strict=True)]
+    first = results[0].motion
+    if first.heading_rod not in first.rod_names:
+        raise PlotInputError(
+            f"{paths[0]}: best/figure_motion's heading_rod {first.heading_rod!r} is not one of "
+            f"its rods {', '.join(first.rod_names)}"
+        )
+    times, endpoints, coms, segments, starts = [], [], [], [], []
+    end = 0.0
+    for k, (result, path) in enumerate(zip(results, paths, strict=True)):
+        motion = result.motion
+        skip = 0
+        if k:
+            _check_continues(result, path, results[k - 1], paths[k - 1], names[k - 1])
+            skip = 1  # its first sample is the last of the one before
+        if motion.rod_names != first.rod_names:
+            raise PlotInputError(
+                f"{path}: its figure's rods {', '.join(motion.rod_names)} are not those of "
+                f"{paths[0]} ({', '.join(first.rod_names)})"
+            )
+        starts.append(sum(len(t) for t in times) - skip)
+        times.append(motion.t[skip:] - motion.t[0] + end)
+        endpoints.append(motion.endpoints[skip:])
+        coms.append(motion.com[skip:])
+        segments.append(np.full(len(motion.t) - skip, k, dtype=np.int64))
+        end = float(times[-1][-1]) if len(times[-1]) else end
+    joined = dataclasses.replace(
+        first,
+        t=np.concatenate(times),
+        endpoints=np.concatenate(endpoints),
+        com=np.concatenate(coms),
+    )
+    return ChainMotion(
+        joined,
+        np.concatenate(segments),
+        np.array(starts, dtype=np.int64),
+        tuple(results),
+        tuple(Path(path) for path in paths),
+        tuple(names),
+    )
+
+
+def _check_continues(
+    result: BsrResult, path: str | Path, before: BsrResult, before_path: str | Path, name: str
+) -> None:
+    """PlotInputError unless ``result`` continues ``before`` (search ``name``)."""
+    chain = str(result.attrs.get("chain", ""))
+    this = search_name(result.attrs, path)
+    if chain != name:
+        continues = f"continues {chain!r}" if chain else "continues no search"
+        raise PlotInputError(
+            f"{path}: search {this} {continues}, so it cannot follow {before_path} (search "
+            f"{name}): give a chain's files in order, each search after the one it continues"
+        )
+    seed, before_seed = int(result.attrs.get("chain_seed", 0)), int(before.attrs["seed"])
+    if seed != before_seed:
+        raise PlotInputError(
+            f"{path}: search {this} continues seed {seed} of {name}, not seed {before_seed} "
+            f"({before_path})"
+        )
+    gap = np.linalg.norm(result.motion.endpoints[0] - before.motion.endpoints[-1], axis=-1)
+    if gap.max() > CHAIN_TOLERANCE:
+        raise PlotInputError(
+            f"{path}: its first pose is {gap.max():.3g} m from the last pose of {before_path} "
+            f"(at most {CHAIN_TOLERANCE:g} m: a chained search starts where the one it "
+            "continues ends)"
+        )
+
+
+def chain_paths(paths: Sequence[str | Path]) -> list[Path]:
+    """The files of a chain, one per search, from the seed files of its searches (grouped by
+    search name, the searches in the order first met): the last search's best seed
+    (``best_result_path``), and before each chosen file the seed it continues (its
+    ``chain_seed``) of the search before, if it continues that search; else that search's best
+    seed (``join_chain`` then reports the break)."""
+    if not paths:
+        raise PlotInputError("no BSR result files given")
+    groups = list(group_by_search(paths).items())
+    chosen = [best_result_path(groups[-1][1])]
+    for name, files in reversed(groups[:-1]):
+        after = root_attrs(chosen[0])
+        if str(after.get("chain", "")) != name:
+            chosen.insert(0, best_result_path(files))
+            continue
+        seed = int(after.get("chain_seed", 0))
+        matches = [path for path in files if int(root_attrs(path).get("seed", -1)) == seed]
+        if not matches:
+            raise PlotInputError(
+                f"{chosen[0]}: continues seed {seed} of {name}, which is not among its files "
+                f"given: {', '.join(str(path) for path in files)}"
+            )
+        chosen.insert(0, matches[0])
+    return chosen
+
+
+def headings(motion: FigureMotion) -> np.ndarray:
+    """The figure's heading at each sample, (N,) deg, unwrapped: the direction of its
+    ``heading_rod``'s horizontal (x, z) projection, proximal to distal, plus its
+    ``heading_offset``, counter-clockwise seen from above (+x 0, -z +90)."""
+    rod = motion.rod_names.index(motion.heading_rod)
+    along = motion.endpoints[:, rod, 1] - motion.endpoints[:, rod, 0]
+    angle = np.unwrap(np.arctan2(-along[:, 2], along[:, 0]))
+    return np.degrees(angle) + motion.heading_offset
+
+
+# --------------------------------------------------------------------------- the floor
+
+NICE_CELLS = (0.05, 0.1, 0.2, 0.25, 0.5, 1.0, 2.0, 2.5, 5.0, 10.0)  # m: a floor square's side
+CELLS_PER_SIZE = 5  # at most this many squares across the figure's size
+FLOOR_CELLS = 30  # at most this many squares along the floor's longer side
+FLOOR_MARGIN = 0.3  # of the largest pose's size: floor beyond the farthest rod end
+FLOOR_LIGHT, FLOOR_DARK, FLOOR_EDGE = "0.95", "0.84", "0.55"
+SHADOW_COLOR, SHADOW_ALPHA = "0.25", 0.22  # the figure's shadow, straight down on the floor
+
+
+def pose_size(endpoints: np.ndarray, most: int = 200) -> float:
+    """The figure's size, m: the largest distance between two rod ends of one pose, over
+    ``most`` poses spread evenly through ``endpoints`` (N, rods, 2, 3) m (at least 0.1 m)."""
+    picks = np.unique(np.linspace(0, len(endpoints) - 1, min(len(endpoints), most)).astype(int))
+    points = np.asarray(endpoints, dtype=np.float64)[picks].reshape(len(picks), -1, 3)
+    gaps = np.linalg.norm(points[:, :, None] - points[:, None], axis=-1)
+    return max(float(gaps.max()), 0.1)
+
+
+def floor_cells(
+    points: np.ndarray, margin: float, size: float
+) -> tuple[float, np.ndarray, np.ndarray]:
+    """The floor under ``points`` (..., 3) m with ``margin`` m round them, for a figure of
+    ``size`` m (``pose_size``): its squares' side, m (the smallest of NICE_CELLS giving at most
+    CELLS_PER_SIZE across the figure and FLOOR_CELLS along the floor's longer side), and the
+    squares' edges along x and along z, m, multiples of the side (so that the squares of one
+    world are the same whatever part of it is drawn)."""
+    flat = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    low = flat[:, [0, 2]].min(axis=0) - margin
+    high = flat[:, [0, 2]].max(axis=0) + margin
+    least = max(size / CELLS_PER_SIZE, float((high - low).max()) / FLOOR_CELLS)
+    cell = next((c for c in NICE_CELLS if c >= least - 1e-12), NICE_CELLS[-1])
+    first = np.floor(low / cell + 1e-9)
+    last = np.ceil(high / cell - 1e-9)
+    x_edges = cell * np.arange(first[0], last[0] + 1)
+    z_edges = cell * np.arange(first[1], last[1] + 1)
+    return cell, x_edges, z_edges
+
+
+def _floor_corners(x_edges: np.ndarray, z_edges: np.ndarray) -> np.ndarray:
+    """(4, 3) m: the floor's corners."""
+    return np.array([[x, 0.0, z] for x in x_edges[[0, -1]] for z in z_edges[[0, -1]]])
+
+
+def draw_floor(
+    ax: Axes, x_edges: np.ndarray, z_edges: np.ndarray, camera: Camera = VIEW
+) -> PolyCollection:
+    """The floor y = 0 as a checker of squares between the edges (m) along x and z, seen by
+    ``camera``; returns its collection (one polygon per square)."""
+    cell = float(x_edges[1] - x_edges[0]) if len(x_edges) > 1 else 1.0
+    squares, colors = [], []
+    for x0, x1 in zip(x_edges[:-1], x_edges[1:], strict=True):
+        for z0, z1 in zip(z_edges[:-1], z_edges[1:], strict=True):
+            corners = np.array([[x0, 0, z0], [x1, 0, z0], [x1, 0, z1], [x0, 0, z1]])
+            squares.append(project(corners, camera)[:, :2])
+            parity = (round(x0 / cell) + round(z0 / cell)) % 2
+            colors.append(FLOOR_DARK if parity else FLOOR_LIGHT)
+    floor = PolyCollection(squares, facecolors=colors, edgecolors="none", zorder=0.5)
+    ax.add_collection(floor, autolim=False)
+    rim = project(_floor_corners(x_edges, z_edges)[[0, 1, 3, 2, 0]], camera)
+    ax.plot(rim[:, 0], rim[:, 1], color=FLOOR_EDGE, linewidth=0.8, zorder=0.6)
+    return floor
+
+
+def _shadows(poses: np.ndarray, camera: Camera) -> np.ndarray:
+    """The poses' (..., rods, 2, 3) m shadows straight down on the floor, projected: (K·rods,
+    2, 2)."""
+    flat = np.array(poses, dtype=np.float64)
+    flat[..., 1] = 0.0
+    return project(flat, camera)[..., :2].reshape(-1, 2, 2)
+
+
+def _drawn_pose(pose: np.ndarray, camera: Camera) -> np.ndarray:
+    """A pose (rods, 2, 3) m as ``camera`` sees it, its rods farthest first: (rods, 2, 2) m."""
+    seen = project(pose, camera)
+    return seen[np.argsort(seen[..., 2].mean(axis=1), kind="stable"), :, :2]
+
+
+def draw_axes_key(figure: Figure, box: tuple[float, float, float, float], camera: Camera) -> Axes:
+    """A small key in ``box`` (figure fraction: left, bottom, width, height) of the world's x,
+    y and z axes as ``camera`` sees them, each an arrow lettered at its tip."""
+    key = figure.add_axes(box)
+    key.set_axis_off()
+    key.set_xlim(-1.35, 1.35)
+    key.set_ylim(-1.35, 1.35)
+    key.set_aspect("equal")
+    for axis, letter in enumerate(("x", "y", "z")):
+        tip = project(np.eye(3)[axis], camera)[:2]
+        key.annotate(
+            "",
+            xy=tip,
+            xytext=(0, 0),
+            arrowprops={"arrowstyle": "-|>", "color": "0.2", "linewidth": 1.2},
+        )
+        key.text(*(tip * 1.22), letter, ha="center", va="center", fontsize=9, style="italic")
+    return key
+
+
+# --------------------------------------------------------------------------- the filmstrip
+
+SCENE_WIDTH = 9.0  # inches: the filmstrip's scene
+KEY_SIZE = 0.75  # inches: the axes key in the scene's top left corner
+PATH_WIDTH = 2.4  # pt: the centre of mass's path on the floor
+ARROW_SIZE = 0.4  # of the largest pose's size: the heading arrows' length
+ARROW_COLOR = "black"
+POSE_COUNT = (6, 14)  # a filmstrip's poses: the fewest and the most (``pose_count``)
+POSES_PER_SIZE = 3.0  # poses per distance the figure covers as long as its size
+LEGEND_SIZE = 8.5  # pt
+LIGHTEST = 0.6  # a search's first pose: its colour mixed this much with white; its last pure
+
+
+def search_colors(chain: ChainMotion) -> list[tuple[float, float, float, float]]:
+    """One colour per search of the chain (``controller_colors`` of their names)."""
+    colors = controller_colors(list(dict.fromkeys(chain.names)))
+    return [colors[name] for name in chain.names]
+
+
+def lighten(color: str | tuple[float, ...], amount: float) -> tuple[float, float, float, float]:
+    """``color`` mixed ``amount`` (0..1) with white."""
+    rgba = np.array(to_rgba(color))
+    rgba[:3] += (1.0 - rgba[:3]) * float(np.clip(amount, 0.0, 1.0))
+    return tuple(float(c) for c in rgba)
+
+
+def pose_colors(chain: ChainMotion) -> list[tuple[float, float, float, float]]:
+    """The colour of the pose at each sample (N): its search's colour, mixed LIGHTEST with
+    white at the search's start, pure at its end."""
+    t = chain.motion.t
+    ends = np.array([*chain.starts[1:], len(t) - 1])
+    start, end = t[chain.starts][chain.segment], t[ends][chain.segment]
+    span = np.where(end > start, end - start, 1.0)
+    fraction = np.clip((t - start) / span, 0.0, 1.0)
+    colors = search_colors(chain)
+    return [
+        lighten(colors[k], LIGHTEST * (1.0 - f))
+        for k, f in zip(chain.segment, fraction, strict=True)
+    ]
+
+
+def time_colormap(chain: ChainMotion, steps: int = 256) -> ListedColormap:
+    """The pose colours (``pose_colors``) as a colour map over the time of the joined motion,
+    from 0 to its end, for a colour bar of time."""
+    t = chain.motion.t
+    times = np.linspace(t[0], t[-1], steps)
+    samples = np.minimum(np.searchsorted(t, times), len(t) - 1)
+    colors = pose_colors(chain)
+    return ListedColormap([colors[s] for s in samples])
+
+
+def camera_text(camera: Camera) -> str:
+    """Where ``camera`` looks from, in words."""
+    if camera.elevation >= 90:
+        return "seen from above"
+    side = {0.0: "its right side", 90.0: "its front"}.get(camera.azimuth)
+    if side is None:
+        side = "its front right" if 0 < camera.azimuth < 90 else f"azimuth {camera.azimuth:g}°"
+    return f"seen from {side}, {camera.elevation:g}° above the floor"
+
+
+def _chain_title(chain: ChainMotion) -> str:
+    """The first title line: the figure and its searches."""
+    figure_name = str(chain.results[0].attrs.get("figure", "")) or "the figure"
+    if len(chain.names) == 1:
+        return f"{figure_name}: the best motion of BSR search {chain.names[0]}"
+    return f"{figure_name}: the chained BSR searches {' → '.join(chain.names)}"
+
+
+def _segment_label(chain: ChainMotion, k: int) -> str:
+    """A search's legend entry: its name, controller, seed, time span (s) in the joined
+    motion, best fitness and measured terms."""
+    result = chain.results[k]
+    kind = str(result.attrs["controller_kind"])
+    t = chain.motion.t
+    start = float(t[chain.starts[k]])
+    end = float(t[chain.starts[k + 1]] if k + 1 < len(chain.starts) else t[-1])
+    fitness = minus_signs(f"{float(result.attrs['best_fitness']):.4g}")
+    label = (
+        f"{chain.names[k]}: {KIND_TEXT.get(kind, kind)} controller, seed "
+        f"{int(result.attrs['seed'])}, t {start:g}–{end:.3g} s, fitness {fitness}"
+    )
+    if "fitness_terms" not in result.attrs:
+        return label
+    return f"{label}\n    {terms_text(result.fitness_terms, TERMS_3D)}"
+
+
+def pose_count(chain: ChainMotion) -> int:
+    """How many poses a filmstrip of ``chain`` draws: one, and POSES_PER_SIZE more for each
+    ``pose_size`` the figure covers, between POSE_COUNT. What it covers, m: the length of its
+    centre of mass's path on the floor (sampled every 0.1 s, so that the sway of each step
+    counts little) and, for each search, half its size times the net change of its heading,
+    rad (a turn on the spot sweeps its ends round)."""
+    motion = chain.motion
+    size = pose_size(motion.endpoints)
+    samples = samples_to_the_end(motion.t, 0.1)
+    floor = motion.com[samples][:, [0, 2]]
+    path = float(np.linalg.norm(np.diff(floor, axis=0), axis=1).sum())
+    heading = headings(motion)
+    ends = [*chain.starts[1:], len(motion.t) - 1]
+    turned = sum(
+        abs(heading[end] - heading[start]) for start, end in zip(chain.starts, ends, strict=True)
+    )
+    covered = path + size / 2 * math.radians(turned)
+    least, most = POSE_COUNT
+    return int(np.clip(round(1 + POSES_PER_SIZE * covered / size), least, most))
+
+
+def _arrow(ax: Axes, base: np.ndarray, heading: float, length: float, camera: Camera) -> None:
+    """An arrow on the floor from ``base`` (3,) m, ``length`` m along ``heading`` deg."""
+    angle = math.radians(heading)
+    tip = base + length * np.array([math.cos(angle), 0.0, -math.sin(angle)])
+    ends = project(np.array([base, tip]), camera)[:, :2]
+    ax.annotate(
+        "",
+        xy=ends[1],
+        xytext=ends[0],
+        arrowprops={
+            "arrowstyle": "-|>",
+            "color": ARROW_COLOR,
+            "linewidth": 1.5,
+            "mutation_scale": 13,
+            "shrinkA": 0,
+            "shrinkB": 0,
+        },
+        zorder=1.4,  # under the path of the centre of mass: a head shows past it
+    )
+
+
+def plot_filmstrip(
+    result_paths: Sequence[str | Path], path: str | Path, interval: float | None = None
+) -> None:
+    """Write ``filmstrip_figure`` as a PNG to ``path``."""
+    with plot_style():
+        save_png(filmstrip_figure(result_paths, interval), path)
+
+
+def filmstrip_figure(
+    result_paths: Sequence[str | Path], interval: float | None = None, camera: Camera = VIEW
+) -> Figure:
+    """Figures 15 to 17: the best motion of a 3-D search, or of a chain of them in order
+    (``join_chain``) drawn as one, seen by ``camera``: the figure's rods (lines with round
+    ends, the nearer drawn over the farther) every ``interval`` s and at the end (None: a
+    round interval, ``choose_interval``, giving about ``pose_count`` poses), coloured by
+    search, light to dark through each (``pose_colors``; the colour bar maps them to time, s,
+    a line across it where one search hands over to the next), their shadows straight down,
+    the path of the centre of mass on the floor coloured by search, a square at its start and
+    a dot at each hand-over, an arrow of the heading at each search's start and at the end,
+    over a checkered floor covering the motion (its squares' side in the subtitle), a key of
+    the world axes in the corner. The title names the figure and the searches; the legend
+    gives each search's controller, seed, time span, fitness and measured terms."""
+    chain = join_chain(result_paths)
+    motion = chain.motion
+    t = motion.t
+    duration = float(t[-1] - t[0])
+    if interval is None:
+        count = pose_count(chain)
+        interval = choose_interval(duration, (max(count - 2, 2), count + 2))
+    if not interval > 0:
+        raise ValueError(f"interval must be a positive number of seconds, got {interval!r}")
+    samples = samples_to_the_end(t, interval)
+    poses = motion.endpoints[samples]
+    size = pose_size(motion.endpoints)
+    cell, x_edges, z_edges = floor_cells(motion.endpoints, FLOOR_MARGIN * size, size)
+    seen = project(np.concatenate([poses.reshape(-1, 3), _floor_corners(x_edges, z_edges)]))
+    limits = fit_aspect(
+        np.array([seen[:, :2].min(axis=0) - VIEW_PADDING, seen[:, :2].max(axis=0) + VIEW_PADDING])
+    )
+    colors = search_colors(chain)
+    entries = [
+        (Line2D([], [], color=colors[k], linewidth=PATH_WIDTH), _segment_label(chain, k))
+        for k in range(len(chain.names))
+    ]
+    chained = len(chain.names) > 1
+    title = (
+        f"{_chain_title(chain)}\n"
+        f"poses every {interval:g} s from 0 s to {t[-1]:.3g} s"
+        f"{', coloured by search' if chained else ''}, light → dark, with their shadows; "
+        "the centre of mass's path on the floor "
+        f"{'(■ start, ● hand-over)' if chained else '(■ its start)'}\n"
+        f"arrows: the heading at the start{' of each search' if chained else ''} and at the "
+        f"end; floor squares {cell:g} m; {camera_text(camera)}"
+    )
+    legend_rows = sum(label.count("\n") + 1 for _, label in entries)
+    norm = Normalize(0.0, duration if duration > 0 else 1.0)
+    shades = pose_colors(chain)
+    with plot_style():
+        figure, ax, bar = scene_figure(
+            limits, SCENE_WIDTH, title.count("\n") + 1, legend_rows, colorbar=True
+        )
+        ax.set_axis_off()
+        height = figure.get_size_inches()[1]
+        figure.suptitle(title, y=1 - 0.1 / height, va="top", fontsize=10)
+        draw_floor(ax, x_edges, z_edges, camera)
+        shadows = LineCollection(
+            _shadows(poses, camera),
+            colors=SHADOW_COLOR,
+            alpha=SHADOW_ALPHA,
+            linewidths=ROD_WIDTH + 0.5,
+            capstyle="round",
+            zorder=1,
+        )
+        ax.add_collection(shadows, autolim=False)
+        floor_com = motion.com * np.array([1.0, 0.0, 1.0])
+        ends = [*chain.starts[1:], len(t) - 1]
+        heading = headings(motion)
+        for sample in [*chain.starts, len(t) - 1]:
+            _arrow(ax, floor_com[sample], heading[sample], ARROW_SIZE * size, camera)
+        for k, color in enumerate(colors):
+            piece = project(floor_com[chain.starts[k] : ends[k] + 1], camera)
+            ax.plot(piece[:, 0], piece[:, 1], color=color, linewidth=PATH_WIDTH, zorder=1.5)
+            if k:  # where this search takes over
+                ax.plot(*piece[0, :2], "o", color=color, mec="white", ms=7, mew=1.2, zorder=1.7)
+        start = project(floor_com[0], camera)
+        mark_start(ax, start[0], start[1], colors[0], size=7.0, zorder=1.7)
+        depth = project(motion.com[samples], camera)[:, 2]
+        for rank, j in enumerate(np.argsort(depth, kind="stable")):  # the farthest first
+            draw_pose(
+                ax, _drawn_pose(poses[j], camera), shades[samples[j]], 3 + rank / len(samples)
+            )
+        add_legend(figure, entries, ncols=1, fontsize=LEGEND_SIZE)
+        figure.colorbar(ScalarMappable(norm, time_colormap(chain)), cax=bar, label="time t (s)")
+        for sample in chain.starts[1:]:
+            bar.axhline(t[sample], color="black", linewidth=1.4)
+        box = ax.get_position()
+        width = figure.get_size_inches()[0]
+        draw_axes_key(
+            figure,
+            (box.x0, box.y1 - KEY_SIZE / height, KEY_SIZE / width, KEY_SIZE / height),
+            camera,
+        )
+    return figure
+
+
+# --------------------------------------------------------------------------- the animation
+
+GIF_WIDTH = 6.0  # inches, the scene's data area
+FOLLOW_HEIGHT = 0.6  # height / width of a view that pans
+FAR_LIGHTER = 0.5  # the farthest rod of a pose is mixed this much with white, the nearest not
+
+
+def write_motion_gif(
+    result_paths: Sequence[str | Path],
+    path: str | Path,
+    fps: int = GIF_FPS,
+    max_frames: int = GIF_MAX_FRAMES,
+    camera: Camera = VIEW,
+) -> None:
+    """An animated GIF of the best motion of a 3-D search, or of a chain of them in order
+    (``join_chain``), seen by ``camera`` as in ``filmstrip_figure``: the checkered floor, the
+    centre of mass's path on it coloured by search, the figure's shadow and its rods coloured
+    by search (the farther rods of a pose lighter, FAR_LIGHTER at most, drawn first), and in
+    the corners the time (s) and the search's name. One frame per 1/``fps`` s of motion time
+    (``frame_samples``: every 40 ms by default, the step widened to keep to ``max_frames``
+    frames), played in real time; the last frame held; loops. A motion ranging wider or taller
+    than FOLLOW_POSES times the figure's size is followed by a view that pans
+    (``mosys.plots.style.pan``). Written atomically."""
+    check_animation_options(fps, max_frames)
+    chain = join_chain(result_paths)
+    motion = chain.motion
+    t, endpoints = motion.t, motion.endpoints
+    samples, step = frame_samples(t, int(fps), int(max_frames))
+    size = pose_size(endpoints)
+    cell, x_edges, z_edges = floor_cells(endpoints, FLOOR_MARGIN * size, size)
+    seen = project(endpoints[samples], camera)  # (frames, rods, 2, 3)
+    points = np.concatenate([seen.reshape(-1, 3), project(_floor_corners(x_edges, z_edges))])
+    limits = fit_aspect(
+        np.array([points[:, :2].min(axis=0), points[:, :2].max(axis=0)]) + [[-0.1], [0.1]]
+    )
+    flat = seen[..., :2].reshape(len(samples), -1, 2)
+    centre = (flat.min(axis=1) + flat.max(axis=1)) / 2  # (frames, 2) m
+    window = FOLLOW_POSES * size * np.array([1.0, FOLLOW_HEIGHT])  # m: a view that pans
+    follow = bool(np.any(np.ptp(flat.reshape(-1, 2), axis=0) > window))
+    if follow:
+        limits = fit_aspect(centre[0] + np.array([-0.5, 0.5])[:, None] * window)
+    colors = search_colors(chain)
+    segment = chain.segment[samples]
+    title = (
+        f"{_chain_title(chain)}\n"
+        f"rods{' coloured by search' if len(chain.names) > 1 else ''} (the farther ones "
+        "lighter), their shadows on the floor\n"
+        f"floor squares {cell:g} m; {camera_text(camera)}; played in real time"
+    )
+    with plot_style():
+        figure, ax, _ = scene_figure(
+            limits, GIF_WIDTH, title.count("\n") + 1, legend_rows=0, dpi=GIF_DPI
+        )
+        ax.set_axis_off()
+        figure.suptitle(title, y=1 - 0.08 / figure.get_size_inches()[1], va="top", fontsize=8)
+        draw_floor(ax, x_edges, z_edges, camera)
+        floor_com = project(motion.com * np.array([1.0, 0.0, 1.0]), camera)
+        ends = [*chain.starts[1:], len(t) - 1]
+        for k, color in enumerate(colors):
+            piece = floor_com[chain.starts[k] : ends[k] + 1]
+            ax.plot(piece[:, 0], piece[:, 1], color=color, linewidth=1.6, alpha=0.6)
+        shadow = LineCollection(
+            np.zeros((endpoints.shape[1], 2, 2)),
+            colors=SHADOW_COLOR,
+            alpha=SHADOW_ALPHA + 0.1,
+            linewidths=ROD_WIDTH + 1.0,
+            capstyle="round",
+            zorder=2,
+        )
+        rods = LineCollection(
+            np.zeros((endpoints.shape[1], 2, 2)),
+            linewidths=ROD_WIDTH + 1.0,
+            capstyle="round",
+            zorder=3,
+        )
+        for artist in (shadow, rods):
+            ax.add_collection(artist, autolim=False)
+        (joints,) = ax.plot([], [], "o", markersize=JOINT_SIZE + 1.0, zorder=3.1, color=OUTLINE)
+        box = {"boxstyle": "round,pad=0.3", "facecolor": "white", "alpha": 0.9}
+        corner = {"transform": ax.transAxes, "va": "top", "bbox": box, "zorder": 10}
+        clock = ax.text(0.02, 0.97, "", ha="left", fontsize=10, family="monospace", **corner)
+        label = ax.text(0.98, 0.97, "", ha="right", fontsize=11, fontweight="bold", **corner)
+        shadows = _shadows(endpoints[samples], camera).reshape(len(samples), -1, 2, 2)
+
+        def update(frame: int) -> bool:
+            pose = seen[frame]
+            order = np.argsort(pose[..., 2].mean(axis=1), kind="stable")
+            depth = pose[order, :, 2].mean(axis=1)
+            spread = depth[-1] - depth[0]
+            far = (depth[-1] - depth) / spread if spread > 1e-9 else np.zeros(len(depth))
+            color = colors[int(segment[frame])]
+            rods.set_segments(pose[order, :, :2])
+            rods.set_color([lighten(color, FAR_LIGHTER * f) for f in far])
+            joints.set_data(pose[..., 0].ravel(), pose[..., 1].ravel())
+            shadow.set_segments(shadows[frame])
+            clock.set_text(f"t = {t[samples[frame]]:5.2f} s")
+            label.set_text(chain.names[int(segment[frame])])
+            label.set_color(color)
+            if not follow:
+                return False
+            views = [pan(ax.get_xlim(), centre[frame, 0]), pan(ax.get_ylim(), centre[frame, 1])]
+            if views == [None, None]:
+                return False
+            if views[0] is not None:
+                ax.set_xlim(*views[0])
+            if views[1] is not None:
+                ax.set_ylim(*views[1])
+            return True
+
+        frames = animation_frames(
+            figure, [shadow, rods, joints, clock, label], range(len(samples)), update
+        )
+    write_real_time_gif(frames, path, step)
+
+
+# --------------------------------------------------------------------------- learning curves
+
+SEED_ALPHA, SEED_WIDTH = 0.35, 0.9  # each seed's faint line
+MEDIAN_WIDTH = CURVE_WIDTH + 1.1  # pt
+KIND_COLORS = controller_colors(["time", "sense"])  # one colour per controller kind
+
+
+def _load_kind(paths: Sequence[str | Path], kind: str) -> tuple[str, list[BsrResult]]:
+    """The results of one kind's files, checked to be of one search of that kind: (search
+    name, results sorted by seed)."""
+    loaded = [(read_result(path, dimensions=None), path) for path in paths]
+    for result, path in loaded:
+        found = str(result.attrs["controller_kind"])
+        if found != kind:
+            raise PlotInputError(
+                f"{path}: a {KIND_TEXT.get(found, found)} search's result given as "
+                f"{KIND_TEXT[kind]}"
+            )
+    names = sorted({search_name(result.attrs, path) for result, path in loaded})
+    if len(names) > 1:
+        raise PlotInputError(
+            f"the {KIND_TEXT[kind]} files are of more than one search ({', '.join(names)}): "
+            "give the seeds of one search per kind"
+        )
+    ordered = sorted((result for result, _ in loaded), key=lambda r: int(r.attrs["seed"]))
+    return names[0], ordered
+
+
+def plot_learning_kinds(
+    time_results: Sequence[str | Path],
+    sense_results: Sequence[str | Path],
+    path: str | Path,
+    log_x: bool = False,
+) -> None:
+    """Write ``learning_kinds_figure`` as a PNG to ``path``."""
+    with plot_style():
+        save_png(learning_kinds_figure(time_results, sense_results, log_x), path)
+
+
+def learning_kinds_figure(
+    time_results: Sequence[str | Path],
+    sense_results: Sequence[str | Path],
+    log_x: bool = False,
+) -> Figure:
+    """Figure 7 ("Learning curves for both kinds of motion controller"): the best fitness so
+    far against the number of controller evaluations of a time-based search and a
+    sense-based search of one problem (the seed files of each; one kind may be left out): each
+    seed a faint step line, the median over seeds (``curves_on_grid``, up to the fewest
+    evaluations any seed ran) a bold one, time-based dashed and sense-based solid as in
+    ``mosys.plots.bsr``, its final value written at its end. ``log_x``: evaluations on a log
+    axis (default linear, as the paper draws them). The title names the
+    figure, the searches and their fitness functions. PlotInputError when no file is given, a
+    file is of the other kind, or one kind's files are of two searches."""
+    if not time_results and not sense_results:
+        raise PlotInputError("plot_learning_kinds: no BSR result files given")
+    kinds = [
+        (kind, *_load_kind(paths, kind))
+        for kind, paths in (("time", time_results), ("sense", sense_results))
+        if paths
+    ]
+    first = min(int(r.evaluations[0]) for _, _, results in kinds for r in results)
+    last = max(int(r.evaluations[-1]) for _, _, results in kinds for r in results)
+    if log_x and first <= 0:
+        raise PlotInputError("plot_learning_kinds: a log axis needs evaluations above 0")
+    figures = sorted({str(r.attrs.get("figure", "")) for _, _, rs in kinds for r in rs} - {""})
+    formulas = {fitness_formula(results[0].fitness_weights) for _, _, results in kinds}
+    versus = " vs ".join(
+        f"{KIND_TEXT[kind]} {name} ({len(results)} seeds)" for kind, name, results in kinds
+    )
+    if len(formulas) == 1:
+        fitness = formulas.pop()
+    else:
+        fitness = "; ".join(
+            f"{name}: {fitness_formula(results[0].fitness_weights)}" for _, name, results in kinds
+        )
+    title = (
+        "Learning curves for both kinds of motion controller"
+        f"{': ' + ', '.join(figures) if figures else ''}\n{versus}\n{fitness}"
+    )
+    entries: list[tuple[object, str]] = []
+    with plot_style():
+        figure = new_figure(LEARNING_WIDTH, LEARNING_HEIGHT)
+        ax = figure.subplots()
+        for kind, name, results in kinds:
+            color, style = KIND_COLORS[kind], KIND_LINESTYLE[kind]
+            for result in results:
+                ax.step(
+                    result.evaluations,
+                    result.best_fitness,
+                    where="post",
+                    color=color,
+                    alpha=SEED_ALPHA,
+                    linewidth=SEED_WIDTH,
+                    linestyle=style,
+                )
+            grid, values = curves_on_grid(results)
+            median = np.nanmedian(values, axis=0)
+            ax.step(grid, median, where="post", color=color, linewidth=MEDIAN_WIDTH, ls=style)
+            ax.annotate(
+                minus_signs(f"{median[-1]:.3g}"),
+                (grid[-1], median[-1]),
+                xytext=(4, 0),
+                textcoords="offset points",
+                va="center",
+                fontsize=9,
+                color=color,
+                fontweight="bold",
+            )
+            entries.append(
+                (
+                    Line2D([], [], color=color, linewidth=MEDIAN_WIDTH, linestyle=style),
+                    f"{name} ({KIND_TEXT[kind]}): median over {len(results)} seeds",
+                )
+            )
+            entries.append(
+                (
+                    Line2D([], [], color=color, alpha=SEED_ALPHA, lw=SEED_WIDTH, ls=style),
+                    f"{name}: each seed",
+                )
+            )
+        if log_x:
+            ax.set_xscale("log")
+            ax.set_xlim(first / 1.2, last * 1.6)
+        else:
+            ax.set_xlim(0, last * 1.07 if last > 0 else 1)
+        ax.xaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))
+        ax.set_xlabel(f"controller evaluations (count{', log scale' if log_x else ''})")
+        ax.set_ylabel("best fitness so far (Σ weight × term)")
+        add_legend(figure, entries, ncols=2, fontsize=LEGEND_SIZE)
+        width, height = figure.get_size_inches()
+        figure.suptitle(title, y=1 - 0.1 / height, va="top", fontsize=10.5)
+        figure.subplots_adjust(
+            top=1 - (MARGIN_TOP + 0.1 + TITLE_LINE * (title.count("\n") + 1)) / height,
+            left=(MARGIN_LEFT + 0.1) / width,
+            right=1 - (MARGIN_RIGHT + 0.3) / width,
+        )
+    return figure
+
+
+def plot_seeds(results: Sequence[str | Path], path: str | Path) -> None:
+    """Write ``seeds_figure`` as a PNG to ``path``."""
+    with plot_style():
+        save_png(seeds_figure(results), path)
+
+
+def seeds_figure(results: Sequence[str | Path]) -> Figure:
+    """Figure 8 ("Variability in search-algorithm performance"): the seeds of one search (Bob's
+    sense-based walk), each its own learning curve, and beside them each seed's final best
+    fitness, as ``mosys.plots.bsr.learning_figure`` draws them for 2-D and 3-D figures alike."""
+    if not results:
+        raise PlotInputError("plot_seeds: no BSR result files given")
+    return learning_figure(results)
+
+
+# --------------------------------------------------------------------------- a figure at rest
+
+REST_VIEWS = (("side", SIDE), ("front", FRONT), ("top", TOP))  # the small views, top to bottom
+REST_TITLES = {"side": "from its right side", "front": "from its front", "top": "from above"}
+# the small views' axes: the world coordinate along the picture's right and up axes
+REST_AXES = {"side": ("x (m)", "y (m)"), "front": ("−z (m)", "y (m)"), "top": ("x (m)", "−z (m)")}
+REST_MAIN = (7.4, 6.6)  # inches: the oblique view's width and greatest height
+REST_PAD = 1.2  # inches of the oblique view's height above and below its drawing
+REST_SMALL = 1.75  # inches: the small views' side
+REST_SMALL_GAP = 0.8  # inches above each small view: its title and the x label of the one above
+REST_SMALL_LEFT = 0.75  # inches left of the small views: their y labels
+LABEL_COLUMN = 1.3  # inches left and right of the oblique view's drawing for the rod names
+LABEL_SIZE = 9.0  # pt
+LABEL_GAP = 0.2  # inches between two rod names' middles
+FOOT_MARKER = "^"
+
+
+def plot_figure_at_rest(motion: FigureMotion, path: str | Path, name: str = "") -> None:
+    """Write ``figure_at_rest_figure`` as a PNG to ``path``."""
+    with plot_style():
+        save_png(figure_at_rest_figure(motion, name), path)
+
+
+def figure_at_rest_figure(motion: FigureMotion, name: str = "") -> Figure:
+    """A 3-D figure at rest (``motion`` at its first sample; ``name`` for the title): large,
+    seen by ``VIEW`` over a patch of checkered floor with its shadow, each rod its own colour
+    and named in a column beside the drawing (a leader line to the rod's middle); and small,
+    from its right side, its front and above, all three to one scale in metres, each with the
+    world axes it shows. In every view the rod ends it walks on (``feet``) are triangles and
+    the heading rod is drawn thicker. PlotInputError for a motion that is not 3-D or has no
+    samples."""
+    endpoints = np.asarray(motion.endpoints, dtype=np.float64)
+    if motion.dimensions != 3 or endpoints.ndim != 4 or endpoints.shape[2:] != (2, 3):
+        raise PlotInputError(
+            "plot_figure_at_rest: needs a 3-D figure's motion, endpoints (N, rods, 2, 3); got "
+            f"dimensions {motion.dimensions}, endpoints {endpoints.shape}"
+        )
+    if len(endpoints) == 0:
+        raise PlotInputError("plot_figure_at_rest: the motion has no samples")
+    pose = endpoints[0]
+    colors = controller_colors(list(motion.rod_names))
+    heading = motion.heading_rod or "(none)"
+    title = (
+        f"{name or 'The figure'} at rest (t = {float(motion.t[0]):g} s): "
+        f"{len(motion.rod_names)} rods, {float(np.sum(motion.rod_mass)):.3g} kg, heading rod "
+        f"{heading}\n▲ the rod ends it walks on; the heading rod is drawn thicker"
+    )
+    size = pose_size(pose[None])
+    floor = floor_cells(pose, FLOOR_MARGIN * size, size)
+    drawn = project(np.concatenate([pose.reshape(-1, 3), _floor_corners(*floor[1:])]))
+    span = np.ptp(drawn[:, :2], axis=0)
+    top = MARGIN_TOP + 0.1 + TITLE_LINE * 2
+    main_width, most = REST_MAIN
+    width = 0.2 + main_width + REST_SMALL_LEFT + REST_SMALL + MARGIN_RIGHT + 0.1
+    room = max(most, 3 * (REST_SMALL + REST_SMALL_GAP))  # inches under the title
+    height = top + room + MARGIN_BOTTOM
+    # the oblique view as tall as its drawing needs at the width it has, centred in the room
+    main_height = min(most, span[1] / span[0] * (main_width - 2 * LABEL_COLUMN) + REST_PAD)
+    with plot_style():
+        figure = new_figure(width, height)
+        figure.suptitle(title, y=1 - 0.1 / height, va="top", fontsize=11)
+        main = figure.add_axes(
+            (
+                0.2 / width,
+                (MARGIN_BOTTOM + (room - main_height) / 2) / height,
+                main_width / width,
+                main_height / height,
+            )
+        )
+        _draw_rest_oblique(main, motion, pose, colors, floor)
+        main.set_title(camera_text(VIEW), fontsize=10)
+        seen = {view: project(pose, camera)[..., :2].reshape(-1, 2) for view, camera in REST_VIEWS}
+        half = 0.55 * max(float(np.ptp(points, axis=0).max()) for points in seen.values())
+        half = max(half, 0.05)  # m: every small view spans twice this, to one scale
+        for k, (view, camera) in enumerate(REST_VIEWS):
+            bottom = height - top - (k + 1) * (REST_SMALL + REST_SMALL_GAP) + 0.45
+            left = 0.2 + main_width + REST_SMALL_LEFT
+            ax = figure.add_axes(
+                (left / width, bottom / height, REST_SMALL / width, REST_SMALL / height)
+            )
+            middle = (seen[view].min(axis=0) + seen[view].max(axis=0)) / 2
+            if view != "top":  # the floor at the bottom of the view, a little of it showing
+                middle[1] = max(middle[1], 0.9 * half)
+            ax.set_xlim(middle[0] - half, middle[0] + half)
+            ax.set_ylim(middle[1] - half, middle[1] + half)
+            ax.set_aspect("equal")
+            if view != "top":
+                ax.axhspan(-2 * half, 0.0, color=FLOOR_DARK, zorder=0.5)
+                ax.axhline(0.0, color=FLOOR_EDGE, linewidth=1.0, zorder=0.6)
+            _draw_rest_pose(ax, motion, pose, colors, camera)
+            xlabel, ylabel = REST_AXES[view]
+            ax.set_xlabel(xlabel, labelpad=1)
+            ax.set_ylabel(ylabel, labelpad=1)
+            ax.tick_params(labelsize=7.5)
+            ax.set_title(REST_TITLES[view], fontsize=9.5)
+    return figure
+
+
+def plot_result_at_rest(result_path: str | Path, path: str | Path) -> None:
+    """``plot_figure_at_rest`` of a 3-D BSR result's best motion, named by its ``figure``."""
+    result = read_result(result_path, dimensions=3)
+    plot_figure_at_rest(result.motion, path, str(result.attrs.get("figure", "")))
+
+
+def _draw_rest_pose(
+    ax: Axes, motion: FigureMotion, pose: np.ndarray, colors: dict, camera: Camera
+) -> np.ndarray:
+    """The rods of ``pose`` (rods, 2, 3) m seen by ``camera``, the farthest first, each in its
+    colour with round ends, the heading rod thicker, the feet marked; returns the projected
+    pose (rods, 2, 3)."""
+    seen = project(pose, camera)
+    names = list(motion.rod_names)
+    for rank, rod in enumerate(np.argsort(seen[..., 2].mean(axis=1), kind="stable")):
+        width = ROD_WIDTH + (2.5 if names[rod] == motion.heading_rod else 1.0)
+        ax.plot(
+            seen[rod, :, 0],
+            seen[rod, :, 1],
+            color=colors[names[rod]],
+            linewidth=width,
+            solid_capstyle="round",
+            marker="o",
+            markersize=JOINT_SIZE,
+            markeredgecolor=OUTLINE,
+            markeredgewidth=0.5,
+            zorder=3 + rank / len(names),
+        )
+    for rod, end in motion.feet:
+        ax.plot(
+            seen[rod, end, 0],
+            seen[rod, end, 1],
+            FOOT_MARKER,
+            color="black",
+            markersize=7,
+            markerfacecolor="white",
+            markeredgewidth=1.3,
+            zorder=5,
+        )
+    return seen
+
+
+def _draw_rest_oblique(
+    ax: Axes, motion: FigureMotion, pose: np.ndarray, colors: dict, floor: tuple
+) -> None:
+    """The large view of ``figure_at_rest_figure``: the ``floor`` (``floor_cells``), the
+    shadow, the rods and their names in a column each side (rods left of the middle named on
+    the left), LABEL_COLUMN inches wide, the names spread apart (``spread_labels``) and joined
+    to their rods."""
+    cell, x_edges, z_edges = floor
+    ax.set_axis_off()
+    draw_floor(ax, x_edges, z_edges)
+    shadows = LineCollection(
+        _shadows(pose[None], VIEW),
+        colors=SHADOW_COLOR,
+        alpha=SHADOW_ALPHA,
+        linewidths=ROD_WIDTH + 0.5,
+        capstyle="round",
+        zorder=1,
+    )
+    ax.add_collection(shadows, autolim=False)
+    seen = _draw_rest_pose(ax, motion, pose, colors, VIEW)
+    drawn = np.concatenate([seen.reshape(-1, 3), project(_floor_corners(x_edges, z_edges))])
+    low, high = drawn[:, :2].min(axis=0), drawn[:, :2].max(axis=0)
+    centre = (low + high) / 2
+    box = ax.get_position()
+    inches = np.array([box.width, box.height]) * ax.figure.get_size_inches()
+    room = inches - [2 * LABEL_COLUMN, REST_PAD]  # inches for the drawing
+    scale = float(max((high - low) / room))  # m per inch
+    ax.set_xlim(centre[0] - inches[0] * scale / 2, centre[0] + inches[0] * scale / 2)
+    ax.set_ylim(centre[1] - inches[1] * scale / 2, centre[1] + inches[1] * scale / 2)
+    ax.set_aspect("equal")
+    middles = seen[..., :2].mean(axis=1)
+    names = list(motion.rod_names)
+    reach = (high[0] - low[0]) / 2 + 0.1 * scale
+    y_low, y_high = ax.get_ylim()
+    for side in (-1, 1):
+        rods = [r for r in range(len(names)) if (middles[r, 0] >= centre[0]) == (side > 0)]
+        if not rods:
+            continue
+        column = centre[0] + side * reach
+        heights = spread_labels(middles[rods, 1], LABEL_GAP * scale, y_low, y_high)
+        for rod, y in zip(rods, heights, strict=True):
+            color = colors[names[rod]]
+            ax.plot(
+                [middles[rod, 0], column], [middles[rod, 1], y], color=color, lw=0.7, zorder=2.5
+            )
+            ax.text(
+                column + side * 0.05 * scale,
+                y,
+                names[rod],
+                ha="left" if side > 0 else "right",
+                va="center",
+                fontsize=LABEL_SIZE,
+                color=color,
+                fontweight="bold",
+                zorder=6,
+            )
+    ax.text(0.02, 0.02, f"floor squares {cell:g} m", transform=ax.transAxes, color="0.3")
+    width, height = ax.figure.get_size_inches()
+    draw_axes_key(
+        ax.figure, (box.x0, box.y1 - KEY_SIZE / height, KEY_SIZE / width, KEY_SIZE / height), VIEW
+    )
