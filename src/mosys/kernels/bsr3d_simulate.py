@@ -44,6 +44,10 @@ LX = 10  # angular momentum x, y, z
 JOINTS = 13  # θ starts here, θ' follows it
 MAX_CONTACTS = 8
 COMPLIANCE = 1e-6  # of a contact's own response: splits loads the rigid body leaves undecided
+FIXED_POINT_ITERATIONS = 50  # of the shared-friction shares
+# a twist whose horizontal impulse at some contact exceeds its normal impulse this many times is
+# not used (the shares of a contact that barely touches cannot stop a spin): slide only then
+TWIST_RATIO = 1.0
 
 
 class FigureArrays3D(NamedTuple):
@@ -420,7 +424,9 @@ def _solve(system, size):
 
 
 @njit(cache=True, error_model="numpy")
-def _shared_friction(u, r, active, count, responses, impulse, system, weight, compliance, share):
+def _shared_friction(
+    u, r, active, count, responses, impulse, system, weight, compliance, share, twisting
+):
     """Impulses at the active contacts (at least two), the paper's friction carried to 3-D: no
     active point sinks; each point's horizontal impulse is its share (its normal impulse over
     their sum) of a common one, a slide (T_x, T_z) plus a twist Γ about the vertical (at offset
@@ -429,12 +435,14 @@ def _shared_friction(u, r, active, count, responses, impulse, system, weight, co
     neither slide nor spin on the floor (in a vertical plane the twist is 0 and this is the 2-D
     rule). A fixed point over the shares, iterated to 1e-12. ``compliance`` (s/kg, 0: none) is
     added to each contact's own normal response: it splits the load of contacts that a rigid
-    body leaves undecided (more than three on a plane, several in a line). u, r (count, 3).
-    Returns the index of the contact whose normal impulse pulls most (-1: none pulls; -2: the
-    system is singular). ``share`` (count,): the shares the points had the step before (0: not in
-    contact then), where the iteration starts if every active point had one and there are three
-    or more (which the 2-D rule never has: two start at even shares, as in 2-D, since where the
-    iteration starts can decide whether a normal impulse is found to pull)."""
+    body leaves undecided (more than three on a plane, several in a line). ``twisting``: False
+    leaves the twist out (Γ = 0: slide only, the 2-D rule as it is). u, r (count, 3). Returns
+    the index of the contact whose normal impulse pulls most (-1: none pulls; -2: the system is
+    singular; -3: the shares of a twisting solve did not settle; slide only keeps its last
+    iterate, as the 2-D rule does). ``share`` (count,): the shares the points had the step
+    before (0: not in contact then), where the iteration starts if every active point had one
+    and there are three or more (which the 2-D rule never has: two start at even shares, as in
+    2-D, since where the iteration starts can decide whether a normal impulse pulls)."""
     n = 0
     known = 0.0
     for i in range(count):
@@ -448,8 +456,9 @@ def _shared_friction(u, r, active, count, responses, impulse, system, weight, co
             weight[i] = share[i] / known
         else:
             weight[i] = 1.0 / n
-    size = n + 3
-    for _ in range(50):
+    size = n + 3 if twisting else n + 2
+    converged = False
+    for _ in range(FIXED_POINT_ITERATIONS):
         system[:size, : size + 1] = 0.0
         row = 0
         for i in range(count):
@@ -481,20 +490,24 @@ def _shared_friction(u, r, active, count, responses, impulse, system, weight, co
                         system[n, column] += scale_x * normal if a == 0 else 0.0
                         system[n + 1, column] += scale_x * normal if a == 2 else 0.0
                         lever = r[i, 2] if a == 0 else -r[i, 0]
-                        system[n + 2, column] += weight[i] * lever * normal
+                        if twisting:
+                            system[n + 2, column] += weight[i] * lever * normal
                     column += 1
                 if a == 1:
                     system[target, n] += slide_x
                     system[target, n + 1] += slide_z
-                    system[target, n + 2] += twist
+                    if twisting:
+                        system[target, n + 2] += twist
                     system[target, size] = -u[i, 1]
                 else:
                     axis_row = n if a == 0 else n + 1
                     lever = r[i, 2] if a == 0 else -r[i, 0]
                     system[axis_row, n] += weight[i] * slide_x
                     system[axis_row, n + 1] += weight[i] * slide_z
-                    system[axis_row, n + 2] += weight[i] * twist
                     system[axis_row, size] -= weight[i] * u[i, a]
+                    if not twisting:
+                        continue
+                    system[axis_row, n + 2] += weight[i] * twist
                     system[n + 2, n] += weight[i] * lever * slide_x
                     system[n + 2, n + 1] += weight[i] * lever * slide_z
                     system[n + 2, n + 2] += weight[i] * lever * twist
@@ -527,10 +540,13 @@ def _shared_friction(u, r, active, count, responses, impulse, system, weight, co
             weight[i] = updated
             row += 1
         if change <= 1e-12:
+            converged = True
             break
+    if twisting and not converged:
+        return -3
     slide_x = system[n, size]
     slide_z = system[n + 1, size]
-    twist = system[n + 2, size]
+    twist = system[n + 2, size] if twisting else 0.0
     row = 0
     for i in range(count):
         if active[i]:
@@ -571,6 +587,17 @@ def _others_hold(u, count, responses, impulse, members):
 
 
 @njit(cache=True, error_model="numpy")
+def _twist_too_strong(impulse, active, count):
+    """True if some active contact's horizontal impulse exceeds TWIST_RATIO times its normal."""
+    for i in range(count):
+        if active[i]:
+            horizontal = math.sqrt(impulse[i, 0] ** 2 + impulse[i, 2] ** 2)
+            if horizontal > TWIST_RATIO * impulse[i, 1]:
+                return True
+    return False
+
+
+@njit(cache=True, error_model="numpy")
 def contact_impulses(
     u, r, count, inverse_mass, world_inverse, impulse, responses, system, work, chosen, end_share
 ):
@@ -603,8 +630,13 @@ def contact_impulses(
     compliance = 0.0 if n < 3 else COMPLIANCE * (responses[0, 0, 0, 0] + responses[0, 0, 1, 1])
     while n >= 2:
         worst = _shared_friction(
-            u, r, active, count, responses, impulse, system, weight, compliance, share
+            u, r, active, count, responses, impulse, system, weight, compliance, share, True
         )
+        if worst == -1 and _twist_too_strong(impulse, active, count) or worst == -3:
+            # slide only: the paper's rule as it is
+            worst = _shared_friction(
+                u, r, active, count, responses, impulse, system, weight, compliance, share, False
+            )
         if worst == -2 and compliance == 0.0:
             # the rigid body leaves the split undecided: a little compliance decides it
             compliance = COMPLIANCE * (responses[0, 0, 0, 0] + responses[0, 0, 1, 1])
@@ -614,7 +646,8 @@ def contact_impulses(
                 end_share[chosen[i]] = weight[i]
             return
         if worst < 0:
-            # still singular, or another point would sink: drop the one sinking slowest
+            # still singular, unsettled, or another point would sink: drop the one sinking
+            # slowest
             for i in range(count):
                 if active[i] and (worst < 0 or u[i, 1] > u[worst, 1]):
                     worst = i
