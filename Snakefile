@@ -12,6 +12,7 @@ include: "workflow/rules/tables.smk"
 include: "workflow/rules/car.smk"
 include: "workflow/rules/luxo.smk"
 include: "workflow/rules/bsr.smk"
+include: "workflow/rules/bsr3d.smk"
 include: "workflow/rules/composite.smk"
 
 
@@ -21,6 +22,7 @@ rule all:
         "results/car_all",
         "results/luxo_all",
         "results/bsr_all",
+        "results/bsr3d_all",
         "results/composite_all",
         "results/paper_tables",
 
@@ -69,6 +71,17 @@ rule bsr_all:
         "mosys index {input} -o {output} 2> {log}"
 
 
+rule bsr3d_all:
+    input:
+        bsr3d_targets(),
+    output:
+        "results/bsr3d_all",
+    log:
+        "results/logs/bsr3d_all.log",
+    shell:
+        "mosys index {input} -o {output} 2> {log}"
+
+
 rule composite_all:
     input:
         composite_targets(),
@@ -83,7 +96,7 @@ rule composite_all:
 rule paper_tables:
     input:
         paper_table_targets() + car_table_targets() + luxo_table_targets()
-        + bsr_table_targets() + composite_table_targets(),
+        + bsr_table_targets() + bsr3d_table_targets() + composite_table_targets(),
     output:
         "results/paper_tables",
     log:

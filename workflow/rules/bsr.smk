@@ -5,6 +5,7 @@ rule bsr_search:
     input:
         spec="specs/bsr/{name}.bsr",
         figure=bsr_figure_spec,
+        chain=bsr_chain_results,
         code=code_inputs("mosys.cli.bsr", "mosys.bsr.result_file"),  # mosys bsr-search
     output:
         "results/bsr/{name}/seed{seed}.h5",
@@ -15,10 +16,12 @@ rule bsr_search:
     params:
         generations=bsr_generations_option,
         budget=bsr_budget,
+        chain=bsr_chain_option,
     threads: config["bsr"]["threads"]
     shell:
         "mosys bsr-search {input.spec} --seed {wildcards.seed} --figures specs/figures"
-        " {params.generations} --budget {params.budget} --threads {threads} -o {output}"
+        " {params.generations} --budget {params.budget} {params.chain} --threads {threads}"
+        " -o {output}"
         " 2> {log} || (cat {log} >&2; exit 1)"
 
 

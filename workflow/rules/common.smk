@@ -258,13 +258,37 @@ def luxo_targets():
     )
 
 
+def bsr_settings(name):
+    """The config section of a search's budget: bsr3d for the 3-D searches, else bsr."""
+    return config["bsr3d"] if name in config["bsr3d"]["searches"] else config["bsr"]
+
+
 def bsr_seeds(name):
-    """The seeds of a search: its spec's 'seeds' line, the first config bsr.seeds of them if
-    that is set (a reduced budget)."""
+    """The seeds of a search: its spec's 'seeds' line, the first config bsr.seeds (bsr3d.seeds
+    for a 3-D search) of them if that is set (a reduced budget)."""
     seeds = [word for words in spec_words(f"specs/bsr/{name}.bsr", "seeds")[:1]
              for word in words[1:] if re.fullmatch(r"\d+", word)]
-    limit = config["bsr"]["seeds"]
+    limit = bsr_settings(name)["seeds"]
     return seeds if limit is None else seeds[:limit]
+
+
+def bsr_chain(name):
+    """The search a 3-D search continues (its 'chain' line), or None."""
+    return next((words[1] for words in spec_words(f"specs/bsr/{name}.bsr", "chain")[:1]
+                 if len(words) > 1 and re.fullmatch(r"\w+", words[1])), None)
+
+
+def bsr_chain_results(wildcards):
+    """The result files of the search this one continues: its job waits for them, and editing
+    that search's spec reruns this one too."""
+    chained = bsr_chain(wildcards.name)
+    return [] if chained is None else [f"results/bsr/{chained}/seed{seed}.h5"
+                                       for seed in bsr_seeds(chained)]
+
+
+def bsr_chain_option(wildcards, input):
+    """'--chain FILES' for a search that continues another, else nothing."""
+    return "--chain " + " ".join(input.chain) if input.chain else ""
 
 
 def bsr_seed_results(wildcards):
@@ -285,20 +309,22 @@ def bsr_figure_spec(wildcards):
 
 def bsr_full_budget(name):
     """Whether a search runs at its spec's own G: no cap is set, or the config exempts it."""
-    return config["bsr"]["generations"] is None or name in config["bsr"]["full_budget"]
+    settings = bsr_settings(name)
+    return settings["generations"] is None or name in settings["full_budget"]
 
 
 def bsr_generations_option(wildcards):
     """'--generations G' when the config caps this search's generations, else nothing."""
     if bsr_full_budget(wildcards.name):
         return ""
-    return f"--generations {config['bsr']['generations']}"
+    return f"--generations {bsr_settings(wildcards.name)['generations']}"
 
 
 def bsr_budget(wildcards):
     """The budget a search's result is labelled with: the config's, or 'paper' for a search
     the config exempts from its cap."""
-    exempt = config["bsr"]["generations"] is not None and bsr_full_budget(wildcards.name)
+    exempt = (bsr_settings(wildcards.name)["generations"] is not None
+              and bsr_full_budget(wildcards.name))
     return "paper" if exempt else config["budget"]
 
 
@@ -310,6 +336,28 @@ def bsr_targets():
     plots = [f"results/plots/bsr/{name}/{plot}" for name in config["bsr"]["searches"]
              for plot in ("learning.png", "filmstrip.png", "motion.gif")]
     return bsr_all_results() + plots + ["results/plots/bsr/learning_curves.png"] + bsr_table_targets()
+
+
+def bsr3d_results(*names):
+    """Every seed's result file of the given 3-D searches (all of them if none given)."""
+    return [f"results/bsr/{name}/seed{seed}.h5"
+            for name in (names or config["bsr3d"]["searches"]) for seed in bsr_seeds(name)]
+
+
+def bsr3d_motion_results(wildcards):
+    """The result files of a 3-D motion's chain of searches, in order."""
+    return bsr3d_results(*config["bsr3d"]["motions"][wildcards.motion])
+
+
+def bsr3d_table_targets():
+    return ["results/tables/bsr3d_runs.csv", "results/tables/bsr3d_runs.md"]
+
+
+def bsr3d_targets():
+    plots = [f"results/plots/bsr3d/{motion}/{plot}" for motion in config["bsr3d"]["motions"]
+             for plot in ("filmstrip.png", "motion.gif", "rest.png")]
+    figures = ["results/plots/bsr3d/learning_kinds.png", "results/plots/bsr3d/seeds.png"]
+    return bsr3d_results() + plots + figures + bsr3d_table_targets()
 
 
 def composite_searches(name):

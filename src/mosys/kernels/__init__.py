@@ -1,0 +1,41 @@
+"""The numeric kernels (numba, ``cache=True``).
+
+numba checks a cached function against its own source file only: a kernel that calls a kernel of
+another file (``bsr3d_controller.run_population`` steps ``bsr3d_simulate.step``) would keep
+running the callee as it was compiled. So the cache stands for the whole package: importing it
+compares a digest of every kernel source file with the one the cache was built from and, if they
+differ, removes the package's cached machine code (numba's ``.nbi``/``.nbc`` files beside the
+sources) before anything is compiled.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+
+def _forget_stale_machine_code(directory: Path) -> None:
+    """Remove the cached machine code of the kernels in ``directory`` if any source changed
+    since it was built (recorded in ``__pycache__/kernels.sha256``); nothing if unwritable."""
+    digest = hashlib.sha256()
+    for source in sorted(directory.glob("*.py")):
+        digest.update(source.name.encode())
+        digest.update(source.read_bytes())
+    cache = directory / "__pycache__"
+    stamp = cache / "kernels.sha256"
+    try:
+        if stamp.read_text(encoding="ascii") == digest.hexdigest():
+            return
+    except OSError:
+        pass
+    try:
+        cache.mkdir(exist_ok=True)
+        for pattern in ("*.nbi", "*.nbc"):
+            for stale in cache.glob(pattern):
+                stale.unlink(missing_ok=True)
+        stamp.write_text(digest.hexdigest(), encoding="ascii")
+    except OSError:
+        return
+
+
+_forget_stale_machine_code(Path(__file__).parent)
