@@ -116,7 +116,7 @@ def test_rod_ends_at_one_point_count_once():
 
 def test_bad_shapes_and_times_are_input_errors():
     with pytest.raises(InputError, match="n_rods, 2, 2"):
-        lone_contacts(T, np.zeros((T.size, 3, 2, 3)))
+        lone_contacts(T, np.zeros((T.size, 3, 2, 4)))
     with pytest.raises(InputError, match="increase strictly"):
         lone_contacts(np.zeros(T.size), one_foot_down())
 
@@ -139,3 +139,23 @@ def test_moving_the_world_and_adding_a_rod_far_up_change_nothing(shift, floor, s
     assert [c.excursion for c in contacts] == pytest.approx(
         [c.excursion for c in expected], abs=1e-9
     )
+
+
+@settings(max_examples=30, deadline=None)
+@given(slide=st.floats(0.0, 0.02), sideways=st.floats(0.0, 0.02))
+def test_a_3d_motion_counts_the_slide_across_as_well_as_along(slide, sideways):
+    """The planar motion placed in 3-D (z = 0) has the same lone contacts; a foot that also
+    slides across (z) by ``sideways`` has the diagonal of its horizontal extent as excursion."""
+    planar = one_foot_down(slide)
+    flat = np.concatenate([planar, np.zeros(planar.shape[:3] + (1,))], axis=3)
+    assert [(c.rod, c.end, c.t_start, c.t_end, c.excursion) for c in lone_contacts(T, flat)] == [
+        (c.rod, c.end, c.t_start, c.t_end, c.excursion) for c in lone_contacts(T, planar)
+    ]
+    across = flat.copy()
+    across[..., 2] += np.linspace(0.0, sideways, T.size)[:, None, None]
+    contacts = lone_contacts(T, across)
+    assert len(contacts) == len(lone_contacts(T, planar)) > 0
+    for contact, flat_contact in zip(contacts, lone_contacts(T, planar), strict=True):
+        duration = (flat_contact.t_end - flat_contact.t_start) / (T[-1] - T[0])
+        expected = np.hypot(flat_contact.excursion, sideways * duration)
+        assert contact.excursion == pytest.approx(expected, rel=1e-6, abs=1e-12)

@@ -1,4 +1,4 @@
-"""Lone contacts in a recorded planar figure motion: the 1995 paper's friction rule
+"""Lone contacts in a recorded figure motion (planar or 3-D): the 1995 paper's friction rule
 "when only one rod endpoint is in contact with the ground, it is not allowed to move
 horizontally" (§2.1.1), checked on a ``figure_motion`` group after the fact.
 
@@ -6,7 +6,8 @@ A *lone contact* is a stretch of consecutive samples during which exactly one di
 endpoint is down (within ``CONTACT_HEIGHT`` of the floor and moving vertically slower than
 ``STILL_SPEED``) while every other distinct endpoint is at least ``CLEAR_HEIGHT`` above the
 floor, lasting at least ``MIN_DURATION``. Its *excursion* is the horizontal extent (max x − min x)
-of that endpoint over the stretch; the rule holds if the excursion stays under ``MAX_EXCURSION``.
+of that endpoint over the stretch (3-D: the diagonal of its x-z extent); the rule holds if the
+excursion stays under ``MAX_EXCURSION``.
 
 Choices: an endpoint below the floor counts as down; the vertical speed of sample i is the
 central difference (y[i+1] − y[i−1]) / (t[i+1] − t[i−1]), one-sided at the first and last
@@ -53,10 +54,10 @@ class LoneContact:
 
 def distinct_endpoints(endpoints: np.ndarray) -> np.ndarray:
     """(E, 2) int64 rod and end (0 proximal, 1 distal) of each distinct endpoint of a motion's
-    endpoints (N, n_rods, 2, 2) m: a rod end that stays within ``SAME_POINT`` of an earlier one
-    (in (rod, end) order) at every sample is that one, not a new endpoint."""
+    endpoints (N, n_rods, 2, D) m (D = 2 or 3): a rod end that stays within ``SAME_POINT`` of an
+    earlier one (in (rod, end) order) at every sample is that one, not a new endpoint."""
     n_rods = endpoints.shape[1]
-    points = endpoints.reshape(endpoints.shape[0], 2 * n_rods, 2)
+    points = endpoints.reshape(endpoints.shape[0], 2 * n_rods, endpoints.shape[3])
     kept: list[int] = []
     for slot in range(2 * n_rods):
         if not any(
@@ -77,21 +78,26 @@ def vertical_speed(t: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 
 def lone_contacts(t: np.ndarray, endpoints: np.ndarray, floor: float = 0.0) -> list[LoneContact]:
-    """Every maximal lone contact lasting at least ``MIN_DURATION`` in a planar motion, in order
-    of start time (then rod, then end).
+    """Every maximal lone contact lasting at least ``MIN_DURATION`` in a motion, in order of
+    start time (then rod, then end).
 
-    t: (N,) s, strictly increasing; endpoints: (N, n_rods, 2, 2) m, per sample and rod its
-    proximal then distal end (x, y), y up (the ``figure_motion`` contract); floor: the floor's
-    height, m. Raises InputError for arrays of another shape or times that do not increase.
+    t: (N,) s, strictly increasing; endpoints: (N, n_rods, 2, D) m, per sample and rod its
+    proximal then distal end (x, y) or (x, y, z), y up (the ``figure_motion`` contract); floor:
+    the floor's height, m. Raises InputError for arrays of another shape or times that do not
+    increase.
     """
     t = np.asarray(t, np.float64)
     endpoints = np.asarray(endpoints, np.float64)
     if t.ndim != 1:
         raise InputError(f"t must be 1-D (N,), got shape {t.shape}")
-    if endpoints.ndim != 4 or endpoints.shape[0] != t.shape[0] or endpoints.shape[2:] != (2, 2):
+    if (
+        endpoints.ndim != 4
+        or endpoints.shape[0] != t.shape[0]
+        or endpoints.shape[2:] not in ((2, 2), (2, 3))
+    ):
         raise InputError(
-            f"endpoints must have shape (N, n_rods, 2, 2) with N = {t.shape[0]} samples of t, "
-            f"got {endpoints.shape}"
+            f"endpoints must have shape (N, n_rods, 2, 2) or (N, n_rods, 2, 3) with N = "
+            f"{t.shape[0]} samples of t, got {endpoints.shape}"
         )
     steps = np.diff(t)
     if np.any(~(steps > 0.0)):
@@ -103,7 +109,8 @@ def lone_contacts(t: np.ndarray, endpoints: np.ndarray, floor: float = 0.0) -> l
     if t.shape[0] < 2 or endpoints.shape[1] == 0:
         return []
     ends = distinct_endpoints(endpoints)
-    x = endpoints[:, ends[:, 0], ends[:, 1], 0]
+    horizontal = [axis for axis in range(endpoints.shape[3]) if axis != 1]
+    places = endpoints[:, ends[:, 0], ends[:, 1]][:, :, horizontal]  # (N, E, 1 or 2)
     height = endpoints[:, ends[:, 0], ends[:, 1], 1] - floor
     down = (height <= CONTACT_HEIGHT) & (np.abs(vertical_speed(t, height)) < STILL_SPEED)
     clear = height >= CLEAR_HEIGHT
@@ -119,14 +126,15 @@ def lone_contacts(t: np.ndarray, endpoints: np.ndarray, floor: float = 0.0) -> l
             last = stop - 1
             if t[last] - t[first] < MIN_DURATION - TIME_TOLERANCE:
                 continue
-            span = x[first:stop, e]
+            span = places[first:stop, e]
+            extent = span.max(axis=0) - span.min(axis=0)
             found.append(
                 LoneContact(
                     rod=int(ends[e, 0]),
                     end=int(ends[e, 1]),
                     t_start=float(t[first]),
                     t_end=float(t[last]),
-                    excursion=float(span.max() - span.min()),
+                    excursion=float(np.sqrt((extent**2).sum())),
                 )
             )
     return sorted(found, key=lambda c: (c.t_start, c.rod, c.end))

@@ -20,8 +20,9 @@ displacement across it|, m; ``heading_change`` the unwrapped change of heading, 
 ``max_height`` the largest com height, m; ``fall`` the fraction of steps that end fallen (com
 below ``fall_height`` or a ``fall`` endpoint on the floor); ``heading_deviation`` the mean of
 |heading - heading at t = 0| over the steps, deg; ``feet_distance`` the mean displacement
-of the feet along the heading at t = 0, m; ``foot_steps`` the touch-downs of a foot other than
-the one that touched down last; ``min_height`` the lowest com height, m.
+of the feet along the heading at t = 0, m; ``foot_steps`` the touch-downs (after a lift of at
+least ``STEP_LIFT``) of a foot other than the one that touched down last; ``min_height`` the
+lowest com height, m.
 """
 
 from __future__ import annotations
@@ -70,6 +71,7 @@ from mosys.kernels.bsr_simulate import CONTACT_TOLERANCE
 ) = range(9)
 TERM_COUNT = 9
 PHYSICAL_SENSES = 10  # height, velocity (3), angular velocity (3), up (3)
+STEP_LIFT = 0.01  # m: a foot that comes down counts as a step if it rose this high since it left
 
 
 class Task(NamedTuple):
@@ -270,6 +272,7 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
     fallen_steps = 0
     foot_steps = 0
     last_foot = -1
+    foot_lift = np.zeros(n_feet)  # each foot's highest point since it left the floor, m
     for n in range(steps):
         step(
             parent,
@@ -315,12 +318,18 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
                 + rotation[1, 2] * end_offset[e, 2]
             )
             now_touching = not math.isnan(floor) and y <= floor + CONTACT_TOLERANCE
-            if now_touching and not touching[e]:
-                for f in range(n_feet):
-                    if task.feet[f] == e:
-                        if f != last_foot:
-                            foot_steps += 1
-                        last_foot = f
+            for f in range(n_feet):
+                if task.feet[f] != e:
+                    continue
+                if not now_touching:
+                    foot_lift[f] = max(foot_lift[f], y - floor)
+                    continue
+                if not touching[e] and foot_lift[f] >= STEP_LIFT:
+                    # a touch-down after a lift: a step if another foot made the last one
+                    if f != last_foot:
+                        foot_steps += 1
+                    last_foot = f
+                foot_lift[f] = 0.0
             touching[e] = now_touching
         for f in range(task.falls.shape[0]):
             if touching[task.falls[f]]:

@@ -1,0 +1,125 @@
+"""results/bsr3d_all built by the real workflow at CI's reduced budget (config/ci.yaml: G = 20,
+two seeds): the files keep the 3-D contracts, Rex's three searches chain through their result
+files (each starts where the best seed of the one before ends, and editing the turn reruns the
+turn and the second walk only), and the physics rules hold on every motion built."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import h5py
+import numpy as np
+import pytest
+from test_workflow import copy_workflow, edited_spec, planned_jobs, snakemake
+
+from mosys.bsr.lone_contact import lone_contacts, sliding
+from mosys.io.bsr_result import read_bsr_result
+
+CI = ("--configfile", "config/ci.yaml")
+SEARCHES = (
+    "cujo_bound",
+    "rex_walk",
+    "rex_turn",
+    "rex_walk_again",
+    "rex_walk_sense",
+    "bob_walk",
+    "bob_walk_time",
+)
+SINK = 0.01  # m: no endpoint goes further into the floor than this
+CHAIN = {"rex_turn": "rex_walk", "rex_walk_again": "rex_turn"}  # search -> the one it continues
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    work = copy_workflow(tmp_path_factory.mktemp("bsr3d"))
+    snakemake(work, "results/bsr3d_all", *CI)
+    return work
+
+
+def results(work, name):
+    return sorted((work / "results/bsr" / name).glob("seed*.h5"))
+
+
+@pytest.mark.slow
+def test_bsr3d_all_builds_every_search_plot_and_the_table(built):
+    listed = (built / "results/bsr3d_all").read_text()
+    for name in SEARCHES:
+        assert len(results(built, name)) == 2
+        assert f"results/bsr/{name}/seed1.h5" in listed
+    for motion in ("cujo", "rex", "bob", "bob_time"):
+        for plot in ("filmstrip.png", "motion.gif", "rest.png"):
+            assert (built / "results/plots/bsr3d" / motion / plot).stat().st_size > 10_000
+    for plot in ("learning_kinds.png", "seeds.png"):
+        assert (built / "results/plots/bsr3d" / plot).stat().st_size > 10_000
+    table = (built / "results/tables/bsr3d_runs.csv").read_text()
+    assert all(name in table for name in SEARCHES)
+    assert table.count(",ci,") == len(SEARCHES)
+
+
+@pytest.mark.slow
+def test_every_3d_result_keeps_the_contract(built):
+    for name in SEARCHES:
+        for path in results(built, name):
+            with h5py.File(path, "r") as h5:
+                motion = h5["best/figure_motion"]
+                n = motion["t"].shape[0]
+                rods = len(motion.attrs["rod_names"])
+                assert motion["endpoints"].shape == (n, rods, 2, 3)
+                assert motion["com"].shape == (n, 3)
+                assert int(motion.attrs["dimensions"]) == 3
+                assert motion.attrs["heading_rod"] in list(motion.attrs["rod_names"])
+                assert json.loads(motion.attrs["terrain"]) == [[-1000, 0], [1000, 0]]
+                feet = json.loads(motion.attrs["feet"])
+                assert feet and all(0 <= rod < rods and end in (0, 1) for rod, end in feet)
+                terms = json.loads(h5.attrs["fitness_terms"])
+                assert {"distance", "sideways", "heading_change", "max_height"} <= set(terms)
+                assert h5["best/active_rule"].shape == (n,)
+                assert h5.attrs["chain"] == CHAIN.get(name, "")
+                assert np.all(np.diff(h5["learning_curve/best_fitness"][()]) >= 0)
+                # unchained searches start facing +x
+                if not h5.attrs["chain"]:
+                    assert motion["com"][0, 2] == pytest.approx(0.0, abs=1e-12)
+
+
+@pytest.mark.slow
+def test_each_of_rexs_searches_starts_where_the_best_seed_of_the_one_before_ends(built):
+    for name, before in CHAIN.items():
+        previous = {int(h5py.File(p, "r").attrs["seed"]): p for p in results(built, before)}
+        fitness = {seed: read_bsr_result(p).attrs["best_fitness"] for seed, p in previous.items()}
+        best_seed = max(sorted(fitness), key=lambda seed: fitness[seed])
+        ending = read_bsr_result(previous[best_seed]).motion
+        for path in results(built, name):
+            result = read_bsr_result(path)
+            assert int(result.attrs["chain_seed"]) == best_seed
+            np.testing.assert_allclose(
+                result.motion.endpoints[0], ending.endpoints[-1], rtol=0, atol=1e-12
+            )
+
+
+@pytest.mark.slow
+def test_no_endpoint_sinks_and_no_lone_contact_slides_in_any_3d_motion(built):
+    for name in SEARCHES:
+        for path in results(built, name):
+            motion = read_bsr_result(path).motion
+            assert motion.endpoints[..., 1].min() > -SINK
+            assert sliding(lone_contacts(motion.t, motion.endpoints)) == []
+
+
+@pytest.mark.slow
+def test_editing_the_turn_reruns_the_turn_and_the_second_walk_not_the_first(built):
+    spec = built / "specs/bsr/rex_turn.bsr"
+    text = spec.read_text()
+    edited = re.sub(r"heading_change=[\d.]+", "heading_change=0.06", text)
+    assert edited != text
+    with edited_spec(spec, edited):
+        jobs = planned_jobs(built, "results/bsr3d_all", *CI)
+        output = snakemake(built, "--dry-run", "results/bsr3d_all", *CI)
+    searched = sorted(re.findall(r"wildcards: name=(\w+), seed=(\d+)", output))
+    assert searched == [(name, seed) for name in ("rex_turn", "rex_walk_again") for seed in "12"]
+    assert jobs == {
+        "bsr_search": 4,
+        "bsr3d_motion_plots": 1,
+        "bsr3d_runs_table": 1,
+        "bsr3d_all": 1,
+    }
