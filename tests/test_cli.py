@@ -222,6 +222,7 @@ TOP_LEVEL_HELP = (
     "  luxo-table         Luxo's motions table\n"
     "  bsr-table          the BSR runs table\n"
     "  bsr3d-table        the 3-D BSR runs table\n"
+    "  bsr3d-targets      the 3-D motions against their targets\n"
     "  composite-table    the composite-motion table\n"
     "  robustness-table   robust BSR searches against their plain twins\n"
     "pipeline:\n"
@@ -271,6 +272,7 @@ VERBS = [
     "luxo-table",
     "bsr-table",
     "bsr3d-table",
+    "bsr3d-targets",
     "composite-table",
     "robustness-table",
     "index",

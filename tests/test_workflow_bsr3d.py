@@ -10,6 +10,7 @@ import re
 
 import h5py
 import numpy as np
+import pandas as pd
 import pytest
 from test_workflow import copy_workflow, edited_spec, planned_jobs, snakemake
 
@@ -121,5 +122,31 @@ def test_editing_the_turn_reruns_the_turn_and_the_second_walk_not_the_first(buil
         "bsr_search": 4,
         "bsr3d_motion_plots": 1,
         "bsr3d_runs_table": 1,
+        "bsr3d_targets_table": 1,
         "bsr3d_all": 1,
     }
+
+
+@pytest.mark.slow
+def test_the_targets_table_measures_each_target_on_the_files(built):
+    frame = pd.read_csv(built / "results/tables/bsr3d_targets.csv", keep_default_na=False)
+    assert list(frame["search"]) == [
+        "cujo_bound",
+        "rex_walk -> rex_turn -> rex_walk_again",
+        "bob_walk",
+        "bob_walk_time vs bob_walk",
+        "every motion",
+    ]
+    # Cujo's body lengths, measured again: the best seed's distance over his spine's length
+    best = max(
+        (read_bsr_result(path) for path in results(built, "cujo_bound")),
+        key=lambda result: (result.attrs["best_fitness"], -result.attrs["seed"]),
+    )
+    lengths = best.fitness_terms["distance"] / best.motion.rod_length[0]
+    assert frame["measured"][0].startswith(f"{lengths:.2f} body lengths")
+    assert frame["met"][0] == (
+        "yes" if lengths >= 3 and "fell" not in frame["measured"][0] else "no"
+    )
+    # the physics holds at any budget
+    assert frame["met"][4] == "yes"
+    assert set(frame["budget"][:4]) == {"ci"}

@@ -63,3 +63,20 @@ rule bsr3d_runs_table:
     shell:
         "mosys bsr3d-table {input.results} --csv {output.csv} --md {output.md}"
         " 2> {log} || (cat {log} >&2; exit 1)"
+
+
+rule bsr3d_targets_table:
+    input:
+        results=bsr3d_results(),
+        code=code_inputs("mosys.cli.paper_tables", "mosys.paper_tables.bsr3d_targets"),
+    output:
+        csv="results/tables/bsr3d_targets.csv",
+        md="results/tables/bsr3d_targets.md",
+    log:
+        "results/logs/tables/bsr3d_targets.log",
+    params:
+        roles=bsr3d_target_roles,
+    threads: 1
+    shell:
+        "mosys bsr3d-targets {input.results} {params.roles} --csv {output.csv} --md {output.md}"
+        " 2> {log} || (cat {log} >&2; exit 1)"

@@ -350,7 +350,15 @@ def bsr3d_motion_results(wildcards):
 
 
 def bsr3d_table_targets():
-    return ["results/tables/bsr3d_runs.csv", "results/tables/bsr3d_runs.md"]
+    return ["results/tables/bsr3d_runs.csv", "results/tables/bsr3d_runs.md",
+            "results/tables/bsr3d_targets.csv", "results/tables/bsr3d_targets.md"]
+
+
+def bsr3d_target_roles(wildcards):
+    """The bsr3d-targets options: which search plays which part (config bsr3d.targets)."""
+    roles = config["bsr3d"]["targets"]
+    return (f"--bound {roles['bound']} --chain {' '.join(roles['chain'])}"
+            f" --walk {roles['walk']} --time-walk {roles['time_walk']}")
 
 
 def bsr3d_targets():

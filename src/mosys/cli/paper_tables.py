@@ -74,6 +74,29 @@ def _bsr3d_table(args: argparse.Namespace) -> None:
     write_bsr3d_table(args.results, args.csv, args.md)
 
 
+def _bsr3d_targets_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("results", nargs="+", help="seed files (.h5) of the 3-D searches")
+    parser.add_argument("--bound", required=True, help="the bounding search (Cujo)")
+    parser.add_argument(
+        "--chain",
+        nargs=3,
+        required=True,
+        metavar=("WALK", "TURN", "WALK_AGAIN"),
+        help="Rex's three chained searches",
+    )
+    parser.add_argument("--walk", required=True, help="the sense-based biped walk (Bob)")
+    parser.add_argument("--time-walk", required=True, help="its time-based twin")
+    add_table_outputs(parser)
+
+
+def _bsr3d_targets(args: argparse.Namespace) -> None:
+    from mosys.paper_tables.bsr3d_targets import write_bsr3d_targets
+
+    write_bsr3d_targets(
+        args.results, args.csv, args.md, args.bound, args.chain, args.walk, args.time_walk
+    )
+
+
 def _composite_table_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("results", nargs="+", help="composite results (.h5)")
     add_table_outputs(parser)
@@ -145,6 +168,12 @@ FAMILY = Family(
             "the 3-D BSR runs table",
             _bsr3d_table_arguments,
             _bsr3d_table,
+        ),
+        Verb(
+            "bsr3d-targets",
+            "the 3-D motions against their targets",
+            _bsr3d_targets_arguments,
+            _bsr3d_targets,
         ),
         Verb(
             "composite-table",
