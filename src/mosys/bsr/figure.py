@@ -18,7 +18,7 @@ import numpy as np
 from mosys.io.trajectory import FigureMotion
 from mosys.kernels.bsr_simulate import FigureArrays
 from mosys.parsing.bsr import ENDPOINT_ENDS
-from mosys.parsing.figure import Figure, parse_figure_spec
+from mosys.parsing.figure import Figure, Joint, parse_figure_spec
 from mosys.parsing.tokens import SpecError, Token
 
 # the figure_motion contract's contact attribute of every BSR motion
@@ -124,12 +124,8 @@ def bsr_figure(figure: Figure) -> BsrFigure:
             ball.token,
             "a planar figure (ball joints are for the 3-D BSR search: bsr.figure3d)",
         )
-    root = figure.root
-    if root.kind != "free":
-        raise SpecError.at(figure.path, root.token, "a 'free' root (BSR figures fly and fall)")
+    root = check_bsr_figure(figure)
     names = [rod.name for rod in figure.rods]
-    if names[0] != root.rod:
-        raise SpecError.at(figure.path, figure.rods[0].token, f"the root rod '{root.rod}' first")
     index = {name: i for i, name in enumerate(names)}
     limits = {limit.rod: limit for limit in figure.limits}
     n = len(names)
@@ -160,8 +156,6 @@ def bsr_figure(figure: Figure) -> BsrFigure:
         joint_min.append(limit.lower)
         joint_max.append(limit.upper)
     terrain = figure.terrain
-    if terrain.kind not in ("none", "floor"):
-        raise SpecError(figure.path, 1, 1, "a flat 'terrain floor' for a BSR figure", None)
     length = np.array([rod.length for rod in figure.rods])
     endpoints = distinct_endpoints(parent, hinge, length)
     return BsrFigure(
@@ -186,8 +180,21 @@ def bsr_figure(figure: Figure) -> BsrFigure:
     )
 
 
-def load_bsr_figure(figures_dir: str | Path, spec_path: str, token: Token) -> BsrFigure:
-    """The figure a spec names (``token``, its word in ``spec_path``), read from
+def check_bsr_figure(figure: Figure) -> Joint:
+    """The checks every BSR figure (2-D or 3-D) passes: a ``free`` root listed first and a flat
+    floor (or no terrain); returns the root's joint, raises SpecError at the offending line."""
+    root = figure.root
+    if root.kind != "free":
+        raise SpecError.at(figure.path, root.token, "a 'free' root (BSR figures fly and fall)")
+    if figure.rods[0].name != root.rod:
+        raise SpecError.at(figure.path, figure.rods[0].token, f"the root rod '{root.rod}' first")
+    if figure.terrain.kind not in ("none", "floor"):
+        raise SpecError(figure.path, 1, 1, "a flat 'terrain floor' for a BSR figure", None)
+    return root
+
+
+def load_rod_figure(figures_dir: str | Path, spec_path: str, token: Token) -> Figure:
+    """The figure a spec names (``token``, its word in ``spec_path``), parsed from
     ``figures_dir``/NAME.fig; one that is missing or is a vehicle raises SpecError at the word."""
     figure_path = Path(figures_dir) / f"{token.text}.fig"
     if not figure_path.is_file():
@@ -195,7 +202,12 @@ def load_bsr_figure(figures_dir: str | Path, spec_path: str, token: Token) -> Bs
     parsed = parse_figure_spec(figure_path)
     if not isinstance(parsed, Figure):
         raise SpecError.at(spec_path, token, "a figure of rods, not a vehicle")
-    return bsr_figure(parsed)
+    return parsed
+
+
+def load_bsr_figure(figures_dir: str | Path, spec_path: str, token: Token) -> BsrFigure:
+    """The 2-D BSR figure a spec names (``load_rod_figure``, then ``bsr_figure``)."""
+    return bsr_figure(load_rod_figure(figures_dir, spec_path, token))
 
 
 def distinct_endpoints(parent: np.ndarray, hinge: np.ndarray, length: np.ndarray) -> np.ndarray:

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mosys.bsr.figure import distinct_endpoints
+from mosys.bsr.figure import check_bsr_figure, distinct_endpoints, load_rod_figure
 from mosys.io.trajectory import FigureMotion
 from mosys.kernels.bsr3d_simulate import FigureArrays3D
 from mosys.parsing.figure import (
@@ -26,7 +26,6 @@ from mosys.parsing.figure import (
     Joint,
     JointLimit,
     default_swing_name,
-    parse_figure_spec,
 )
 from mosys.parsing.tokens import SpecError, Token
 
@@ -149,17 +148,11 @@ def bsr_figure3d(figure: Figure) -> BsrFigure3D:
     """Lay out the 3-D ``figure`` for the 3-D BSR simulator; a figure it cannot simulate raises
     SpecError at the offending line (a planar figure, a pinned root, a joint before its parent's
     rod, an angle without a finite range, terrain that is not a flat floor)."""
-    root = figure.root
     if figure.dimensions != 3:
-        raise SpecError.at(figure.path, root.token, "a 3-D figure (one with 'ball' joints)")
-    if root.kind != "free":
-        raise SpecError.at(figure.path, root.token, "a 'free' root (BSR figures fly and fall)")
+        raise SpecError.at(figure.path, figure.root.token, "a 3-D figure (one with 'ball' joints)")
+    root = check_bsr_figure(figure)
     names = [rod.name for rod in figure.rods]
-    if names[0] != root.rod:
-        raise SpecError.at(figure.path, figure.rods[0].token, f"the root rod '{root.rod}' first")
     terrain = figure.terrain
-    if terrain.kind not in ("none", "floor"):
-        raise SpecError(figure.path, 1, 1, "a flat 'terrain floor' for a BSR figure", None)
     index = {name: i for i, name in enumerate(names)}
     limits = {limit.rod: limit for limit in figure.limits}
     n = len(names)
@@ -215,15 +208,8 @@ def bsr_figure3d(figure: Figure) -> BsrFigure3D:
 
 
 def load_bsr_figure3d(figures_dir: str | Path, spec_path: str, token: Token) -> BsrFigure3D:
-    """The 3-D figure a spec names (``token``, its word in ``spec_path``), read from
-    ``figures_dir``/NAME.fig; one that is missing or is a vehicle raises SpecError at the word."""
-    figure_path = Path(figures_dir) / f"{token.text}.fig"
-    if not figure_path.is_file():
-        raise SpecError.at(spec_path, token, f"a figure in {figures_dir}")
-    parsed = parse_figure_spec(figure_path)
-    if not isinstance(parsed, Figure):
-        raise SpecError.at(spec_path, token, "a figure of rods, not a vehicle")
-    return bsr_figure3d(parsed)
+    """The 3-D BSR figure a spec names (``load_rod_figure``, then ``bsr_figure3d``)."""
+    return bsr_figure3d(load_rod_figure(figures_dir, spec_path, token))
 
 
 def _ranges(path: str, joint: Joint, limit: JointLimit | None) -> list[tuple[float, float]]:

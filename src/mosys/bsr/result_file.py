@@ -7,13 +7,12 @@ import json
 import os
 from pathlib import Path
 
-from mosys.bsr.figure import load_bsr_figure
-from mosys.bsr.figure3d import load_bsr_figure3d
+from mosys.bsr.figure import bsr_figure, load_rod_figure
+from mosys.bsr.figure3d import bsr_figure3d
 from mosys.bsr.search import SearchOutcome, SearchSetup, bind_search, run_search, searched_variables
 from mosys.bsr.search3d import bind_search3d, chain_start, standing_height
 from mosys.io.bsr_result import BsrResult, write_bsr_result
 from mosys.parsing.bsr import BsrSpec, parse_bsr_spec
-from mosys.parsing.figure import parse_figure_spec
 from mosys.parsing.tokens import SpecError
 
 
@@ -92,14 +91,12 @@ def _bind(
 ) -> tuple[SearchSetup, dict]:
     """The search set-up of a 2-D or 3-D figure (as its .fig says), and the root attrs only
     3-D results have."""
-    token = spec.tokens["figure"]
-    figure_path = Path(figures_dir) / f"{token.text}.fig"
-    parsed = parse_figure_spec(figure_path) if figure_path.is_file() else None
-    if getattr(parsed, "dimensions", 2) != 3:
+    parsed = load_rod_figure(figures_dir, spec.path, spec.tokens["figure"])
+    if parsed.dimensions != 3:
         if spec.chain:
             raise SpecError.at(spec.path, spec.tokens["chain"], "a 3-D figure to continue")
-        return bind_search(spec, load_bsr_figure(figures_dir, spec.path, token), generations), {}
-    figure = load_bsr_figure3d(figures_dir, spec.path, token)
+        return bind_search(spec, bsr_figure(parsed), generations), {}
+    figure = bsr_figure3d(parsed)
     chain = None
     if spec.chain:
         if not chain_results:
