@@ -42,7 +42,7 @@ CX, CY, CZ, VX, VY, VZ = 0, 1, 2, 3, 4, 5
 QW = 6  # quaternion w, x, y, z
 LX = 10  # angular momentum x, y, z
 JOINTS = 13  # θ starts here, θ' follows it
-MAX_CONTACTS = 8
+MAX_CONTACTS = 4  # the lowest endpoints solved together (a body needs three on a plane)
 COMPLIANCE = 1e-6  # of a contact's own response: splits loads the rigid body leaves undecided
 FIXED_POINT_ITERATIONS = 50  # of the shared-friction shares
 # a twist whose horizontal impulse at some contact exceeds its normal impulse this many times is
