@@ -170,3 +170,10 @@ def test_a_start_name_the_figure_lacks_is_an_error_at_its_word():
         "test.bsr:8:19: expected an endpoint of figure 'starman' (torso.proximal, torso.distal, "
         "arm_a.distal, arm_b.distal, leg_a.distal, leg_b.distal), found 'arm_c.distal'"
     )
+
+
+def test_a_term_of_the_other_dimension_is_an_error_at_its_word():
+    with pytest.raises(SpecError) as error:
+        setup(SPEC.replace("fitness distance=1", "fitness distance=1 sideways=-1"))
+    assert "expected a fitness term of figure 'starman' (distance, max_height, " in str(error.value)
+    assert str(error.value).endswith("found 'sideways=-1'")

@@ -134,10 +134,30 @@ class SearchOutcome:
         return json.dumps({name: float(value) for name, value in terms})
 
 
-def bind_search(spec: BsrSpec, figure: BsrFigure, generations: int | None = None) -> SearchSetup:
-    """Check the spec's names against the figure (start coordinates, fall endpoints) and lay
-    out its numbers; a name the figure lacks raises SpecError at its word. ``generations``
-    overrides the spec's G (a reduced budget)."""
+@dataclass(frozen=True)
+class BoundNames:
+    """A spec's names looked up in its figure: the start pose (root angle rad, joint angles
+    (J,) rad, x m), the fall endpoints' indices (F,) and the term weights in the figure's term
+    order."""
+
+    root_angle: float
+    joints: np.ndarray
+    x: float
+    fall_endpoints: np.ndarray
+    weights: np.ndarray
+
+
+def bind_names(spec: BsrSpec, figure, term_names: tuple[str, ...]) -> BoundNames:
+    """Look the spec's start coordinates, fall endpoints and fitness terms up in the figure (a
+    2-D or 3-D BSR figure: its ``root_angle``, ``root_x``, ``joint_names``, ``endpoint_names``)
+    and ``term_names``; a name it lacks raises SpecError at its word."""
+    for term in spec.weights:
+        if term not in term_names:
+            raise SpecError.at(
+                spec.path,
+                spec.tokens[f"fitness.{term}"],
+                f"a fitness term of figure '{figure.figure.name}' ({', '.join(term_names)})",
+            )
     known = {figure.root_angle: "angle", figure.root_x: "x"}
     known.update({name: "joint" for name in figure.joint_names})
     joints = np.zeros(len(figure.joint_names))
@@ -168,14 +188,28 @@ def bind_search(spec: BsrSpec, figure: BsrFigure, generations: int | None = None
                 f"({', '.join(figure.endpoint_names)})",
             )
         fall.append(figure.endpoint_names.index(name))
+    return BoundNames(
+        root_angle,
+        joints,
+        x,
+        np.array(fall, np.int64),
+        np.array([spec.weights.get(term, 0.0) for term in term_names]),
+    )
+
+
+def bind_search(spec: BsrSpec, figure: BsrFigure, generations: int | None = None) -> SearchSetup:
+    """Check the spec's names against the figure (start coordinates, fall endpoints, terms) and
+    lay out its numbers; a name the figure lacks raises SpecError at its word. ``generations``
+    overrides the spec's G (a reduced budget)."""
+    names = bind_names(spec, figure, FITNESS_TERMS)
     return SearchSetup(
         spec=spec,
         figure=figure,
-        root_angle=root_angle,
-        joints=joints,
-        x=x,
-        fall_endpoints=np.array(fall, np.int64),
-        weights=np.array([spec.weights.get(term, 0.0) for term in FITNESS_TERMS]),
+        root_angle=names.root_angle,
+        joints=names.joints,
+        x=names.x,
+        fall_endpoints=names.fall_endpoints,
+        weights=names.weights,
         generations=spec.generations if generations is None else generations,
         simulation=PlanarSimulation(),
     )

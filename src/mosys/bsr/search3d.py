@@ -16,7 +16,7 @@ import h5py
 import numpy as np
 
 from mosys.bsr.figure3d import BsrFigure3D
-from mosys.bsr.search import RecordedRun, SearchSetup, population_arrays
+from mosys.bsr.search import RecordedRun, SearchSetup, bind_names, population_arrays
 from mosys.bsr.start3d import standing_state
 from mosys.io.bsr_result import BsrController
 from mosys.kernels.bsr3d_controller import RunRecord, Task, run_controller, run_population
@@ -158,56 +158,20 @@ def bind_search3d(
     generations: int | None = None,
     chain: ChainStart | None = None,
 ) -> SearchSetup:
-    """Check the spec's names against the 3-D figure (start coordinates, fall endpoints, terms)
-    and lay out its numbers; a mistake raises SpecError at its word. ``chain``: where a
-    continued search starts (required exactly when the spec has a ``chain`` line)."""
+    """Check the spec's names against the 3-D figure (``bind_names``) and lay out its numbers;
+    a mistake raises SpecError at its word. ``chain``: where a continued search starts
+    (required exactly when the spec has a ``chain`` line)."""
     if spec.perturbation.any:
         raise SpecError.at(
             spec.path, spec.tokens["perturb"], "no 'perturb' line for a 3-D figure (not built)"
         )
-    for term in spec.weights:
-        if term not in FITNESS_TERMS_3D:
-            raise SpecError.at(
-                spec.path,
-                spec.tokens[f"fitness.{term}"],
-                f"a fitness term of a 3-D figure ({', '.join(FITNESS_TERMS_3D)})",
-            )
-    known = {figure.root_angle: "angle", figure.root_x: "x"}
-    known.update({name: "joint" for name in figure.joint_names})
-    angles = np.zeros(len(figure.joint_names))
-    root_angle = 0.0
-    x = 0.0
-    for name, value in spec.start.items():
-        kind = known.get(name)
-        if kind is None:
-            raise SpecError.at(
-                spec.path,
-                spec.tokens[f"start.{name}"],
-                f"a coordinate of figure '{figure.figure.name}' ({', '.join(known)})",
-            )
-        if kind == "x":
-            x = value
-        elif kind == "angle":
-            root_angle = math.radians(value)
-        else:
-            angles[figure.joint_names.index(name)] = math.radians(value)
-    fall = []
-    for i, endpoint in enumerate(spec.fall):
-        name = f"{endpoint.rod}.{endpoint.end}"
-        if name not in figure.endpoint_names:
-            raise SpecError.at(
-                spec.path,
-                spec.tokens[f"fall.{i}"],
-                f"an endpoint of figure '{figure.figure.name}' "
-                f"({', '.join(figure.endpoint_names)})",
-            )
-        fall.append(figure.endpoint_names.index(name))
+    names = bind_names(spec, figure, FITNESS_TERMS_3D)
     endpoints = [tuple(row) for row in figure.endpoints.tolist()]
     feet = np.array([endpoints.index(tuple(foot)) for foot in figure.feet], np.int64)
     height = standing_height(figure)
     speed = math.sqrt(figure.gravity * height)
     task = Task(
-        falls=np.array(fall, np.int64),
+        falls=names.fall_endpoints,
         fall_height=spec.fall_below * height,
         feet=feet,
         heading_rod=int(figure.heading_rod),
@@ -217,18 +181,18 @@ def bind_search3d(
         filter_time=spec.sense_filter,
     )
     if chain is None:
-        start = standing_state(figure, root_angle, angles, x)
+        start = standing_state(figure, names.root_angle, names.joints, names.x)
         start_force = np.zeros(figure.endpoints.shape[0])
     else:
         start, start_force = chain.state, chain.force
     return SearchSetup(
         spec=spec,
         figure=figure,
-        root_angle=root_angle,
-        joints=angles,
-        x=x,
-        fall_endpoints=task.falls,
-        weights=np.array([spec.weights.get(term, 0.0) for term in FITNESS_TERMS_3D]),
+        root_angle=names.root_angle,
+        joints=names.joints,
+        x=names.x,
+        fall_endpoints=names.fall_endpoints,
+        weights=names.weights,
         generations=spec.generations if generations is None else generations,
         simulation=SpatialSimulation(task, start, start_force),
         relevance="contain",

@@ -1,0 +1,100 @@
+"""The 1995 paper's search for 3-D figures (§4): binding a spec to a 3-D figure, the relevance
+heuristic that contains a point of the sense trajectory, the enriched first population, chained
+starts, and determinism whatever the threads."""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+import pytest
+
+from mosys.bsr.figure3d import load_bsr_figure3d
+from mosys.bsr.search import _Population, run_search
+from mosys.bsr.search3d import ChainStart, bind_search3d
+from mosys.kernels.bsr_controller import active_rule, rule_weights
+from mosys.parsing.bsr import parse_bsr_text
+from mosys.parsing.tokens import SpecError, Token
+
+SPEC = """\
+figure cujo
+controller time rules=3 period=0.4
+simulate duration=0.5 dt=0.01 tau_min=0.03
+search controllers=4 generations=3 reseed=2
+seeds 1
+start spine=0
+fitness distance=1 sideways=-1 fall=-5
+fall below=0.5
+"""
+CUJO = load_bsr_figure3d("specs/figures", "test.bsr", Token("cujo", 1, 1))
+
+
+def setup(text: str = SPEC, chain: ChainStart | None = None):
+    return bind_search3d(parse_bsr_text(text, "test.bsr"), CUJO, chain=chain)
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        (
+            SPEC.replace("sideways=-1", "rotations=1"),
+            "test.bsr:7:20: expected a fitness term of figure 'cujo' (distance, sideways, ",
+        ),
+        (
+            SPEC + "perturb angle=2\n",
+            "test.bsr:9:1: expected no 'perturb' line for a 3-D figure (not built), "
+            "found 'perturb'",
+        ),
+        (
+            SPEC.replace("spine=0", "hip=3"),
+            "test.bsr:6:7: expected a coordinate of figure 'cujo' (spine, x, head, head_turn, ",
+        ),
+    ],
+)
+def test_a_3d_spec_names_what_its_figure_has(text, message):
+    with pytest.raises(SpecError) as error:
+        setup(text)
+    assert str(error.value).startswith(message)
+
+
+def test_a_new_sense_rule_contains_a_point_of_the_parents_sense_trajectory():
+    spec = SPEC.replace("controller time rules=3 period=0.4", "controller sense rules=3")
+    bound = setup(spec)
+    rng = np.random.default_rng(4)
+    population = _Population(bound, rng)
+    senses = rng.uniform(0.0, 1.0, (30, len(CUJO.sense_names)))
+    for _ in range(20):
+        population.draw_rule(0, 1, rng, senses)
+        center, side = population.center[0], population.side[0]
+        inside = np.all(np.abs(senses - center[1]) < side[1] / 2.0, axis=1)
+        assert inside.any()
+        point = senses[np.flatnonzero(inside)[0]]
+        # the rule fires there (alone, it would be the active one)
+        assert active_rule(point, center[1:2], side[1:2], rule_weights(side[1:2]), -1) == 0
+
+
+def test_a_sense_based_search_enriches_its_first_population_with_three_rounds():
+    spec = SPEC.replace("controller time rules=3 period=0.4", "controller sense rules=3")
+    outcome = run_search(setup(spec), 1)
+    # C controllers, three rounds of C more, then C per generation
+    assert list(outcome.evaluations) == [16, 20, 24, 28]
+    assert setup(SPEC).enrich_rounds == 0
+
+
+def test_a_search_gives_the_same_result_on_one_thread_and_two():
+    results = []
+    for threads in (1, 2):
+        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+        outcome = run_search(setup(), 3)
+        results.append((outcome.best_fitness, outcome.terms, outcome.rod_ends))
+    numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+    for one, two in zip(*results, strict=True):
+        assert np.array_equal(one, two)
+
+
+def test_a_chained_search_starts_from_the_state_it_is_given():
+    first = run_search(setup(), 1)
+    text = SPEC.replace("start spine=0\n", "") + "chain cujo_bound\n"
+    chain = ChainStart("cujo_bound", 1, first.final_state, first.final_force)
+    continued = run_search(setup(text, chain), 1)
+    np.testing.assert_allclose(continued.rod_ends[0], first.rod_ends[-1], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(continued.com[0], first.com[-1], rtol=0, atol=1e-12)
