@@ -98,3 +98,19 @@ def test_a_chained_search_starts_from_the_state_it_is_given():
     continued = run_search(setup(text, chain), 1)
     np.testing.assert_allclose(continued.rod_ends[0], first.rod_ends[-1], rtol=0, atol=1e-12)
     np.testing.assert_allclose(continued.com[0], first.com[-1], rtol=0, atol=1e-12)
+
+
+def test_continuing_a_result_without_a_final_state_is_a_clear_error(tmp_path):
+    import h5py
+
+    from mosys.bsr.search3d import chain_start
+    from mosys.errors import InputError
+
+    old = tmp_path / "seed1.h5"
+    with h5py.File(old, "w") as h5:
+        h5.attrs["best_fitness"] = 1.0
+        h5.attrs["seed"] = 1
+    with pytest.raises(InputError, match="no best/final_state to continue from"):
+        chain_start("cujo_bound", [old])
+    with pytest.raises(InputError, match="no result files of search 'cujo_bound'"):
+        chain_start("cujo_bound", [])

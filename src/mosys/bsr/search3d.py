@@ -18,6 +18,7 @@ import numpy as np
 from mosys.bsr.figure3d import BsrFigure3D
 from mosys.bsr.search import RecordedRun, SearchSetup, bind_names, population_arrays
 from mosys.bsr.start3d import standing_state
+from mosys.errors import InputError
 from mosys.io.bsr_result import BsrController
 from mosys.kernels.bsr3d_controller import RunRecord, Task, run_controller, run_population
 from mosys.kernels.bsr3d_simulate import CY
@@ -49,8 +50,13 @@ def chain_start(name: str, result_paths: list[str | Path]) -> ChainStart:
         if best is None or key[:2] > best[:2]:
             best = key
     if best is None:
-        raise ValueError(f"no result files of search '{name}' to continue")
+        raise InputError(f"no result files of search '{name}' to continue")
     with h5py.File(best[2], "r") as h5:
+        if "best/final_state" not in h5 or "best/final_force" not in h5:
+            raise InputError(
+                f"{best[2]}: no best/final_state to continue from (a result of an older mosys: "
+                "run its search again)"
+            )
         return ChainStart(name, -best[1], h5["best/final_state"][()], h5["best/final_force"][()])
 
 
