@@ -164,7 +164,8 @@ KEYWORDS = (
 )
 TERMS = (
     "'distance=', 'max_height=', 'contact_distance=', 'rotations=', 'fall=', 'sideways=', "
-    "'heading_change=', 'heading_deviation=', 'feet_distance=', 'foot_steps=', 'min_height='"
+    "'heading_change=', 'heading_deviation=', 'feet_distance=', 'foot_steps=', 'min_height=', "
+    "'heading_sine='"
 )
 FALL_LINE = (
     "a 'fall' line naming the endpoints whose ground contact the fall term measures "

@@ -111,7 +111,7 @@ def test_no_endpoint_sinks_and_no_lone_contact_slides_in_any_3d_motion(built):
 def test_editing_the_turn_reruns_the_turn_and_the_second_walk_not_the_first(built):
     spec = built / "specs/bsr/rex_turn.bsr"
     text = spec.read_text()
-    edited = re.sub(r"heading_change=[\d.]+", "heading_change=0.06", text)
+    edited = re.sub(r"heading_sine=[\d.]+", "heading_sine=3.5", text)
     assert edited != text
     with edited_spec(spec, edited):
         jobs = planned_jobs(built, "results/bsr3d_all", *CI)

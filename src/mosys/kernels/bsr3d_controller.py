@@ -22,7 +22,8 @@ below ``fall_height`` or a ``fall`` endpoint on the floor); ``heading_deviation`
 |heading - heading at t = 0| over the steps, deg; ``feet_distance`` the mean displacement
 of the feet along the heading at t = 0, m; ``foot_steps`` the touch-downs (after a lift of at
 least ``STEP_LIFT``) of a foot other than the one that touched down last; ``min_height`` the
-lowest com height, m.
+lowest com height, m; ``heading_sine`` the sine of the heading change (1: a quarter turn to the
+left, whatever the turns before it: a turn that a spin does not beat).
 """
 
 from __future__ import annotations
@@ -68,8 +69,9 @@ from mosys.kernels.bsr_simulate import CONTACT_TOLERANCE
     FEET_DISTANCE,
     FOOT_STEPS,
     MIN_HEIGHT,
-) = range(9)
-TERM_COUNT = 9
+    HEADING_SINE,
+) = range(10)
+TERM_COUNT = 10
 PHYSICAL_SENSES = 10  # height, velocity (3), angular velocity (3), up (3)
 STEP_LIFT = 0.01  # m: a foot that comes down counts as a step if it rose this high since it left
 
@@ -391,6 +393,7 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
     terms_out[FEET_DISTANCE] = feet_distance / n_feet if n_feet > 0 else 0.0
     terms_out[FOOT_STEPS] = foot_steps
     terms_out[MIN_HEIGHT] = min_height
+    terms_out[HEADING_SINE] = math.sin(heading - heading_start)
     final_state[:] = state
     final_force[:] = end_force
     return total_mass

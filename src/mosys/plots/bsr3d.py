@@ -109,6 +109,8 @@ TERMS_3D = {
     "heading_deviation": ("heading deviation", "deg", ".1f"),
     "feet_distance": ("feet distance", "m", "+.2f"),
     "foot_steps": ("foot steps", "", ".0f"),
+    "min_height": ("min height", "m", ".2f"),
+    "heading_sine": ("sin(heading change)", "", "+.2f"),
     **TERMS,
 }
 CHAIN_TOLERANCE = 1e-3  # m: a continuing search's first pose is its predecessor's last pose
