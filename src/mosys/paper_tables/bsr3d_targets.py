@@ -3,8 +3,9 @@ measured on the result files: Cujo bounds at least three body lengths without fa
 turns so that his second walk heads at least 45° away from his first, and walks on, without
 falling; Bob walks at least four steps (alternating foot touch-downs), facing forward, without
 falling, in at least one seed, and the time-based Bob does worse than the sense-based one (the
-paper's finding, reported either way); no endpoint sinks more than 1 cm into the floor and no
-lone contact slides, in any motion.
+paper's finding, reported either way: here, it walks in fewer of its seeds and has the lower
+median fitness; the best fitness of each is shown too); no endpoint sinks more than 1 cm into
+the floor and no lone contact slides, in any motion.
 
 Definitions: a *body length* is the length of the figure's heading rod (Cujo's spine); *fallen*:
 the centre of mass below half its standing height at some sample; *facing forward*: the heading
@@ -42,6 +43,19 @@ def fell(result: BsrResult) -> bool:
     """Whether the centre of mass went below FALLEN times its standing height."""
     return float(result.attrs["min_com_height"]) < FALLEN * float(
         result.attrs["standing_com_height"]
+    )
+
+
+def walks(result: BsrResult) -> bool:
+    """Whether a biped's best motion is a walk: at least STEPS alternating steps, forward, facing
+    forward (within FACING at the end and on average), never fallen."""
+    terms = result.fitness_terms
+    return (
+        terms["foot_steps"] >= STEPS
+        and terms["distance"] > 0.0
+        and abs(terms["heading_change"]) <= FACING
+        and terms["heading_deviation"] <= FACING
+        and not fell(result)
     )
 
 
@@ -149,15 +163,7 @@ def targets_frame(
     )
     # Bob
     walkers = _need(searches, walk)
-    good = [
-        result
-        for result in walkers
-        if result.fitness_terms["foot_steps"] >= STEPS
-        and result.fitness_terms["distance"] > 0.0
-        and abs(result.fitness_terms["heading_change"]) <= FACING
-        and result.fitness_terms["heading_deviation"] <= FACING
-        and not fell(result)
-    ]
+    good = [result for result in walkers if walks(result)]
     steps = ", ".join(
         f"seed {int(r.attrs['seed'])}: {int(r.fitness_terms['foot_steps'])}" for r in walkers
     )
@@ -170,14 +176,21 @@ def targets_frame(
             str(walkers[0].attrs["budget"]),
         )
     )
-    sense = max(float(r.attrs["best_fitness"]) for r in walkers)
-    time_based = max(float(r.attrs["best_fitness"]) for r in _need(searches, time_walk))
+    timed = _need(searches, time_walk)
+    shares = [sum(map(walks, results)) / len(results) for results in (timed, walkers)]
+    medians = [
+        float(np.median([r.attrs["best_fitness"] for r in results])) for results in (timed, walkers)
+    ]
+    bests = [max(float(r.attrs["best_fitness"]) for r in results) for results in (timed, walkers)]
     rows.append(
         _row(
             f"{time_walk} vs {walk}",
-            "time-based does worse than sense-based (the paper's finding)",
-            f"best fitness {time_based:.2f} (time) vs {sense:.2f} (sense)",
-            time_based < sense,
+            "time-based does worse than sense-based (the paper's finding): walks in fewer of its "
+            "seeds and has the lower median fitness",
+            f"seeds that walk {sum(map(walks, timed))} of {len(timed)} (time) vs "
+            f"{len(good)} of {len(walkers)} (sense); median fitness {medians[0]:.2f} vs "
+            f"{medians[1]:.2f}; best fitness {bests[0]:.2f} vs {bests[1]:.2f}",
+            shares[0] < shares[1] and medians[0] < medians[1],
             str(walkers[0].attrs["budget"]),
         )
     )
