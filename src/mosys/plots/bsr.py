@@ -19,6 +19,7 @@ a line with round ends, metres in the world frame, y up, equal aspect, over the 
 from __future__ import annotations
 
 import math
+import textwrap
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -79,6 +80,7 @@ TERMS = {
 
 # learning curves
 LEARNING_WIDTH, LEARNING_HEIGHT = 9.5, 5.4  # inches
+TITLE_WIDTH = 110  # characters of a title line at the learning figures' width
 FINALS_WIDTH = 1.9  # inches: the panel of each seed's final best fitness
 CURVE_WIDTH = 1.5  # pt
 COMPARISON_WIDTH, COMPARISON_HEIGHT = 12.5, 5.6  # inches
@@ -217,6 +219,12 @@ def fitness_formula(weights: Mapping[str, float]) -> str:
     return f"fitness = {text}"
 
 
+def wrapped(text: str, width: int = TITLE_WIDTH) -> str:
+    """``text`` broken into lines of at most ``width`` characters (a long fitness formula or
+    list of terms would run off the figure)."""
+    return textwrap.fill(text, width, break_on_hyphens=False)
+
+
 def terms_text(
     terms: Mapping[str, float], known: Mapping[str, tuple[str, str, str]] = TERMS
 ) -> str:
@@ -291,7 +299,9 @@ def learning_figure(results: Sequence[str | Path]) -> Figure:
     title = (
         f"BSR search {name}: {KIND_TEXT.get(kind, kind)} controller"
         f"{f' for {figure_name}' if figure_name else ''}, {len(loaded)} seeds\n"
-        f"best fitness found so far by each seed; {fitness_formula(first.fitness_weights)}"
+        + wrapped(
+            f"best fitness found so far by each seed; {fitness_formula(first.fitness_weights)}"
+        )
     )
     with plot_style():
         figure = new_figure(LEARNING_WIDTH, LEARNING_HEIGHT)

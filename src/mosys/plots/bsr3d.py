@@ -65,6 +65,7 @@ from mosys.plots.bsr import (
     root_attrs,
     search_name,
     terms_text,
+    wrapped,
 )
 from mosys.plots.style import (
     GIF_DPI,
@@ -113,6 +114,7 @@ TERMS_3D = {
     "heading_sine": ("sin(heading change)", "", "+.2f"),
     **TERMS,
 }
+LEGEND_WIDTH = 130  # characters of a filmstrip legend's line of terms
 CHAIN_TOLERANCE = 1e-3  # m: a continuing search's first pose is its predecessor's last pose
 
 # the camera
@@ -465,7 +467,8 @@ def _segment_label(chain: ChainMotion, k: int) -> str:
     )
     if "fitness_terms" not in result.attrs:
         return label
-    return f"{label}\n    {terms_text(result.fitness_terms, TERMS_3D)}"
+    terms = wrapped(terms_text(result.fitness_terms, TERMS_3D), LEGEND_WIDTH)
+    return f"{label}\n    " + terms.replace("\n", "\n    ")
 
 
 def pose_count(chain: ChainMotion) -> int:
