@@ -1,9 +1,9 @@
 """The text of a generated dynamics module: derived equations -> plain Python + numba source.
 
 ``emit_module`` only makes text (compile.py writes it). The emitted module imports math, numpy
-and numba, never sympy or mosys, and defines the names listed in ``docs/figure-spec.md``
-("The generated module"). Each function's expressions go through ``sympy.cse``; the mass matrix
-is solved by an unrolled LDLᵀ factorization (no np.linalg: numba's needs SciPy).
+and numba, never sympy or mosys, and defines the names listed in the README ("The generated
+module", under "Figure spec"). Each function's expressions go through ``sympy.cse``; the mass
+matrix is solved by an unrolled LDLᵀ factorization (no np.linalg: numba's needs SciPy).
 """
 
 from __future__ import annotations

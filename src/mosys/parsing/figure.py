@@ -10,7 +10,7 @@ joints) 3-D.
 Keywords: ``gravity``, ``rod``, ``pin`` or ``free`` (the root), ``hinge``, ``limit``,
 ``contact``, ``terrain``; or a single ``vehicle`` line for the built-in car (``parsing.vehicle``).
 Lengths in metres, masses in kg, angles in degrees (radians in the parsed ``Figure``).
-The full grammar, with every default and convention, is in ``docs/figure-spec.md``.
+The full grammar, with every default and convention, is in the README ("Figure spec").
 
 A figure with any ``ball`` line is 3-D (the 3-D BSR figures of the 1995 paper's §4; frames as in
 ``kernels.bsr3d_simulate``: a child's frame is ``R_parent @ Rz(offset) @ Ry(splay) @ Rz(θ) @
