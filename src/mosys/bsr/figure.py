@@ -17,9 +17,8 @@ import numpy as np
 
 from mosys.io.trajectory import FigureMotion
 from mosys.kernels.bsr_simulate import FigureArrays
-from mosys.parsing.bsr import ENDPOINT_ENDS
 from mosys.parsing.figure import Figure, Joint, parse_figure_spec
-from mosys.parsing.tokens import SpecError, Token
+from mosys.parsing.tokens import ENDPOINT_ENDS, SpecError, Token
 
 # the figure_motion contract's contact attribute of every BSR motion
 CONTACT_MODEL = "bsr-impulse: rigid-body impulses at <= 2 rod endpoints, paper's friction"

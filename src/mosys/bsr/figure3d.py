@@ -21,13 +21,12 @@ from mosys.bsr.figure import check_bsr_figure, distinct_endpoints, load_rod_figu
 from mosys.io.trajectory import FigureMotion
 from mosys.kernels.bsr3d_simulate import FigureArrays3D
 from mosys.parsing.figure import (
-    ENDPOINT_ENDS,
     Figure,
     Joint,
     JointLimit,
     default_swing_name,
 )
-from mosys.parsing.tokens import SpecError, Token
+from mosys.parsing.tokens import ENDPOINT_ENDS, SpecError, Token
 
 # the figure_motion contract's contact attribute of every 3-D BSR motion
 CONTACT_MODEL = "bsr3d-impulse: rigid-body impulses at rod endpoints, paper's friction"

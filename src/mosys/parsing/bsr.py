@@ -23,6 +23,7 @@ from mosys.parsing.tokens import (
     figure_line,
     format_number,
     missing_line,
+    parse_endpoint,
     parse_int,
     parse_number,
     read_spec_text,
@@ -52,7 +53,6 @@ FITNESS_TERMS_3D = (
 )
 DEFAULT_FALL_BELOW = 0.5  # 3-D: fallen below this fraction of the standing com height
 DEFAULT_SENSE_FILTER = 0.05  # s: 3-D sense-based: the physical senses' low-pass time constant
-ENDPOINT_ENDS = ("proximal", "distal")
 
 
 @dataclass(frozen=True)
@@ -455,19 +455,7 @@ class _Parser:
                 )
                 self.tokens["fall.below"] = token
                 continue
-            rod, sep, end = token.text.partition(".")
-            if not sep:
-                raise self.error(token, expected)
-            if NAME.fullmatch(rod) is None:
-                raise SpecError(self.path, token.line, token.column, "a rod name before '.'", rod)
-            if end not in ENDPOINT_ENDS:
-                raise SpecError(
-                    self.path,
-                    token.line,
-                    token.column + len(rod) + 1,
-                    f"'proximal' or 'distal' after '{rod}.'",
-                    end,
-                )
+            rod, end = parse_endpoint(token, self.path, expected)
             endpoint = Endpoint(rod, end, token)
             if endpoint in endpoints:
                 first = endpoints[endpoints.index(endpoint)].token

@@ -39,13 +39,13 @@ from pathlib import Path
 
 from mosys.parsing.tokens import (
     END_OF_FILE,
-    NAME,
     Line,
     LineReader,
     SpecError,
     Token,
     format_number,
     missing_line,
+    parse_endpoint,
     parse_name,
     parse_number,
     read_spec,
@@ -60,7 +60,6 @@ KEYWORDS = ("gravity", "rod", "pin", "free", "hinge", "limit", "contact", "terra
 KEYWORDS_3D = ("ball", "heading", "feet")  # only in a 3-D figure: one with a 'ball' line
 ROOT_KINDS = ("pin", "free")
 CHILD_KINDS = ("hinge", "ball")
-ENDPOINT_ENDS = ("proximal", "distal")  # a rod's ends, as 'feet' names them: ROD.END
 DEFAULT_GRAVITY = 9.81  # m/s²
 DEFAULT_COM = 0.5  # fraction of the rod from its proximal end
 DEFAULT_SLIP = 0.01  # m/s: tangential speed at which contact friction reaches friction * normal
@@ -807,19 +806,7 @@ class _Parser:
             raise SpecError(self.path, line.number, line.end_column, expected, None)
         firsts: dict[str, Token] = {}
         for token in line.tokens[1:]:
-            rod, sep, end = token.text.partition(".")
-            if not sep:
-                raise self.error(token, expected)
-            if NAME.fullmatch(rod) is None:
-                raise SpecError(self.path, token.line, token.column, "a rod name before '.'", rod)
-            if end not in ENDPOINT_ENDS:
-                raise SpecError(
-                    self.path,
-                    token.line,
-                    token.column + len(rod) + 1,
-                    f"'proximal' or 'distal' after '{rod}.'",
-                    end,
-                )
+            rod, end = parse_endpoint(token, self.path, expected)
             if token.text in firsts:
                 raise self.error(
                     token,

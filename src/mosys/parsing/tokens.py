@@ -16,6 +16,7 @@ from pathlib import Path
 
 NUMBER = re.compile(r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?")
 NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+ENDPOINT_ENDS = ("proximal", "distal")  # a rod's ends, as specs name them: ROD.END
 END_OF_FILE = "\x00end of file"  # the 'found' of an error about a line that never came
 
 
@@ -237,6 +238,25 @@ def figure_line(line: Line) -> Token:
     reader.end()
     assert token is not None
     return token
+
+
+def parse_endpoint(token: Token, path: str, expected: str) -> tuple[str, str]:
+    """The rod and end (``proximal`` or ``distal``) of a ``ROD.END`` word; SpecError at the
+    word (``expected`` naming what it should be), at the rod or at the end otherwise."""
+    rod, sep, end = token.text.partition(".")
+    if not sep:
+        raise SpecError.at(path, token, expected)
+    if NAME.fullmatch(rod) is None:
+        raise SpecError(path, token.line, token.column, "a rod name before '.'", rod)
+    if end not in ENDPOINT_ENDS:
+        raise SpecError(
+            path,
+            token.line,
+            token.column + len(rod) + 1,
+            f"'proximal' or 'distal' after '{rod}.'",
+            end,
+        )
+    return rod, end
 
 
 def value_token(token: Token, key: str) -> Token:
