@@ -75,21 +75,7 @@ class BsrFigure:
     def motion(self, rod_ends: np.ndarray, com: np.ndarray, dt: float) -> FigureMotion:
         """A run of the figure as the ``figure_motion`` contract: rod_ends (N, rods, 2, 2) m and
         com (N, 2) m, one sample every simulator step of dt s from t = 0."""
-        floor = 0.0 if np.isnan(self.floor) else self.floor
-        terrain = [] if np.isnan(self.floor) else [[-1000.0, floor], [1000.0, floor]]
-        return FigureMotion(
-            t=np.arange(com.shape[0]) * dt,
-            endpoints=rod_ends,
-            com=com,
-            rod_names=tuple(rod.name for rod in self.figure.rods),
-            rod_mass=self.mass,
-            rod_length=self.length,
-            rod_com=self.com,
-            rod_inertia=self.inertia,
-            gravity=self.gravity,
-            terrain=terrain,
-            contact=CONTACT_MODEL,
-        )
+        return rod_figure_motion(self, rod_ends, com, dt, CONTACT_MODEL)
 
     @property
     def arrays(self) -> FigureArrays:
@@ -176,6 +162,29 @@ def bsr_figure(figure: Figure) -> BsrFigure:
         gravity=figure.gravity,
         root_angle=root.coordinates[2].name,
         root_x=root.coordinates[0].name,
+    )
+
+
+def rod_figure_motion(
+    bsr_figure, rod_ends: np.ndarray, com: np.ndarray, dt: float, contact: str, **three_d
+) -> FigureMotion:
+    """A BSR figure's run (``bsr_figure`` a BsrFigure or a BsrFigure3D: its parsed ``figure``
+    and its rods' ``mass``, ``length``, ``com``, ``inertia``) as the ``figure_motion``
+    contract: rod_ends (N, rods, 2, D) m and com (N, D) m, one sample every simulator step of dt
+    s from t = 0; ``three_d``: the 3-D group attributes (``dimensions``, ``heading_rod``, ...)."""
+    return FigureMotion(
+        t=np.arange(com.shape[0]) * dt,
+        endpoints=rod_ends,
+        com=com,
+        rod_names=tuple(rod.name for rod in bsr_figure.figure.rods),
+        rod_mass=bsr_figure.mass,
+        rod_length=bsr_figure.length,
+        rod_com=bsr_figure.com,
+        rod_inertia=bsr_figure.inertia,
+        gravity=bsr_figure.gravity,
+        terrain=[list(vertex) for vertex in bsr_figure.figure.terrain.vertices],
+        contact=contact,
+        **three_d,
     )
 
 

@@ -17,7 +17,12 @@ from pathlib import Path
 
 import numpy as np
 
-from mosys.bsr.figure import check_bsr_figure, distinct_endpoints, load_rod_figure
+from mosys.bsr.figure import (
+    check_bsr_figure,
+    distinct_endpoints,
+    load_rod_figure,
+    rod_figure_motion,
+)
 from mosys.io.trajectory import FigureMotion
 from mosys.kernels.bsr3d_simulate import FigureArrays3D
 from mosys.parsing.figure import (
@@ -124,18 +129,12 @@ class BsrFigure3D:
         """A run of the figure as the 3-D ``figure_motion`` contract: rod_ends (S, N, 2, 3) m
         (per sample and rod, its proximal then distal end (x, y, z), y up) and com (S, 3) m, one
         sample every simulator step of dt s from t = 0."""
-        return FigureMotion(
-            t=np.arange(com.shape[0]) * dt,
-            endpoints=rod_ends,
-            com=com,
-            rod_names=tuple(rod.name for rod in self.figure.rods),
-            rod_mass=self.mass,
-            rod_length=self.length,
-            rod_com=self.com,
-            rod_inertia=self.inertia,
-            gravity=self.gravity,
-            terrain=[list(vertex) for vertex in self.figure.terrain.vertices],
-            contact=CONTACT_MODEL,
+        return rod_figure_motion(
+            self,
+            rod_ends,
+            com,
+            dt,
+            CONTACT_MODEL,
             dimensions=3,
             heading_rod=self.figure.rods[self.heading_rod].name,
             heading_offset=math.degrees(self.heading_offset),
