@@ -489,6 +489,51 @@ class RecordedRun:
     final_state: np.ndarray
     final_force: np.ndarray
 
+    @classmethod
+    def empty(
+        cls, terms: int, steps: int, figure, dimensions: int, start: np.ndarray
+    ) -> RecordedRun:
+        """Zeroed arrays for a run of ``steps`` steps of ``figure`` (its ``parent`` (N,) and
+        ``endpoints`` (E, 2)) in ``dimensions`` (2 or 3) from the state ``start`` (S,)."""
+        return cls(
+            terms=np.zeros(terms),
+            active_rule=np.zeros(steps + 1, np.int64),
+            rod_ends=np.zeros((steps + 1, figure.parent.shape[0], 2, dimensions)),
+            com=np.zeros((steps + 1, dimensions)),
+            final_state=np.empty_like(start),
+            final_force=np.empty(figure.endpoints.shape[0]),
+        )
+
+    def record(self, senses: int) -> RunRecord:
+        """The kernels' RunRecord writing into these arrays, with room for ``senses`` senses."""
+        return RunRecord(
+            np.zeros((self.active_rule.shape[0], senses)),
+            self.active_rule,
+            self.terms,
+            self.rod_ends,
+            self.com,
+            self.final_state,
+            self.final_force,
+        )
+
+
+def controller_arrays(controller: BsrController) -> ControllerArrays:
+    """One controller as the kernels take it (a time-based one's segments as their cumulative
+    ends, s, the last exactly its period)."""
+    time_based = controller.kind == "time"
+    segment_end = np.cumsum(controller.segment) if time_based else np.zeros(controller.rules)
+    if time_based:
+        segment_end[-1] = controller.period
+    return ControllerArrays(
+        time_based,
+        controller.target,
+        controller.tau,
+        controller.center,
+        controller.side,
+        segment_end,
+        controller.period if time_based else 1.0,
+    )
+
 
 def record_run(
     figure: BsrFigure,
@@ -505,45 +550,16 @@ def record_run(
     keeps the senses (contact forces) where the last one left them and starts with the rule
     they select."""
     n_ends = figure.endpoints.shape[0]
-    time_based = controller.kind == "time"
-    segment_end = np.cumsum(controller.segment) if time_based else np.zeros(controller.rules)
-    if time_based:
-        segment_end[-1] = controller.period
-    run = RecordedRun(
-        terms=np.zeros(len(FITNESS_TERMS)),
-        active_rule=np.zeros(steps + 1, np.int64),
-        rod_ends=np.zeros((steps + 1, figure.parent.shape[0], 2, 2)),
-        com=np.zeros((steps + 1, 2)),
-        final_state=np.empty_like(start),
-        final_force=np.empty(n_ends),
-    )
-    arrays = ControllerArrays(
-        time_based,
-        controller.target,
-        controller.tau,
-        controller.center,
-        controller.side,
-        segment_end,
-        controller.period if time_based else 1.0,
-    )
-    record = RunRecord(
-        np.zeros((steps + 1, len(figure.sense_names))),
-        run.active_rule,
-        run.terms,
-        run.rod_ends,
-        run.com,
-        run.final_state,
-        run.final_force,
-    )
+    run = RecordedRun.empty(len(FITNESS_TERMS), steps, figure, 2, start)
     run_controller(
         figure.arrays,
-        arrays,
+        controller_arrays(controller),
         np.asarray(start, np.float64),
         np.zeros(n_ends) if start_force is None else np.asarray(start_force, np.float64),
         carry_over,
         steps,
         dt,
         np.zeros(0, np.int64) if fall_endpoints is None else fall_endpoints,
-        record,
+        run.record(len(figure.sense_names)),
     )
     return run

@@ -16,13 +16,18 @@ import h5py
 import numpy as np
 
 from mosys.bsr.figure3d import BsrFigure3D
-from mosys.bsr.search import RecordedRun, SearchSetup, bind_names, population_arrays
+from mosys.bsr.search import (
+    RecordedRun,
+    SearchSetup,
+    bind_names,
+    controller_arrays,
+    population_arrays,
+)
 from mosys.bsr.start3d import standing_state
 from mosys.errors import InputError
 from mosys.io.bsr_result import BsrController
-from mosys.kernels.bsr3d_controller import RunRecord, Task, run_controller, run_population
+from mosys.kernels.bsr3d_controller import Task, run_controller, run_population
 from mosys.kernels.bsr3d_simulate import CY
-from mosys.kernels.bsr_controller import ControllerArrays
 from mosys.parsing.bsr import FITNESS_TERMS_3D, BsrSpec
 from mosys.parsing.tokens import SpecError
 
@@ -107,47 +112,17 @@ def record_run(
 ) -> RecordedRun:
     """Run ``controller`` for the spec's steps from the state ``start`` (S,) with the endpoint
     forces ``start_force`` (E,) N, recording every step."""
-    steps = spec.steps
-    time_based = controller.kind == "time"
-    segment_end = np.cumsum(controller.segment) if time_based else np.zeros(controller.rules)
-    if time_based:
-        segment_end[-1] = controller.period
-    n_ends = figure.endpoints.shape[0]
-    run = RecordedRun(
-        terms=np.zeros(len(FITNESS_TERMS_3D)),
-        active_rule=np.zeros(steps + 1, np.int64),
-        rod_ends=np.zeros((steps + 1, figure.parent.shape[0], 2, 3)),
-        com=np.zeros((steps + 1, 3)),
-        final_state=np.empty_like(start),
-        final_force=np.empty(n_ends),
-    )
-    senses = len(figure.sense_names) if not time_based else 0
+    run = RecordedRun.empty(len(FITNESS_TERMS_3D), spec.steps, figure, 3, start)
     run_controller(
         figure.arrays,
-        ControllerArrays(
-            time_based,
-            controller.target,
-            controller.tau,
-            controller.center,
-            controller.side,
-            segment_end,
-            controller.period if time_based else 1.0,
-        ),
+        controller_arrays(controller),
         task,
         np.asarray(start, np.float64),
         np.asarray(start_force, np.float64),
         False,
-        steps,
+        spec.steps,
         spec.dt,
-        RunRecord(
-            np.zeros((steps + 1, senses)),
-            run.active_rule,
-            run.terms,
-            run.rod_ends,
-            run.com,
-            run.final_state,
-            run.final_force,
-        ),
+        run.record(0 if controller.kind == "time" else len(figure.sense_names)),
     )
     return run
 

@@ -52,6 +52,7 @@ from mosys.kernels.bsr3d_simulate import (
 )
 from mosys.kernels.bsr_controller import (
     ControllerArrays,
+    RunRecord,
     active_rule,
     rule_weights,
     segment_rule,
@@ -91,22 +92,6 @@ class Task(NamedTuple):
     free: np.ndarray
     scales: np.ndarray
     filter_time: float
-
-
-class RunRecord(NamedTuple):
-    """What ``run_controller`` fills: senses_out (steps + 1, V) (sense-based controllers only;
-    time-based may pass (steps + 1, 0)) and rule_out (steps + 1,) (sample 0: the start),
-    terms_out (TERM_COUNT,); ends_out (steps + 1, N, 2, 3) and com_out (steps + 1, 3), world
-    metres, if ends_out has steps + 1 rows (else nothing is recorded); final_state (S,) and
-    final_force (E,) N: the state and the endpoints' forces at the end."""
-
-    senses_out: np.ndarray
-    rule_out: np.ndarray
-    terms_out: np.ndarray
-    ends_out: np.ndarray
-    com_out: np.ndarray
-    final_state: np.ndarray
-    final_force: np.ndarray
 
 
 @njit(cache=True, error_model="numpy")

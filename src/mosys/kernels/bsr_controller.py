@@ -118,10 +118,12 @@ class ControllerArrays(NamedTuple):
 
 
 class RunRecord(NamedTuple):
-    """What ``run_controller`` fills: senses_out (steps + 1, V) and rule_out (steps + 1,)
-    (sample 0: the start), terms_out (TERM_COUNT,); ends_out (steps + 1, N, 2, 2) and com_out
-    (steps + 1, 2), world metres, if ends_out has steps + 1 rows (else nothing is recorded);
-    final_state (S,) and final_force (E,) N: the state and the endpoints' forces at the end."""
+    """What ``run_controller`` fills (this one's and the 3-D one's, D = 2 or 3): senses_out
+    (steps + 1, V) and rule_out (steps + 1,) (sample 0: the start), terms_out (TERM_COUNT,);
+    ends_out (steps + 1, N, 2, D) and com_out (steps + 1, D), world metres, if ends_out has
+    steps + 1 rows (else nothing is recorded); final_state (S,) and final_force (E,) N: the
+    state and the endpoints' forces at the end. The 3-D run may pass senses_out (steps + 1, 0)
+    for a time-based controller (it then measures no senses)."""
 
     senses_out: np.ndarray
     rule_out: np.ndarray
