@@ -79,23 +79,8 @@ class BsrFigure:
 
     @property
     def arrays(self) -> FigureArrays:
-        """The figure as the kernels take it."""
-        return FigureArrays(
-            self.parent,
-            self.hinge,
-            self.offset,
-            self.length,
-            self.mass,
-            self.com,
-            self.inertia,
-            self.joint,
-            self.endpoints,
-            self.joint_min,
-            self.joint_max,
-            self.gravity,
-            self.floor,
-            self.reach,
-        )
+        """The figure as the kernels take it (each field this figure's attribute of its name)."""
+        return FigureArrays(**{name: getattr(self, name) for name in FigureArrays._fields})
 
 
 def bsr_figure(figure: Figure) -> BsrFigure:

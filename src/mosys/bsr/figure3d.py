@@ -107,23 +107,8 @@ class BsrFigure3D:
 
     @property
     def arrays(self) -> FigureArrays3D:
-        """The figure as the kernels take it."""
-        return FigureArrays3D(
-            self.parent,
-            self.hinge,
-            self.rest,
-            self.length,
-            self.mass,
-            self.com,
-            self.inertia,
-            self.joint,
-            self.endpoints,
-            self.joint_min,
-            self.joint_max,
-            self.gravity,
-            self.floor,
-            self.reach,
-        )
+        """The figure as the kernels take it (each field this figure's attribute of its name)."""
+        return FigureArrays3D(**{name: getattr(self, name) for name in FigureArrays3D._fields})
 
     def motion(self, rod_ends: np.ndarray, com: np.ndarray, dt: float) -> FigureMotion:
         """A run of the figure as the 3-D ``figure_motion`` contract: rod_ends (S, N, 2, 3) m

@@ -95,6 +95,31 @@ class SearchSetup:
     relevance: str = "corner"
     enrich_rounds: int = 0
 
+    @classmethod
+    def bound(
+        cls,
+        spec: BsrSpec,
+        figure,
+        names: BoundNames,
+        generations: int | None,
+        simulation: Simulation,
+        **search,
+    ) -> SearchSetup:
+        """The set-up of a spec whose names ``bind_names`` looked up in its figure (2-D or 3-D);
+        ``generations`` overrides the spec's G; ``search``: ``relevance``, ``enrich_rounds``."""
+        return cls(
+            spec=spec,
+            figure=figure,
+            root_angle=names.root_angle,
+            joints=names.joints,
+            x=names.x,
+            fall_endpoints=names.fall_endpoints,
+            weights=names.weights,
+            generations=spec.generations if generations is None else generations,
+            simulation=simulation,
+            **search,
+        )
+
     @property
     def tau_range(self) -> tuple[float, float]:
         """Table 2: tau in [2 dt, T / 4], s (from tau_min if the spec raises the floor)."""
@@ -202,17 +227,7 @@ def bind_search(spec: BsrSpec, figure: BsrFigure, generations: int | None = None
     lay out its numbers; a name the figure lacks raises SpecError at its word. ``generations``
     overrides the spec's G (a reduced budget)."""
     names = bind_names(spec, figure, FITNESS_TERMS)
-    return SearchSetup(
-        spec=spec,
-        figure=figure,
-        root_angle=names.root_angle,
-        joints=names.joints,
-        x=names.x,
-        fall_endpoints=names.fall_endpoints,
-        weights=names.weights,
-        generations=spec.generations if generations is None else generations,
-        simulation=PlanarSimulation(),
-    )
+    return SearchSetup.bound(spec, figure, names, generations, PlanarSimulation())
 
 
 def searched_variables(setup: SearchSetup) -> int:

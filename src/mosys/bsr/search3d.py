@@ -166,16 +166,12 @@ def bind_search3d(
         start_force = np.zeros(figure.endpoints.shape[0])
     else:
         start, start_force = chain.state, chain.force
-    return SearchSetup(
-        spec=spec,
-        figure=figure,
-        root_angle=names.root_angle,
-        joints=names.joints,
-        x=names.x,
-        fall_endpoints=names.fall_endpoints,
-        weights=names.weights,
-        generations=spec.generations if generations is None else generations,
-        simulation=SpatialSimulation(task, start, start_force),
+    return SearchSetup.bound(
+        spec,
+        figure,
+        names,
+        generations,
+        SpatialSimulation(task, start, start_force),
         relevance="contain",
         enrich_rounds=ENRICH_ROUNDS if spec.kind == "sense" else 0,
     )
