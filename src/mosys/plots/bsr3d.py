@@ -357,6 +357,19 @@ def _shadows(poses: np.ndarray, camera: Camera) -> np.ndarray:
     return project(flat, camera)[..., :2].reshape(-1, 2, 2)
 
 
+def _draw_shadows(ax, poses: np.ndarray, camera: Camera) -> None:
+    """Draw the poses' (..., rods, 2, 3) m shadows on the floor, under everything else."""
+    shadows = LineCollection(
+        _shadows(poses, camera),
+        colors=SHADOW_COLOR,
+        alpha=SHADOW_ALPHA,
+        linewidths=ROD_WIDTH + 0.5,
+        capstyle="round",
+        zorder=1,
+    )
+    ax.add_collection(shadows, autolim=False)
+
+
 def _drawn_pose(pose: np.ndarray, camera: Camera) -> np.ndarray:
     """A pose (rods, 2, 3) m as ``camera`` sees it, its rods farthest first: (rods, 2, 2) m."""
     seen = project(pose, camera)
@@ -578,15 +591,7 @@ def filmstrip_figure(
         height = figure.get_size_inches()[1]
         figure.suptitle(title, y=1 - 0.1 / height, va="top", fontsize=10)
         draw_floor(ax, x_edges, z_edges, camera)
-        shadows = LineCollection(
-            _shadows(poses, camera),
-            colors=SHADOW_COLOR,
-            alpha=SHADOW_ALPHA,
-            linewidths=ROD_WIDTH + 0.5,
-            capstyle="round",
-            zorder=1,
-        )
-        ax.add_collection(shadows, autolim=False)
+        _draw_shadows(ax, poses, camera)
         floor_com = motion.com * np.array([1.0, 0.0, 1.0])
         ends = [*chain.starts[1:], len(t) - 1]
         heading = headings(motion)
@@ -1037,15 +1042,7 @@ def _draw_rest_oblique(
     cell, x_edges, z_edges = floor
     ax.set_axis_off()
     draw_floor(ax, x_edges, z_edges)
-    shadows = LineCollection(
-        _shadows(pose[None], VIEW),
-        colors=SHADOW_COLOR,
-        alpha=SHADOW_ALPHA,
-        linewidths=ROD_WIDTH + 0.5,
-        capstyle="round",
-        zorder=1,
-    )
-    ax.add_collection(shadows, autolim=False)
+    _draw_shadows(ax, pose[None], VIEW)
     seen = _draw_rest_pose(ax, motion, pose, colors, VIEW)
     drawn = np.concatenate([seen.reshape(-1, 3), project(_floor_corners(x_edges, z_edges))])
     low, high = drawn[:, :2].min(axis=0), drawn[:, :2].max(axis=0)
