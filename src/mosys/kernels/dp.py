@@ -4,9 +4,13 @@ For every grid node S and every sampled control u, the figure is simulated from 
 constant until its state leaves S's cell — the box of half-width one grid step around S, whose
 boundary carries S's neighbours (points A, B, C, F of the paper's Figure 10). The exit state E, the
 segment cost ``t + Σ K|u| t`` and E's interpolation weights over the nodes of the face it crosses do
-not depend on the cost-to-go, so they are computed once (``exit_transitions``). Value iteration then
-repeats Bellman sweeps ``V(S) = min_u [cost(S,u) + Σ w V(corner)]`` until the largest change is
-below a tolerance (``bellman_sweep``).
+not depend on the cost-to-go, so they are computed once (``exit_transitions_template``, specialised
+to each model). Value iteration then repeats Bellman sweeps ``V(S) = min_u [cost(S,u) + Σ w
+V(corner)]`` until the largest change is below a tolerance (``gauss_seidel_sweep``). The paper: "It
+is difficult to sequence local optimizations such that each local optimization always uses accurate
+information. It is simpler to approximate this order and repeat this for several iterations" —
+the sweeps run through the grid in the 2**d orders of the fast sweeping method in turn
+(``sweep_order``), each node using the values the sweep has just updated.
 
 All quantities here are SI (rad, rad/s, m, m/s, s, N·m); grids follow ``kernels.interpolate``.
 """
@@ -14,19 +18,12 @@ All quantities here are SI (rad, rad/s, m, m/s, s, N·m); grids follow ``kernels
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange, types
+from numba import njit, prange
 
-from mosys.kernels.figure_state import load_state, read_state
+from mosys.kernels.figure_state import load_state
 from mosys.kernels.geometry import pose_is_free
-from mosys.kernels.integrate import (
-    DERIVATIVE_INTO,
-    FLAGS,
-    INDICES,
-    VECTOR,
-    rk4_scratch,
-    rk4_step,
-)
 from mosys.kernels.interpolate import corner_weights, grid_strides, interpolation_scratch
+from mosys.kernels.specialise import model_derivative
 
 
 @njit(cache=True)
@@ -39,38 +36,105 @@ def node_coordinates(axis_min, axis_step, axis_count, node, out):
 
 
 WEIGHT_EPSILON = 1e-9  # interpolation weights below this are rounding noise
-EXIT_TRANSITIONS_SIGNATURE = types.void(
-    DERIVATIVE_INTO,  # derivative_into
-    VECTOR,  # axis_min
-    VECTOR,  # axis_step
-    INDICES,  # axis_count
-    FLAGS,  # wrap
-    INDICES,  # state_slot
-    VECTOR,  # base_state
-    types.float64[:, ::1],  # control_samples
-    INDICES,  # control_slot
-    types.int64,  # input_size
-    VECTOR,  # effort_weight
-    types.float64,  # dt
-    types.int64,  # max_steps
-    INDICES,  # nodes
-    FLAGS,  # node_valid
-    INDICES,  # pose_slot
-    types.float64[:, ::1],  # outline
-    types.float64[:, ::1],  # obstacle_vertices
-    INDICES,  # obstacle_start
-    types.float64[:, ::1],  # domain
-    types.int32[:, :, ::1],  # exit_index
-    types.float32[:, :, ::1],  # exit_weight
-    types.float64[:, ::1],  # segment_cost
+CELL_FRACTION = 1.0  # an integration step moves no controller coordinate further than this
+# fraction of its grid step (at the rates of the step's start)
+STEP_TOLERANCE = 1e-3  # the integrator's error per step on each controller axis, in grid steps
+MIN_STEP = 1e-7  # s: a segment that needs shorter steps than this is discarded
+MAX_SEGMENT_SECONDS = 2.0  # a segment still in its cell after this long is discarded
+# Dormand–Prince 5(4) (Hairer, Nørsett and Wanner, Solving ODEs I, Table 5.2): the stages' weights
+# (row i: stage i's state from k1..k_i; the last row is the fifth-order solution, so k7 is the
+# derivative at the step's end) and the difference between the fifth- and fourth-order weights
+DORMAND_PRINCE_A = np.array(
+    [
+        [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        [1 / 5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        [3 / 40, 9 / 40, 0.0, 0.0, 0.0, 0.0, 0.0],
+        [44 / 45, -56 / 15, 32 / 9, 0.0, 0.0, 0.0, 0.0],
+        [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0.0, 0.0, 0.0],
+        [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656, 0.0, 0.0],
+        [35 / 384, 0.0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84, 0.0],
+    ]
+)
+DORMAND_PRINCE_ERROR = np.array(
+    [71 / 57600, 0.0, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40]
 )
 
 
-# An explicit signature types derivative_into as a first-class function, so this kernel is cached
-# once for every model (a plain Dispatcher argument would recompile it in every process).
-@njit(EXIT_TRANSITIONS_SIGNATURE, parallel=True, cache=True)
-def exit_transitions(
-    derivative_into,
+@njit(cache=True)
+def hermite(x0, x1, d0, d1, s):
+    """The cubic Hermite through x0 (s = 0) and x1 (s = 1) with slopes d0 and d1 (per unit s),
+    at s."""
+    s2 = s * s
+    s3 = s2 * s
+    return (
+        (2.0 * s3 - 3.0 * s2 + 1.0) * x0
+        + (s3 - 2.0 * s2 + s) * d0
+        + (3.0 * s2 - 2.0 * s3) * x1
+        + (s3 - s2) * d1
+    )
+
+
+@njit(cache=True)
+def _level_in_piece(x0, x1, d0, d1, start, end, level):
+    """The s in [start, end] where the Hermite (monotone there) equals ``level``, by
+    bisection to 1e-12."""
+    rising = hermite(x0, x1, d0, d1, end) > hermite(x0, x1, d0, d1, start)
+    for _ in range(45):
+        middle = 0.5 * (start + end)
+        if (hermite(x0, x1, d0, d1, middle) < level) == rising:
+            start = middle
+        else:
+            end = middle
+        if end - start < 1e-12:
+            break
+    return 0.5 * (start + end)
+
+
+@njit(cache=True)
+def first_crossing(x0, x1, d0, d1, low, high):
+    """The first s in (0, 1] where the cubic Hermite (``hermite``) from x0, inside (low, high),
+    reaches low or high; 2.0 if it stays inside. The cubic is monotone between its turning
+    points, which split [0, 1] into at most three pieces, each checked at its end."""
+    # p'(s) = a s² + b s + c
+    a = 6.0 * (x0 - x1) + 3.0 * (d0 + d1)
+    b = 6.0 * (x1 - x0) - 4.0 * d0 - 2.0 * d1
+    c = d0
+    first = 1.0
+    second = 1.0
+    if abs(a) > 1e-12 * (abs(b) + abs(c)):
+        discriminant = b * b - 4.0 * a * c
+        if discriminant > 0.0:
+            root = np.sqrt(discriminant)
+            q = -0.5 * (b + root if b >= 0.0 else b - root)
+            r1 = q / a
+            r2 = c / q if q != 0.0 else r1
+            if r1 > r2:
+                r1, r2 = r2, r1
+            if 0.0 < r1 < 1.0:
+                first = r1
+                if r2 < 1.0:
+                    second = r2
+            elif 0.0 < r2 < 1.0:
+                first = r2
+    elif b != 0.0:
+        r = -c / b
+        if 0.0 < r < 1.0:
+            first = r
+    start = 0.0
+    for piece in range(3):
+        end = first if piece == 0 else (second if piece == 1 else 1.0)
+        if end <= start:
+            continue
+        value = hermite(x0, x1, d0, d1, end)
+        if value >= high:
+            return _level_in_piece(x0, x1, d0, d1, start, end, high)
+        if value <= low:
+            return _level_in_piece(x0, x1, d0, d1, start, end, low)
+        start = end
+    return 2.0
+
+
+def exit_transitions_template(
     axis_min,
     axis_step,
     axis_count,
@@ -81,8 +145,7 @@ def exit_transitions(
     control_slot,
     input_size,
     effort_weight,
-    dt,
-    max_steps,
+    max_step,
     nodes,
     node_valid,
     pose_slot,
@@ -94,20 +157,22 @@ def exit_transitions(
     exit_weight,
     segment_cost,
 ):
-    """Simulate every (node, control sample) pair until it leaves the node's cell.
+    """Simulate every (node, control sample) pair until it leaves the node's cell; a template
+    (``specialise.specialise``, with the model's ``derivative_into`` as ``model_derivative``).
 
-    Long because the explicit signature (one cached kernel for every model) lists each argument
-    and each prange iteration allocates its own scratch in this body; the cell-crossing and
-    exit-weight blocks could move into helpers later.
+    The integrator is Dormand–Prince 5(4) with a step sized to the cell: at most ``max_step``
+    seconds, short enough that no controller coordinate moves further than ``CELL_FRACTION`` of
+    its grid step at the rate it has at the step's start, and shortened (the step repeated)
+    where its error on some controller coordinate exceeds ``STEP_TOLERANCE`` grid steps. Where
+    the state leaves the cell within a step, the crossing is found on the step's cubic Hermite
+    (the states and rates at both ends), not on the chord between them.
 
-    derivative_into: the model's first-class dynamics (``integrate.DERIVATIVE_INTO``).
     axis_*: (d,) the controller grid, SI; state_slot: (d,) int64 index of each controller axis in
     the model's state (length S); base_state: (S,) values of the uncovered slots.
     control_samples: (U, m) sampled controls; control_slot: (m,) int64 entry of the model's
     inputs (input_size of them) each control drives; effort_weight: (m,) K of the cost
-    t + Σ K|u| t.
-    dt: RK4 step, s; max_steps: a segment that has not left its cell after this many steps is
-    discarded (cost inf).
+    t + Σ K|u| t. max_step: the longest integration step, s. A segment still in its cell after
+    ``MAX_SEGMENT_SECONDS``, or whose state becomes non-finite, is discarded (cost inf).
     nodes: (P,) int64 flat node indices to process; node_valid: (N,) bool (False: removed node).
     pose_slot, outline, obstacle_vertices, obstacle_start, domain: the obstacles, as
     ``geometry.pose_is_free`` takes them (pose_slot[0] < 0: none); a segment whose state is not
@@ -129,12 +194,11 @@ def exit_transitions(
                 segment_cost[node, u] = np.inf
             continue
         center = np.empty(d)
-        before = np.empty(d)
-        after = np.empty(d)
         exit_state = np.empty(d)
+        stages = np.empty((7, size))  # Dormand–Prince's k1..k7, k7 at the step's end
         state = np.empty(size)
+        after = np.empty(size)
         inputs = np.zeros(input_size)
-        scratch = rk4_scratch(size)
         body = np.empty_like(outline)
         integer_scratch, fraction, corner_index, corner_weight = interpolation_scratch(d)
         node_coordinates(axis_min, axis_step, axis_count, node, center)
@@ -150,33 +214,72 @@ def exit_transitions(
             for i in range(exit_index.shape[2]):
                 exit_index[node, u, i] = node
                 exit_weight[node, u, i] = 0.0
-            for step in range(max_steps):
-                read_state(state, state_slot, before)
-                rk4_step(derivative_into, state, inputs, dt, scratch)
+            model_derivative(state, inputs, stages[0])
+            elapsed = 0.0
+            h = max_step
+            while elapsed < MAX_SEGMENT_SECONDS:
+                for k in range(d):
+                    speed = abs(stages[0, state_slot[k]])
+                    if speed * h > CELL_FRACTION * axis_step[k]:
+                        h = CELL_FRACTION * axis_step[k] / speed
+                for stage in range(1, 7):
+                    for i in range(size):
+                        total = 0.0
+                        for j in range(stage):
+                            total += DORMAND_PRINCE_A[stage, j] * stages[j, i]
+                        after[i] = state[i] + h * total
+                    model_derivative(after, inputs, stages[stage])
+                # the error of the step, in units of the tolerance on each controller axis
+                error = 0.0
+                for k in range(d):
+                    slot = state_slot[k]
+                    total = 0.0
+                    for j in range(7):
+                        total += DORMAND_PRINCE_ERROR[j] * stages[j, slot]
+                    error = max(error, abs(h * total) / (STEP_TOLERANCE * axis_step[k]))
+                if not np.isfinite(error):
+                    break  # the model diverged: cost stays inf
+                if error > 1.0:
+                    h *= max(0.2, 0.9 * error**-0.2)
+                    if h < MIN_STEP:
+                        break  # too stiff to follow: cost stays inf
+                    continue
                 if not pose_is_free(
-                    state, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
+                    after, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
                 ):
                     break  # hits an obstacle or leaves the domain polygon: cost stays inf
-                read_state(state, state_slot, after)
-                # earliest crossing of the cell boundary within this step, by linear interpolation
+                # the earliest crossing of the cell boundary within this step
                 crossing = 2.0
                 axis = -1
                 for k in range(d):
-                    low = center[k] - axis_step[k]
-                    high = center[k] + axis_step[k]
-                    if after[k] >= high:
-                        s = (high - before[k]) / (after[k] - before[k])
-                    elif after[k] <= low:
-                        s = (low - before[k]) / (after[k] - before[k])
-                    else:
-                        continue
+                    slot = state_slot[k]
+                    s = first_crossing(
+                        state[slot],
+                        after[slot],
+                        h * stages[0, slot],
+                        h * stages[6, slot],
+                        center[k] - axis_step[k],
+                        center[k] + axis_step[k],
+                    )
                     if s < crossing:
                         crossing = s
                         axis = k
                 if axis < 0:
+                    elapsed += h
+                    for i in range(size):
+                        state[i] = after[i]
+                        stages[0, i] = stages[6, i]
+                    h = min(max_step, h * min(5.0, 0.9 * max(error, 1e-10) ** -0.2))
                     continue
                 for k in range(d):
-                    exit_state[k] = before[k] + crossing * (after[k] - before[k])
+                    slot = state_slot[k]
+                    exit_state[k] = hermite(
+                        state[slot],
+                        after[slot],
+                        h * stages[0, slot],
+                        h * stages[6, slot],
+                        crossing,
+                    )
                 if exit_state[axis] > center[axis]:
                     exit_state[axis] = center[axis] + axis_step[axis]
                 else:
@@ -190,7 +293,7 @@ def exit_transitions(
                         if exit_state[k] > top + 1e-9 * axis_step[k]:
                             leaves_domain = True
                 if not leaves_domain:
-                    seconds = (step + crossing) * dt
+                    seconds = elapsed + crossing * h
                     segment_cost[node, u] = seconds * (1.0 + effort)
                     count = corner_weights(
                         axis_min,
@@ -217,16 +320,44 @@ def exit_transitions(
                 break
 
 
-@njit(parallel=True, cache=True)
-def reach_sweep(exit_index, exit_weight, segment_cost, valid, reached, new_reached):
-    """One sweep of reachability: a valid node joins ``reached`` when some control leaves its
-    cell (finite cost) onto a face with at least one reached corner (weight > 0). Start from the
-    destination nodes; repeat until nothing joins. The nodes never reached cannot reach the
-    destination: their cost-to-go is inf.
-    valid, reached, new_reached: (N,) bool. Returns how many nodes joined."""
-    joined = np.zeros(reached.shape[0], np.int64)
-    for node in prange(reached.shape[0]):
-        new_reached[node] = reached[node]
+@njit(cache=True)
+def sweep_order(axis_count, sweep, out):
+    """The grid's nodes in the order of sweep number ``sweep`` (out: (N,) int64): C order with
+    the axes whose bit is set in ``sweep mod 2**d`` run backwards. Successive sweeps take the
+    2**d orders in turn (the fast sweeping method), so that what is known spreads along every
+    direction of the grid within a few sweeps, each running through memory in order."""
+    d = axis_count.shape[0]
+    backwards = sweep % (1 << d)
+    strides = np.empty(d, np.int64)
+    grid_strides(axis_count, strides)
+    position = np.zeros(d, np.int64)
+    for p in range(out.shape[0]):
+        node = 0
+        for k in range(d):
+            i = position[k]
+            if (backwards >> k) & 1:
+                i = axis_count[k] - 1 - i
+            node += i * strides[k]
+        out[p] = node
+        k = d - 1
+        while k >= 0:
+            position[k] += 1
+            if position[k] < axis_count[k]:
+                break
+            position[k] = 0
+            k -= 1
+
+
+@njit(cache=True)
+def reach_sweep(exit_index, exit_weight, segment_cost, valid, reached, order):
+    """One sweep of reachability in ``order`` (``sweep_order``), in place: a valid node joins
+    ``reached`` when some control leaves its cell (finite cost) onto a face with at least one
+    reached corner (weight > 0). Start from the destination nodes; repeat until nothing joins.
+    The nodes never reached cannot reach the destination: their cost-to-go is inf.
+    valid, reached: (N,) bool. Returns how many nodes joined."""
+    joined = 0
+    for p in range(order.shape[0]):
+        node = order[p]
         if reached[node] or not valid[node]:
             continue
         for u in range(segment_cost.shape[1]):
@@ -234,12 +365,12 @@ def reach_sweep(exit_index, exit_weight, segment_cost, valid, reached, new_reach
                 continue
             for i in range(exit_index.shape[2]):
                 if exit_weight[node, u, i] > 0.0 and reached[exit_index[node, u, i]]:
-                    new_reached[node] = True
-                    joined[node] = 1
+                    reached[node] = True
                     break
-            if new_reached[node]:
+            if reached[node]:
+                joined += 1
                 break
-    return joined.sum()
+    return joined
 
 
 @njit(parallel=True, cache=True)
@@ -292,28 +423,30 @@ def _bellman(exit_index, exit_weight, segment_cost, value, node):
     return best, choice
 
 
-@njit(parallel=True, cache=True)
-def bellman_sweep(exit_index, exit_weight, segment_cost, is_destination, value, new_value, change):
-    """One Jacobi sweep of value iteration; returns the largest decrease of the cost-to-go.
+@njit(cache=True)
+def gauss_seidel_sweep(exit_index, exit_weight, segment_cost, is_destination, value, order):
+    """One Gauss–Seidel sweep of value iteration over the nodes in ``order`` (``sweep_order``):
+    each node's cost-to-go becomes ``min(old, update)`` at once, so the nodes after it in the
+    sweep use it. Returns the largest decrease, s.
 
-    value, new_value, change: (N,) float64 cost-to-go, s. Value iteration starts from an upper
-    bound (0 at the destination nodes, a large finite ``UNKNOWN`` at the other reachable nodes:
-    the paper's "values not yet known"; inf at unreachable nodes, which no finite transition
-    touches after ``interpolate_known_values_only``) and each sweep keeps ``min(old, update)``,
-    so values only decrease, as the paper describes. is_destination: (N,) bool, held at 0.
-    Deterministic whatever the thread count: each node writes only its own entries.
+    value: (N,) float64 cost-to-go, s, in place. Value iteration starts from an upper bound (0
+    at the destination nodes, a large finite ``UNKNOWN`` at the other reachable nodes: the
+    paper's "values not yet known"; inf at unreachable nodes, which no finite transition touches
+    after ``interpolate_known_values_only``), so values only decrease, as the paper describes.
+    is_destination: (N,) bool, held at 0. One thread, in a fixed order: the same result on any
+    machine whatever the thread count.
     """
-    nodes = value.shape[0]
-    for node in prange(nodes):
-        best = value[node]
-        if not is_destination[node]:
-            best = min(best, _bellman(exit_index, exit_weight, segment_cost, value, node)[0])
-        new_value[node] = best
-        change[node] = 0.0 if best == value[node] else value[node] - best
     largest = 0.0
-    for node in range(nodes):
-        if change[node] > largest:
-            largest = change[node]
+    for p in range(order.shape[0]):
+        node = order[p]
+        if is_destination[node]:
+            continue
+        old = value[node]
+        best = _bellman(exit_index, exit_weight, segment_cost, value, node)[0]
+        if best < old:
+            value[node] = best
+            if old - best > largest:
+                largest = old - best
     return largest
 
 

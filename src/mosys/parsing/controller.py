@@ -9,7 +9,7 @@
     dest angle=0 omega=0               # destination state (grid nodes)
     tol 1e-6                           # optional: convergence tolerance, s (default 1e-6)
     maxiter 1000                       # optional: iteration cap (default 1000)
-    dt 0.001                           # optional: DP integration step, s (default 0.001)
+    dt 0.05                            # optional: longest DP integration step, s (default 0.05)
     obstacle curb -20,-1 20,-1 20,0 -20,0   # optional: a polygon the body must not overlap, m
     domain -4,0.5 8,0.5 8,4 -4,4       # optional: a polygon the reference point stays in, m
     hold                               # optional: the destination nodes hold the figure at rest
@@ -66,7 +66,7 @@ DEFAULT_TOLERANCE = (
     1e-6  # s: largest change of the cost-to-go in one sweep that counts as converged
 )
 DEFAULT_MAX_ITERATIONS = 1000
-DEFAULT_DT = 0.001  # s
+DEFAULT_DT = 0.05  # s: the longest step of the DP's integrator (kernels.dp)
 GRID_TOLERANCE = 1e-9  # a destination lies on a node if within GRID_TOLERANCE * step of it
 
 
@@ -182,7 +182,7 @@ class ControllerSpec:
     state order restricted to these dimensions: see ``ordered_state``. ``destination`` is in
     ``dest`` order; dimensions it does not name are free. ``tolerance`` (s) stops the DP when
     no cost-to-go changes by more than it in one sweep; ``max_iterations`` caps the sweeps;
-    ``dt`` (s) is the integration step of the DP's simulations. ``spec_sha256`` is the hex
+    ``dt`` (s) is the longest step of the DP's integrator. ``spec_sha256`` is the hex
     SHA-256 of the file's bytes. ``obstacles`` and ``domain`` (None: no such line) restrict a
     figure with a body outline: states whose body overlaps an obstacle or whose reference point
     lies outside the domain are removed from the table. ``hold`` (the keyword's token, None

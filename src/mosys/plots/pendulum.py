@@ -53,7 +53,7 @@ from mosys.plots.style import (
 PORTRAIT_STARTS = 8  # start states per portrait
 PORTRAIT_SECONDS = 3.0  # s simulated from each start
 CYCLE_SECONDS = (3.0, 5.0)  # s: a periodic destination's cycle is drawn over this window
-DEFAULT_DT = 0.001  # s: simulator step when a table does not record its own
+SIMULATION_DT = 0.001  # s: the step of the closed-loop paths (the DP's own step is longer)
 
 
 @dataclass(frozen=True)
@@ -290,7 +290,7 @@ def portrait_figure(
     controller = Controller.load(table_path, dynamics)
     table = controller.table
     axes = table_axes(table, table_path)
-    dt = float(table.attrs.get("dt", DEFAULT_DT))
+    dt = SIMULATION_DT
     units = dict(zip(table.state_order, table.axis_units, strict=True))
     palette = matplotlib.colormaps["tab10"]
     with plot_style():

@@ -10,6 +10,7 @@ import itertools
 import json
 import resource
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
@@ -20,20 +21,21 @@ from mosys import __version__
 from mosys.io.controller_table import ControllerTable, write_controller_table
 from mosys.io.progress import Progress
 from mosys.kernels.dp import (
-    bellman_sweep,
     best_controls,
-    exit_transitions,
+    exit_transitions_template,
     free_nodes,
+    gauss_seidel_sweep,
     interpolate_known_values_only,
     node_coordinates,
     reach_sweep,
+    sweep_order,
 )
+from mosys.kernels.specialise import specialise
 from mosys.parsing.controller import ControllerSpec
 from mosys.ssc.grid import FigureGrid, control_scale, figure_grid, figure_state_names
 from mosys.ssc.obstacles import Obstacles, blocked_reason, spec_obstacles
 
 UNKNOWN = 1.0e9  # s: cost-to-go of a reachable node whose value is not known yet
-MAX_SEGMENT_SECONDS = 2.0  # a simulated segment that stays in its cell longer is discarded
 PROGRESS_CHUNKS = 20
 
 
@@ -164,14 +166,19 @@ def reachable_nodes(
     segment_cost: np.ndarray,
     destination: np.ndarray,
     valid: np.ndarray,
+    axis_count: np.ndarray,
 ) -> np.ndarray:
     """(N,) bool: the nodes from which some sequence of controls leads to the destination (every
-    step onto a face with a weight on a node already known to lead there)."""
+    step onto a face with a weight on a node already known to lead there), by sweeps in the
+    orders of ``sweep_order`` until one adds nothing."""
     reached = destination & valid
-    spare = np.empty_like(reached)
-    while reach_sweep(exit_index, exit_weight, segment_cost, valid, reached, spare):
-        reached, spare = spare, reached
-    return reached
+    order = np.empty(reached.shape[0], dtype=np.int64)
+    sweep = 0
+    while True:
+        sweep_order(axis_count, sweep, order)
+        if not reach_sweep(exit_index, exit_weight, segment_cost, valid, reached, order):
+            return reached
+        sweep += 1
 
 
 @dataclass(frozen=True)
@@ -184,6 +191,129 @@ class Solution:
     residual: float
     transition_seconds: float
     iteration_seconds: float
+    kernel_load_seconds: float
+
+
+@dataclass
+class Transitions:
+    """What the exit transitions give, rows indexed by node: exit_index and exit_weight (N, U,
+    2**(d-1)) int32 and float32, segment_cost (N, U) s (``dp.exit_transitions_template``)."""
+
+    exit_index: np.ndarray
+    exit_weight: np.ndarray
+    segment_cost: np.ndarray
+
+    @classmethod
+    def empty(cls, nodes: int, controls: int, dimensions: int) -> Transitions:
+        corners = 1 << (dimensions - 1)
+        return cls(
+            np.zeros((nodes, controls, corners), dtype=np.int32),
+            np.zeros((nodes, controls, corners), dtype=np.float32),
+            np.empty((nodes, controls)),
+        )
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return self.exit_index, self.exit_weight, self.segment_cost
+
+
+def exit_transition_arguments(problem: Problem, dt: float, valid: np.ndarray) -> tuple:
+    """The arguments of the exit-transition kernel before ``nodes``, and those after it up to
+    the outputs (``dp.exit_transitions_template``), SI."""
+    grid = problem.grid
+    # the kernels take SI controls; K stays per spec unit: K |u_spec| = (K / scale) |u_SI|
+    samples_si = np.ascontiguousarray(problem.control_samples * problem.control_scale)
+    effort = np.array([c.effort_weight for c in problem.spec.controls]) / problem.control_scale
+    before = (
+        grid.axis_min,
+        grid.axis_step,
+        grid.axis_count,
+        grid.wrap,
+        grid.state_slot,
+        problem.base_state,
+        samples_si,
+        problem.control_slot,
+        problem.input_size,
+        effort,
+        float(dt),
+    )
+    return before, (valid, *problem.obstacles.kernel_arguments())
+
+
+def load_kernels(
+    exit_transitions: Callable,
+    problem: Problem,
+    dt: float,
+    valid: np.ndarray,
+    transitions: Transitions,
+) -> float:
+    """Load (or compile, on a cold cache) every kernel of ``solve`` and start numba's threads,
+    by calling each on no nodes, so that the DP's timings are the DP's; returns the seconds."""
+    started = time.perf_counter()
+    none = np.empty(0, dtype=np.int64)
+    before, after = exit_transition_arguments(problem, dt, valid)
+    exit_transitions(*before, none, *after, *transitions.arrays())
+    empty = Transitions.empty(0, problem.control_samples.shape[0], len(problem.grid.names))
+    flags = np.empty(0, dtype=np.bool_)
+    reach_sweep(*empty.arrays(), flags, flags, none)
+    interpolate_known_values_only(*empty.arrays(), flags)
+    gauss_seidel_sweep(*empty.arrays(), flags, np.empty(0), none)
+    best_controls(*empty.arrays(), np.empty(0), none.copy())
+    sweep_order(problem.grid.axis_count, 0, np.empty(0, dtype=np.int64))
+    return time.perf_counter() - started
+
+
+def compute_transitions(
+    exit_transitions: Callable,
+    problem: Problem,
+    dt: float,
+    valid: np.ndarray,
+    transitions: Transitions,
+    quiet: bool,
+) -> None:
+    """Fill ``transitions`` in chunks of nodes, showing progress unless ``quiet``."""
+    nodes = problem.grid.node_count
+    controls = problem.control_samples.shape[0]
+    before, after = exit_transition_arguments(problem, dt, valid)
+    progress = Progress("exit transitions", nodes * controls, "simulations")
+    chunks = np.array_split(np.arange(nodes, dtype=np.int64), min(PROGRESS_CHUNKS, nodes))
+    done = 0
+    for chunk in chunks:
+        exit_transitions(*before, np.ascontiguousarray(chunk), *after, *transitions.arrays())
+        done += chunk.size * controls
+        if not quiet:
+            progress.update(done)
+    if not quiet:
+        progress.finish()
+
+
+def value_iteration(
+    problem: Problem,
+    transitions: Transitions,
+    reachable: np.ndarray,
+    tolerance: float,
+    max_iterations: int,
+    quiet: bool,
+) -> tuple[np.ndarray, int, float]:
+    """Gauss–Seidel sweeps (``dp.gauss_seidel_sweep``) in the orders of ``dp.sweep_order`` until
+    the largest decrease < tolerance (s) or ``max_iterations`` sweeps, from the paper's upper
+    bound; returns the cost-to-go (N,) s, the sweeps and the last sweep's largest decrease."""
+    grid = problem.grid
+    value = np.where(problem.is_destination, 0.0, np.where(reachable, UNKNOWN, np.inf))
+    order = np.empty(grid.node_count, dtype=np.int64)
+    progress = Progress("value iteration", max_iterations, "sweeps")
+    residual = np.inf
+    iterations = 0
+    while iterations < max_iterations:
+        sweep_order(grid.axis_count, iterations, order)
+        residual = gauss_seidel_sweep(*transitions.arrays(), problem.is_destination, value, order)
+        iterations += 1
+        if not quiet:
+            progress.update(iterations, f"largest change {residual:.3g} s")
+        if residual < tolerance:
+            break
+    if not quiet:
+        progress.finish(f"largest change {residual:.3g} s")
+    return value, iterations, float(residual)
 
 
 def solve(
@@ -195,84 +325,39 @@ def solve(
     node_valid: np.ndarray | None = None,
     quiet: bool = False,
 ) -> Solution:
-    """Exit transitions once, then Bellman sweeps until the largest decrease < tolerance (s) or
-    ``max_iterations`` sweeps. ``node_valid``: (N,) bool, False for further nodes to remove
-    (on top of ``problem.node_valid``).
+    """Exit transitions once (RK4 steps of at most ``dt`` s), then Bellman sweeps until the
+    largest decrease < tolerance (s) or ``max_iterations`` sweeps. ``node_valid``: (N,) bool,
+    False for further nodes to remove (on top of ``problem.node_valid``). The kernels are
+    loaded first, outside the DP's timings (``kernel_load_seconds``).
     """
     grid = problem.grid
-    nodes = grid.node_count
-    controls = problem.control_samples.shape[0]
-    corners = 1 << (len(grid.names) - 1)
     valid = problem.node_valid if node_valid is None else problem.node_valid & node_valid
-    exit_index = np.zeros((nodes, controls, corners), dtype=np.int32)
-    exit_weight = np.zeros((nodes, controls, corners), dtype=np.float32)
-    segment_cost = np.empty((nodes, controls))
-    max_steps = int(np.ceil(MAX_SEGMENT_SECONDS / dt))
-    # the kernels take SI controls; K stays per spec unit: K |u_spec| = (K / scale) |u_SI|
-    samples_si = np.ascontiguousarray(problem.control_samples * problem.control_scale)
-    effort = np.array([c.effort_weight for c in problem.spec.controls]) / problem.control_scale
-    started = time.perf_counter()
-    progress = Progress("exit transitions", nodes * controls, "simulations")
-    chunks = np.array_split(np.arange(nodes, dtype=np.int64), min(PROGRESS_CHUNKS, nodes))
-    done = 0
-    for chunk in chunks:
-        exit_transitions(
-            dynamics.derivative_into,
-            grid.axis_min,
-            grid.axis_step,
-            grid.axis_count,
-            grid.wrap,
-            grid.state_slot,
-            problem.base_state,
-            samples_si,
-            problem.control_slot,
-            problem.input_size,
-            effort,
-            float(dt),
-            max_steps,
-            np.ascontiguousarray(chunk),
-            valid,
-            *problem.obstacles.kernel_arguments(),
-            exit_index,
-            exit_weight,
-            segment_cost,
-        )
-        done += chunk.size * controls
-        if not quiet:
-            progress.update(done)
-    transition_seconds = time.perf_counter() - started
-    if not quiet:
-        progress.finish()
-
-    reachable = reachable_nodes(
-        exit_index, exit_weight, segment_cost, problem.is_destination, valid
+    transitions = Transitions.empty(
+        grid.node_count, problem.control_samples.shape[0], len(grid.names)
     )
-    interpolate_known_values_only(exit_index, exit_weight, segment_cost, reachable)
-
-    value = np.where(problem.is_destination, 0.0, np.where(reachable, UNKNOWN, np.inf))
-    new_value = np.empty(nodes)
-    change = np.empty(nodes)
-    progress = Progress("value iteration", max_iterations, "sweeps")
-    residual = np.inf
-    iterations = 0
-    while iterations < max_iterations:
-        residual = bellman_sweep(
-            exit_index, exit_weight, segment_cost, problem.is_destination, value, new_value, change
-        )
-        value, new_value = new_value, value
-        iterations += 1
-        if not quiet:
-            progress.update(iterations, f"largest change {residual:.3g} s")
-        if residual < tolerance:
-            break
-    best_control = np.empty(nodes, dtype=np.int64)
-    best_controls(exit_index, exit_weight, segment_cost, value, best_control)
+    exit_transitions = specialise(exit_transitions_template, dynamics, parallel=True)
+    kernel_load_seconds = load_kernels(exit_transitions, problem, dt, valid, transitions)
+    started = time.perf_counter()
+    compute_transitions(exit_transitions, problem, dt, valid, transitions, quiet)
+    transition_seconds = time.perf_counter() - started
+    reachable = reachable_nodes(
+        *transitions.arrays(), problem.is_destination, valid, grid.axis_count
+    )
+    interpolate_known_values_only(*transitions.arrays(), reachable)
+    value, iterations, residual = value_iteration(
+        problem, transitions, reachable, tolerance, max_iterations, quiet
+    )
+    best_control = np.empty(grid.node_count, dtype=np.int64)
+    best_controls(*transitions.arrays(), value, best_control)
     iteration_seconds = time.perf_counter() - started - transition_seconds
-    if not quiet:
-        progress.finish(f"largest change {residual:.3g} s")
-    value = np.where(reachable, value, np.inf)
     return Solution(
-        value, best_control, iterations, float(residual), transition_seconds, iteration_seconds
+        np.where(reachable, value, np.inf),
+        best_control,
+        iterations,
+        residual,
+        transition_seconds,
+        iteration_seconds,
+        kernel_load_seconds,
     )
 
 
@@ -366,7 +451,7 @@ def generate_controller(
         spec.dt,
         quiet=quiet,
     )
-    generation_seconds = time.perf_counter() - started
+    generation_seconds = time.perf_counter() - started - solution.kernel_load_seconds
     grid = problem.grid
     lower = np.array([c.minimum for c in spec.controls])
     upper = np.array([c.maximum for c in spec.controls])
@@ -393,6 +478,7 @@ def generate_controller(
             "generation_seconds": generation_seconds,
             "transition_seconds": solution.transition_seconds,
             "iteration_seconds": solution.iteration_seconds,
+            "kernel_load_seconds": solution.kernel_load_seconds,
             "iterations": solution.iterations,
             "residual": solution.residual,
             "converged": bool(
