@@ -41,23 +41,16 @@ CELL_FRACTION = 1.0  # an integration step moves no controller coordinate furthe
 STEP_TOLERANCE = 1e-3  # the integrator's error per step on each controller axis, in grid steps
 MIN_STEP = 1e-7  # s: a segment that needs shorter steps than this is discarded
 MAX_SEGMENT_SECONDS = 2.0  # a segment still in its cell after this long is discarded
-# Dormand–Prince 5(4) (Hairer, Nørsett and Wanner, Solving ODEs I, Table 5.2): the stages' weights
-# (row i: stage i's state from k1..k_i; the last row is the fifth-order solution, so k7 is the
-# derivative at the step's end) and the difference between the fifth- and fourth-order weights
-DORMAND_PRINCE_A = np.array(
-    [
-        [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-        [1 / 5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-        [3 / 40, 9 / 40, 0.0, 0.0, 0.0, 0.0, 0.0],
-        [44 / 45, -56 / 15, 32 / 9, 0.0, 0.0, 0.0, 0.0],
-        [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0.0, 0.0, 0.0],
-        [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656, 0.0, 0.0],
-        [35 / 384, 0.0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84, 0.0],
-    ]
-)
-DORMAND_PRINCE_ERROR = np.array(
-    [71 / 57600, 0.0, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40]
-)
+# Dormand–Prince 5(4) (Hairer, Nørsett and Wanner, Solving ODEs I, Table 5.2): the stages'
+# weights (stage i's state from k1..k_(i-1)); the last stage is the fifth-order solution B, so k7
+# is the derivative at the step's end; E = B minus the fourth-order weights (the error estimate)
+A21 = 1 / 5
+A31, A32 = 3 / 40, 9 / 40
+A41, A42, A43 = 44 / 45, -56 / 15, 32 / 9
+A51, A52, A53, A54 = 19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729
+A61, A62, A63, A64, A65 = 9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656
+B1, B3, B4, B5, B6 = 35 / 384, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84
+E1, E3, E4, E5, E6, E7 = 71 / 57600, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40
 
 
 @njit(cache=True)
@@ -75,19 +68,44 @@ def hermite(x0, x1, d0, d1, s):
 
 
 @njit(cache=True)
+def hermite_slope(x0, x1, d0, d1, s):
+    """d/ds of ``hermite`` at s."""
+    return (
+        6.0 * (s * s - s) * (x0 - x1)
+        + (3.0 * s * s - 4.0 * s + 1.0) * d0
+        + (3.0 * s * s - 2.0 * s) * d1
+    )
+
+
+@njit(cache=True)
 def _level_in_piece(x0, x1, d0, d1, start, end, level):
-    """The s in [start, end] where the Hermite (monotone there) equals ``level``, by
-    bisection to 1e-12."""
-    rising = hermite(x0, x1, d0, d1, end) > hermite(x0, x1, d0, d1, start)
-    for _ in range(45):
-        middle = 0.5 * (start + end)
-        if (hermite(x0, x1, d0, d1, middle) < level) == rising:
-            start = middle
+    """The s in [start, end] where the Hermite, monotone there and on either side of ``level``
+    at the ends, equals ``level``: Newton's method from the chord's guess, kept inside the
+    bracket (a bisection step where Newton would leave it), until a step moves s by less than
+    1e-13 of the bracket."""
+    low_value = hermite(x0, x1, d0, d1, start) - level
+    high_value = hermite(x0, x1, d0, d1, end) - level
+    rising = high_value > low_value
+    s = start + (end - start) * (-low_value) / (high_value - low_value)
+    width = end - start
+    for _ in range(60):
+        value = hermite(x0, x1, d0, d1, s) - level
+        if value == 0.0:
+            return s
+        if (value < 0.0) == rising:
+            start = s
         else:
-            end = middle
-        if end - start < 1e-12:
+            end = s
+        if end - start <= 1e-13 * width:
             break
-    return 0.5 * (start + end)
+        slope = hermite_slope(x0, x1, d0, d1, s)
+        step = s - value / slope if slope != 0.0 else -1.0
+        if not start < step < end:
+            step = 0.5 * (start + end)
+        elif abs(step - s) <= 1e-13 * width:
+            return step
+        s = step
+    return s
 
 
 @njit(cache=True)
@@ -196,6 +214,13 @@ def exit_transitions_template(
         center = np.empty(d)
         exit_state = np.empty(d)
         stages = np.empty((7, size))  # Dormand–Prince's k1..k7, k7 at the step's end
+        k1 = stages[0]
+        k2 = stages[1]
+        k3 = stages[2]
+        k4 = stages[3]
+        k5 = stages[4]
+        k6 = stages[5]
+        k7 = stages[6]
         state = np.empty(size)
         after = np.empty(size)
         inputs = np.zeros(input_size)
@@ -214,29 +239,51 @@ def exit_transitions_template(
             for i in range(exit_index.shape[2]):
                 exit_index[node, u, i] = node
                 exit_weight[node, u, i] = 0.0
-            model_derivative(state, inputs, stages[0])
+            model_derivative(state, inputs, k1)
             elapsed = 0.0
             h = max_step
             while elapsed < MAX_SEGMENT_SECONDS:
                 for k in range(d):
-                    speed = abs(stages[0, state_slot[k]])
+                    speed = abs(k1[state_slot[k]])
                     if speed * h > CELL_FRACTION * axis_step[k]:
                         h = CELL_FRACTION * axis_step[k] / speed
-                for stage in range(1, 7):
-                    for i in range(size):
-                        total = 0.0
-                        for j in range(stage):
-                            total += DORMAND_PRINCE_A[stage, j] * stages[j, i]
-                        after[i] = state[i] + h * total
-                    model_derivative(after, inputs, stages[stage])
+                for i in range(size):
+                    after[i] = state[i] + h * (A21 * k1[i])
+                model_derivative(after, inputs, k2)
+                for i in range(size):
+                    after[i] = state[i] + h * (A31 * k1[i] + A32 * k2[i])
+                model_derivative(after, inputs, k3)
+                for i in range(size):
+                    after[i] = state[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
+                model_derivative(after, inputs, k4)
+                for i in range(size):
+                    after[i] = state[i] + h * (
+                        A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i]
+                    )
+                model_derivative(after, inputs, k5)
+                for i in range(size):
+                    after[i] = state[i] + h * (
+                        A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]
+                    )
+                model_derivative(after, inputs, k6)
+                for i in range(size):
+                    after[i] = state[i] + h * (
+                        B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i]
+                    )
+                model_derivative(after, inputs, k7)
                 # the error of the step, in units of the tolerance on each controller axis
                 error = 0.0
                 for k in range(d):
                     slot = state_slot[k]
-                    total = 0.0
-                    for j in range(7):
-                        total += DORMAND_PRINCE_ERROR[j] * stages[j, slot]
-                    error = max(error, abs(h * total) / (STEP_TOLERANCE * axis_step[k]))
+                    estimate = h * (
+                        E1 * k1[slot]
+                        + E3 * k3[slot]
+                        + E4 * k4[slot]
+                        + E5 * k5[slot]
+                        + E6 * k6[slot]
+                        + E7 * k7[slot]
+                    )
+                    error = max(error, abs(estimate) / (STEP_TOLERANCE * axis_step[k]))
                 if not np.isfinite(error):
                     break  # the model diverged: cost stays inf
                 if error > 1.0:
@@ -256,8 +303,8 @@ def exit_transitions_template(
                     s = first_crossing(
                         state[slot],
                         after[slot],
-                        h * stages[0, slot],
-                        h * stages[6, slot],
+                        h * k1[slot],
+                        h * k7[slot],
                         center[k] - axis_step[k],
                         center[k] + axis_step[k],
                     )
@@ -268,7 +315,7 @@ def exit_transitions_template(
                     elapsed += h
                     for i in range(size):
                         state[i] = after[i]
-                        stages[0, i] = stages[6, i]
+                        k1[i] = k7[i]
                     h = min(max_step, h * min(5.0, 0.9 * max(error, 1e-10) ** -0.2))
                     continue
                 for k in range(d):
@@ -276,8 +323,8 @@ def exit_transitions_template(
                     exit_state[k] = hermite(
                         state[slot],
                         after[slot],
-                        h * stages[0, slot],
-                        h * stages[6, slot],
+                        h * k1[slot],
+                        h * k7[slot],
                         crossing,
                     )
                 if exit_state[axis] > center[axis]:
@@ -395,7 +442,7 @@ def interpolate_known_values_only(exit_index, exit_weight, segment_cost, reachab
                     exit_weight[node, u, i] /= total
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _expected_value(exit_index, exit_weight, node, u, value):
     """Σ w·V over the exit corners of (node, u); zero-weight corners are skipped."""
     total = 0.0
@@ -406,10 +453,11 @@ def _expected_value(exit_index, exit_weight, node, u, value):
     return total
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _bellman(exit_index, exit_weight, segment_cost, value, node):
     """(min over u of cost(node, u) + Σ w·V(corner), the first minimising u); (inf, 0) where
-    every control costs inf."""
+    every control costs inf. Inlined where it is called (numba's ``inline="always"``): a call
+    per node would cost more than the node's arithmetic."""
     best = np.inf
     choice = 0
     for u in range(segment_cost.shape[1]):
@@ -448,6 +496,34 @@ def gauss_seidel_sweep(exit_index, exit_weight, segment_cost, is_destination, va
             if old - best > largest:
                 largest = old - best
     return largest
+
+
+@njit(cache=True)
+def gauss_seidel_sweeps(
+    exit_index,
+    exit_weight,
+    segment_cost,
+    is_destination,
+    value,
+    axis_count,
+    first,
+    count,
+    tolerance,
+    order,
+):
+    """Sweeps number ``first``, ``first + 1``, ... (``gauss_seidel_sweep`` in the orders of
+    ``sweep_order``), at most ``count`` of them, stopping after the first whose largest decrease
+    is below ``tolerance`` (s). order: (N,) int64 work space. Returns (sweeps run, the last
+    one's largest decrease)."""
+    largest = np.inf
+    for k in range(count):
+        sweep_order(axis_count, first + k, order)
+        largest = gauss_seidel_sweep(
+            exit_index, exit_weight, segment_cost, is_destination, value, order
+        )
+        if largest < tolerance:
+            return k + 1, largest
+    return count, largest
 
 
 @njit(parallel=True, cache=True)

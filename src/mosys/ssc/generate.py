@@ -24,7 +24,7 @@ from mosys.kernels.dp import (
     best_controls,
     exit_transitions_template,
     free_nodes,
-    gauss_seidel_sweep,
+    gauss_seidel_sweeps,
     interpolate_known_values_only,
     node_coordinates,
     reach_sweep,
@@ -37,6 +37,7 @@ from mosys.ssc.obstacles import Obstacles, blocked_reason, spec_obstacles
 
 UNKNOWN = 1.0e9  # s: cost-to-go of a reachable node whose value is not known yet
 PROGRESS_CHUNKS = 20
+SWEEPS_PER_CALL = 8  # value-iteration sweeps between progress updates
 
 
 @dataclass(frozen=True)
@@ -256,9 +257,11 @@ def load_kernels(
     flags = np.empty(0, dtype=np.bool_)
     reach_sweep(*empty.arrays(), flags, flags, none)
     interpolate_known_values_only(*empty.arrays(), flags)
-    gauss_seidel_sweep(*empty.arrays(), flags, np.empty(0), none)
+    gauss_seidel_sweeps(
+        *empty.arrays(), flags, np.empty(0), problem.grid.axis_count, 0, 0, 1.0, none
+    )
     best_controls(*empty.arrays(), np.empty(0), none.copy())
-    sweep_order(problem.grid.axis_count, 0, np.empty(0, dtype=np.int64))
+    sweep_order(problem.grid.axis_count, 0, none)
     return time.perf_counter() - started
 
 
@@ -294,7 +297,7 @@ def value_iteration(
     max_iterations: int,
     quiet: bool,
 ) -> tuple[np.ndarray, int, float]:
-    """Gauss–Seidel sweeps (``dp.gauss_seidel_sweep``) in the orders of ``dp.sweep_order`` until
+    """Gauss–Seidel sweeps (``dp.gauss_seidel_sweeps``) in the orders of ``dp.sweep_order`` until
     the largest decrease < tolerance (s) or ``max_iterations`` sweeps, from the paper's upper
     bound; returns the cost-to-go (N,) s, the sweeps and the last sweep's largest decrease."""
     grid = problem.grid
@@ -303,14 +306,20 @@ def value_iteration(
     progress = Progress("value iteration", max_iterations, "sweeps")
     residual = np.inf
     iterations = 0
-    while iterations < max_iterations:
-        sweep_order(grid.axis_count, iterations, order)
-        residual = gauss_seidel_sweep(*transitions.arrays(), problem.is_destination, value, order)
-        iterations += 1
+    while iterations < max_iterations and not residual < tolerance:
+        swept, residual = gauss_seidel_sweeps(
+            *transitions.arrays(),
+            problem.is_destination,
+            value,
+            grid.axis_count,
+            iterations,
+            min(SWEEPS_PER_CALL, max_iterations - iterations),
+            tolerance,
+            order,
+        )
+        iterations += swept
         if not quiet:
             progress.update(iterations, f"largest change {residual:.3g} s")
-        if residual < tolerance:
-            break
     if not quiet:
         progress.finish(f"largest change {residual:.3g} s")
     return value, iterations, float(residual)
