@@ -28,14 +28,13 @@ PAPER_SECONDS = {"A": 381.0, "B": 452.0, "C": 341.0, "D": 460.0, "E": 459.0, "F"
 def finer_spec(factor: int) -> str:
     """Controller A with every grid step divided by ``factor`` over the same domain (the angle
     axis keeps its 360° wrap: 36·factor nodes; ω keeps ±500 deg/s with 0 on a node:
-    20·factor + 1 nodes) and the DP's time step divided likewise."""
+    20·factor + 1 nodes), at the DP's default step (its steps are sized to the cell)."""
     return (
         "dyn link1\n"
         f"ssd omega -500.0 500.0 {20 * factor + 1}\n"
         f"ssd angle -180 {180 - 10 / factor:g} {36 * factor} wrap\n"
         "torq torque -10.0 10.0 11 0.1\n"
         "dest angle=0 omega=0\n"
-        f"dt {0.001 / factor:g}\n"
     )
 
 

@@ -36,7 +36,8 @@ from mosys.ssc.grid import FigureGrid, control_scale, figure_grid, figure_state_
 from mosys.ssc.obstacles import Obstacles, blocked_reason, spec_obstacles
 
 UNKNOWN = 1.0e9  # s: cost-to-go of a reachable node whose value is not known yet
-PROGRESS_CHUNKS = 20
+PROGRESS_CHUNKS = 20  # at most; fewer for small grids (each chunk wakes numba's threads)
+SIMULATIONS_PER_CHUNK = 20_000  # at least, but for the last chunk
 SWEEPS_PER_CALL = 8  # value-iteration sweeps between progress updates
 
 
@@ -278,7 +279,8 @@ def compute_transitions(
     controls = problem.control_samples.shape[0]
     before, after = exit_transition_arguments(problem, dt, valid)
     progress = Progress("exit transitions", nodes * controls, "simulations")
-    chunks = np.array_split(np.arange(nodes, dtype=np.int64), min(PROGRESS_CHUNKS, nodes))
+    count = max(1, min(PROGRESS_CHUNKS, nodes * controls // SIMULATIONS_PER_CHUNK))
+    chunks = np.array_split(np.arange(nodes, dtype=np.int64), count)
     done = 0
     for chunk in chunks:
         exit_transitions(*before, np.ascontiguousarray(chunk), *after, *transitions.arrays())
