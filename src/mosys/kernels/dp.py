@@ -420,13 +420,13 @@ def reach_sweep(exit_index, exit_weight, segment_cost, valid, reached, order):
     return joined
 
 
-@njit(parallel=True, cache=True)
+@njit(cache=True)
 def interpolate_known_values_only(exit_index, exit_weight, segment_cost, reachable):
     """Restrict every exit's interpolation to the reachable corners of its face (the paper's
     Figure 10: the cost-to-go at the exit is interpolated between the neighbours whose values
     are known) by zeroing the other weights and renormalising; an exit with no reachable corner
     gets cost inf. Afterwards every finite transition rests on reachable nodes only."""
-    for node in prange(segment_cost.shape[0]):
+    for node in range(segment_cost.shape[0]):
         for u in range(segment_cost.shape[1]):
             if segment_cost[node, u] == np.inf:
                 continue
@@ -526,11 +526,11 @@ def gauss_seidel_sweeps(
     return count, largest
 
 
-@njit(parallel=True, cache=True)
+@njit(cache=True)
 def best_controls(exit_index, exit_weight, segment_cost, value, best_control):
     """The minimising control sample index of every node (the first on ties; 0 where every
     sample costs inf). best_control: (N,) int64 out."""
-    for node in prange(value.shape[0]):
+    for node in range(value.shape[0]):
         best_control[node] = _bellman(exit_index, exit_weight, segment_cost, value, node)[1]
 
 
