@@ -151,6 +151,32 @@ def test_first_collision_turns_the_body():
     assert first_collision(outline, 0.0, 1.0, math.radians(30), vertices, start, body) == 0
 
 
+@settings(max_examples=300, deadline=None)
+@given(
+    st.floats(-6.0, 6.0),
+    st.floats(-2.0, 4.0),
+    st.floats(-math.pi, math.pi),
+    st.lists(
+        st.tuples(st.floats(-8.0, 8.0), st.floats(-3.0, 5.0), st.floats(0.05, 4.0)),
+        min_size=1,
+        max_size=4,
+    ),
+)
+def test_first_collision_is_the_first_overlapping_obstacle(x, y, heading, squares):
+    """The bounding-box shortcut changes no answer: the first obstacle that polygons_overlap
+    finds the placed body overlapping, or -1."""
+    from mosys.kernels.geometry import place_outline
+
+    outline = np.array([[-3.2, -0.85], [0.8, -0.85], [0.8, 0.85], [-0.2, 0.85], [-3.2, 0.6]])
+    obstacles = [box(cx, cy, cx + side, cy + side / 2) for cx, cy, side in squares]
+    vertices, start = pack_polygons(obstacles)
+    body = np.empty_like(outline)
+    placed = np.empty_like(outline)
+    place_outline(outline, x, y, heading, placed)
+    expected = next((k for k, b in enumerate(obstacles) if polygons_overlap(placed, b)), -1)
+    assert first_collision(outline, x, y, heading, vertices, start, body) == expected
+
+
 # --- controller spec lines
 
 SMALL = """dyn car

@@ -87,8 +87,24 @@ def first_collision(outline, x, y, heading, obstacle_vertices, obstacle_start, b
     obstacle_vertices: (M, 2) every obstacle's vertices in turn; obstacle_start: (K+1,) int64,
     obstacle k is rows obstacle_start[k]:obstacle_start[k+1]; body: (V, 2) work array."""
     place_outline(outline, x, y, heading, body)
+    low_x = high_x = body[0, 0]
+    low_y = high_y = body[0, 1]
+    for i in range(1, body.shape[0]):
+        low_x = min(low_x, body[i, 0])
+        high_x = max(high_x, body[i, 0])
+        low_y = min(low_y, body[i, 1])
+        high_y = max(high_y, body[i, 1])
     for k in range(obstacle_start.shape[0] - 1):
         polygon = obstacle_vertices[obstacle_start[k] : obstacle_start[k + 1]]
+        # bounding boxes apart: no overlap (the edge tests below cost far more)
+        right = left = above = below = True  # of the body's box, every vertex
+        for i in range(polygon.shape[0]):
+            right = right and polygon[i, 0] > high_x
+            left = left and polygon[i, 0] < low_x
+            above = above and polygon[i, 1] > high_y
+            below = below and polygon[i, 1] < low_y
+        if right or left or above or below:
+            continue
         if polygons_overlap(body, polygon):
             return k
     return -1
