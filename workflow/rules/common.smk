@@ -3,7 +3,10 @@
 import ast
 import functools
 import importlib.util
+import json
+import os
 import re
+import tempfile
 from importlib.machinery import PathFinder
 from pathlib import Path
 
@@ -33,6 +36,7 @@ def package_directory():
     return Path(list(spec.submodule_search_locations)[0])
 
 
+@functools.cache
 def module_file(name):
     """The source file of the package module name (mosys.a.b), or None if there is none."""
     parts = name.split(".")
@@ -45,26 +49,94 @@ def module_file(name):
     return None
 
 
+# The import statements found in each package file, kept between runs while the file is
+# unchanged (its size and mtime): parsing every module the rules' code inputs name took as long
+# as the rest of the workflow's set-up (Snakemake's own import aside).
+IMPORT_STATEMENTS_CACHE = Path(".snakemake/mosys_import_statements.json")
+unsaved_import_statements = set()  # files parsed since the cache was last written
+
+
+@functools.cache
+def import_statements_cache():
+    try:
+        cached = json.loads(IMPORT_STATEMENTS_CACHE.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return {}
+    return cached if isinstance(cached, dict) else {}
+
+
+def save_import_statements_cache():
+    """Write the cache if files were parsed (atomically: other Snakemake runs may read it);
+    nothing if unwritable."""
+    if not unsaved_import_statements:
+        return
+    unsaved_import_statements.clear()
+    try:
+        IMPORT_STATEMENTS_CACHE.parent.mkdir(parents=True, exist_ok=True)
+        handle, partial = tempfile.mkstemp(dir=IMPORT_STATEMENTS_CACHE.parent, suffix=".partial")
+    except OSError:
+        return
+    try:
+        with os.fdopen(handle, "w", encoding="utf-8") as stream:
+            json.dump(import_statements_cache(), stream)
+        os.replace(partial, IMPORT_STATEMENTS_CACHE)
+    except OSError:
+        Path(partial).unlink(missing_ok=True)
+
+
+def statements(body):
+    """Every statement in body and in the statements nested in it (function and class bodies,
+    branches, handlers, match cases): where an import statement can be."""
+    todo = list(body)
+    while todo:
+        node = todo.pop()
+        yield node
+        for field in ("body", "orelse", "finalbody", "handlers", "cases"):
+            todo += [child for child in getattr(node, field, ()) if isinstance(child, ast.AST)]
+
+
+def import_statements(path):
+    """[line, level, module, names] of every import statement in the file at path (function
+    bodies too; module None for ``import a.b``, whose names are the dotted modules), read with
+    ast, nothing imported; from the cache while the file is unchanged."""
+    stat = path.stat()
+    stamp = [stat.st_size, stat.st_mtime_ns]
+    cache = import_statements_cache()
+    entry = cache.get(str(path))
+    if entry is not None and entry.get("stamp") == stamp:
+        return entry["imports"]
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    imports = []
+    for node in statements(tree.body):
+        if isinstance(node, ast.Import):
+            imports.append([node.lineno, 0, None, [alias.name for alias in node.names]])
+        elif isinstance(node, ast.ImportFrom):
+            imports.append([node.lineno, node.level, node.module, [a.name for a in node.names]])
+    imports.sort(key=lambda statement: statement[0])
+    cache[str(path)] = {"stamp": stamp, "imports": imports}
+    unsaved_import_statements.add(str(path))
+    return imports
+
+
 @functools.cache
 def imported_modules(name):
     """The package modules that module name imports anywhere (function bodies too), with the
-    packages along each dotted path; read with ast, nothing is imported."""
+    packages along each dotted path."""
     path = module_file(name)
-    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
     package = name if path.name == "__init__.py" else name.rpartition(".")[0]
     found = []  # (line, dotted name)
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            found += [(node.lineno, alias.name) for alias in node.names]
-        elif isinstance(node, ast.ImportFrom):
-            source = node.module or ""
-            if node.level:  # from . import x, from ..a import b
-                parts = package.split(".")[: len(package.split(".")) - node.level + 1]
-                source = ".".join(parts + ([source] if source else []))
-            found.append((node.lineno, source))
-            # from mosys.plots import bsr names a submodule; from mosys.io.atomic import f, not
-            found += [(node.lineno, f"{source}.{alias.name}") for alias in node.names
-                      if module_file(f"{source}.{alias.name}") is not None]
+    for line, level, module, names in import_statements(path):
+        if module is None and not level:  # import a.b
+            found += [(line, dotted) for dotted in names]
+            continue
+        source = module or ""
+        if level:  # from . import x, from ..a import b
+            parts = package.split(".")[: len(package.split(".")) - level + 1]
+            source = ".".join(parts + ([source] if source else []))
+        found.append((line, source))
+        # from mosys.plots import bsr names a submodule; from mosys.io.atomic import f, not
+        found += [(line, f"{source}.{alias}") for alias in names
+                  if module_file(f"{source}.{alias}") is not None]
     modules = set()
     for line, dotted in found:
         parts = dotted.split(".")
@@ -109,6 +181,7 @@ def code_inputs(*entries):
         for dotted in modules:
             path = module_file(dotted)
             files.add(str(path.relative_to(cwd)) if path.is_relative_to(cwd) else str(path))
+    save_import_statements_cache()
     return sorted(files)
 
 

@@ -15,10 +15,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from mosys.animation.motor_program import BoundMotorProgram, load_motor_program
 from mosys.parsing.script import (
     AnimationScript,
     Breakpoint,
@@ -30,6 +30,9 @@ from mosys.parsing.script import (
 from mosys.ssc.controller import Controller
 from mosys.ssc.grid import control_scale, figure_state_names, state_unit
 from mosys.ssc.regions import Bounds, regions
+
+if TYPE_CHECKING:  # motor programs are imported when a script runs one
+    from mosys.animation.motor_program import BoundMotorProgram
 
 
 @dataclass(frozen=True)
@@ -113,6 +116,8 @@ def load_programs(
         path = Path(motor_dir) / figure / f"{command.program}.mot"
         if not path.exists():
             raise script.error(command.program_token, f"a motor program ({path} does not exist)")
+        from mosys.animation.motor_program import load_motor_program
+
         programs[command.program] = load_motor_program(path, figure, dynamics)
     return programs
 

@@ -15,11 +15,9 @@ from mosys.animation.runner import (
 )
 from mosys.dynamics.figure_motion import figure_contacts, figure_motion
 from mosys.dynamics.load import figure_dynamics
-from mosys.io.car_scene import car_scene_attributes, controller_table_scene
 from mosys.io.controller_table import read_controller_table
 from mosys.io.trajectory import Trajectory, write_trajectory
 from mosys.parsing.script import SwapController, parse_script
-from mosys.ssc.parking import parking_outcome
 
 
 def run_animation_script(
@@ -52,6 +50,9 @@ def run_animation_script(
     run = run_script(script, sources, dt)
     contacts = None
     if getattr(dynamics, "MODEL_KIND", "figure") == "vehicle":
+        from mosys.io.car_scene import car_scene_attributes, controller_table_scene
+        from mosys.ssc.parking import parking_outcome
+
         motion = None  # not an articulated figure: no figure_motion (DESIGN.md)
         first_table = next(iter(sources.controllers.values())).table
         scene = controller_table_scene(first_table)

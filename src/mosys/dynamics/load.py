@@ -81,6 +81,9 @@ def load_dynamics(path: str | Path) -> ModuleType:
     spec = importlib.util.spec_from_file_location(name, copy)
     if spec is None or spec.loader is None:
         raise InputError(f"{path} cannot be imported as a Python module")
+    from mosys.kernels import compile_lock
+
+    compile_lock.serialize_cold_compilation()  # its jitted functions compile as it runs
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module
     try:

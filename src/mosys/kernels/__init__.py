@@ -5,13 +5,17 @@ another file (``bsr3d_controller.run_population`` steps ``bsr3d_simulate.step``)
 running the callee as it was compiled. So the cache stands for the whole package: importing it
 compares a digest of every kernel source file with the one the cache was built from and, if they
 differ, removes the package's cached machine code (numba's ``.nbi``/``.nbc`` files beside the
-sources) before anything is compiled.
+sources) before anything is compiled. And cold compilation happens once per machine, not once
+per parallel job (``compile_lock``): importing the package puts numba's compilations after a
+cache miss under a machine-wide lock.
 """
 
 from __future__ import annotations
 
 import hashlib
 from pathlib import Path
+
+from mosys.kernels.compile_lock import serialize_cold_compilation
 
 
 def _forget_stale_machine_code(directory: Path) -> None:
@@ -39,3 +43,4 @@ def _forget_stale_machine_code(directory: Path) -> None:
 
 
 _forget_stale_machine_code(Path(__file__).parent)
+serialize_cold_compilation()

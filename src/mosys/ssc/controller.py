@@ -10,16 +10,18 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from mosys.io.controller_table import ControllerTable, read_controller_table
 from mosys.kernels.interpolate import clamp_to_domain, interpolate_into
-from mosys.kernels.lookahead import simulate_lookahead
 from mosys.kernels.simulate import simulate_controlled
 from mosys.ssc.grid import FigureGrid, control_scale, figure_grid, figure_state_names, state_unit
-from mosys.ssc.lookahead import MAX_SEGMENT_SECONDS, Lookahead, lookahead_runtime
 from mosys.ssc.regions import ARRIVAL_STEPS, REST_RATE, Bounds, Regions, state_periods
+
+if TYPE_CHECKING:  # the lookahead policy (a vehicle's) is imported when a table uses it
+    from mosys.ssc.lookahead import Lookahead
 
 
 @dataclass(frozen=True)
@@ -62,11 +64,11 @@ class Controller:
         self.control_min_si = np.ascontiguousarray(table.control_min * self.control_scale)
         self.control_max_si = np.ascontiguousarray(table.control_max * self.control_scale)
         # 'policy lookahead' (a vehicle's spec): run by lookahead on the cost-to-go instead
-        self.lookahead: Lookahead | None = (
-            lookahead_runtime(table, dynamics, self.grid)
-            if table.attrs.get("policy") == "lookahead"
-            else None
-        )
+        self.lookahead: Lookahead | None = None
+        if table.attrs.get("policy") == "lookahead":
+            from mosys.ssc.lookahead import lookahead_runtime
+
+            self.lookahead = lookahead_runtime(table, dynamics, self.grid)
 
     @classmethod
     def load(cls, path: str | Path, dynamics: ModuleType) -> Controller:
@@ -154,6 +156,9 @@ class Controller:
         outside = np.empty(steps, dtype=np.bool_)
         grid = self.grid
         if self.lookahead is not None:
+            from mosys.kernels.lookahead import simulate_lookahead
+            from mosys.ssc.lookahead import MAX_SEGMENT_SECONDS
+
             policy = self.lookahead
             taken = simulate_lookahead(
                 self.dynamics.derivative_into,

@@ -1,0 +1,113 @@
+"""Cold compilation once per machine, not once per parallel job.
+
+numba compiles a ``cache=True`` function on its first call (or at import, given a signature)
+unless its machine code is in the cache. Two jobs that start together with a cold cache — the
+pipeline's first two ``mosys dp`` jobs, say — would both compile the same kernels, each for
+seconds, and both write the same cache entries. So every top-level compilation that misses the
+cache (in memory and on disk) runs under one machine-wide file lock, and looks at the cache again
+once it holds the lock: a job that waited loads what the other compiled. Cache hits take no lock
+(numba reports a compilation only after a miss: the ``numba:compile`` event), nor do the
+compilations of callees within one (the lock is held already), nor functions without a cache.
+
+The lock is ``mosys-compile.lock`` in ``$NUMBA_CACHE_DIR`` if set (the cache it guards), else in
+``$XDG_CACHE_HOME/mosys`` (``~/.cache/mosys``); without ``fcntl`` (Windows), or if the file
+cannot be opened or locked, compilation goes unguarded, as numba alone does it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from collections.abc import Iterator
+from pathlib import Path
+
+_installed = False
+
+
+def lock_path() -> Path:
+    """The machine-wide compilation lock file (see the module docstring)."""
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return Path(os.environ["NUMBA_CACHE_DIR"]) / "mosys-compile.lock"
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "mosys" / "mosys-compile.lock"
+
+
+@contextlib.contextmanager
+def machine_lock() -> Iterator[None]:
+    """Hold the compilation lock (an exclusive ``flock``; released when the process ends, too)."""
+    try:
+        import fcntl
+
+        path = lock_path()
+        path.parent.mkdir(parents=True, exist_ok=True)
+        handle = open(path, "a")  # noqa: SIM115 (closed below, after the lock is released)
+    except (ImportError, OSError):
+        yield
+        return
+    with handle:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX)
+        except OSError:  # a file system without locks
+            yield
+            return
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
+
+
+def serialize_cold_compilation() -> None:
+    """Make numba's dispatchers compile under ``machine_lock`` after a cache miss (see the
+    module docstring). Idempotent; call it before the first ``@njit(cache=True)`` function of
+    the process is compiled or loaded."""
+    global _installed
+    if _installed:
+        return
+    from numba.core import event
+    from numba.core.caching import NullCache
+    from numba.core.compiler_lock import global_compiler_lock
+    from numba.core.dispatcher import Dispatcher
+
+    class CacheMissError(Exception):
+        """Raised at a probed cache miss, before numba compiles anything."""
+
+    class MissProbe(event.Listener):
+        """While armed, stops the compilation that follows a cache miss."""
+
+        armed = False
+
+        def on_start(self, _event: event.Event) -> None:
+            if self.armed:
+                self.armed = False
+                raise CacheMissError
+
+        def on_end(self, _event: event.Event) -> None:
+            pass
+
+    probe = MissProbe()
+    event.register("numba:compile", probe)
+    compile_signature = Dispatcher.compile
+    depth = 0  # top-level compilations under the lock; numba's compiler lock guards it
+
+    def compile_once(self: Dispatcher, sig):
+        nonlocal depth
+        with global_compiler_lock:
+            if depth or isinstance(self._cache, NullCache):
+                return compile_signature(self, sig)
+            armed, probe.armed = probe.armed, True  # armed: when loading needs another
+            try:
+                return compile_signature(self, sig)  # in memory or on disk: no lock
+            except CacheMissError:
+                pass
+            finally:
+                probe.armed = armed
+            with machine_lock():
+                depth += 1
+                try:  # loads it if another process compiled it while this one waited
+                    return compile_signature(self, sig)
+                finally:
+                    depth -= 1
+
+    compile_once.__doc__ = compile_signature.__doc__
+    Dispatcher.compile = compile_once
+    _installed = True
