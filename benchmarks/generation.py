@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -57,3 +58,12 @@ def write_results(frame: pd.DataFrame, name: str, smoke: bool) -> None:
     frame.to_csv(out / f"{name}{suffix}.csv", index=False)
     (out / f"{name}{suffix}.md").write_text(frame.to_markdown(index=False) + "\n")
     print(frame.to_markdown(index=False))
+
+
+def copy_workflow(work: Path) -> Path:
+    """A copy of the repository at ``work`` (which must not exist) for a pipeline run that leaves
+    this one's results/ alone: everything but results/, Snakemake's state, git, the venv and
+    caches (the copies keep their mtimes, which are rule inputs)."""
+    ignored = ("results", ".snakemake", ".git", ".venv", "__pycache__", ".hypothesis")
+    shutil.copytree(ROOT, work, ignore=shutil.ignore_patterns(*ignored))
+    return work

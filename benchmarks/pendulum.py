@@ -19,7 +19,7 @@ import time
 from pathlib import Path
 
 import pandas as pd
-from generation import generate, write_results
+from generation import copy_workflow, generate, write_results
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER_SECONDS = {"A": 381.0, "B": 452.0, "C": 341.0, "D": 460.0, "E": 459.0, "F": 454.0}
@@ -43,13 +43,7 @@ def pipeline_seconds(cache: Path, work: Path) -> float:
     workflow."""
     if work.exists():
         shutil.rmtree(work)
-    shutil.copytree(
-        ROOT,
-        work,
-        ignore=shutil.ignore_patterns(
-            "results", ".snakemake", ".git", ".venv", "__pycache__", ".hypothesis"
-        ),
-    )
+    copy_workflow(work)
     env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
     started = time.perf_counter()
     subprocess.run(

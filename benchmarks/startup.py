@@ -38,7 +38,7 @@ import time
 from pathlib import Path
 
 import pandas as pd
-from generation import write_results
+from generation import copy_workflow, write_results
 
 ROOT = Path(__file__).resolve().parents[1]
 VERB_TARGET_S = 0.5
@@ -121,18 +121,6 @@ def verb_rows(repeats: int, tmp: Path) -> list[dict]:
         heavy = heavy.removeprefix("imported:").strip()
         rows.append(row("verb start-up", what, runs, VERB_TARGET_S, heavy_imports=heavy))
     return rows
-
-
-def copy_workflow(work: Path) -> Path:
-    """A copy of the workflow, its specs and sources (their mtimes are rule inputs) in work."""
-    work.mkdir(parents=True, exist_ok=True)
-    for name in ("Snakefile", "workflow", "config", "profiles", "specs", "src"):
-        source = ROOT / name
-        if source.is_dir():
-            shutil.copytree(source, work / name, ignore=shutil.ignore_patterns("__pycache__"))
-        else:
-            shutil.copy2(source, work / name)
-    return work
 
 
 def job_seconds(work: Path) -> float:
