@@ -46,4 +46,4 @@ def test_two_cold_processes_compile_a_kernel_once(tmp_path):
     # one compiled; the other missed the cache, waited for the lock, and loaded that code (its
     # hit); without the lock both would compile (no hit)
     assert [hits for _, hits in outcomes] == [0, 1] or [hits for _, hits in outcomes] == [1, 0]
-    assert (tmp_path / "cache" / "mosys-compile.lock").exists()
+    assert (tmp_path / "cache" / "mosys-compile-cold_kernel.lock").exists()

@@ -4,14 +4,16 @@ numba compiles a ``cache=True`` function on its first call (or at import, given 
 unless its machine code is in the cache. Two jobs that start together with a cold cache — the
 pipeline's first two ``mosys dp`` jobs, say — would both compile the same kernels, each for
 seconds, and both write the same cache entries. So every top-level compilation that misses the
-cache (in memory and on disk) runs under one machine-wide file lock, and looks at the cache again
-once it holds the lock: a job that waited loads what the other compiled. Cache hits take no lock
-(numba reports a compilation only after a miss: the ``numba:compile`` event), nor do the
-compilations of callees within one (the lock is held already), nor functions without a cache.
+cache (in memory and on disk) runs under a machine-wide file lock, one per Python module (so that
+two jobs compiling different modules' kernels still run side by side), and looks at the cache
+again once it holds the lock: a job that waited loads what the other compiled. Cache hits take no
+lock (numba reports a compilation only after a miss: the ``numba:compile`` event), nor do the
+compilations of callees within one (which therefore never wait: no deadlock), nor functions
+without a cache.
 
-The lock is ``mosys-compile.lock`` in ``$NUMBA_CACHE_DIR`` if set (the cache it guards), else in
-``$XDG_CACHE_HOME/mosys`` (``~/.cache/mosys``); without ``fcntl`` (Windows), or if the file
-cannot be opened or locked, compilation goes unguarded, as numba alone does it.
+The lock of module M is ``mosys-compile-M.lock`` in ``$NUMBA_CACHE_DIR`` if set (the cache it
+guards), else in ``$XDG_CACHE_HOME/mosys`` (``~/.cache/mosys``); without ``fcntl`` (Windows), or
+if the file cannot be opened or locked, compilation goes unguarded, as numba alone does it.
 """
 
 from __future__ import annotations
@@ -24,21 +26,24 @@ from pathlib import Path
 _installed = False
 
 
-def lock_path() -> Path:
-    """The machine-wide compilation lock file (see the module docstring)."""
+def lock_path(module: str) -> Path:
+    """The machine-wide lock file of compilations of the Python module ``module``'s functions
+    (see the module docstring)."""
+    name = f"mosys-compile-{module}.lock"
     if os.environ.get("NUMBA_CACHE_DIR"):
-        return Path(os.environ["NUMBA_CACHE_DIR"]) / "mosys-compile.lock"
+        return Path(os.environ["NUMBA_CACHE_DIR"]) / name
     base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
-    return Path(base) / "mosys" / "mosys-compile.lock"
+    return Path(base) / "mosys" / name
 
 
 @contextlib.contextmanager
-def machine_lock() -> Iterator[None]:
-    """Hold the compilation lock (an exclusive ``flock``; released when the process ends, too)."""
+def machine_lock(module: str) -> Iterator[None]:
+    """Hold the compilation lock of ``module`` (an exclusive ``flock``; released when the process
+    ends, too)."""
     try:
         import fcntl
 
-        path = lock_path()
+        path = lock_path(module)
         path.parent.mkdir(parents=True, exist_ok=True)
         handle = open(path, "a")  # noqa: SIM115 (closed below, after the lock is released)
     except (ImportError, OSError):
@@ -101,7 +106,7 @@ def serialize_cold_compilation() -> None:
                 pass
             finally:
                 probe.armed = armed
-            with machine_lock():
+            with machine_lock(self.py_func.__module__ or ""):
                 depth += 1
                 try:  # loads it if another process compiled it while this one waited
                     return compile_signature(self, sig)
