@@ -196,7 +196,7 @@ class Solution:
     kernel_load_seconds: float
 
 
-@dataclass
+@dataclass(frozen=True)
 class Transitions:
     """What the exit transitions give, rows indexed by node: exit_index and exit_weight (N, U,
     2**(d-1)) int32 and float32, segment_cost (N, U) s (``dp.exit_transitions_template``)."""
