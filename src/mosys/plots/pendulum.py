@@ -53,7 +53,6 @@ from mosys.plots.style import (
 PORTRAIT_STARTS = 8  # start states per portrait
 PORTRAIT_SECONDS = 3.0  # s simulated from each start
 CYCLE_SECONDS = (3.0, 5.0)  # s: a periodic destination's cycle is drawn over this window
-SIMULATION_DT = 0.001  # s: the step of the closed-loop paths (the DP's own step is longer)
 
 
 @dataclass(frozen=True)
@@ -285,12 +284,12 @@ def portrait_figure(
     ``starts`` start states (small squares) for ``seconds`` each, to the destination (encircled
     X). A periodic destination's cycle (the path from the destination itself, between
     ``CYCLE_SECONDS``) is drawn as a thick grey line."""
-    from mosys.ssc.controller import Controller
+    from mosys.ssc.controller import CLOSED_LOOP_DT, Controller
 
     controller = Controller.load(table_path, dynamics)
     table = controller.table
     axes = table_axes(table, table_path)
-    dt = SIMULATION_DT
+    dt = CLOSED_LOOP_DT
     units = dict(zip(table.state_order, table.axis_units, strict=True))
     palette = matplotlib.colormaps["tab10"]
     with plot_style():

@@ -20,6 +20,9 @@ from mosys.kernels.simulate import simulate_controlled
 from mosys.ssc.grid import FigureGrid, control_scale, figure_grid, figure_state_names, state_unit
 from mosys.ssc.regions import ARRIVAL_STEPS, REST_RATE, Bounds, Regions, state_periods
 
+CLOSED_LOOP_DT = 0.001  # s: the simulator step of the closed-loop runs that judge and draw a
+# table (quality, portraits); the DP's own steps are longer (kernels.dp)
+
 if TYPE_CHECKING:  # the lookahead policy (a vehicle's) is imported when a table uses it
     from mosys.ssc.lookahead import Lookahead
 

@@ -242,17 +242,14 @@ def exit_transition_arguments(problem: Problem, dt: float, valid: np.ndarray) ->
 
 
 def load_kernels(
-    exit_transitions: Callable,
-    problem: Problem,
-    dt: float,
-    valid: np.ndarray,
-    transitions: Transitions,
+    exit_transitions: Callable, arguments: tuple, problem: Problem, transitions: Transitions
 ) -> float:
     """Load (or compile, on a cold cache) every kernel of ``solve`` and start numba's threads,
-    by calling each on no nodes, so that the DP's timings are the DP's; returns the seconds."""
+    by calling each on no nodes, so that the DP's timings are the DP's; returns the seconds.
+    arguments: ``exit_transition_arguments``."""
     started = time.perf_counter()
     none = np.empty(0, dtype=np.int64)
-    before, after = exit_transition_arguments(problem, dt, valid)
+    before, after = arguments
     exit_transitions(*before, none, *after, *transitions.arrays())
     empty = Transitions.empty(0, problem.control_samples.shape[0], len(problem.grid.names))
     flags = np.empty(0, dtype=np.bool_)
@@ -261,23 +258,23 @@ def load_kernels(
     gauss_seidel_sweeps(
         *empty.arrays(), flags, np.empty(0), problem.grid.axis_count, 0, 0, 1.0, none
     )
-    best_controls(*empty.arrays(), np.empty(0), none.copy())
+    best_controls(*empty.arrays(), np.empty(0), none)
     sweep_order(problem.grid.axis_count, 0, none)
     return time.perf_counter() - started
 
 
 def compute_transitions(
     exit_transitions: Callable,
+    arguments: tuple,
     problem: Problem,
-    dt: float,
-    valid: np.ndarray,
     transitions: Transitions,
     quiet: bool,
 ) -> None:
-    """Fill ``transitions`` in chunks of nodes, showing progress unless ``quiet``."""
+    """Fill ``transitions`` in chunks of nodes, showing progress unless ``quiet``. arguments:
+    ``exit_transition_arguments``."""
     nodes = problem.grid.node_count
     controls = problem.control_samples.shape[0]
-    before, after = exit_transition_arguments(problem, dt, valid)
+    before, after = arguments
     progress = Progress("exit transitions", nodes * controls, "simulations")
     count = max(1, min(PROGRESS_CHUNKS, nodes * controls // SIMULATIONS_PER_CHUNK))
     chunks = np.array_split(np.arange(nodes, dtype=np.int64), count)
@@ -336,7 +333,7 @@ def solve(
     node_valid: np.ndarray | None = None,
     quiet: bool = False,
 ) -> Solution:
-    """Exit transitions once (RK4 steps of at most ``dt`` s), then Bellman sweeps until the
+    """Exit transitions once (integrator steps of at most ``dt`` s), then Bellman sweeps until the
     largest decrease < tolerance (s) or ``max_iterations`` sweeps. ``node_valid``: (N,) bool,
     False for further nodes to remove (on top of ``problem.node_valid``). The kernels are
     loaded first, outside the DP's timings (``kernel_load_seconds``).
@@ -347,9 +344,10 @@ def solve(
         grid.node_count, problem.control_samples.shape[0], len(grid.names)
     )
     exit_transitions = specialise(exit_transitions_template, dynamics, parallel=True)
-    kernel_load_seconds = load_kernels(exit_transitions, problem, dt, valid, transitions)
+    arguments = exit_transition_arguments(problem, dt, valid)
+    kernel_load_seconds = load_kernels(exit_transitions, arguments, problem, transitions)
     started = time.perf_counter()
-    compute_transitions(exit_transitions, problem, dt, valid, transitions, quiet)
+    compute_transitions(exit_transitions, arguments, problem, transitions, quiet)
     transition_seconds = time.perf_counter() - started
     reachable = reachable_nodes(
         *transitions.arrays(), problem.is_destination, valid, grid.axis_count

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mosys.ssc.controller import Controller
+from mosys.ssc.controller import CLOSED_LOOP_DT, Controller
 
 #: The fixed start states of the quality test, (angle deg, omega deg/s): a 8 × 5 grid over the
 #: pendulum's domain.
@@ -52,7 +52,7 @@ class Arrivals:
 
 
 def arrivals(
-    controller: Controller, starts: np.ndarray, seconds: float, dt: float = 0.001
+    controller: Controller, starts: np.ndarray, seconds: float, dt: float = CLOSED_LOOP_DT
 ) -> Arrivals:
     """Simulate every start (S, d) for ``seconds`` under ``controller`` and time its arrivals."""
     first = np.full(len(starts), np.nan)
