@@ -313,6 +313,7 @@ ERRORS = [
     ("", "x.ssc:1:1: expected a 'dyn' line, found end of file"),
     (BASE + "tol 0", "x.ssc:6:5: expected a number > 0 for tol (s), found '0'"),
     (BASE + "dt -1e-3", "x.ssc:6:4: expected a number > 0 for dt (s), found '-1e-3'"),
+    (BASE + "dt 1e-300", "x.ssc:6:4: expected a dt of at least 1e-05 s, found '1e-300'"),
     (BASE + "maxiter 0", "x.ssc:6:9: expected a whole number >= 1 for maxiter, found '0'"),
     (
         BASE + "maxiter 10\nmaxiter 20",

@@ -9,7 +9,7 @@
     dest angle=0 omega=0               # destination state (grid nodes)
     tol 1e-6                           # optional: convergence tolerance, s (default 1e-6)
     maxiter 1000                       # optional: iteration cap (default 1000)
-    dt 0.05                            # optional: longest DP integration step, s (default 0.05)
+    dt 0.05                            # optional: longest DP step, s (default 0.05; >= 1e-5)
     obstacle curb -20,-1 20,-1 20,0 -20,0   # optional: a polygon the body must not overlap, m
     domain -4,0.5 8,0.5 8,4 -4,4       # optional: a polygon the reference point stays in, m
     hold                               # optional: the destination nodes hold the figure at rest
@@ -67,6 +67,7 @@ DEFAULT_TOLERANCE = (
 )
 DEFAULT_MAX_ITERATIONS = 1000
 DEFAULT_DT = 0.05  # s: the longest step of the DP's integrator (kernels.dp)
+MIN_DT = 1e-5  # s: below this a segment that stays in its cell (2 s) would take 200,000 steps
 GRID_TOLERANCE = 1e-9  # a destination lies on a node if within GRID_TOLERANCE * step of it
 
 
@@ -516,7 +517,11 @@ class _Parser:
         self.options["tol"] = self.positive(line, "tol (s)")
 
     def line_dt(self, line: Line) -> None:
-        self.options["dt"] = self.positive(line, "dt (s)")
+        value = self.positive(line, "dt (s)")
+        if value < MIN_DT:
+            token = line.tokens[1]
+            raise self.error(token, f"a dt of at least {MIN_DT:g} s", token.text)
+        self.options["dt"] = value
 
     def line_hold(self, line: Line) -> None:
         line.reader().end()
