@@ -10,11 +10,13 @@ import numpy as np
 import pytest
 from test_car import SMALL
 
+from mosys.io.start_grid import read_start_grid, write_start_grid
 from mosys.kernels.geometry import first_colliding_sample, point_in_polygon
 from mosys.parsing.controller import parse_controller_text
 from mosys.parsing.tokens import SpecError
 from mosys.ssc.controller import Controller
 from mosys.ssc.generate import build_problem, generate_controller
+from mosys.ssc.parking import NOT_FREE, evaluate_starts
 
 ARRIVAL = "policy lookahead x=0.1 y=0.1 heading=4\n"
 DT = 0.01
@@ -54,18 +56,20 @@ def test_the_table_records_the_policy_and_its_arrival_box(small):
 
 @pytest.mark.parametrize("seed", range(12))
 def test_it_never_touches_an_obstacle_or_leaves_the_domain(small, seed):
-    """Random free starts at rest or rolling: every step of the run is free, because a sample is
-    taken only if the vehicle can brake to rest from its segment's exit."""
+    """Random free starts, rolling (odd seeds; anywhere in the domain) or at rest within the
+    table's axes (even seeds): every step of the run is free, because a sample is taken only
+    if the vehicle can brake to rest from its segment's exit; from rest within the axes, the
+    run stays within them too."""
     rng = np.random.default_rng(seed)
     obstacles = small.lookahead
     while True:
         start = np.array(
             [
-                rng.uniform(-2.5, 2.5),
-                rng.uniform(1.0, 2.4),
+                rng.uniform(-2.5, 2.5) if seed % 2 else rng.uniform(-2, 2),
+                rng.uniform(1.0, 2.4) if seed % 2 else rng.uniform(1.0, 2.0),
                 rng.uniform(-20, 20),
                 rng.uniform(-30, 30),
-                rng.uniform(-0.8, 0.8),
+                rng.uniform(-0.8, 0.8) if seed % 2 else 0.0,
             ]
         )
         state = small.figure_state(start)
@@ -86,6 +90,12 @@ def test_it_never_touches_an_obstacle_or_leaves_the_domain(small, seed):
     )
     assert sample == -1
     assert all(_in_domain(s, small) for s in run.states)
+    grid = small.grid
+    lower, upper = grid.axis_min, grid.axis_min + grid.axis_step * (grid.axis_count - 1)
+    si = run.states[:, grid.state_slot]
+    if seed % 2 == 0:  # from rest within the table's axes, it stays within them (to 1 % of a
+        slack = 0.01 * grid.axis_step  # grid step: its segments are simulated with the DP's dt)
+        assert np.all(si >= lower - slack) and np.all(si <= upper + slack)
 
 
 def _in_domain(state, controller) -> bool:
@@ -93,12 +103,26 @@ def _in_domain(state, controller) -> bool:
 
 
 def test_controls_are_the_dp_samples_held_for_whole_segments(small):
-    run = small.simulate(small.figure_state(np.array([1.5, 2.0, 0.0, 0.0, 0.0])), 4.0, DT)
+    run = small.simulate(small.figure_state(np.array([1.0, 1.75, -10.0, 0.0, 0.0])), 4.0, DT)
     samples = small.lookahead.control_samples / small.control_scale
     moving = run.controls[: np.argmax(np.all(run.controls == 0.0, axis=1)) or None]
-    for control in moving:
-        assert np.any(np.all(np.isclose(samples, control), axis=1)) or control[0] == 0.0
+    states = small.controller_states(run.states)
+    ends = {name: (small.table.axes[k][0], small.table.axes[k][-1]) for k, name in
+            enumerate(small.state_order)}  # fmt: skip
+    for step, control in enumerate(moving):
+        after = dict(zip(small.state_order, states[step + 1], strict=True))
+        at_an_end = any(  # a control cut so that steer or speed stops at its axis end
+            np.isclose(after[name], end) for name in ("steer", "speed") for end in ends[name]
+        )
+        sample = np.any(np.all(np.isclose(samples, control), axis=1))
+        assert sample or at_an_end or control[0] == 0.0
+    columns = [small.state_order.index(name) for name in ("steer", "speed")]
+    ends = np.array([[ends[name][0] for name in ("steer", "speed")],
+                     [ends[name][1] for name in ("steer", "speed")]])  # fmt: skip
+    after = states[1:, columns]
+    cut = np.any(np.isclose(after, ends[0]) | np.isclose(after, ends[1]), axis=1)
     changes = np.flatnonzero(np.any(np.diff(run.controls, axis=0) != 0.0, axis=1))
+    changes = changes[~cut[changes] & ~cut[changes + 1]]  # between whole samples
     assert changes.size > 0
     assert np.min(np.diff(changes)) >= 2  # held for more than one step between choices
 
@@ -118,12 +142,23 @@ def test_in_the_arrival_box_it_brakes_to_rest_and_holds(small):
 
 def test_its_choices_do_not_depend_on_the_simulator_step(small):
     """Segments are simulated with the DP's step, so runs at 0.01 s and 0.0025 s make the same
-    choices at the same times and end in the same place (to RK4 accuracy)."""
+    choices at the same times and end in the same place (to RK4 accuracy); only the step in
+    which steer or speed reaches its axis end is cut differently (``_limit_inputs``)."""
     start = small.figure_state(np.array([1.5, 2.0, 5.0, 0.0, 0.0]))
     coarse = small.simulate(start, 4.0, 0.01)
     fine = small.simulate(start, 4.0, 0.0025)
-    np.testing.assert_allclose(fine.controls[::4], coarse.controls)
-    np.testing.assert_allclose(fine.states[-1], coarse.states[-1], atol=1e-6)
+    differ = ~np.isclose(fine.controls[::4], coarse.controls, rtol=1e-7, atol=1e-6)
+    states = small.controller_states(coarse.states)[1:]
+    columns = [small.state_order.index(name) for name in ("steer", "speed")]
+    ends = np.array([[small.table.axes[k][0], small.table.axes[k][-1]] for k in columns])
+    reaching = np.any(
+        np.isclose(states[:, columns], ends[:, 0]) | np.isclose(states[:, columns], ends[:, 1]),
+        axis=1,
+    )
+    assert np.all(reaching[np.any(differ, axis=1)])
+    assert np.sum(np.any(differ, axis=1)) <= 2
+    # the cut step ends at the limit either way, a fraction of a step apart in time: 10 µm
+    np.testing.assert_allclose(fine.states[-1], coarse.states[-1], atol=1e-4)
 
 
 def test_lookahead_needs_a_wheel_accel_that_brakes(car):
@@ -152,3 +187,33 @@ def test_a_car_without_obstacles_parks_in_the_open(car, tmp_path):
     final = controller.controller_states(run.states)[-1]
     assert final[4] == pytest.approx(0.0, abs=1e-9)
     assert abs(final[0]) <= 0.1 and abs(final[1] - 1.0) <= 0.1
+
+
+def test_a_start_grid_runs_the_starts_that_can_park_and_excludes_the_others(small, tmp_path):
+    """Starts whose pose overlaps the curb or lies outside the domain are excluded (not run),
+    with the reason; every start records the table's cost-to-go there; the rate counts only
+    the starts that are not excluded; two threads give the same file as one."""
+    starts = np.array(
+        [
+            [1.5, 2.0, 0.0, 0.0, 0.0],
+            [-1.0, 1.5, 5.0, 0.0, 0.0],
+            [0.0, 0.6, 0.0, 0.0, 0.0],  # the body overlaps the curb
+            [0.0, 2.7, 0.0, 0.0, 0.0],  # the reference point is outside the domain
+        ]
+    )
+    one = evaluate_starts(small, starts, 10.0, DT, threads=1)
+    assert one.excluded.tolist() == ["", "", NOT_FREE, NOT_FREE]
+    assert not one.parked[2:].any() and not one.collided[2:].any()
+    assert np.isnan(one.parking_seconds[2:]).all() and np.isnan(one.path_length[2:]).all()
+    assert np.isfinite(one.path_length[:2]).all() and np.all(one.path_length[:2] > 0)
+    assert one.cost_to_go.tolist() == [small.cost_to_go(start) for start in starts]
+    assert np.isfinite(one.cost_to_go[:2]).all()
+    assert one.success_rate == one.parked[:2].mean()
+    two = evaluate_starts(small, starts, 10.0, DT, threads=2)
+    for name in ("parked", "collided", "parking_seconds", "cost_to_go", "path_length"):
+        np.testing.assert_array_equal(getattr(one, name), getattr(two, name))
+    write_start_grid(tmp_path / "grid.h5", one)
+    back = read_start_grid(tmp_path / "grid.h5")
+    assert back.excluded.tolist() == one.excluded.tolist()
+    np.testing.assert_array_equal(back.cost_to_go, one.cost_to_go)
+    np.testing.assert_array_equal(back.consistency, one.consistency)

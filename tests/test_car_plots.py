@@ -21,18 +21,22 @@ from matplotlib.patches import Polygon
 from PIL import Image
 
 import mosys.plots.car as car
+from mosys.io.start_grid import NO_WAY, NOT_FREE, consistency_summary
 from mosys.io.trajectory import Trajectory, write_trajectory
 from mosys.kernels.geometry import first_colliding_sample, pack_polygons
 from mosys.plots.car import (
     FAILURE_COLOR,
     OBSTACLE_FACE,
     TIMEOUT_COLOR,
+    consistency_figure,
     drawn_samples,
     outcome_text,
     parking_frames_figure,
+    plot_consistency,
     plot_parking_frames,
     plot_success_map,
     read_car_trajectory,
+    read_start_grid,
     success_map_figure,
     view_limits,
     wheel_segments,
@@ -158,22 +162,40 @@ def lost(tmp_path) -> Path:
     return write_car_trajectory(tmp_path / "park_3.h5", lost_states(), seconds=6.0)
 
 
-def write_start_grid(path: Path, steers=(0.0,)) -> Path:
-    """A 2 × 3 grid of start positions (per steer value), outcomes by position: the lower row
-    parks (slower further right), the upper row's left start collides, the rest time out."""
-    rows, parked, collided, seconds = [], [], [], []
-    for steer in steers:
-        for j, y in enumerate((4.0, 6.0)):
-            for i, x in enumerate((0.0, 3.0, 6.0)):
-                rows.append([x, y, 0.0, steer, 0.0])
-                parked.append(j == 0 and steer == steers[0])
-                collided.append(j == 1 and i == 0)
-                seconds.append(8.0 + 2.0 * i if parked[-1] else math.nan)
+def write_start_grid(path: Path, steers=(0.0,), headings=(0.0,)) -> Path:
+    """Per (heading, steer), a 2 × 3 grid of start positions run, outcomes by position: the lower
+    row parks at the first heading and steer (8, 10 and 12 s, left to right, from a cost-to-go
+    of 8 s: 1.0, 1.25 and 1.5 times it), the upper row's left start collides, the rest time
+    out; and two starts not run: one in the front car (not free), one the pose search found no
+    path from. Cost-to-go 9 s at the other starts run, inf at those not run."""
+    rows, parked, collided, seconds, excluded = [], [], [], [], []
+    for heading in headings:
+        for steer in steers:
+            first = steer == steers[0] and heading == headings[0]
+            for j, y in enumerate((4.0, 6.0)):
+                for i, x in enumerate((0.0, 3.0, 6.0)):
+                    rows.append([x, y, heading, steer, 0.0])
+                    parked.append(j == 0 and first)
+                    collided.append(j == 1 and i == 0)
+                    seconds.append(8.0 + 2.0 * i if parked[-1] else math.nan)
+                    excluded.append("")
+            for x, reason in ((6.0, NOT_FREE), (0.0, NO_WAY)):
+                rows.append([x, 1.0, heading, steer, 0.0])
+                parked.append(False)
+                collided.append(False)
+                seconds.append(math.nan)
+                excluded.append(reason)
+    excluded = np.array(excluded, dtype=object)
+    cost_to_go = np.where(np.array(parked), 8.0, np.where(excluded == "", 9.0, math.inf))
+    path_length = np.select([excluded == NOT_FREE, excluded == NO_WAY], [math.nan, math.inf], 6.5)
     with h5py.File(path, "w") as h5:
         h5["start"] = np.array(rows)
         h5["parked"] = np.array(parked)
         h5["collided"] = np.array(collided)
         h5["parking_seconds"] = np.array(seconds)
+        h5.create_dataset("excluded", data=excluded, dtype=h5py.string_dtype())
+        h5["cost_to_go"] = cost_to_go
+        h5["path_length"] = path_length
         h5.attrs["state_order"] = list(STATE_ORDER)
         h5.attrs["body_outline"] = json.dumps(BODY)
         h5.attrs["obstacles"] = json.dumps(list(OBSTACLES.values()))
@@ -182,6 +204,15 @@ def write_start_grid(path: Path, steers=(0.0,)) -> Path:
         h5.attrs["controller"] = "park"
         h5.attrs["simulated_seconds"] = 20.0
     return path
+
+
+def markers(ax) -> dict[str, np.ndarray]:
+    """A map panel's marker collections by gid (their legend text): the (k, 2) m positions."""
+    return {
+        c.get_gid(): np.asarray(c.get_offsets())
+        for c in ax.collections
+        if isinstance(c, PathCollection)
+    }
 
 
 def assert_gif(path: Path) -> None:
@@ -420,49 +451,196 @@ def test_parking_gif(tmp_path, crashes, parks):
     assert not [p for p in tmp_path.iterdir() if "partial" in p.name]
 
 
+HEADLINE = (
+    "Controller park: parks from 3 of 6 starts (50.0 %); 2 more cannot park at all, not counted"
+)
+MAP_LEGEND = [
+    "parked",
+    "collision",
+    "not parked in 20 s",
+    "cannot park (start not free)",
+    "cannot park (no path found)",
+    "destination (car outline)",
+]
+
+
 def test_success_map_one_panel(tmp_path):
     figure = success_map_figure(write_start_grid(tmp_path / "grid.h5"))
     assert figure.get_suptitle() == (
-        "Controller park: parks from 3 of 6 starts (50 %)\n"
+        f"{HEADLINE}\n"
         "every start: heading 0°, steer 0°, speed 0.0 m/s; each run simulated for up to 20 s"
     )
     panel, colorbar = figure.axes
     assert colorbar.get_ylabel() == "parking time (s)"
     assert panel.get_aspect() == 1.0 and panel.get_title() == ""
-    parked, collided, late = (c for c in panel.collections if isinstance(c, PathCollection))
+    parked, collided, late, not_free, no_way = (
+        c for c in panel.collections if isinstance(c, PathCollection)
+    )
+    assert [c.get_gid() for c in (parked, collided, late, not_free, no_way)] == MAP_LEGEND[:-1]
     np.testing.assert_array_equal(parked.get_offsets(), [[0, 4], [3, 4], [6, 4]])
     np.testing.assert_array_equal(parked.get_array(), [8.0, 10.0, 12.0])  # s, the colours
     assert parked.get_clim() == (8.0, 12.0)
     np.testing.assert_array_equal(collided.get_offsets(), [[0, 6]])
-    assert same_color(collided.get_edgecolor()[0], FAILURE_COLOR)
+    assert same_color(collided.get_facecolor()[0], FAILURE_COLOR)
     np.testing.assert_array_equal(late.get_offsets(), [[3, 6], [6, 6]])
     assert same_color(late.get_facecolor()[0], TIMEOUT_COLOR)
     assert len([p for p in panel.patches if same_color(p.get_facecolor(), OBSTACLE_FACE)]) == 3
     assert len(polygons(panel, linestyle=":")) == 1  # the destination
-    assert legend_labels(figure) == [
-        "parked",
-        "collision",
-        "not parked in 20 s",
-        "destination (car outline)",
-    ]
+    assert legend_labels(figure) == MAP_LEGEND
+
+
+def test_excluded_starts_have_their_own_markers_and_are_not_counted(tmp_path):
+    figure = success_map_figure(write_start_grid(tmp_path / "grid.h5"))
+    panel = figure.axes[0]
+    drawn = markers(panel)
+    np.testing.assert_array_equal(drawn["cannot park (start not free)"], [[6, 1]])
+    np.testing.assert_array_equal(drawn["cannot park (no path found)"], [[0, 1]])
+    # drawn once each, in no outcome's collection
+    every = np.concatenate(list(drawn.values()))
+    assert len(every) == 8 and len(np.unique(every, axis=0)) == 8
+    by_gid = {c.get_gid(): c for c in panel.collections if isinstance(c, PathCollection)}
+    not_free, no_way = by_gid["cannot park (start not free)"], by_gid["cannot park (no path found)"]
+    shapes = {c.get_gid(): c.get_paths()[0].vertices.round(3).tobytes() for c in by_gid.values()}
+    assert len(set(shapes.values())) == 5, "each kind of start has a marker of its own shape"
+    assert same_color(not_free.get_facecolor()[0], car.NOT_FREE_COLOR)
+    assert len(no_way.get_facecolor()) == 0  # hollow
+    assert same_color(no_way.get_edgecolor()[0], car.NO_WAY_COLOR)
+    (legend,) = figure.legends
+    handles = dict(zip(legend_labels(figure), legend.legend_handles, strict=True))
+    assert handles["cannot park (start not free)"].get_marker() == "+"
+    assert handles["cannot park (no path found)"].get_marker() == "D"
+    # 3 of the 6 starts run park: 50 %, not 3 of 8
+    assert figure.get_suptitle().startswith(HEADLINE)
+
+
+def test_only_the_exclusion_reasons_present_are_in_the_legend(tmp_path):
+    path = write_start_grid(tmp_path / "grid.h5")
+    with h5py.File(path, "a") as h5:
+        excluded = h5["excluded"].asstr()[()]
+        excluded[excluded == NO_WAY] = ""  # now counted and run: it timed out
+        del h5["excluded"]
+        h5.create_dataset("excluded", data=excluded.astype(object), dtype=h5py.string_dtype())
+    figure = success_map_figure(path)
+    assert legend_labels(figure) == [label for label in MAP_LEGEND if "no path" not in label]
+    assert figure.get_suptitle().startswith(
+        "Controller park: parks from 3 of 7 starts (42.9 %); 1 more cannot park at all, not counted"
+    )
+    np.testing.assert_array_equal(
+        markers(figure.axes[0])["not parked in 20 s"], [[3, 6], [6, 6], [0, 1]]
+    )
 
 
 def test_success_map_one_panel_per_steer(tmp_path):
     figure = success_map_figure(write_start_grid(tmp_path / "grid.h5", steers=(-30.0, 0.0)))
     panels = [ax for ax in figure.axes if ax.get_title()]
     assert [ax.get_title() for ax in panels] == ["start steer δ = −30°", "start steer δ = 0°"]
-    assert figure.get_suptitle().startswith("Controller park: parks from 3 of 12 starts (25 %)")
-    markers = [
-        [len(c.get_offsets()) for c in ax.collections if isinstance(c, PathCollection)]
-        for ax in panels
-    ]
-    assert markers == [[3, 1, 2], [1, 5]]  # no parked marker where none parks
+    assert figure.get_suptitle().startswith(
+        "Controller park: parks from 3 of 12 starts (25.0 %); 4 more cannot park at all"
+    )
+    counts = [{gid: len(xy) for gid, xy in markers(ax).items()} for ax in panels]
+    assert (
+        counts
+        == [  # no parked marker where none parks
+            dict(zip(MAP_LEGEND[:-1], [3, 1, 2, 1, 1], strict=True)),
+            dict(zip(MAP_LEGEND[1:-1], [1, 5, 1, 1], strict=True)),
+        ]
+    )
+
+
+def test_success_map_table_of_panels(tmp_path):
+    """Four headings × three steers: rows heading, columns steer, one colour bar."""
+    path = write_start_grid(
+        tmp_path / "grid.h5", steers=(-30.0, 0.0, 30.0), headings=(0.0, 90.0, 180.0, 270.0)
+    )
+    figure = success_map_figure(path)
+    panels = [ax for ax in figure.axes if ax.get_title()]
+    assert len(panels) == 12 and len(figure.axes) == 13
+    boxes = [ax.get_position() for ax in panels]
+    rows = sorted({round(b.y0, 6) for b in boxes}, reverse=True)
+    columns = sorted({round(b.x0, 6) for b in boxes})
+    assert len(rows) == 4 and len(columns) == 3
+    for k, (ax, box) in enumerate(zip(panels, boxes, strict=True)):
+        heading, steer = divmod(k, 3)
+        assert (rows.index(round(box.y0, 6)), columns.index(round(box.x0, 6))) == (heading, steer)
+        assert ax.get_title() == (
+            f"start heading φ = {90 * heading}°, "
+            f"steer δ = {car.describe_value('steer', 30.0 * (steer - 1))}"
+        )
+    assert [ax.get_ylabel() for ax in panels] == ["y (m)", "", ""] * 4
+    assert [ax.get_xlabel() for ax in panels] == [""] * 9 + ["x (m)"] * 3
+    assert figure.get_suptitle().startswith(
+        "Controller park: parks from 3 of 72 starts (4.2 %); 24 more cannot park at all"
+    )
+    assert figure.get_suptitle().split("\n")[1] == (
+        "every start: speed 0.0 m/s; each run simulated for up to 20 s"
+    )
+    counts = [sum(len(xy) for xy in markers(ax).values()) for ax in panels]
+    assert counts == [8] * 12
+
+
+def test_marker_diameter_follows_the_grid_spacing():
+    xy = np.array([[0.0, 0.0], [0.5, 0.0], [0.0, 2.0]])
+    assert car._marker_diameter(xy, 10.0) == pytest.approx(0.75 * 0.5 * 10.0)  # pt
+    low, high = car.MARKER_DIAMETER_RANGE
+    assert car._marker_diameter(xy, 1.0) == low
+    assert car._marker_diameter(xy, 100.0) == high
+    assert car._marker_diameter(xy[:1], 10.0) == high  # a single start
 
 
 def test_success_map_png(tmp_path):
     out = tmp_path / "map.png"
     plot_success_map(write_start_grid(tmp_path / "grid.h5"), out)
     assert_png(out)
+
+
+def test_consistency_summary():
+    median, p90, within = consistency_summary(np.array([1.0, 1.25, 1.5]))
+    assert (median, within) == (1.25, pytest.approx(2 / 3))
+    assert p90 == pytest.approx(1.25 + 0.8 * 0.25)  # linear interpolation
+    # 0: parked from a start whose cost-to-go is unknown (inf); never within the band
+    assert consistency_summary(np.array([0.75, 0.7499, 0.0]))[2] == pytest.approx(1 / 3)
+    assert all(math.isnan(value) for value in consistency_summary(np.empty(0)))
+
+
+def test_consistency_figure(tmp_path):
+    figure = consistency_figure(write_start_grid(tmp_path / "grid.h5", steers=(-30.0, 0.0)))
+    assert figure.get_suptitle() == (
+        "Controller park: parking time / cost-to-go at the start, 3 starts that parked\n"
+        "within ±25 %: 2 of 3 (66.7 %); median 1.25, 90th percentile 1.45"
+    )
+    (ax,) = figure.axes
+    assert ax.get_xlabel() == "parking time / cost-to-go at the start (1: as the table predicts)"
+    assert ax.get_ylabel() == "starts (count)"
+    (histogram,) = ax.containers
+    bars = [bar for bar in histogram if bar.get_height() > 0]
+    assert [round(bar.get_x(), 9) for bar in bars] == [1.0, 1.25, 1.5]  # [left, left + 0.05)
+    assert all(bar.get_height() == 1 for bar in bars)
+    assert histogram[0].get_x() == pytest.approx(0.0)
+    assert histogram[0].get_width() == pytest.approx(0.05)
+    dashed = sorted(line.get_xdata()[0] for line in ax.lines if line.get_linestyle() == "--")
+    assert dashed == [0.75, 1.25]
+    assert legend_labels(figure) == [
+        "within ±25 % of the cost-to-go",
+        "as the table predicts",
+        "median 1.25",
+        "90th percentile 1.45",
+    ]
+    out = tmp_path / "consistency.png"
+    plot_consistency(tmp_path / "grid.h5", out)
+    assert_png(out)
+
+
+def test_consistency_figure_without_a_parked_start(tmp_path):
+    path = write_start_grid(tmp_path / "grid.h5")
+    with h5py.File(path, "a") as h5:
+        h5["parked"][...] = False
+        h5["parking_seconds"][...] = math.nan
+    figure = consistency_figure(path)
+    assert figure.get_suptitle().endswith(
+        "0 starts that parked\nno start parked: nothing to compare"
+    )
+    (histogram,) = figure.axes[0].containers
+    assert not [bar for bar in histogram if bar.get_height() > 0]
 
 
 # --------------------------------------------------------------------------- bad inputs
@@ -544,8 +722,54 @@ def test_a_start_grid_with_missing_parts(tmp_path):
         h5.attrs["destination"] = json.dumps(DESTINATION)
     with pytest.raises(PlotInputError) as error:
         plot_success_map(path, tmp_path / "map.png")
-    assert str(error.value) == f"{path}: /collided has shape (4,), expected (6,)"
+    assert str(error.value) == f"{path}: /collided has shape (4,), expected (8,)"
     assert not (tmp_path / "map.png").exists()
+
+
+@pytest.mark.parametrize("name", ["excluded", "cost_to_go", "path_length"])
+def test_a_start_grid_with_a_wrong_shaped_new_dataset(tmp_path, name):
+    path = write_start_grid(tmp_path / "grid.h5")
+    with h5py.File(path, "a") as h5:
+        values = h5[name].asstr()[()] if name == "excluded" else h5[name][()]
+        del h5[name]
+        dtype = h5py.string_dtype() if name == "excluded" else None
+        h5.create_dataset(name, data=values.reshape(2, 4), dtype=dtype)
+    for plot in (plot_success_map, plot_consistency):
+        with pytest.raises(PlotInputError) as error:
+            plot(path, tmp_path / "x.png")
+        assert str(error.value) == f"{path}: /{name} has shape (2, 4), expected (8,)"
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_a_start_grid_with_bad_exclusions(tmp_path):
+    path = write_start_grid(tmp_path / "grid.h5")
+    with h5py.File(path, "a") as h5:
+        excluded = h5["excluded"].asstr()[()]
+        del h5["excluded"]
+        h5["excluded"] = np.zeros(8)
+    with pytest.raises(PlotInputError) as error:
+        read_start_grid(path)
+    assert str(error.value) == f"{path}: /excluded must hold strings (h5py.string_dtype())"
+    with h5py.File(path, "a") as h5:
+        del h5["excluded"]
+        guessed = excluded.astype(object)
+        guessed[6] = "looks blocked"
+        h5.create_dataset("excluded", data=guessed, dtype=h5py.string_dtype())
+    with pytest.raises(PlotInputError) as error:
+        read_start_grid(path)
+    assert str(error.value) == (
+        f"{path}: start 6 is excluded for an unknown reason 'looks blocked' (known: "
+        f"{NOT_FREE!r}, {NO_WAY!r})"
+    )
+    with h5py.File(path, "a") as h5:
+        del h5["excluded"]
+        h5.create_dataset("excluded", data=excluded.astype(object), dtype=h5py.string_dtype())
+        h5["collided"][7] = True
+    with pytest.raises(PlotInputError) as error:
+        read_start_grid(path)
+    assert str(error.value) == (
+        f"{path}: start 7 is excluded ({NO_WAY}) but has an outcome: parked False, collided True"
+    )
 
 
 def test_no_trajectories(tmp_path):

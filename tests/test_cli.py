@@ -145,7 +145,10 @@ def usage_error(message: str) -> str:
             usage_error("plot controller: --portrait needs --dynamics"),
         ),
         (["plot", "script", "T.h5"], usage_error("plot script: give --path and/or --gif")),
-        (["plot", "car"], usage_error("plot car: give --frames, --gif and/or --map")),
+        (
+            ["plot", "car"],
+            usage_error("plot car: give --frames, --gif, --map and/or --consistency"),
+        ),
         (
             ["plot", "car", "--gif", "A.gif"],
             usage_error("plot car: --frames and --gif need trajectories"),

@@ -54,6 +54,7 @@ def values(spec: ControllerSpec) -> tuple:
         spec.tolerance,
         spec.max_iterations,
         spec.dt,
+        spec.known_weight,
     )
 
 
@@ -138,12 +139,14 @@ def test_wrap_destinations_are_wrapped_onto_nodes(written, index):
 
 def test_options_and_order_free_lines():
     text = (
-        "tol 1e-4 # s\nmaxiter 50\ndt 0.0005\n"
+        "tol 1e-4 # s\nmaxiter 50\ndt 0.0005\nknown_weight 0.75\n"
         "dest omega=-500\ntorq a 0 0 1 0\ntorq b -1 1 2 2.5\n"
         "ssd omega -500 500 3\ndyn car\n"
     )
     spec = parse_controller_text(text)
     assert (spec.tolerance, spec.max_iterations, spec.dt) == (1e-4, 50, 0.0005)
+    assert spec.known_weight == 0.75
+    assert parse_controller_text(text.replace("known_weight 0.75\n", "")).known_weight == 0.0
     assert spec.destination_values() == {"omega": -500.0}
     assert spec.controls[0].values() == (0.0,)
     assert spec.controls[1].values() == (-1.0, 1.0)
@@ -189,7 +192,7 @@ ERRORS = [
     (
         replace_line(2, "ssdd omega -500.0 500.0 21"),
         "x.ssc:2:1: expected one of 'dyn', 'ssd', 'torq', 'dest', 'tol', 'maxiter', 'dt', "
-        "'obstacle', 'domain', 'hold', 'policy', found 'ssdd'",
+        "'known_weight', 'obstacle', 'domain', 'hold', 'policy', found 'ssdd'",
     ),
     (
         replace_line(2, "ssd omega -500.0 500.0"),
@@ -316,6 +319,16 @@ ERRORS = [
     (BASE + "dt 1e-300", "x.ssc:6:4: expected a dt of at least 1e-05 s, found '1e-300'"),
     (BASE + "maxiter 0", "x.ssc:6:9: expected a whole number >= 1 for maxiter, found '0'"),
     (
+        BASE + "known_weight 0",
+        "x.ssc:6:14: expected a number > 0 for known_weight (a share of the weight), found '0'",
+    ),
+    (BASE + "known_weight 1.5", "x.ssc:6:14: expected a known_weight in (0, 1], found '1.5'"),
+    (
+        BASE + "known_weight 0.5\nknown_weight 0.5",
+        "x.ssc:7:1: expected one 'known_weight' line only (the first is line 6), "
+        "found 'known_weight'",
+    ),
+    (
         BASE + "maxiter 10\nmaxiter 20",
         "x.ssc:7:1: expected one 'maxiter' line only (the first is line 6), found 'maxiter'",
     ),
@@ -438,6 +451,7 @@ def controller_specs(draw) -> ControllerSpec:
         tolerance=draw(st.sampled_from([DEFAULT_TOLERANCE, 1e-3, 2.5e-8])),
         max_iterations=draw(st.sampled_from([DEFAULT_MAX_ITERATIONS, 1, 20])),
         dt=draw(st.sampled_from([DEFAULT_DT, 0.01, 1e-4])),
+        known_weight=draw(st.sampled_from([0.0, 0.5, 1.0])),
         spec_sha256="",
     )
 

@@ -208,6 +208,7 @@ def test_editing_an_obstacle_rebuilds_the_car_and_nothing_else(workflow):
         "car_frames": 1,
         "car_gif": 1,
         "car_start_map": 1,
+        "car_consistency": 1,
         "car_controller_table": 1,
         "car_all": 1,
     }

@@ -24,11 +24,11 @@ rule car_start_grid:
         steer=" ".join(str(v) for v in config["car"]["start_grid"]["steer"]),
         seconds=config["car"]["start_grid"]["seconds"],
         dt=config["car"]["start_grid"]["dt"],
-    threads: 1
+    threads: 2
     shell:
-        "NUMBA_NUM_THREADS={threads} mosys starts {input.table} --dynamics {input.dynamics}"
+        "NUMBA_NUM_THREADS=1 mosys starts {input.table} --dynamics {input.dynamics}"
         " --x {params.x} --y {params.y} --heading {params.heading} --steer {params.steer}"
-        " --seconds {params.seconds} --dt {params.dt} -o {output} 2> {log}"
+        " --seconds {params.seconds} --dt {params.dt} --threads {threads} -o {output} 2> {log}"
         " || (cat {log} >&2; exit 1)"
 
 
@@ -76,6 +76,21 @@ rule car_start_map:
     threads: 1
     shell:
         "mosys plot car --map {input.grid} {output} 2> {log} || (cat {log} >&2; exit 1)"
+
+
+rule car_consistency:
+    input:
+        grid="results/car/start_grid.h5",
+        code=code_inputs("mosys.cli.plots", "mosys.plots.car"),  # mosys plot car
+    output:
+        "results/plots/car/consistency.png",
+    log:
+        "results/logs/plots/car/consistency.log",
+    benchmark:
+        "results/benchmarks/plots/car/consistency.tsv"
+    threads: 1
+    shell:
+        "mosys plot car --consistency {input.grid} {output} 2> {log} || (cat {log} >&2; exit 1)"
 
 
 rule car_controller_table:

@@ -305,7 +305,7 @@ def car_targets():
         [car_table(), "results/car/start_grid.h5"]
         + car_trajectories()
         + ["results/plots/car/figure19_frames.png", "results/plots/car/manoeuvre.gif",
-           "results/plots/car/start_map.png"]
+           "results/plots/car/start_map.png", "results/plots/car/consistency.png"]
         + car_table_targets()
     )
 

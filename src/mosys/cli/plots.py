@@ -60,18 +60,29 @@ def _car_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--frames", help="PNG: one panel per trajectory, the car every 0.3 s")
     parser.add_argument("--gif", help="animated GIF of the first trajectory")
     parser.add_argument("--map", nargs=2, metavar=("START_GRID", "PNG"), help="success map")
+    parser.add_argument(
+        "--consistency",
+        nargs=2,
+        metavar=("START_GRID", "PNG"),
+        help="parking time / cost-to-go of the starts that parked",
+    )
 
 
 def _car_check(args: argparse.Namespace) -> str | None:
-    if not (args.frames or args.gif or args.map):
-        return "plot car: give --frames, --gif and/or --map"
+    if not (args.frames or args.gif or args.map or args.consistency):
+        return "plot car: give --frames, --gif, --map and/or --consistency"
     if (args.frames or args.gif) and not args.trajectories:
         return "plot car: --frames and --gif need trajectories"
     return None
 
 
 def _car(args: argparse.Namespace) -> None:
-    from mosys.plots.car import plot_parking_frames, plot_success_map, write_parking_gif
+    from mosys.plots.car import (
+        plot_consistency,
+        plot_parking_frames,
+        plot_success_map,
+        write_parking_gif,
+    )
 
     if args.frames:
         plot_parking_frames(args.trajectories, args.frames)
@@ -79,6 +90,8 @@ def _car(args: argparse.Namespace) -> None:
         write_parking_gif(args.trajectories[0], args.gif)
     if args.map:
         plot_success_map(args.map[0], args.map[1])
+    if args.consistency:
+        plot_consistency(args.consistency[0], args.consistency[1])
 
 
 def _luxo_arguments(parser: argparse.ArgumentParser) -> None:

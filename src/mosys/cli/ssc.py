@@ -55,6 +55,7 @@ def _starts_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--steer", nargs="+", type=float, default=[0.0], help="deg")
     parser.add_argument("--seconds", type=float, default=20.0, help="simulated time per start")
     parser.add_argument("--dt", type=float, default=0.01, help="simulator step, s")
+    parser.add_argument("--threads", type=int, default=1, help="runs at once")
     parser.add_argument("-o", "--output", required=True)
 
 
@@ -78,7 +79,9 @@ def _starts(args: argparse.Namespace) -> None:
     }
     order = controller.state_order
     starts = np.array(list(itertools.product(*(axes[name] for name in order))))
-    write_start_grid(args.output, evaluate_starts(controller, starts, args.seconds, args.dt))
+    write_start_grid(
+        args.output, evaluate_starts(controller, starts, args.seconds, args.dt, args.threads)
+    )
 
 
 FAMILY = Family(

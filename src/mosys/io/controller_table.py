@@ -22,7 +22,10 @@ class ControllerTable:
     axes: one (n_k,) float64 grid per state dimension, in ``state_order``; axis_units: 'deg',
     'deg/s', 'm' or 'm/s'; wrap: periodic axes (period n_k * step). torque: (n_1, ..., n_d, m)
     float64, N·m or N; value: (n_1, ..., n_d) cost-to-go, s (inf: destination unreachable).
-    attrs: every other root attribute (figure, dest, K, timings, ...), as read.
+    attrs: every other root attribute (figure, dest, K, timings, ...), as read. dead_end:
+    (n_1, ..., n_d) bool, dataset ``/dead_end``, for a spec with ``known_weight`` (None
+    otherwise): the free nodes whose value is inf because no trusted exit leads on from them
+    (``ssc.generate``), not because they cannot be reached.
     """
 
     state_order: tuple[str, ...]
@@ -38,6 +41,7 @@ class ControllerTable:
     dest: dict[str, float]
     figure: str
     attrs: dict
+    dead_end: np.ndarray | None = None
 
 
 def write_controller_table(path: str | Path, table: ControllerTable) -> None:
@@ -54,6 +58,8 @@ def write_controller_table(path: str | Path, table: ControllerTable) -> None:
                 dataset.attrs["wrap"] = bool(wrap)
             h5.create_dataset("torque", data=table.torque.astype(np.float64))
             h5.create_dataset("value", data=table.value.astype(np.float64))
+            if table.dead_end is not None:
+                h5.create_dataset("dead_end", data=np.asarray(table.dead_end, dtype=np.bool_))
             h5.attrs["format_version"] = FORMAT_VERSION
             h5.attrs["state_order"] = list(table.state_order)
             h5.attrs["control_names"] = list(table.control_names)
@@ -92,4 +98,5 @@ def read_controller_table(path: str | Path) -> ControllerTable:
             dest=json.loads(h5.attrs["dest"]),
             figure=str(h5.attrs["figure"]),
             attrs=attrs,
+            dead_end=np.asarray(h5["dead_end"][()], dtype=np.bool_) if "dead_end" in h5 else None,
         )

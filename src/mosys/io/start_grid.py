@@ -1,7 +1,12 @@
 """The start-grid result of a car controller (``results/car/start_grid.h5``): which start states
 park. Datasets ``start`` (n, d) spec units (columns: root attr ``state_order``), ``parked`` (n,)
-bool, ``collided`` (n,) bool, ``parking_seconds`` (n,) float64 (nan: not parked); root attrs
-``controller``, ``simulated_seconds``, ``dt`` and the scene (``io.car_scene``)."""
+bool, ``collided`` (n,) bool, ``parking_seconds`` (n,) float64 (nan: not parked), ``excluded``
+(n,) str (why the start cannot park at all, computed; "" for the starts that count and were
+run), ``cost_to_go`` (n,) float64 s (the table's, interpolated at the start as the runtime does;
+inf: unknown) and ``path_length`` (n,) float64 m (the shortest collision-free path the pose
+search found; inf: none, nan: the start is not free); root attrs ``controller``,
+``simulated_seconds``, ``dt`` and the scene (``io.car_scene``). The success rate counts the
+starts that are not excluded."""
 
 from __future__ import annotations
 
@@ -15,6 +20,22 @@ from mosys.errors import InputError
 from mosys.io.atomic import write_atomically
 from mosys.io.attributes import string_tuple
 
+STRING = h5py.string_dtype()
+
+NOT_FREE = "start pose overlaps an obstacle or lies outside the domain"  # why a start is
+NO_WAY = "no collision-free path to the destination (pose search)"  # excluded (``excluded``)
+CONSISTENCY_BAND = 0.25  # consistent: |parking time / cost-to-go - 1| <= this (within 25 %)
+
+
+def consistency_summary(ratios: np.ndarray) -> tuple[float, float, float]:
+    """(median, 90th percentile, share within CONSISTENCY_BAND of 1) of parking time /
+    cost-to-go ratios (p,); NaN for each when there are none. A non-finite ratio is never
+    within the band."""
+    if not len(ratios):
+        return float("nan"), float("nan"), float("nan")
+    within = np.abs(ratios - 1.0) <= CONSISTENCY_BAND
+    return float(np.median(ratios)), float(np.percentile(ratios, 90)), float(within.mean())
+
 
 @dataclass(frozen=True)
 class StartGrid:
@@ -25,11 +46,26 @@ class StartGrid:
     parked: np.ndarray
     collided: np.ndarray
     parking_seconds: np.ndarray
+    excluded: np.ndarray
+    cost_to_go: np.ndarray
+    path_length: np.ndarray
     attrs: dict
 
     @property
+    def counted(self) -> np.ndarray:
+        """(n,) bool: the starts that count toward the success rate (not excluded)."""
+        return np.asarray(self.excluded == "", dtype=bool)
+
+    @property
     def success_rate(self) -> float:
-        return float(self.parked.mean()) if self.parked.size else float("nan")
+        counted = self.counted
+        return float(self.parked[counted].mean()) if counted.any() else float("nan")
+
+    @property
+    def consistency(self) -> np.ndarray:
+        """(p,) parking seconds / cost-to-go at the start, for each start that parked."""
+        parked = self.parked & self.counted
+        return self.parking_seconds[parked] / self.cost_to_go[parked]
 
 
 def write_start_grid(path: str | Path, grid: StartGrid) -> None:
@@ -41,6 +77,11 @@ def write_start_grid(path: str | Path, grid: StartGrid) -> None:
             h5.create_dataset("parked", data=np.asarray(grid.parked, dtype=np.bool_))
             h5.create_dataset("collided", data=np.asarray(grid.collided, dtype=np.bool_))
             h5.create_dataset("parking_seconds", data=np.asarray(grid.parking_seconds, float))
+            h5.create_dataset(
+                "excluded", data=np.asarray(grid.excluded, dtype=object), dtype=STRING
+            )
+            h5.create_dataset("cost_to_go", data=np.asarray(grid.cost_to_go, float))
+            h5.create_dataset("path_length", data=np.asarray(grid.path_length, float))
             h5.attrs["state_order"] = list(grid.state_order)
             for key, value in grid.attrs.items():
                 h5.attrs[key] = value
@@ -48,7 +89,15 @@ def write_start_grid(path: str | Path, grid: StartGrid) -> None:
     write_atomically(path, write)
 
 
-DATASETS = ("start", "parked", "collided", "parking_seconds")
+DATASETS = (
+    "start",
+    "parked",
+    "collided",
+    "parking_seconds",
+    "excluded",
+    "cost_to_go",
+    "path_length",
+)
 
 
 def read_start_grid(path: str | Path) -> StartGrid:
@@ -68,5 +117,8 @@ def read_start_grid(path: str | Path) -> StartGrid:
             parked=h5["parked"][()],
             collided=h5["collided"][()],
             parking_seconds=h5["parking_seconds"][()],
+            excluded=h5["excluded"].asstr()[()].astype(object),
+            cost_to_go=h5["cost_to_go"][()],
+            path_length=h5["path_length"][()],
             attrs={k: h5.attrs[k] for k in h5.attrs if k != "state_order"},
         )

@@ -165,7 +165,7 @@ def exit_transitions_template(
     effort_weight,
     max_step,
     nodes,
-    node_valid,
+    row_of,
     pose_slot,
     outline,
     obstacle_vertices,
@@ -191,14 +191,15 @@ def exit_transitions_template(
     inputs (input_size of them) each control drives; effort_weight: (m,) K of the cost
     t + Σ K|u| t. max_step: the longest integration step, s. A segment still in its cell after
     ``MAX_SEGMENT_SECONDS``, or whose state becomes non-finite, is discarded (cost inf).
-    nodes: (P,) int64 flat node indices to process; node_valid: (N,) bool (False: removed node).
+    nodes: (P,) int64 flat node indices to process, each with a row (``row_of``: (N,) int64,
+    the row of each node in the outputs, -1 for a removed node, which has none).
     pose_slot, outline, obstacle_vertices, obstacle_start, domain: the obstacles, as
     ``geometry.pose_is_free`` takes them (pose_slot[0] < 0: none); a segment whose state is not
     free at the end of any integration step is discarded.
-    Outputs, rows indexed by node: exit_index (N, U, 2**(d-1)) int32 and exit_weight
-    (N, U, 2**(d-1)) float32, the nodes and weights interpolating the exit state on the face it
-    crosses; segment_cost (N, U) float64, inf where the segment never leaves the cell, leaves
-    the domain or hits an obstacle.
+    Outputs, one row per node that is not removed: exit_index (R, U, 2**(d-1)) int32 and
+    exit_weight (R, U, 2**(d-1)) float32, the nodes and weights interpolating the exit state on
+    the face it crosses; segment_cost (R, U) float64, inf where the segment never leaves the
+    cell, leaves the domain or hits an obstacle.
     """
     d = axis_min.shape[0]
     size = base_state.shape[0]
@@ -207,10 +208,7 @@ def exit_transitions_template(
     grid_strides(axis_count, strides)
     for p in prange(nodes.shape[0]):
         node = nodes[p]
-        if not node_valid[node]:
-            for u in range(n_controls):
-                segment_cost[node, u] = np.inf
-            continue
+        row = row_of[node]
         center = np.empty(d)
         exit_state = np.empty(d)
         stages = np.empty((7, size))  # Dormand–Prince's k1..k7, k7 at the step's end
@@ -235,10 +233,10 @@ def exit_transitions_template(
             for j in range(control_slot.shape[0]):
                 inputs[control_slot[j]] += control_samples[u, j]
                 effort += effort_weight[j] * abs(control_samples[u, j])
-            segment_cost[node, u] = np.inf
+            segment_cost[row, u] = np.inf
             for i in range(exit_index.shape[2]):
-                exit_index[node, u, i] = node
-                exit_weight[node, u, i] = 0.0
+                exit_index[row, u, i] = node
+                exit_weight[row, u, i] = 0.0
             model_derivative(state, inputs, k1)
             elapsed = 0.0
             h = max_step
@@ -341,7 +339,7 @@ def exit_transitions_template(
                             leaves_domain = True
                 if not leaves_domain:
                     seconds = elapsed + crossing * h
-                    segment_cost[node, u] = seconds * (1.0 + effort)
+                    segment_cost[row, u] = seconds * (1.0 + effort)
                     count = corner_weights(
                         axis_min,
                         axis_step,
@@ -362,8 +360,8 @@ def exit_transitions_template(
                             corner_weight[i] = 0.0
                         total += corner_weight[i]
                     for i in range(count):
-                        exit_index[node, u, i] = corner_index[i]
-                        exit_weight[node, u, i] = corner_weight[i] / total
+                        exit_index[row, u, i] = corner_index[i]
+                        exit_weight[row, u, i] = corner_weight[i] / total
                 break
 
 
@@ -396,22 +394,24 @@ def sweep_order(axis_count, sweep, out):
 
 
 @njit(cache=True)
-def reach_sweep(exit_index, exit_weight, segment_cost, valid, reached, order):
-    """One sweep of reachability in ``order`` (``sweep_order``), in place: a valid node joins
-    ``reached`` when some control leaves its cell (finite cost) onto a face with at least one
-    reached corner (weight > 0). Start from the destination nodes; repeat until nothing joins.
-    The nodes never reached cannot reach the destination: their cost-to-go is inf.
-    valid, reached: (N,) bool. Returns how many nodes joined."""
+def reach_sweep(exit_index, exit_weight, segment_cost, row_of, reached, order):
+    """One sweep of reachability in ``order`` (``sweep_order``), in place: a node with a row
+    joins ``reached`` when some control leaves its cell (finite cost) onto a face with at least
+    one reached corner (weight > 0). Start from the destination nodes; repeat until nothing
+    joins. The nodes never reached cannot reach the destination: their cost-to-go is inf.
+    row_of: (N,) int64, each node's row in the exit tables (-1: removed); reached: (N,) bool.
+    Returns how many nodes joined."""
     joined = 0
     for p in range(order.shape[0]):
         node = order[p]
-        if reached[node] or not valid[node]:
+        row = row_of[node]
+        if reached[node] or row < 0:
             continue
         for u in range(segment_cost.shape[1]):
-            if segment_cost[node, u] == np.inf:
+            if segment_cost[row, u] == np.inf:
                 continue
             for i in range(exit_index.shape[2]):
-                if exit_weight[node, u, i] > 0.0 and reached[exit_index[node, u, i]]:
+                if exit_weight[row, u, i] > 0.0 and reached[exit_index[row, u, i]]:
                     reached[node] = True
                     break
             if reached[node]:
@@ -421,50 +421,53 @@ def reach_sweep(exit_index, exit_weight, segment_cost, valid, reached, order):
 
 
 @njit(cache=True)
-def interpolate_known_values_only(exit_index, exit_weight, segment_cost, reachable):
+def interpolate_known_values_only(
+    exit_index, exit_weight, segment_cost, reachable, minimum_known_weight
+):
     """Restrict every exit's interpolation to the reachable corners of its face (the paper's
     Figure 10: the cost-to-go at the exit is interpolated between the neighbours whose values
-    are known) by zeroing the other weights and renormalising; an exit with no reachable corner
-    gets cost inf. Afterwards every finite transition rests on reachable nodes only."""
-    for node in range(segment_cost.shape[0]):
+    are known) by zeroing the other weights and renormalising; an exit whose reachable corners
+    carry less than ``minimum_known_weight`` of its weight (in (0, 1]) gets cost inf.
+    Afterwards every finite transition rests on reachable nodes only."""
+    for row in range(segment_cost.shape[0]):
         for u in range(segment_cost.shape[1]):
-            if segment_cost[node, u] == np.inf:
+            if segment_cost[row, u] == np.inf:
                 continue
             total = 0.0
             for i in range(exit_index.shape[2]):
-                if exit_weight[node, u, i] > 0.0 and not reachable[exit_index[node, u, i]]:
-                    exit_weight[node, u, i] = 0.0
-                total += exit_weight[node, u, i]
-            if total == 0.0:
-                segment_cost[node, u] = np.inf
+                if exit_weight[row, u, i] > 0.0 and not reachable[exit_index[row, u, i]]:
+                    exit_weight[row, u, i] = 0.0
+                total += exit_weight[row, u, i]
+            if total == 0.0 or total < minimum_known_weight:
+                segment_cost[row, u] = np.inf
             else:
                 for i in range(exit_index.shape[2]):
-                    exit_weight[node, u, i] /= total
+                    exit_weight[row, u, i] /= total
 
 
 @njit(cache=True, inline="always")
-def _expected_value(exit_index, exit_weight, node, u, value):
-    """Σ w·V over the exit corners of (node, u); zero-weight corners are skipped."""
+def _expected_value(exit_index, exit_weight, row, u, value):
+    """Σ w·V over the exit corners of (row, u); zero-weight corners are skipped."""
     total = 0.0
     for i in range(exit_index.shape[2]):
-        w = exit_weight[node, u, i]
+        w = exit_weight[row, u, i]
         if w != 0.0:
-            total += w * value[exit_index[node, u, i]]
+            total += w * value[exit_index[row, u, i]]
     return total
 
 
 @njit(cache=True, inline="always")
-def _bellman(exit_index, exit_weight, segment_cost, value, node):
-    """(min over u of cost(node, u) + Σ w·V(corner), the first minimising u); (inf, 0) where
+def _bellman(exit_index, exit_weight, segment_cost, value, row):
+    """(min over u of cost(row, u) + Σ w·V(corner), the first minimising u); (inf, 0) where
     every control costs inf. Inlined where it is called (numba's ``inline="always"``): a call
     per node would cost more than the node's arithmetic."""
     best = np.inf
     choice = 0
     for u in range(segment_cost.shape[1]):
-        cost = segment_cost[node, u]
+        cost = segment_cost[row, u]
         if cost == np.inf:
             continue
-        candidate = cost + _expected_value(exit_index, exit_weight, node, u, value)
+        candidate = cost + _expected_value(exit_index, exit_weight, row, u, value)
         if candidate < best:
             best = candidate
             choice = u
@@ -472,7 +475,7 @@ def _bellman(exit_index, exit_weight, segment_cost, value, node):
 
 
 @njit(cache=True)
-def gauss_seidel_sweep(exit_index, exit_weight, segment_cost, is_destination, value, order):
+def gauss_seidel_sweep(exit_index, exit_weight, segment_cost, row_of, is_destination, value, order):
     """One Gauss–Seidel sweep of value iteration over the nodes in ``order`` (``sweep_order``):
     each node's cost-to-go becomes ``min(old, update)`` at once, so the nodes after it in the
     sweep use it. Returns the largest decrease, s.
@@ -481,16 +484,18 @@ def gauss_seidel_sweep(exit_index, exit_weight, segment_cost, is_destination, va
     at the destination nodes, a large finite ``UNKNOWN`` at the other reachable nodes: the
     paper's "values not yet known"; inf at unreachable nodes, which no finite transition touches
     after ``interpolate_known_values_only``), so values only decrease, as the paper describes.
+    row_of: (N,) int64, each node's row in the exit tables (-1: removed, skipped);
     is_destination: (N,) bool, held at 0. One thread, in a fixed order: the same result on any
     machine whatever the thread count.
     """
     largest = 0.0
     for p in range(order.shape[0]):
         node = order[p]
-        if is_destination[node]:
+        row = row_of[node]
+        if row < 0 or is_destination[node]:
             continue
         old = value[node]
-        best = _bellman(exit_index, exit_weight, segment_cost, value, node)[0]
+        best = _bellman(exit_index, exit_weight, segment_cost, value, row)[0]
         if best < old:
             value[node] = best
             if old - best > largest:
@@ -503,6 +508,7 @@ def gauss_seidel_sweeps(
     exit_index,
     exit_weight,
     segment_cost,
+    row_of,
     is_destination,
     value,
     axis_count,
@@ -519,7 +525,7 @@ def gauss_seidel_sweeps(
     for k in range(count):
         sweep_order(axis_count, first + k, order)
         largest = gauss_seidel_sweep(
-            exit_index, exit_weight, segment_cost, is_destination, value, order
+            exit_index, exit_weight, segment_cost, row_of, is_destination, value, order
         )
         if largest < tolerance:
             return k + 1, largest
@@ -527,11 +533,14 @@ def gauss_seidel_sweeps(
 
 
 @njit(cache=True)
-def best_controls(exit_index, exit_weight, segment_cost, value, best_control):
+def best_controls(exit_index, exit_weight, segment_cost, row_of, value, best_control):
     """The minimising control sample index of every node (the first on ties; 0 where every
-    sample costs inf). best_control: (N,) int64 out."""
+    sample costs inf or the node is removed). best_control: (N,) int64 out."""
     for node in range(value.shape[0]):
-        best_control[node] = _bellman(exit_index, exit_weight, segment_cost, value, node)[1]
+        row = row_of[node]
+        best_control[node] = (
+            0 if row < 0 else _bellman(exit_index, exit_weight, segment_cost, value, row)[1]
+        )
 
 
 @njit(parallel=True, cache=True)

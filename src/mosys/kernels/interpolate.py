@@ -144,7 +144,8 @@ def interpolate_with(
     nodes whose entries count: the weights of the others are dropped and the rest renormalised
     (the paper's Figure 10: interpolate between the neighbours whose values are known); where no
     corner with weight is known, every corner counts. strides: from ``grid_strides``; state:
-    (d,), inside the domain (clamp first with ``clamp_to_domain``); out: (m,) float64.
+    (d,), inside the domain (clamp first with ``clamp_to_domain``); out: (m,) float64. Returns
+    the weight of the known corners (in [0, 1]).
     """
     integer_scratch, fraction, corner_index, corner_weight = scratch
     count = corner_weights(
@@ -175,6 +176,7 @@ def interpolate_with(
             w /= known_weight
         for j in range(out.shape[0]):
             out[j] += w * table[row, j]
+    return known_weight
 
 
 @njit(cache=True)
@@ -183,12 +185,12 @@ def interpolate_into(axis_min, axis_step, axis_count, wrap, table, known, state,
 
     table: (prod(axis_count), m) float64, nodes in C order; known: (prod(axis_count),) bool, as
     in ``interpolate_with``; state: (d,), inside the domain (clamp first with
-    ``clamp_to_domain``); out: (m,) float64.
+    ``clamp_to_domain``); out: (m,) float64. Returns the weight of the known corners.
     """
     d = state.shape[0]
     strides = np.empty(d, np.int64)
     grid_strides(axis_count, strides)
     scratch = interpolation_scratch(d)
-    interpolate_with(
+    return interpolate_with(
         axis_min, axis_step, axis_count, wrap, strides, table, known, state, scratch, out
     )

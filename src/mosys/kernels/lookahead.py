@@ -54,6 +54,7 @@ LOOKAHEAD_SIGNATURE = types.int64(
     FLAGS,  # wrap
     types.float64[:, ::1],  # value
     FLAGS,  # known
+    types.float64,  # minimum_known_weight
     types.float64[:, ::1],  # control_samples
     INDICES,  # control_slot
     types.int64,  # input_size
@@ -92,6 +93,36 @@ def _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs):
 
 
 @njit(cache=True)
+def _axis_limits(axis_min, axis_step, axis_count, state_slot, vehicle_slot):
+    """(2, 2): the ends of the table's steer and speed axes (rad, m/s); ±inf for a vehicle
+    variable the table has no axis for."""
+    limits = np.empty((2, 2))
+    limits[:, 0] = -np.inf
+    limits[:, 1] = np.inf
+    for k in range(state_slot.shape[0]):
+        for j in range(2):
+            if state_slot[k] == vehicle_slot[3 + j]:
+                limits[j, 0] = axis_min[k]
+                limits[j, 1] = axis_min[k] + axis_step[k] * (axis_count[k] - 1)
+    return limits
+
+
+@njit(cache=True)
+def _limit_inputs(state, vehicle_slot, limits, wheel_radius, dt, inputs, out):
+    """out: ``inputs`` with the steer rate and the wheel acceleration cut so that a step of dt
+    seconds ends with steer and speed no further out than ``limits`` (2, 2): (steer low, high)
+    rad and (speed low, high) m/s, the table's axis ends. So the vehicle stops at the ends of
+    the axes instead of overshooting them (the model's steer_limit lies further out)."""
+    for i in range(inputs.shape[0]):
+        out[i] = inputs[i]
+    for k, gain in ((0, 1.0), (1, wheel_radius)):
+        value = state[vehicle_slot[3 + k]]
+        slot = vehicle_slot[5 + k]
+        out[slot] = min(out[slot], max(0.0, (limits[k, 1] - value) / (gain * dt)))
+        out[slot] = max(out[slot], min(0.0, (limits[k, 0] - value) / (gain * dt)))
+
+
+@njit(cache=True)
 def _stops_in_box(state, vehicle_slot, wheelbase, wheel_radius, brake, state_slot, box, stop):
     """True when the state where full braking from ``state`` ends lies in the arrival box
     (``box`` (3, d): lower, upper and period over the controller's axes, as ``inside_region``
@@ -119,15 +150,30 @@ def _stops_in_box(state, vehicle_slot, wheelbase, wheel_radius, brake, state_slo
 
 @njit(cache=True)
 def _cost_to_go(
-    axis_min, axis_step, axis_count, wrap, strides, value, known, exit_state, clamped, scratch, out
+    axis_min,
+    axis_step,
+    axis_count,
+    wrap,
+    strides,
+    value,
+    known,
+    minimum_known_weight,
+    exit_state,
+    clamped,
+    scratch,
+    out,
 ):
     """Interpolated cost-to-go (s) at a controller state (d,); beyond the axes, the value at the
     nearest covered state plus OUTSIDE_PENALTY per grid step outside (summed over the axes), so
-    that the way back in is the cheapest; inf where no corner's value is known."""
+    that the way back in is the cheapest; inf where the corners whose value is known carry less
+    than ``minimum_known_weight`` of the weight (as the DP, ``dp.interpolate_known_values_only``)
+    or none."""
     clamp_to_domain(axis_min, axis_step, axis_count, wrap, exit_state, clamped)
-    interpolate_with(
+    known_weight = interpolate_with(
         axis_min, axis_step, axis_count, wrap, strides, value, known, clamped, scratch, out
     )
+    if known_weight < minimum_known_weight:
+        return np.inf
     steps_outside = 0.0
     for k in range(exit_state.shape[0]):
         steps_outside += abs(exit_state[k] - clamped[k]) / axis_step[k]
@@ -135,11 +181,29 @@ def _cost_to_go(
 
 
 @njit(cache=True)
+def within_axes(axis_min, axis_step, axis_count, wrap, state):
+    """True when a controller state (d,) lies within the ends of every non-wrap axis."""
+    for k in range(state.shape[0]):
+        if wrap[k]:
+            continue
+        if state[k] < axis_min[k] or state[k] > axis_min[k] + axis_step[k] * (axis_count[k] - 1):
+            return False
+    return True
+
+
+@njit(cache=True)
 def _segment(
     derivative_into,
     start,
     inputs,
+    vehicle_slot,
+    limits,
+    wheel_radius,
+    limited,
+    axis_min,
     axis_step,
+    axis_count,
+    wrap,
     state_slot,
     pose_slot,
     outline,
@@ -156,20 +220,27 @@ def _segment(
 ):
     """Hold the model's ``inputs`` from ``start`` (S,) until the controller state lies one grid
     step from where it began on some axis, or for max_steps; the last state goes to ``end``.
-    Returns the steps taken, or -1 when some step is not free (obstacle or domain polygon).
-    origin, here: (d,) work arrays; scratch: ``rk4_scratch(S)``; body: like outline."""
+    Returns the steps taken, or -1 when some step is not free (obstacle or domain polygon) or,
+    from a start within the table's axes, lies beyond the end of a (non-wrap) axis.
+    The inputs are cut at the ends of the steer and speed axes (``_limit_inputs``: vehicle_slot,
+    limits, wheel_radius; limited: a work array like inputs). origin, here: (d,) work arrays;
+    scratch: ``rk4_scratch(S)``; body: like outline."""
     for i in range(start.shape[0]):
         end[i] = start[i]
     read_state(start, state_slot, origin)
+    inside = within_axes(axis_min, axis_step, axis_count, wrap, origin)
     taken = 0
     while taken < max_steps:
-        rk4_step(derivative_into, end, inputs, dt, scratch)
+        _limit_inputs(end, vehicle_slot, limits, wheel_radius, dt, inputs, limited)
+        rk4_step(derivative_into, end, limited, dt, scratch)
         taken += 1
         if not pose_is_free(
             end, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
         ):
             return -1
         read_state(end, state_slot, here)
+        if inside and not within_axes(axis_min, axis_step, axis_count, wrap, here):
+            return -1
         for k in range(axis_step.shape[0]):
             if abs(here[k] - origin[k]) >= axis_step[k]:
                 return taken
@@ -190,12 +261,20 @@ def _can_brake(
     domain,
     max_steps,
     dt,
+    axis_min,
+    axis_step,
+    axis_count,
+    wrap,
+    state_slot,
+    inside,
     state,
     inputs,
     scratch,
     body,
+    here,
 ):
-    """True when braking to rest from ``start``, steering held, keeps every step free."""
+    """True when braking to rest from ``start``, steering held, keeps every step free and, if
+    ``inside``, within the ends of the table's (non-wrap) axes. here: (d,) work array."""
     for i in range(start.shape[0]):
         state[i] = start[i]
     for _ in range(max_steps):
@@ -206,6 +285,9 @@ def _can_brake(
         if not pose_is_free(
             state, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
         ):
+            return False
+        read_state(state, state_slot, here)
+        if inside and not within_axes(axis_min, axis_step, axis_count, wrap, here):
             return False
     return True
 
@@ -228,6 +310,7 @@ def _choose(
     wrap,
     value,
     known,
+    minimum_known_weight,
     control_samples,
     control_slot,
     input_size,
@@ -240,6 +323,7 @@ def _choose(
     vehicle_slot,
     wheel_radius,
     brake,
+    limits,
     max_steps,
     dt,
     state,
@@ -262,6 +346,9 @@ def _choose(
     clamped = np.empty(d)
     out = np.empty(1)
     inputs = np.zeros(input_size)
+    limited = np.zeros(input_size)
+    read_state(state, state_slot, here)
+    inside = within_axes(axis_min, axis_step, axis_count, wrap, here)
     best = np.inf
     best_sample = -1
     best_steps = 1
@@ -271,7 +358,14 @@ def _choose(
             derivative_into,
             state,
             inputs,
+            vehicle_slot,
+            limits,
+            wheel_radius,
+            limited,
+            axis_min,
             axis_step,
+            axis_count,
+            wrap,
             state_slot,
             pose_slot,
             outline,
@@ -297,6 +391,7 @@ def _choose(
             strides,
             value,
             known,
+            minimum_known_weight,
             here,
             clamped,
             interpolation,
@@ -318,10 +413,17 @@ def _choose(
             domain,
             max_steps,
             dt,
+            axis_min,
+            axis_step,
+            axis_count,
+            wrap,
+            state_slot,
+            inside,
             braking,
             inputs,
             scratch,
             body,
+            origin,
         ):
             best = cost
             best_sample = u
@@ -329,7 +431,7 @@ def _choose(
     return best_sample, best_steps
 
 
-@njit(LOOKAHEAD_SIGNATURE, cache=True)
+@njit(LOOKAHEAD_SIGNATURE, cache=True, nogil=True)
 def simulate_lookahead(
     derivative_into,
     axis_min,
@@ -338,6 +440,7 @@ def simulate_lookahead(
     wrap,
     value,
     known,
+    minimum_known_weight,
     control_samples,
     control_slot,
     input_size,
@@ -371,7 +474,11 @@ def simulate_lookahead(
     kernel called every step, a named tuple of arrays cost the BSR simulator 10-16% per step.
 
     value: (N, 1) cost-to-go at the grid nodes, s; known: (N,) bool, the nodes with a finite
-    value (interpolation renormalises over them, as ``interpolate_with``). control_samples:
+    value (interpolation renormalises over them, as ``interpolate_with``, and an exit whose
+    known corners carry less than minimum_known_weight of its weight costs inf, as in the DP).
+    Steer and speed stop at the ends of their axes (``_limit_inputs``), and from a state within
+    the table's axes a sample is admissible only if its segment, and braking from its exit,
+    stay within them: the run stays on the table. control_samples:
     (U, m) the DP's control samples, SI, driving ``control_slot`` (m,) of the model's
     ``input_size`` inputs. state_slot: (d,) the controller's axes in the model's state.
     pose_slot, outline, obstacle_vertices, obstacle_start, domain: the obstacles.
@@ -388,6 +495,8 @@ def simulate_lookahead(
     size = state.shape[0]
     d = axis_min.shape[0]
     inputs = np.zeros(input_size)
+    limited = np.zeros(input_size)
+    limits = _axis_limits(axis_min, axis_step, axis_count, state_slot, vehicle_slot)
     here = np.empty(d)
     clamped = np.empty(d)
     regions = region_lower.shape[0]
@@ -423,6 +532,7 @@ def simulate_lookahead(
                 wrap,
                 value,
                 known,
+                minimum_known_weight,
                 control_samples,
                 control_slot,
                 input_size,
@@ -435,6 +545,7 @@ def simulate_lookahead(
                 vehicle_slot,
                 wheel_radius,
                 brake,
+                limits,
                 max_segment_steps,
                 segment_dt,
                 state,
@@ -444,7 +555,8 @@ def simulate_lookahead(
             else:
                 _sample_inputs(control_samples, control_slot, sample, inputs)
             held_until = step + max(1, round(steps * segment_dt / dt))
+        _limit_inputs(state, vehicle_slot, limits, wheel_radius, dt, inputs, limited)
         for j in range(control_slot.shape[0]):
-            record_control[step, j] = inputs[control_slot[j]]
-        rk4_step(derivative_into, state, inputs, dt, scratch)
+            record_control[step, j] = limited[control_slot[j]]
+        rk4_step(derivative_into, state, limited, dt, scratch)
     return record_state.shape[0]

@@ -11,10 +11,51 @@ import pandas as pd
 
 from mosys.io.atomic import write_text_atomically
 from mosys.io.controller_table import read_controller_table
-from mosys.io.start_grid import read_start_grid
+from mosys.io.start_grid import (
+    CONSISTENCY_BAND,
+    NO_WAY,
+    NOT_FREE,
+    StartGrid,
+    consistency_summary,
+    read_start_grid,
+)
 from mosys.io.trajectory import read_trajectory
 
 PAPER_STATES = 13250  # the paper's car controller, after removing collision states
+
+
+def start_grid_columns(grid: StartGrid) -> dict:
+    """The start grid's columns of the car table: its starts, those that count (not excluded),
+    the excluded ones by reason (``NOT_FREE``, ``NO_WAY``), the counted ones that parked, the
+    success rate over the counted starts, the collisions, the mean parking time (s) of the
+    parked starts and the consistency of the table (``StartGrid.consistency``: parking time /
+    cost-to-go at the start): its median, its 90th percentile (linear interpolation) and the
+    share of parked starts within CONSISTENCY_BAND of 1. NaN where no start parked."""
+    parked = grid.parked & grid.counted
+    ratios = grid.consistency
+    if parked.any():
+        median, p90, within = consistency_summary(ratios)
+        consistency = {
+            "mean_parking_s": round(float(grid.parking_seconds[parked].mean()), 2),
+            "consistency_median": round(median, 3),
+            "consistency_p90": round(p90, 3),
+            "consistency_within_25pct": round(within, 3),
+        }
+    else:
+        consistency = dict.fromkeys(
+            ("mean_parking_s", "consistency_median", "consistency_p90", "consistency_within_25pct"),
+            np.nan,
+        )
+    return {
+        "grid_starts": int(grid.start.shape[0]),
+        "grid_counted": int(grid.counted.sum()),
+        "grid_excluded_not_free": int(np.sum(grid.excluded == NOT_FREE)),
+        "grid_excluded_no_path": int(np.sum(grid.excluded == NO_WAY)),
+        "grid_parked": int(parked.sum()),
+        "grid_success_rate": round(grid.success_rate, 3),
+        "grid_collisions": int(grid.collided.sum()),
+        **consistency,
+    }
 
 
 def car_row(
@@ -25,7 +66,6 @@ def car_row(
     attrs = table.attrs
     grid = read_start_grid(start_grid_path)
     figure19 = [read_trajectory(path).attrs for path in trajectory_paths]
-    parked = grid.parked
     row = {
         "controller": str(table_path).rsplit("/", 1)[-1].removesuffix(".h5"),
         "grid": " x ".join(
@@ -46,12 +86,7 @@ def car_row(
         "residual_s": float(attrs["residual"]),
         "figure19_parked": f"{sum(bool(a['parked']) for a in figure19)} of {len(figure19)}",
         "figure19_collisions": sum(int(a["collision_index"]) >= 0 for a in figure19),
-        "grid_starts": int(parked.size),
-        "grid_success_rate": round(grid.success_rate, 3),
-        "grid_collisions": int(grid.collided.sum()),
-        "mean_parking_s": round(float(np.nanmean(grid.parking_seconds)), 2)
-        if parked.any()
-        else np.nan,
+        **start_grid_columns(grid),
         "budget": budget,
     }
     return pd.DataFrame([row])
@@ -75,7 +110,14 @@ def write_car_table(
         f"{PAPER_STATES:,}). Parked: within {tolerance['position_m']} m and "
         f"{tolerance['heading_deg']}° of the destination and at rest "
         f"(|speed| <= {tolerance['speed_m_s']} m/s) to the end of the run, with no collision "
-        "at any instant.\n\n"
+        "at any instant. Start grid: a start that cannot park at all is excluded, and the "
+        "success rate counts only the others (grid_counted): grid_excluded_not_free, the start "
+        "pose overlaps an obstacle or lies outside the domain; grid_excluded_no_path, a search "
+        "over poses (the steer's largest angle, forward and back) finds no collision-free path "
+        "to the destination. Consistency: parking time / the table's cost-to-go at the start, "
+        "for each counted start that parked; its median, 90th percentile and the share within "
+        f"{100 * CONSISTENCY_BAND:.0f} % (|ratio - 1| <= {CONSISTENCY_BAND}); mean_parking_s "
+        "over the same starts; NaN where no start parked.\n\n"
     )
     write_text_atomically(md_path, caption + frame.T.to_markdown(headers=["", "value"]) + "\n")
     return frame

@@ -10,6 +10,7 @@
     tol 1e-6                           # optional: convergence tolerance, s (default 1e-6)
     maxiter 1000                       # optional: iteration cap (default 1000)
     dt 0.05                            # optional: longest DP step, s (default 0.05; >= 1e-5)
+    known_weight 0.8                   # optional: share of an exit's weight on known corners
     obstacle curb -20,-1 20,-1 20,0 -20,0   # optional: a polygon the body must not overlap, m
     domain -4,0.5 8,0.5 8,4 -4,4       # optional: a polygon the reference point stays in, m
     hold                               # optional: the destination nodes hold the figure at rest
@@ -18,9 +19,12 @@
 ``obstacle`` and ``domain`` are for figures with a body outline (the car): their vertices are in
 metres in the frame of the figure's ``x``/``y`` state variables. ``hold`` is for a destination at
 rest: its nodes store the torques that keep the figure still there (``ssc.generate``), instead of
-the DP's best control sample. ``policy`` says how the table runs: ``interpolate`` (the paper's
-n-linear interpolation of the controls) or, for a vehicle, ``lookahead`` (``kernels.lookahead``)
-with the arrival tolerance of some ``dest`` dimensions, where the vehicle brakes and holds.
+the DP's best control sample. ``known_weight`` (in (0, 1]; default: any share) is the share
+of an exit's interpolation weight that must rest on corners whose cost-to-go is known for the
+exit to count, in the DP and in the lookahead runtime alike. ``policy`` says how the table
+runs: ``interpolate`` (the paper's n-linear interpolation of the controls) or, for a vehicle,
+``lookahead`` (``kernels.lookahead``) with the arrival tolerance of some ``dest`` dimensions,
+where the vehicle brakes and holds.
 
 Values are in spec units: degrees for angles, deg/s for angular rates, metres and m/s otherwise
 (the figure says which). The full grammar is in the README, "Controller spec (``.ssc``)".
@@ -56,6 +60,7 @@ KEYWORDS = (
     "tol",
     "maxiter",
     "dt",
+    "known_weight",
     "obstacle",
     "domain",
     "hold",
@@ -183,7 +188,9 @@ class ControllerSpec:
     state order restricted to these dimensions: see ``ordered_state``. ``destination`` is in
     ``dest`` order; dimensions it does not name are free. ``tolerance`` (s) stops the DP when
     no cost-to-go changes by more than it in one sweep; ``max_iterations`` caps the sweeps;
-    ``dt`` (s) is the longest step of the DP's integrator. ``spec_sha256`` is the hex
+    ``dt`` (s) is the longest step of the DP's integrator. ``known_weight``: the share of an
+    exit's interpolation weight on corners with a known cost-to-go below which the exit does
+    not count (0: any share above 0, the paper's rule). ``spec_sha256`` is the hex
     SHA-256 of the file's bytes. ``obstacles`` and ``domain`` (None: no such line) restrict a
     figure with a body outline: states whose body overlaps an obstacle or whose reference point
     lies outside the domain are removed from the table. ``hold`` (the keyword's token, None
@@ -205,6 +212,7 @@ class ControllerSpec:
     domain: Polygon | None = None
     hold: Token | None = None
     policy: Policy | None = None
+    known_weight: float = 0.0
 
     @property
     def name(self) -> str:
@@ -287,7 +295,17 @@ class _Parser:
             keyword = line.keyword.text
             if keyword not in KEYWORDS:
                 raise unknown_keyword(line, KEYWORDS)
-            if keyword in ("dyn", "dest", "tol", "maxiter", "dt", "domain", "hold", "policy"):
+            if keyword in (
+                "dyn",
+                "dest",
+                "tol",
+                "maxiter",
+                "dt",
+                "known_weight",
+                "domain",
+                "hold",
+                "policy",
+            ):
                 record_once(line, self.first_line)
             getattr(self, f"line_{keyword}")(line)
         for keyword, given in (
@@ -310,6 +328,7 @@ class _Parser:
             tolerance=float(self.options.get("tol", DEFAULT_TOLERANCE)),
             max_iterations=int(self.options.get("maxiter", DEFAULT_MAX_ITERATIONS)),
             dt=float(self.options.get("dt", DEFAULT_DT)),
+            known_weight=float(self.options.get("known_weight", 0.0)),
             spec_sha256=spec_sha256,
             obstacles=tuple(self.obstacles),
             domain=self.domain,
@@ -523,6 +542,13 @@ class _Parser:
             raise self.error(token, f"a dt of at least {MIN_DT:g} s", token.text)
         self.options["dt"] = value
 
+    def line_known_weight(self, line: Line) -> None:
+        value = self.positive(line, "known_weight (a share of the weight)")
+        if value > 1.0:
+            token = line.tokens[1]
+            raise self.error(token, "a known_weight in (0, 1]", token.text)
+        self.options["known_weight"] = value
+
     def line_hold(self, line: Line) -> None:
         line.reader().end()
         self.hold = line.keyword
@@ -636,6 +662,8 @@ def render_controller_spec(spec: ControllerSpec) -> str:
         lines.append(f"maxiter {spec.max_iterations}")
     if spec.dt != DEFAULT_DT:
         lines.append(f"dt {number(spec.dt)}")
+    if spec.known_weight:
+        lines.append(f"known_weight {number(spec.known_weight)}")
 
     def vertices(polygon: Polygon) -> str:
         return " ".join(f"{number(x)},{number(y)}" for x, y in polygon.vertices)

@@ -3,7 +3,9 @@
 - ``plot_parking_frames``: one panel per manoeuvre, to scale, the car's outline every
   ``interval`` seconds over the obstacles and the destination (Figure 19).
 - ``write_parking_gif``: an animated GIF of one manoeuvre, wheels and all.
-- ``plot_success_map``: which start positions of a start grid park, collide or run out of time.
+- ``plot_success_map``: which start positions of a start grid park, collide, run out of time or
+  cannot park at all (excluded from the success rate, with the reason).
+- ``plot_consistency``: the start grid's parking times over the controller table's cost-to-go.
 
 Everything is drawn in metres in the world frame, equal aspect. Car states are in spec units and
 located by name through ``state_order``: x, y (m) of the reference point midway between the front
@@ -26,12 +28,20 @@ from matplotlib.collections import PolyCollection
 from matplotlib.colors import LinearSegmentedColormap, Normalize
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
+from matplotlib.markers import MarkerStyle
 from matplotlib.patches import Patch, Polygon
+from matplotlib.ticker import MaxNLocator
 
 from mosys.errors import InputError
 from mosys.io.attributes import string_attr
 from mosys.io.car_scene import CarScene, read_car_scene
-from mosys.io.start_grid import DATASETS
+from mosys.io.start_grid import (
+    CONSISTENCY_BAND,
+    DATASETS,
+    NO_WAY,
+    NOT_FREE,
+    consistency_summary,
+)
 from mosys.io.start_grid import read_start_grid as read_start_grid_file
 from mosys.io.trajectory import read_trajectory
 from mosys.plots.style import (
@@ -89,9 +99,64 @@ SHADE_RANGE = (0.3, 0.95)  # the part of TIME_SHADES used
 PARKING_TIMES = LinearSegmentedColormap.from_list(
     "parking_times", matplotlib.colormaps["Greens"](np.linspace(0.35, 1.0, 256))
 )
+NOT_FREE_COLOR, NO_WAY_COLOR = "0.2", "0.3"  # the markers of the starts that cannot park
+MARKER_DIAMETER_RANGE = (3.5, 7.5)  # pt, a start-grid map's markers
+MAP_LEGEND_COLUMNS = 3
+CONSISTENCY_BIN = 0.05  # width of a consistency histogram bin
+CONSISTENCY_WIDTH, CONSISTENCY_HEIGHT = 7.5, 4.8  # inches
 TITLE_SIZE = 10.0  # pt, panel titles
 SUPTITLE_SIZE = 12.0  # pt
 OBSTACLE_LABEL_SIZE = 8.0  # pt
+
+
+@dataclass(frozen=True)
+class _Marker:
+    """A start-grid map marker: matplotlib ``marker``, ``face`` and ``edge`` colours, edge
+    ``width`` (pt) and ``scale`` (its size over the map's marker diameter)."""
+
+    marker: str
+    face: object
+    edge: object
+    width: float
+    scale: float = 1.0
+
+    def scatter(self, diameter: float, by_value: bool = False) -> dict:
+        """``Axes.scatter`` keywords at ``diameter`` pt; ``by_value``: no face colour (the caller
+        passes ``c`` and a colour map)."""
+        keywords = {
+            "marker": self.marker,
+            "s": (self.scale * diameter) ** 2,
+            "linewidths": self.width,
+            "zorder": 6,
+        }
+        if MarkerStyle(self.marker).is_filled():  # an unfilled one (x, +) is drawn in its face
+            keywords["edgecolors"] = self.edge
+        if not by_value:
+            keywords["facecolors"] = self.face
+        return keywords
+
+    def handle(self) -> Line2D:
+        """The marker's legend handle, at the largest diameter."""
+        return Line2D(
+            [],
+            [],
+            marker=self.marker,
+            linestyle="none",
+            markersize=self.scale * MARKER_DIAMETER_RANGE[1],
+            markerfacecolor=self.face,
+            markeredgecolor=self.edge,
+            markeredgewidth=self.width,
+        )
+
+
+PARKED = _Marker("o", PARKING_TIMES(0.6), "black", 0.5)
+COLLIDED = _Marker("x", FAILURE_COLOR, FAILURE_COLOR, 1.6)
+TIMED_OUT = _Marker("s", TIMEOUT_COLOR, "black", 0.5, 0.85)
+# why a start cannot park at all (io.start_grid's excluded) -> its legend text and marker
+EXCLUSIONS = {
+    NOT_FREE: ("cannot park (start not free)", _Marker("+", NOT_FREE_COLOR, NOT_FREE_COLOR, 1.0)),
+    NO_WAY: ("cannot park (no path found)", _Marker("D", "none", NO_WAY_COLOR, 1.0, 0.75)),
+}
 
 
 # --------------------------------------------------------------------------- reading the inputs
@@ -142,21 +207,39 @@ class CarTrajectory:
 @dataclass(frozen=True)
 class StartGrid:
     """Outcomes from a grid of start states. start: (n, d) spec units in ``state_order``;
-    parked, collided: (n,) bool; parking_seconds: (n,) s (NaN where not parked)."""
+    parked, collided: (n,) bool; parking_seconds: (n,) s (NaN where not parked); excluded: (n,)
+    str, why the start cannot park at all (``NOT_FREE`` or ``NO_WAY``; "" for the starts that
+    count and were run); cost_to_go: (n,) s, the controller table's at the start (inf: unknown);
+    path_length: (n,) m, the shortest collision-free path the pose search found (inf: none, NaN:
+    the start is not free)."""
 
     start: np.ndarray
     state_order: tuple[str, ...]
     parked: np.ndarray
     collided: np.ndarray
     parking_seconds: np.ndarray
+    excluded: np.ndarray
+    cost_to_go: np.ndarray
+    path_length: np.ndarray
     scene: CarScene
     controller: str
     simulated_seconds: float
 
     @property
+    def counted(self) -> np.ndarray:
+        """(n,) bool: the starts the success rate counts (not excluded)."""
+        return self.excluded == ""
+
+    @property
     def succeeded(self) -> np.ndarray:
         """(n,) bool: parked without a collision (a collision never counts as parking)."""
         return self.parked & ~self.collided
+
+    @property
+    def consistency(self) -> np.ndarray:
+        """(p,) parking time / cost-to-go at the start (both s) of each start that parked, in
+        grid order: 1 where the run takes as long as the table predicts."""
+        return self.parking_seconds[self.succeeded] / self.cost_to_go[self.succeeded]
 
 
 def _missing(path, kind: str, names: Sequence[str], present) -> None:
@@ -243,16 +326,20 @@ def read_car_trajectory(path: str | Path) -> CarTrajectory:
 
 
 def read_start_grid(path: str | Path) -> StartGrid:
-    """Read ``results/car/start_grid.h5`` (see ``plot_success_map``); PlotInputError naming the
-    file and what is missing or malformed."""
+    """Read ``results/car/start_grid.h5`` (see ``success_map_figure``); PlotInputError naming the
+    file and what is missing or malformed: a dataset of the wrong shape, a parked start without
+    a finite parking time, an exclusion reason other than ``NOT_FREE`` and ``NO_WAY``, an
+    excluded start that was run."""
     try:
         grid = read_start_grid_file(path)
     except InputError as error:  # a dataset or state_order is missing
         raise PlotInputError(str(error)) from None
+    except TypeError:  # h5py: asstr() of a dataset that does not hold strings
+        raise PlotInputError(f"{path}: /excluded must hold strings (h5py.string_dtype())") from None
     attrs = grid.attrs
     _missing(path, "start grid (root attributes)", GRID_ATTRS, attrs)
     start = np.asarray(grid.start, dtype=np.float64)
-    flags = {name: np.asarray(getattr(grid, name)) for name in DATASETS[1:]}
+    per_start = {name: np.asarray(getattr(grid, name)) for name in DATASETS[1:]}
     state_order = grid.state_order
     _columns(path, state_order, ("x", "y"))
     if start.ndim != 2 or start.shape[1] != len(state_order) or len(start) == 0:
@@ -260,24 +347,44 @@ def read_start_grid(path: str | Path) -> StartGrid:
             f"{path}: /start has shape {start.shape}, expected (n > 0, {len(state_order)}) for "
             f"state_order {list(state_order)}"
         )
-    for name, values in flags.items():
+    for name, values in per_start.items():
         if values.shape != (len(start),):
             raise PlotInputError(
                 f"{path}: /{name} has shape {values.shape}, expected ({len(start)},)"
             )
-    parked = flags["parked"].astype(bool) & ~flags["collided"].astype(bool)
-    if np.any(parked & ~np.isfinite(flags["parking_seconds"])):
-        first = int(np.flatnonzero(parked & ~np.isfinite(flags["parking_seconds"]))[0])
+    parked = per_start["parked"].astype(bool)
+    collided = per_start["collided"].astype(bool)
+    parking_seconds = per_start["parking_seconds"].astype(np.float64)
+    excluded = per_start["excluded"]
+    unknown = ~np.isin(excluded, ["", *EXCLUSIONS])
+    if unknown.any():
+        first = int(np.flatnonzero(unknown)[0])
         raise PlotInputError(
-            f"{path}: start {first} parked but its parking_seconds is "
-            f"{flags['parking_seconds'][first]}"
+            f"{path}: start {first} is excluded for an unknown reason {excluded[first]!r} "
+            f"(known: {', '.join(repr(reason) for reason in EXCLUSIONS)})"
+        )
+    run = (parked | collided) & (excluded != "")
+    if run.any():
+        first = int(np.flatnonzero(run)[0])
+        raise PlotInputError(
+            f"{path}: start {first} is excluded ({excluded[first]}) but has an outcome: "
+            f"parked {parked[first]}, collided {collided[first]}"
+        )
+    bad_time = parked & ~collided & ~np.isfinite(parking_seconds)
+    if bad_time.any():
+        first = int(np.flatnonzero(bad_time)[0])
+        raise PlotInputError(
+            f"{path}: start {first} parked but its parking_seconds is {parking_seconds[first]}"
         )
     return StartGrid(
         start=start,
         state_order=state_order,
-        parked=flags["parked"].astype(bool),
-        collided=flags["collided"].astype(bool),
-        parking_seconds=flags["parking_seconds"].astype(np.float64),
+        parked=parked,
+        collided=collided,
+        parking_seconds=parking_seconds,
+        excluded=excluded,
+        cost_to_go=per_start["cost_to_go"].astype(np.float64),
+        path_length=per_start["path_length"].astype(np.float64),
         scene=_read_scene(path, attrs),
         controller=string_attr(attrs["controller"]),
         simulated_seconds=float(attrs["simulated_seconds"]),
@@ -429,13 +536,14 @@ def _panel_figure(
     legend_rows: int,
     colorbar: bool = False,
     dpi: float | None = None,
+    columns: int = COLUMNS,
 ) -> _Layout:
-    """A figure of ``count`` equal-aspect panels on a grid of up to COLUMNS columns, sized in
+    """A figure of ``count`` equal-aspect panels on a grid of up to ``columns`` columns, sized in
     inches so that each panel's box has the aspect of ``limits``: y tick labels on the left
     column only (all panels share the limits), x labels under the lowest panel of each column,
     room above for the figure's title and each panel's title, below for a legend, and on the
     right for a colour bar."""
-    columns = min(COLUMNS, count)
+    columns = min(columns, count)
     rows = -(-count // columns)
     (x0, y0), (x1, y1) = limits
     width = SINGLE_PANEL_WIDTH if count == 1 else PANEL_WIDTH
@@ -787,9 +895,23 @@ def write_parking_gif(
     write_gif(frames, out_path, [round(1000 / fps)] * (len(frames) - 1) + [GIF_HOLD_MS])
 
 
-def _group_starts(grid: StartGrid) -> tuple[list[str], list[np.ndarray], list[str]]:
-    """The grid's starts grouped by every start variable other than x and y: (panel titles,
-    per panel the (n_k,) row indices, the variables common to all starts in brief)."""
+@dataclass(frozen=True)
+class _StartPanels:
+    """The start grid's panels: per panel its title and the (n_k,) row indices of its starts;
+    the start variables common to all starts in brief; the columns of the panel grid."""
+
+    titles: list[str]
+    groups: list[np.ndarray]
+    common: list[str]
+    columns: int
+
+
+def _group_starts(grid: StartGrid) -> _StartPanels:
+    """The grid's starts grouped by every start variable other than x and y, one panel per
+    distinct combination. When two or more variables vary and every combination is present, the
+    panels form a table: one column per value of the last varying variable (steer, in the
+    runtime's state order), one row per combination of the others (heading); otherwise up to
+    COLUMNS panels a row."""
     others = [k for k, name in enumerate(grid.state_order) if name not in ("x", "y")]
     values = np.round(grid.start[:, others], 6)
     varying = [j for j in range(len(others)) if np.ptp(values[:, j]) > 0]
@@ -814,7 +936,21 @@ def _group_starts(grid: StartGrid) -> tuple[list[str], list[np.ndarray], list[st
         for j in range(len(others))
         if j not in varying
     ]
-    return titles, groups, common
+    counts = [len(np.unique(keys[:, j])) for j in range(len(varying))]
+    table = len(varying) >= 2 and len(distinct) == math.prod(counts)
+    columns = counts[-1] if table else min(COLUMNS, len(distinct))
+    return _StartPanels(titles, groups, common, columns)
+
+
+def _marker_diameter(xy: np.ndarray, points_per_metre: float) -> float:
+    """Marker diameter, pt, for starts at xy (n, 2) m: three quarters of the closest spacing of
+    the grid's x or y values on the page, within MARKER_DIAMETER_RANGE."""
+    spacings = [np.diff(np.unique(np.round(xy[:, k], 6))) for k in range(2)]
+    steps = np.concatenate(spacings)
+    low, high = MARKER_DIAMETER_RANGE
+    if steps.size == 0:
+        return high
+    return float(np.clip(0.75 * steps.min() * points_per_metre, low, high))
 
 
 def plot_success_map(start_grid_path: str | Path, out_path: str | Path) -> None:
@@ -827,134 +963,168 @@ def success_map_figure(start_grid_path: str | Path) -> Figure:
     """Which start positions park: the start grid's obstacles and destination outline, and at
     each start's reference point (x, y) a marker: a green disc where it parked (coloured by the
     parking time, colour bar in s), a red × where it hit an obstacle, an orange square where it
-    did not park within the simulated time. Starts that differ in any other variable (heading,
-    steer, speed) get one panel per distinct combination. The title gives the success rate.
+    did not park within the simulated time; and for a start that cannot park at all (excluded,
+    not run) a grey + where the start pose is not free (``NOT_FREE``), a hollow grey diamond
+    where the pose search found no path to the destination (``NO_WAY``). Markers are sized to
+    the grid's spacing on the page. Starts that differ in any other variable (heading, steer,
+    speed) get one panel per distinct combination: a table of panels when two vary (rows
+    heading, columns steer). The title gives the success rate over the starts that count (not
+    excluded) and how many were excluded; each marker's collection has its legend text as gid.
 
-    The start grid (``results/car/start_grid.h5``): datasets ``start`` (n, d) spec units in the
-    root attribute ``state_order``, ``parked`` and ``collided`` (n,) bool, ``parking_seconds``
-    (n,) s (NaN where not parked); root attributes ``body_outline``, ``obstacles``,
+    The start grid (``results/car/start_grid.h5``, ``io.start_grid``): datasets ``start`` (n, d)
+    spec units in the root attribute ``state_order``, ``parked`` and ``collided`` (n,) bool,
+    ``parking_seconds`` (n,) s (NaN where not parked), ``excluded`` (n,) str, ``cost_to_go``
+    (n,) s and ``path_length`` (n,) m; root attributes ``body_outline``, ``obstacles``,
     ``obstacle_names``, ``destination`` (JSON, as in a car trajectory), ``controller`` and
     ``simulated_seconds`` (s)."""
     grid = read_start_grid(start_grid_path)
     column = {name: k for k, name in enumerate(grid.state_order)}
     xy = grid.start[:, [column["x"], column["y"]]]
-    titles, groups, common = _group_starts(grid)
-    region = [xy, _scene_points(grid.scene)]
-    if "heading" in column:  # the cars' bodies at their starts
-        heading = grid.start[:, column["heading"]]
-        region.append(place_outline(grid.scene.body_outline, xy[:, 0], xy[:, 1], heading))
-    limits = view_limits(np.concatenate([r.reshape(-1, 2) for r in region]), grid.scene.obstacles)
-    parked = grid.succeeded
-    collided = grid.collided
-    timed_out = ~parked & ~collided
+    panels = _group_starts(grid)
+    limits = view_limits(np.concatenate([xy, _scene_points(grid.scene)]), grid.scene.obstacles)
+    parked, counted = grid.succeeded, grid.counted
     times = grid.parking_seconds[parked]
     if len(times):
         low, high = float(times.min()), float(times.max())
         norm = Normalize(low - 0.5, high + 0.5) if high - low < 1e-9 else Normalize(low, high)
     else:
         norm = Normalize(0.0, 1.0)
-    count, total = int(parked.sum()), len(parked)
-    headline = (
-        f"Controller {grid.controller}: parks from {count} of {total} starts "
-        f"({100 * count / total:.0f} %)"
-    )
-    details = f"every start: {', '.join(common)}; " if common else ""
+    count, total = int(parked.sum()), int(counted.sum())
+    rate = f" ({100 * count / total:.1f} %)" if total else ""
+    headline = f"Controller {grid.controller}: parks from {count} of {total} starts{rate}"
+    if total < len(counted):
+        headline += f"; {len(counted) - total} more cannot park at all, not counted"
+    details = f"every start: {', '.join(panels.common)}; " if panels.common else ""
     details += f"each run simulated for up to {grid.simulated_seconds:g} s"
-    legend = [
+    kinds = [  # (legend text, marker, which starts)
+        ("parked", PARKED, parked),
+        ("collision", COLLIDED, grid.collided),
         (
-            Line2D(
-                [],
-                [],
-                marker="o",
-                linestyle="none",
-                markerfacecolor=PARKING_TIMES(0.6),
-                markeredgecolor="black",
-                markeredgewidth=0.5,
-                markersize=7,
-            ),
-            "parked",
-        ),
-        (
-            Line2D(
-                [],
-                [],
-                marker="x",
-                linestyle="none",
-                color=FAILURE_COLOR,
-                markersize=7,
-                markeredgewidth=2,
-            ),
-            "collision",
-        ),
-        (
-            Line2D(
-                [],
-                [],
-                marker="s",
-                linestyle="none",
-                markerfacecolor=TIMEOUT_COLOR,
-                markeredgecolor="black",
-                markeredgewidth=0.5,
-                markersize=6,
-            ),
             f"not parked in {grid.simulated_seconds:g} s",
+            TIMED_OUT,
+            counted & ~parked & ~grid.collided,
         ),
+        *(
+            (label, marker, grid.excluded == reason)
+            for reason, (label, marker) in EXCLUSIONS.items()
+            if np.any(grid.excluded == reason)
+        ),
+    ]
+    legend = [(marker.handle(), label) for label, marker, _ in kinds]
+    legend.append(
         (
             Line2D([], [], color=DESTINATION_COLOR, linestyle=":", linewidth=1.4),
             "destination (car outline)",
-        ),
-    ]
+        )
+    )
     with plot_style():
         layout = _panel_figure(
-            len(groups),
+            len(panels.groups),
             limits,
             suptitle_lines=2,
-            title_lines=1 if any(titles) else 0,
-            legend_rows=1,
+            title_lines=1 if any(panels.titles) else 0,
+            legend_rows=-(-len(legend) // MAP_LEGEND_COLUMNS),
             colorbar=bool(len(times)),
+            columns=panels.columns,
         )
+        panel_inches = layout.panels[0].get_position().width * layout.figure.get_size_inches()[0]
+        diameter = _marker_diameter(xy, panel_inches * 72 / (limits[1, 0] - limits[0, 0]))
         mappable = None
-        for ax, title, rows in zip(layout.panels, titles, groups, strict=True):
+        for ax, title, rows in zip(layout.panels, panels.titles, panels.groups, strict=True):
             _draw_scene(ax, grid.scene, limits)
-            good = rows[parked[rows]]
-            if len(good):
-                mappable = ax.scatter(
-                    xy[good, 0],
-                    xy[good, 1],
-                    c=grid.parking_seconds[good],
-                    cmap=PARKING_TIMES,
-                    norm=norm,
-                    marker="o",
-                    s=46,
-                    edgecolors="black",
-                    linewidths=0.5,
-                    zorder=6,
-                )
-            hit = rows[collided[rows]]
-            ax.scatter(
-                xy[hit, 0],
-                xy[hit, 1],
-                marker="x",
-                s=46,
-                color=FAILURE_COLOR,
-                linewidths=2.0,
-                zorder=6,
-            )
-            late = rows[timed_out[rows]]
-            ax.scatter(
-                xy[late, 0],
-                xy[late, 1],
-                marker="s",
-                s=36,
-                color=TIMEOUT_COLOR,
-                edgecolors="black",
-                linewidths=0.5,
-                zorder=6,
-            )
+            for label, marker, which in kinds:
+                chosen = rows[which[rows]]
+                if marker is PARKED:  # coloured by the parking time; none: no colour scale
+                    if len(chosen):
+                        mappable = ax.scatter(
+                            xy[chosen, 0],
+                            xy[chosen, 1],
+                            c=grid.parking_seconds[chosen],
+                            cmap=PARKING_TIMES,
+                            norm=norm,
+                            gid=label,
+                            **marker.scatter(diameter, by_value=True),
+                        )
+                else:
+                    ax.scatter(xy[chosen, 0], xy[chosen, 1], gid=label, **marker.scatter(diameter))
             if title:
                 _panel_title(ax, title)
         if layout.colorbar is not None and mappable is not None:
             layout.figure.colorbar(mappable, cax=layout.colorbar, label="parking time (s)")
         _suptitle(layout.figure, f"{headline}\n{details}")
-        add_legend(layout.figure, legend, ncols=4)
+        add_legend(layout.figure, legend, ncols=MAP_LEGEND_COLUMNS)
     return layout.figure
+
+
+def plot_consistency(start_grid_path: str | Path, out_path: str | Path) -> None:
+    """Write ``consistency_figure`` as a PNG to ``out_path``."""
+    with plot_style():
+        save_png(consistency_figure(start_grid_path), out_path)
+
+
+def consistency_figure(start_grid_path: str | Path) -> Figure:
+    """Does the controller table predict how long parking takes? A histogram, over the starts of
+    the start grid that count and parked, of parking time (s) / the table's cost-to-go at the
+    start (s), bins CONSISTENCY_BIN wide from 0, each closed on the left: 1 is as predicted, the
+    shaded band between the dashed lines at 1 ± CONSISTENCY_BAND (0.75 and 1.25) is within
+    25 %. The title gives how many starts parked, the share of them within the band, the median
+    and the 90th percentile (linear interpolation) of the ratio (``consistency_summary``), both
+    also drawn; ratios that are not finite (a zero cost-to-go) count as outside the band and are
+    left off the histogram, the title says how many. Reads the start grid as
+    ``success_map_figure`` does."""
+    grid = read_start_grid(start_grid_path)
+    ratios = grid.consistency
+    median, p90, within = consistency_summary(ratios)
+    finite = ratios[np.isfinite(ratios)]
+    headline = (
+        f"Controller {grid.controller}: parking time / cost-to-go at the start, "
+        f"{len(ratios)} starts that parked"
+    )
+    if len(ratios):
+        inside = int(np.sum(np.abs(ratios - 1.0) <= CONSISTENCY_BAND))
+        details = (
+            f"within ±{100 * CONSISTENCY_BAND:.0f} %: {inside} of {len(ratios)} "
+            f"({100 * within:.1f} %); median {median:.2f}, 90th percentile {p90:.2f}"
+        )
+        if len(finite) < len(ratios):
+            details += f"; {len(ratios) - len(finite)} not finite, not drawn"
+    else:
+        details = "no start parked: nothing to compare"
+    upper = max(1.0 + 2 * CONSISTENCY_BAND, float(finite.max()) if len(finite) else 0.0)
+    bins = np.round(CONSISTENCY_BIN * np.arange(math.floor(upper / CONSISTENCY_BIN) + 2), 9)
+    with plot_style():
+        figure = new_figure(CONSISTENCY_WIDTH, CONSISTENCY_HEIGHT)
+        ax = figure.add_subplot()
+        ax.axvspan(
+            1 - CONSISTENCY_BAND,
+            1 + CONSISTENCY_BAND,
+            color=PARKING_TIMES(0.1),
+            alpha=0.35,
+            zorder=0,
+            label=f"within ±{100 * CONSISTENCY_BAND:.0f} % of the cost-to-go",
+        )
+        counts, _, _ = ax.hist(
+            finite, bins=bins, color=PARKING_TIMES(0.7), edgecolor="black", linewidth=0.5, zorder=2
+        )
+        for edge in (1 - CONSISTENCY_BAND, 1 + CONSISTENCY_BAND):
+            ax.axvline(edge, color="black", linestyle="--", linewidth=1.0, zorder=3)
+        ax.axvline(1.0, color="black", linewidth=0.8, zorder=3, label="as the table predicts")
+        if len(ratios):
+            for value, style, name in ((median, "-", "median"), (p90, ":", "90th percentile")):
+                ax.axvline(
+                    value,
+                    color=TIMEOUT_COLOR,
+                    linestyle=style,
+                    linewidth=1.8,
+                    zorder=4,
+                    label=f"{name} {value:.2f}",
+                )
+        ax.set_xlim(0.0, bins[-1] + CONSISTENCY_BIN)
+        ax.set_ylim(0.0, 1.1 * max(1.0, float(counts.max())))
+        ax.yaxis.set_major_locator(MaxNLocator(integer=True))
+        ax.set_xlabel("parking time / cost-to-go at the start (1: as the table predicts)")
+        ax.set_ylabel("starts (count)")
+        figure.suptitle(f"{headline}\n{details}", fontsize=SUPTITLE_SIZE)
+        add_legend(figure, list(zip(*ax.get_legend_handles_labels(), strict=True)), ncols=2)
+        figure.subplots_adjust(top=1 - (0.25 + 2 * SUPTITLE_SIZE * 1.5 / 72) / CONSISTENCY_HEIGHT)
+    return figure

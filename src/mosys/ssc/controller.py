@@ -7,6 +7,7 @@ modulo their period. Interpolated torques are clamped to the controls' limits.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
@@ -101,6 +102,35 @@ class Controller:
         )
         return np.clip(out, self.table.control_min, self.table.control_max)
 
+    def cost_to_go(self, state: np.ndarray) -> float:
+        """The table's cost-to-go (s) at a controller state (d,) in spec units, interpolated as
+        the lookahead runtime does: over the corners whose value is known (a dead end's at the
+        DP's bound ``generate.UNKNOWN``), inf where those carry less than the table's
+        ``minimum_known_weight`` (0 when absent) of the weight; beyond the axes, at the nearest
+        covered state."""
+        grid = self.grid
+        si = np.asarray(state, dtype=np.float64) * grid.scale
+        clamped = np.empty_like(si)
+        clamp_to_domain(grid.axis_min, grid.axis_step, grid.axis_count, grid.wrap, si, clamped)
+        if self.lookahead is not None:  # dead ends at the DP's bound, as the runtime sees them
+            value, known = self.lookahead.value, self.lookahead.known
+        else:
+            value = self.table.value.reshape(-1, 1)
+            known = np.isfinite(value[:, 0])
+        out = np.empty(1)
+        known_weight = interpolate_into(
+            grid.axis_min,
+            grid.axis_step,
+            grid.axis_count,
+            grid.wrap,
+            np.ascontiguousarray(np.where(known[:, None], value, 0.0)),
+            known,
+            clamped,
+            out,
+        )
+        minimum = float(self.table.attrs.get("minimum_known_weight", 0.0))
+        return float(out[0]) if known_weight > 0.0 and known_weight >= minimum else math.inf
+
     def figure_state(self, state: np.ndarray) -> np.ndarray:
         """A full model state (S,), SI, from a controller state (d,) in spec units; model
         state variables the controller does not name are 0."""
@@ -171,6 +201,7 @@ class Controller:
                 grid.wrap,
                 policy.value,
                 policy.known,
+                policy.minimum_known_weight,
                 policy.control_samples,
                 self.control_slot,
                 len(self.dynamics.INPUT_NAMES),

@@ -36,6 +36,7 @@ from mosys.ssc.grid import FigureGrid, control_scale, figure_grid, figure_state_
 from mosys.ssc.obstacles import Obstacles, blocked_reason, spec_obstacles
 
 UNKNOWN = 1.0e9  # s: cost-to-go of a reachable node whose value is not known yet
+DEAD_END_SECONDS = 1.0e6  # s: a cost-to-go this long rests on nodes still at UNKNOWN
 PROGRESS_CHUNKS = 20  # at most; fewer for small grids (each chunk wakes numba's threads)
 SIMULATIONS_PER_CHUNK = 20_000  # at least, but for the last chunk
 SWEEPS_PER_CALL = 8  # value-iteration sweeps between progress updates
@@ -167,28 +168,31 @@ def reachable_nodes(
     exit_weight: np.ndarray,
     segment_cost: np.ndarray,
     destination: np.ndarray,
-    valid: np.ndarray,
+    row_of: np.ndarray,
     axis_count: np.ndarray,
 ) -> np.ndarray:
     """(N,) bool: the nodes from which some sequence of controls leads to the destination (every
     step onto a face with a weight on a node already known to lead there), by sweeps in the
-    orders of ``sweep_order`` until one adds nothing."""
-    reached = destination & valid
+    orders of ``sweep_order`` until one adds nothing. row_of: ``Transitions.row_of``."""
+    reached = destination & (row_of >= 0)
     order = np.empty(reached.shape[0], dtype=np.int64)
     sweep = 0
     while True:
         sweep_order(axis_count, sweep, order)
-        if not reach_sweep(exit_index, exit_weight, segment_cost, valid, reached, order):
+        if not reach_sweep(exit_index, exit_weight, segment_cost, row_of, reached, order):
             return reached
         sweep += 1
 
 
 @dataclass(frozen=True)
 class Solution:
-    """The DP's result: cost-to-go (N,) s, inf where unreachable; best control index (N,)."""
+    """The DP's result: cost-to-go (N,) s, inf where unreachable or a dead end; best control
+    index (N,); dead_end (N,) bool: reachable nodes from which no exit that ``known_weight``
+    trusts leads to the destination (none when the spec has no ``known_weight``)."""
 
     value: np.ndarray
     best_control: np.ndarray
+    dead_end: np.ndarray
     iterations: int
     residual: float
     transition_seconds: float
@@ -198,27 +202,35 @@ class Solution:
 
 @dataclass(frozen=True)
 class Transitions:
-    """What the exit transitions give, rows indexed by node: exit_index and exit_weight (N, U,
-    2**(d-1)) int32 and float32, segment_cost (N, U) s (``dp.exit_transitions_template``)."""
+    """What the exit transitions give, one row per node that is not removed (a removed node
+    takes no memory): exit_index and exit_weight (R, U, 2**(d-1)) int32 and float32,
+    segment_cost (R, U) s (``dp.exit_transitions_template``); row_of (N,) int64, each node's
+    row, -1 for a removed node."""
 
     exit_index: np.ndarray
     exit_weight: np.ndarray
     segment_cost: np.ndarray
+    row_of: np.ndarray
 
     @classmethod
-    def empty(cls, nodes: int, controls: int, dimensions: int) -> Transitions:
+    def empty(cls, valid: np.ndarray, controls: int, dimensions: int) -> Transitions:
+        """Tables for the nodes where ``valid`` (N,) bool is True."""
         corners = 1 << (dimensions - 1)
+        rows = int(valid.sum())
+        row_of = np.full(valid.shape[0], -1, dtype=np.int64)
+        row_of[valid] = np.arange(rows)
         return cls(
-            np.zeros((nodes, controls, corners), dtype=np.int32),
-            np.zeros((nodes, controls, corners), dtype=np.float32),
-            np.empty((nodes, controls)),
+            np.zeros((rows, controls, corners), dtype=np.int32),
+            np.zeros((rows, controls, corners), dtype=np.float32),
+            np.empty((rows, controls)),
+            row_of,
         )
 
     def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         return self.exit_index, self.exit_weight, self.segment_cost
 
 
-def exit_transition_arguments(problem: Problem, dt: float, valid: np.ndarray) -> tuple:
+def exit_transition_arguments(problem: Problem, dt: float, row_of: np.ndarray) -> tuple:
     """The arguments of the exit-transition kernel before ``nodes``, and those after it up to
     the outputs (``dp.exit_transitions_template``), SI."""
     grid = problem.grid
@@ -238,7 +250,7 @@ def exit_transition_arguments(problem: Problem, dt: float, valid: np.ndarray) ->
         effort,
         float(dt),
     )
-    return before, (valid, *problem.obstacles.kernel_arguments())
+    return before, (row_of, *problem.obstacles.kernel_arguments())
 
 
 def load_kernels(
@@ -251,14 +263,14 @@ def load_kernels(
     none = np.empty(0, dtype=np.int64)
     before, after = arguments
     exit_transitions(*before, none, *after, *transitions.arrays())
-    empty = Transitions.empty(0, problem.control_samples.shape[0], len(problem.grid.names))
     flags = np.empty(0, dtype=np.bool_)
-    reach_sweep(*empty.arrays(), flags, flags, none)
-    interpolate_known_values_only(*empty.arrays(), flags)
+    empty = Transitions.empty(flags, problem.control_samples.shape[0], len(problem.grid.names))
+    reach_sweep(*empty.arrays(), none, flags, none)
+    interpolate_known_values_only(*empty.arrays(), flags, 1.0)
     gauss_seidel_sweeps(
-        *empty.arrays(), flags, np.empty(0), problem.grid.axis_count, 0, 0, 1.0, none
+        *empty.arrays(), none, flags, np.empty(0), problem.grid.axis_count, 0, 0, 1.0, none
     )
-    best_controls(*empty.arrays(), np.empty(0), none)
+    best_controls(*empty.arrays(), none, np.empty(0), none)
     sweep_order(problem.grid.axis_count, 0, none)
     return time.perf_counter() - started
 
@@ -272,12 +284,12 @@ def compute_transitions(
 ) -> None:
     """Fill ``transitions`` in chunks of nodes, showing progress unless ``quiet``. arguments:
     ``exit_transition_arguments``."""
-    nodes = problem.grid.node_count
+    nodes = np.flatnonzero(transitions.row_of >= 0)
     controls = problem.control_samples.shape[0]
     before, after = arguments
-    progress = Progress("exit transitions", nodes * controls, "simulations")
-    count = max(1, min(PROGRESS_CHUNKS, nodes * controls // SIMULATIONS_PER_CHUNK))
-    chunks = np.array_split(np.arange(nodes, dtype=np.int64), count)
+    progress = Progress("exit transitions", nodes.size * controls, "simulations")
+    count = max(1, min(PROGRESS_CHUNKS, nodes.size * controls // SIMULATIONS_PER_CHUNK))
+    chunks = np.array_split(nodes, count)
     done = 0
     for chunk in chunks:
         exit_transitions(*before, np.ascontiguousarray(chunk), *after, *transitions.arrays())
@@ -308,6 +320,7 @@ def value_iteration(
     while iterations < max_iterations and not residual < tolerance:
         swept, residual = gauss_seidel_sweeps(
             *transitions.arrays(),
+            transitions.row_of,
             problem.is_destination,
             value,
             grid.axis_count,
@@ -340,28 +353,28 @@ def solve(
     """
     grid = problem.grid
     valid = problem.node_valid if node_valid is None else problem.node_valid & node_valid
-    transitions = Transitions.empty(
-        grid.node_count, problem.control_samples.shape[0], len(grid.names)
-    )
+    transitions = Transitions.empty(valid, problem.control_samples.shape[0], len(grid.names))
     exit_transitions = specialise(exit_transitions_template, dynamics, parallel=True)
-    arguments = exit_transition_arguments(problem, dt, valid)
+    arguments = exit_transition_arguments(problem, dt, transitions.row_of)
     kernel_load_seconds = load_kernels(exit_transitions, arguments, problem, transitions)
     started = time.perf_counter()
     compute_transitions(exit_transitions, arguments, problem, transitions, quiet)
     transition_seconds = time.perf_counter() - started
     reachable = reachable_nodes(
-        *transitions.arrays(), problem.is_destination, valid, grid.axis_count
+        *transitions.arrays(), problem.is_destination, transitions.row_of, grid.axis_count
     )
-    interpolate_known_values_only(*transitions.arrays(), reachable)
+    interpolate_known_values_only(*transitions.arrays(), reachable, problem.spec.known_weight)
     value, iterations, residual = value_iteration(
         problem, transitions, reachable, tolerance, max_iterations, quiet
     )
     best_control = np.empty(grid.node_count, dtype=np.int64)
-    best_controls(*transitions.arrays(), value, best_control)
+    best_controls(*transitions.arrays(), transitions.row_of, value, best_control)
     iteration_seconds = time.perf_counter() - started - transition_seconds
+    dead_end = reachable & (value >= DEAD_END_SECONDS)
     return Solution(
-        np.where(reachable, value, np.inf),
+        np.where(reachable & ~dead_end, value, np.inf),
         best_control,
+        dead_end,
         iterations,
         residual,
         transition_seconds,
@@ -482,6 +495,7 @@ def generate_controller(
         effort_weight=np.array([c.effort_weight for c in spec.controls]),
         dest=spec.destination_values(),
         figure=spec.figure,
+        dead_end=solution.dead_end.reshape(grid.shape) if spec.known_weight else None,
         attrs={
             "spec_sha256": spec.spec_sha256,
             "generation_seconds": generation_seconds,
@@ -496,8 +510,10 @@ def generate_controller(
             "tolerance": spec.tolerance if tolerance is None else tolerance,
             "dt": spec.dt,
             "control_samples": np.array([c.samples for c in spec.controls], dtype=np.int64),
-            "unreachable_nodes": int(unreachable.sum()),
+            "unreachable_nodes": int((unreachable & ~solution.dead_end).sum()),
+            "dead_end_nodes": int(solution.dead_end.sum()),
             "removed_nodes": int((~problem.node_valid).sum()),
+            "minimum_known_weight": spec.known_weight,
             "table_states": int(problem.node_valid.sum()),
             "peak_rss_bytes": peak_rss_bytes(),
             "hold": spec.hold is not None,

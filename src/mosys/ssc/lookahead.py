@@ -13,6 +13,7 @@ import numpy as np
 from mosys.io.car_scene import controller_table_scene, has_car_scene
 from mosys.io.controller_table import ControllerTable
 from mosys.kernels.geometry import pack_polygons
+from mosys.ssc.generate import UNKNOWN
 from mosys.ssc.grid import FigureGrid, control_scale, figure_state_names
 
 MAX_SEGMENT_SECONDS = 2.0  # a held sample still in its cell after this long is chosen again
@@ -36,6 +37,7 @@ class Lookahead:
 
     value: np.ndarray
     known: np.ndarray
+    minimum_known_weight: float
     control_samples: np.ndarray
     pose_slot: np.ndarray
     outline: np.ndarray
@@ -82,9 +84,12 @@ def lookahead_runtime(table: ControllerTable, dynamics: ModuleType, grid: Figure
             box[0, k] = centre - tolerance[name] * grid.scale[k]
             box[1, k] = centre + tolerance[name] * grid.scale[k]
     value = table.value.reshape(-1)
+    if table.dead_end is not None:  # dead ends cost the DP's 'not yet known' bound, as in the DP
+        value = np.where(table.dead_end.reshape(-1), UNKNOWN, value)
     return Lookahead(
         value=np.ascontiguousarray(value[:, None]),
         known=np.ascontiguousarray(np.isfinite(value)),
+        minimum_known_weight=float(attrs.get("minimum_known_weight", 0.0)),
         control_samples=np.ascontiguousarray(samples),
         pose_slot=pose_slot,
         outline=outline,

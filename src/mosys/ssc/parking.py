@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mosys.io.car_scene import CarScene, car_scene_attributes, controller_table_scene
-from mosys.io.start_grid import StartGrid
+from mosys.io.start_grid import NO_WAY, NOT_FREE, StartGrid
 from mosys.kernels.geometry import first_colliding_sample, pack_polygons
 from mosys.ssc.controller import Controller
 
@@ -74,24 +74,65 @@ def parking_outcome(
     )
 
 
+def classify_starts(controller: Controller, starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Why each start (n, d) in the controller's state order, spec units, cannot park at all:
+    (n,) str, "" for none, ``NOT_FREE`` or ``NO_WAY``, computed by ``kernels.pose_reach`` (a
+    search over poses with the steer axis's largest angle, forward and back); and the length of
+    the shortest path it found (n,) m (inf: none; nan: not free)."""
+    from mosys.kernels.pose_reach import pose_reach
+
+    scene = controller_table_scene(controller.table)
+    order = controller.state_order
+    poses = starts[:, [order.index(name) for name in ("x", "y", "heading")]].copy()
+    poses[:, 2] = np.radians(poses[:, 2])
+    destination = scene.destination
+    vertices, start = pack_polygons(list(scene.obstacles))
+    reach = pose_reach(
+        np.array([destination["x"], destination["y"], math.radians(destination["heading"])]),
+        poses,
+        scene.body_outline,
+        vertices,
+        start,
+        scene.domain,
+        float(controller.table.attrs["wheelbase"]),
+        math.radians(float(np.max(np.abs(controller.table.axes[order.index("steer")])))),
+    )
+    reason = np.where(~reach.free, NOT_FREE, np.where(~reach.reachable, NO_WAY, ""))
+    return reason.astype(object), reach.path_length
+
+
 def evaluate_starts(
-    controller: Controller, starts: np.ndarray, seconds: float, dt: float
+    controller: Controller, starts: np.ndarray, seconds: float, dt: float, threads: int = 1
 ) -> StartGrid:
     """Run ``controller`` (a car's) from every start (n, d) in its state order, spec units, for
-    ``seconds`` with step ``dt``, and judge each run (``parking_outcome``)."""
+    ``seconds`` with step ``dt``, and judge each run (``parking_outcome``), ``threads`` runs at
+    once. Starts that cannot park at all (``classify_starts``) are not run."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    starts = np.asarray(starts, dtype=np.float64)
     scene = controller_table_scene(controller.table)
-    outcomes = []
-    for start in starts:
+    excluded, path_length = classify_starts(controller, starts)
+
+    def outcome(start: np.ndarray) -> ParkingOutcome:
         run = controller.simulate(controller.figure_state(start), seconds, dt)
         t = dt * np.arange(run.states.shape[0])
         state = controller.controller_states(run.states)
-        outcomes.append(parking_outcome(t, state, controller.state_order, scene))
+        return parking_outcome(t, state, controller.state_order, scene)
+
+    included = np.flatnonzero(excluded == "")
+    with ThreadPoolExecutor(max_workers=max(1, threads)) as pool:
+        outcomes = dict(zip(included, pool.map(outcome, starts[included]), strict=True))
+    skipped = ParkingOutcome(-1, "", False, math.nan)
+    runs = [outcomes.get(i, skipped) for i in range(len(starts))]
     return StartGrid(
-        start=np.asarray(starts, dtype=np.float64),
+        start=starts,
         state_order=controller.state_order,
-        parked=np.array([o.parked for o in outcomes], dtype=np.bool_),
-        collided=np.array([o.collision_index >= 0 for o in outcomes], dtype=np.bool_),
-        parking_seconds=np.array([o.parking_seconds for o in outcomes]),
+        parked=np.array([o.parked for o in runs], dtype=np.bool_),
+        collided=np.array([o.collision_index >= 0 for o in runs], dtype=np.bool_),
+        parking_seconds=np.array([o.parking_seconds for o in runs]),
+        excluded=excluded,
+        cost_to_go=np.array([controller.cost_to_go(start) for start in starts]),
+        path_length=path_length,
         attrs={
             "controller": controller.name,
             "simulated_seconds": float(seconds),
