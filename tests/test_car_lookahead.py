@@ -124,7 +124,7 @@ def test_controls_are_the_dp_samples_held_for_whole_segments(small):
     changes = np.flatnonzero(np.any(np.diff(run.controls, axis=0) != 0.0, axis=1))
     changes = changes[~cut[changes] & ~cut[changes + 1]]  # between whole samples
     assert changes.size > 0
-    assert np.min(np.diff(changes)) >= 2  # held for more than one step between choices
+    assert np.all(np.diff(changes) >= 2)  # held for more than one step between choices
 
 
 def test_in_the_arrival_box_it_brakes_to_rest_and_holds(small):
@@ -217,3 +217,19 @@ def test_a_start_grid_runs_the_starts_that_can_park_and_excludes_the_others(smal
     assert back.excluded.tolist() == one.excluded.tolist()
     np.testing.assert_array_equal(back.cost_to_go, one.cost_to_go)
     np.testing.assert_array_equal(back.consistency, one.consistency)
+
+
+def test_the_dp_ends_a_segment_where_the_runtime_would_brake_into_the_arrival_box(
+    small, car, tmp_path
+):
+    """Rolling forward at 1 m/s 0.5 m behind the destination, full braking (1.047 m/s²) stops
+    the car 0.48 m on, inside the arrival box: the lookahead runtime brakes at once, so the DP's
+    cost-to-go there is the braking time, 0.955 s (plus at most one DP step, 0.02 s), far less
+    than the same table without the runtime's arrival rule (1.16 s), which must land on the node."""
+    node = small.cost_to_go(np.array([-0.5, 1.0, 0.0, 0.0, 1.0]))
+    braking = 1.0 / (0.3 * np.radians(200.0))
+    assert braking <= node <= braking + 0.02 + 1e-9
+    plain = parse_controller_text(SMALL, "plain.ssc")
+    table = generate_controller(plain, car, tmp_path / "plain.h5", quiet=True)
+    without = Controller("plain", table, car)
+    assert without.cost_to_go(np.array([-0.5, 1.0, 0.0, 0.0, 1.0])) > node + 0.1

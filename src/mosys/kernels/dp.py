@@ -23,7 +23,11 @@ from numba import njit, prange
 from mosys.kernels.figure_state import load_state
 from mosys.kernels.geometry import pose_is_free
 from mosys.kernels.interpolate import corner_weights, grid_strides, interpolation_scratch
+from mosys.kernels.lookahead import stops_in_box
 from mosys.kernels.specialise import model_derivative
+
+UNKNOWN = 1.0e9  # s: cost-to-go of a reachable node whose value is not known yet (the paper's
+# upper bound, from which value iteration decreases)
 
 
 @njit(cache=True)
@@ -171,6 +175,13 @@ def exit_transitions_template(
     obstacle_vertices,
     obstacle_start,
     domain,
+    arrives,
+    arrival_box,
+    vehicle_slot,
+    wheelbase,
+    wheel_radius,
+    brake,
+    terminal_node,
     exit_index,
     exit_weight,
     segment_cost,
@@ -196,6 +207,12 @@ def exit_transitions_template(
     pose_slot, outline, obstacle_vertices, obstacle_start, domain: the obstacles, as
     ``geometry.pose_is_free`` takes them (pose_slot[0] < 0: none); a segment whose state is not
     free at the end of any integration step is discarded.
+    arrives: whether the table runs by lookahead (a vehicle), whose runtime brakes to rest as
+    soon as the point where full braking would stop it lies in ``arrival_box`` (3, d)
+    (``lookahead.stops_in_box``, with vehicle_slot (7,), wheelbase and wheel_radius m, brake
+    rad/s²): then a segment that gets there before leaving its cell ends there, its cost the
+    seconds so far plus the braking time, its exit the destination node ``terminal_node``
+    (weight 1, value 0), so that the DP's cost-to-go is what that runtime takes.
     Outputs, one row per node that is not removed: exit_index (R, U, 2**(d-1)) int32 and
     exit_weight (R, U, 2**(d-1)) float32, the nodes and weights interpolating the exit state on
     the face it crosses; segment_cost (R, U) float64, inf where the segment never leaves the
@@ -309,6 +326,25 @@ def exit_transitions_template(
                     if s < crossing:
                         crossing = s
                         axis = k
+                if (
+                    axis < 0
+                    and arrives
+                    and stops_in_box(
+                        after,
+                        vehicle_slot,
+                        wheelbase,
+                        wheel_radius,
+                        brake,
+                        state_slot,
+                        arrival_box,
+                        exit_state,
+                    )
+                ):
+                    braking = abs(after[vehicle_slot[4]]) / (wheel_radius * brake)
+                    segment_cost[row, u] = (elapsed + h + braking) * (1.0 + effort)
+                    exit_index[row, u, 0] = terminal_node
+                    exit_weight[row, u, 0] = 1.0
+                    break
                 if axis < 0:
                     elapsed += h
                     for i in range(size):
@@ -475,7 +511,9 @@ def _bellman(exit_index, exit_weight, segment_cost, value, row):
 
 
 @njit(cache=True)
-def gauss_seidel_sweep(exit_index, exit_weight, segment_cost, row_of, is_destination, value, order):
+def gauss_seidel_sweep(
+    exit_index, exit_weight, segment_cost, row_of, is_destination, value, order, settled_above
+):
     """One Gauss–Seidel sweep of value iteration over the nodes in ``order`` (``sweep_order``):
     each node's cost-to-go becomes ``min(old, update)`` at once, so the nodes after it in the
     sweep use it. Returns the largest decrease, s.
@@ -485,8 +523,10 @@ def gauss_seidel_sweep(exit_index, exit_weight, segment_cost, row_of, is_destina
     paper's "values not yet known"; inf at unreachable nodes, which no finite transition touches
     after ``interpolate_known_values_only``), so values only decrease, as the paper describes.
     row_of: (N,) int64, each node's row in the exit tables (-1: removed, skipped);
-    is_destination: (N,) bool, held at 0. One thread, in a fixed order: the same result on any
-    machine whatever the thread count.
+    is_destination: (N,) bool, held at 0. A decrease to a value still at or above
+    ``settled_above`` (s; inf: none) does not count in the largest decrease: such a node is a
+    dead end (``known_weight``), whatever its exact bound. One thread, in a fixed order: the
+    same result on any machine whatever the thread count.
     """
     largest = 0.0
     for p in range(order.shape[0]):
@@ -498,7 +538,7 @@ def gauss_seidel_sweep(exit_index, exit_weight, segment_cost, row_of, is_destina
         best = _bellman(exit_index, exit_weight, segment_cost, value, row)[0]
         if best < old:
             value[node] = best
-            if old - best > largest:
+            if old - best > largest and best < settled_above:
                 largest = old - best
     return largest
 
@@ -516,6 +556,7 @@ def gauss_seidel_sweeps(
     count,
     tolerance,
     order,
+    settled_above,
 ):
     """Sweeps number ``first``, ``first + 1``, ... (``gauss_seidel_sweep`` in the orders of
     ``sweep_order``), at most ``count`` of them, stopping after the first whose largest decrease
@@ -525,7 +566,14 @@ def gauss_seidel_sweeps(
     for k in range(count):
         sweep_order(axis_count, first + k, order)
         largest = gauss_seidel_sweep(
-            exit_index, exit_weight, segment_cost, row_of, is_destination, value, order
+            exit_index,
+            exit_weight,
+            segment_cost,
+            row_of,
+            is_destination,
+            value,
+            order,
+            settled_above,
         )
         if largest < tolerance:
             return k + 1, largest

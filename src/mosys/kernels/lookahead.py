@@ -123,7 +123,7 @@ def _limit_inputs(state, vehicle_slot, limits, wheel_radius, dt, inputs, out):
 
 
 @njit(cache=True)
-def _stops_in_box(state, vehicle_slot, wheelbase, wheel_radius, brake, state_slot, box, stop):
+def stops_in_box(state, vehicle_slot, wheelbase, wheel_radius, brake, state_slot, box, stop):
     """True when the state where full braking from ``state`` ends lies in the arrival box
     (``box`` (3, d): lower, upper and period over the controller's axes, as ``inside_region``
     takes them). Braking, steering held, the front wheels roll s = v|v| / 2a: the heading turns
@@ -210,20 +210,26 @@ def _segment(
     obstacle_vertices,
     obstacle_start,
     domain,
+    wheelbase,
+    brake,
+    arrival_box,
     max_steps,
     dt,
     end,
     origin,
     here,
+    stop,
     scratch,
     body,
 ):
     """Hold the model's ``inputs`` from ``start`` (S,) until the controller state lies one grid
-    step from where it began on some axis, or for max_steps; the last state goes to ``end``.
-    Returns the steps taken, or -1 when some step is not free (obstacle or domain polygon) or,
-    from a start within the table's axes, lies beyond the end of a (non-wrap) axis.
-    The inputs are cut at the ends of the steer and speed axes (``_limit_inputs``: vehicle_slot,
-    limits, wheel_radius; limited: a work array like inputs). origin, here: (d,) work arrays;
+    step from where it began on some axis, or the point where full braking would stop it lies
+    in ``arrival_box`` (``stops_in_box``: the runtime brakes there, and so does the DP), or for
+    max_steps; the last state goes to ``end``. Returns (the steps taken, whether it arrived);
+    the steps are -1 when some step is not free (obstacle or domain polygon) or, from a start
+    within the table's axes, lies beyond the end of a (non-wrap) axis. The inputs are cut at
+    the ends of the steer and speed axes (``_limit_inputs``: vehicle_slot, limits,
+    wheel_radius; limited: a work array like inputs). origin, here, stop: (d,) work arrays;
     scratch: ``rk4_scratch(S)``; body: like outline."""
     for i in range(start.shape[0]):
         end[i] = start[i]
@@ -237,14 +243,18 @@ def _segment(
         if not pose_is_free(
             end, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
         ):
-            return -1
+            return -1, False
         read_state(end, state_slot, here)
         if inside and not within_axes(axis_min, axis_step, axis_count, wrap, here):
-            return -1
+            return -1, False
         for k in range(axis_step.shape[0]):
             if abs(here[k] - origin[k]) >= axis_step[k]:
-                return taken
-    return taken
+                return taken, False
+        if stops_in_box(
+            end, vehicle_slot, wheelbase, wheel_radius, brake, state_slot, arrival_box, stop
+        ):
+            return taken, True
+    return taken, False
 
 
 @njit(cache=True)
@@ -321,16 +331,18 @@ def _choose(
     obstacle_start,
     domain,
     vehicle_slot,
+    wheelbase,
     wheel_radius,
     brake,
     limits,
+    arrival_box,
     max_steps,
     dt,
     state,
 ):
     """(sample, steps): the cheapest admissible control sample from ``state`` (its segment's
-    seconds plus the cost-to-go at its exit) and the length of its segment; (-1, 1) when none is
-    admissible."""
+    seconds plus the cost-to-go at its exit, or, for a segment that arrives, plus the time to
+    brake to rest) and the length of its segment; (-1, 1) when none is admissible."""
     size = state.shape[0]
     d = axis_min.shape[0]
     n = control_samples.shape[0]
@@ -354,7 +366,7 @@ def _choose(
     best_steps = 1
     for u in range(n):
         _sample_inputs(control_samples, control_slot, u, inputs)
-        taken = _segment(
+        taken, arrived = _segment(
             derivative_into,
             state,
             inputs,
@@ -372,31 +384,38 @@ def _choose(
             obstacle_vertices,
             obstacle_start,
             domain,
+            wheelbase,
+            brake,
+            arrival_box,
             max_steps,
             dt,
             first,
             origin,
             here,
+            clamped,
             scratch,
             body,
         )
         if taken < 0:
             continue
         read_state(first, state_slot, here)
-        onward = _cost_to_go(
-            axis_min,
-            axis_step,
-            axis_count,
-            wrap,
-            strides,
-            value,
-            known,
-            minimum_known_weight,
-            here,
-            clamped,
-            interpolation,
-            out,
-        )
+        if arrived:  # it brakes to rest from here
+            onward = abs(first[vehicle_slot[4]]) / (wheel_radius * brake)
+        else:
+            onward = _cost_to_go(
+                axis_min,
+                axis_step,
+                axis_count,
+                wrap,
+                strides,
+                value,
+                known,
+                minimum_known_weight,
+                here,
+                clamped,
+                interpolation,
+                out,
+            )
         cost = taken * dt + onward
         if not cost < best:
             continue
@@ -518,7 +537,7 @@ def simulate_lookahead(
             axis_min, axis_step, axis_count, wrap, here, clamped
         )
         if not arrived:
-            arrived = _stops_in_box(
+            arrived = stops_in_box(
                 state, vehicle_slot, wheelbase, wheel_radius, brake, state_slot, arrival_box, here
             )
         if arrived:
@@ -543,9 +562,11 @@ def simulate_lookahead(
                 obstacle_start,
                 domain,
                 vehicle_slot,
+                wheelbase,
                 wheel_radius,
                 brake,
                 limits,
+                arrival_box,
                 max_segment_steps,
                 segment_dt,
                 state,

@@ -21,6 +21,7 @@ from mosys import __version__
 from mosys.io.controller_table import ControllerTable, write_controller_table
 from mosys.io.progress import Progress
 from mosys.kernels.dp import (
+    UNKNOWN,
     best_controls,
     exit_transitions_template,
     free_nodes,
@@ -33,9 +34,9 @@ from mosys.kernels.dp import (
 from mosys.kernels.specialise import specialise
 from mosys.parsing.controller import ControllerSpec
 from mosys.ssc.grid import FigureGrid, control_scale, figure_grid, figure_state_names
+from mosys.ssc.lookahead import vehicle_arrival
 from mosys.ssc.obstacles import Obstacles, blocked_reason, spec_obstacles
 
-UNKNOWN = 1.0e9  # s: cost-to-go of a reachable node whose value is not known yet
 DEAD_END_SECONDS = 1.0e6  # s: a cost-to-go this long rests on nodes still at UNKNOWN
 PROGRESS_CHUNKS = 20  # at most; fewer for small grids (each chunk wakes numba's threads)
 SIMULATIONS_PER_CHUNK = 20_000  # at least, but for the last chunk
@@ -230,7 +231,9 @@ class Transitions:
         return self.exit_index, self.exit_weight, self.segment_cost
 
 
-def exit_transition_arguments(problem: Problem, dt: float, row_of: np.ndarray) -> tuple:
+def exit_transition_arguments(
+    problem: Problem, dynamics: ModuleType, dt: float, row_of: np.ndarray
+) -> tuple:
     """The arguments of the exit-transition kernel before ``nodes``, and those after it up to
     the outputs (``dp.exit_transitions_template``), SI."""
     grid = problem.grid
@@ -250,7 +253,35 @@ def exit_transition_arguments(problem: Problem, dt: float, row_of: np.ndarray) -
         effort,
         float(dt),
     )
-    return before, (row_of, *problem.obstacles.kernel_arguments())
+    obstacles = problem.obstacles.kernel_arguments()
+    return before, (row_of, *obstacles, *arrival_arguments(problem, dynamics))
+
+
+def arrival_arguments(problem: Problem, dynamics: ModuleType) -> tuple:
+    """The exit kernel's arrival arguments (``dp.exit_transitions_template``): a lookahead
+    table's arrival box and braking, else a disabled placeholder."""
+    spec, grid = problem.spec, problem.grid
+    terminal_node = int(np.flatnonzero(problem.is_destination)[0])
+    if spec.policy is None or spec.policy.kind != "lookahead":
+        none = np.zeros((3, len(grid.names)))
+        return False, none, np.zeros(7, dtype=np.int64), 1.0, 1.0, 1.0, terminal_node
+    control = next(c for c in spec.controls if c.name == "wheel_accel")
+    arrival = vehicle_arrival(
+        dynamics,
+        grid,
+        spec.destination_values(),
+        dict(spec.policy.arrival),
+        min(abs(control.minimum), abs(control.maximum)),
+    )
+    return (
+        True,
+        arrival.box,
+        arrival.vehicle_slot,
+        arrival.wheelbase,
+        arrival.wheel_radius,
+        arrival.brake,
+        terminal_node,
+    )
 
 
 def load_kernels(
@@ -268,7 +299,7 @@ def load_kernels(
     reach_sweep(*empty.arrays(), none, flags, none)
     interpolate_known_values_only(*empty.arrays(), flags, 1.0)
     gauss_seidel_sweeps(
-        *empty.arrays(), none, flags, np.empty(0), problem.grid.axis_count, 0, 0, 1.0, none
+        *empty.arrays(), none, flags, np.empty(0), problem.grid.axis_count, 0, 0, 1.0, none, 1.0
     )
     best_controls(*empty.arrays(), none, np.empty(0), none)
     sweep_order(problem.grid.axis_count, 0, none)
@@ -328,6 +359,7 @@ def value_iteration(
             min(SWEEPS_PER_CALL, max_iterations - iterations),
             tolerance,
             order,
+            DEAD_END_SECONDS if problem.spec.known_weight else np.inf,
         )
         iterations += swept
         if not quiet:
@@ -355,7 +387,7 @@ def solve(
     valid = problem.node_valid if node_valid is None else problem.node_valid & node_valid
     transitions = Transitions.empty(valid, problem.control_samples.shape[0], len(grid.names))
     exit_transitions = specialise(exit_transitions_template, dynamics, parallel=True)
-    arguments = exit_transition_arguments(problem, dt, transitions.row_of)
+    arguments = exit_transition_arguments(problem, dynamics, dt, transitions.row_of)
     kernel_load_seconds = load_kernels(exit_transitions, arguments, problem, transitions)
     started = time.perf_counter()
     compute_transitions(exit_transitions, arguments, problem, transitions, quiet)

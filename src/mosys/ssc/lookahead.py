@@ -12,8 +12,8 @@ import numpy as np
 
 from mosys.io.car_scene import controller_table_scene, has_car_scene
 from mosys.io.controller_table import ControllerTable
+from mosys.kernels.dp import UNKNOWN
 from mosys.kernels.geometry import pack_polygons
-from mosys.ssc.generate import UNKNOWN
 from mosys.ssc.grid import FigureGrid, control_scale, figure_state_names
 
 MAX_SEGMENT_SECONDS = 2.0  # a held sample still in its cell after this long is chosen again
@@ -52,11 +52,57 @@ class Lookahead:
     segment_dt: float
 
 
+@dataclass(frozen=True)
+class Arrival:
+    """Where a vehicle counts as arrived and how it brakes there, SI: box (3, d) lower, upper
+    (±inf where free) and period (> 0: an angle) over the controller's axes; vehicle_slot (7,)
+    the state slots of x, y, heading, steer and speed, the input slots of steer_rate and
+    wheel_accel; wheelbase and wheel_radius, m; brake: the largest wheel deceleration, rad/s²
+    (``kernels.lookahead.stops_in_box``)."""
+
+    box: np.ndarray
+    vehicle_slot: np.ndarray
+    wheelbase: float
+    wheel_radius: float
+    brake: float
+
+
+def vehicle_arrival(
+    dynamics: ModuleType,
+    grid: FigureGrid,
+    dest: dict[str, float],
+    tolerance: dict[str, float],
+    wheel_accel_limit: float,
+) -> Arrival:
+    """The arrival of a vehicle's lookahead policy: the box of ``tolerance`` (spec units, per
+    ``dest`` dimension) around ``dest``, braking at ``wheel_accel_limit`` (spec units: the
+    smaller magnitude of the wheel_accel control's range)."""
+    names = figure_state_names(dynamics)
+    inputs = tuple(dynamics.INPUT_NAMES)
+    box = np.zeros((3, len(grid.names)))
+    box[0], box[1] = -np.inf, np.inf
+    box[2] = np.where(grid.wrap, grid.axis_count * grid.axis_step, 0.0)
+    for k, name in enumerate(grid.names):
+        if name in tolerance:
+            centre = dest[name] * grid.scale[k]
+            box[0, k] = centre - tolerance[name] * grid.scale[k]
+            box[1, k] = centre + tolerance[name] * grid.scale[k]
+    return Arrival(
+        box=box,
+        vehicle_slot=np.array(
+            [names.index(n) for n in VEHICLE_STATES] + [inputs.index(n) for n in VEHICLE_INPUTS],
+            dtype=np.int64,
+        ),
+        wheelbase=float(dynamics.WHEELBASE),
+        wheel_radius=float(dynamics.WHEEL_RADIUS),
+        brake=float(wheel_accel_limit * control_scale(dynamics, "wheel_accel")),
+    )
+
+
 def lookahead_runtime(table: ControllerTable, dynamics: ModuleType, grid: FigureGrid) -> Lookahead:
     """The lookahead arrays of a table whose attrs say ``policy`` = ``lookahead``."""
     attrs = table.attrs
     names = figure_state_names(dynamics)
-    inputs = tuple(dynamics.INPUT_NAMES)
     counts = np.atleast_1d(np.asarray(attrs["control_samples"], dtype=np.int64))
     axes = [
         np.linspace(low, high, int(n))
@@ -74,15 +120,13 @@ def lookahead_runtime(table: ControllerTable, dynamics: ModuleType, grid: Figure
         outline, domain = np.zeros((1, 2)), np.zeros((0, 2))
         vertices, start = pack_polygons([])
     brake_control = table.control_names.index("wheel_accel")
-    tolerance = json.loads(attrs["arrival_tolerance"])
-    box = np.zeros((3, len(grid.names)))
-    box[0], box[1] = -np.inf, np.inf
-    box[2] = np.where(grid.wrap, grid.axis_count * grid.axis_step, 0.0)
-    for k, name in enumerate(grid.names):
-        if name in tolerance:
-            centre = table.dest[name] * grid.scale[k]
-            box[0, k] = centre - tolerance[name] * grid.scale[k]
-            box[1, k] = centre + tolerance[name] * grid.scale[k]
+    arrival = vehicle_arrival(
+        dynamics,
+        grid,
+        table.dest,
+        json.loads(attrs["arrival_tolerance"]),
+        min(abs(table.control_min[brake_control]), abs(table.control_max[brake_control])),
+    )
     value = table.value.reshape(-1)
     if table.dead_end is not None:  # dead ends cost the DP's 'not yet known' bound, as in the DP
         value = np.where(table.dead_end.reshape(-1), UNKNOWN, value)
@@ -96,16 +140,10 @@ def lookahead_runtime(table: ControllerTable, dynamics: ModuleType, grid: Figure
         obstacle_vertices=vertices,
         obstacle_start=start,
         domain=domain,
-        vehicle_slot=np.array(
-            [names.index(n) for n in VEHICLE_STATES] + [inputs.index(n) for n in VEHICLE_INPUTS],
-            dtype=np.int64,
-        ),
-        wheelbase=float(dynamics.WHEELBASE),
-        wheel_radius=float(dynamics.WHEEL_RADIUS),
-        brake=float(
-            min(abs(table.control_min[brake_control]), abs(table.control_max[brake_control]))
-            * scale[brake_control]
-        ),
-        arrival_box=box,
+        vehicle_slot=arrival.vehicle_slot,
+        wheelbase=arrival.wheelbase,
+        wheel_radius=arrival.wheel_radius,
+        brake=arrival.brake,
+        arrival_box=arrival.box,
         segment_dt=float(attrs["dt"]),
     )
