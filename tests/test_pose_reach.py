@@ -144,11 +144,13 @@ def test_the_parking_scene(parking):
 # pose, so scattered cells of free space are never landed in); one primitive from the pose
 # itself lands in a reached cell.
 HOLE = [0.75, 3.15, math.radians(40.0)]
+BOX = np.array([[-2.25, 0.5], [8.0, 0.5], [8.0, 4.0], [-2.25, 4.0]])  # a domain of known size
 
 
 def test_a_probe_from_the_query_fills_a_hole_of_the_lattice(parking):
-    destination, obstacles, domain = parking
-    result = reach(destination, [[3.0, 3.0, 0.0], HOLE], obstacles, domain, probe_levels=0)
+    destination, obstacles, _ = parking
+    # HOLE is a hole of the lattice over BOX (its origin and extent)
+    result = reach(destination, [[3.0, 3.0, 0.0], HOLE], obstacles, BOX, probe_levels=0)
     assert result.free.tolist() == [True, True]
     assert result.reachable.tolist() == [True, False]
     assert 4.0 <= result.path_length[0] <= 20.0
@@ -174,9 +176,9 @@ def test_a_lattice_too_big_is_refused_before_allocating(parking):
     with pytest.raises(ValueError, match=r"would take \d+ bytes \(\d+ cells requested") as error:
         reach(destination, [[3.0, 3.0, 0.0]], obstacles, domain, cell=1e-5, max_bytes=10**6)
     assert "max_bytes 1000000" in str(error.value)
-    # the defaults: 205 x 70 x 144 cells of 40 bytes
+    # the defaults over BOX: 205 x 70 x 144 cells of 40 bytes
     with pytest.raises(ValueError, match=r"would take 82656000 bytes \(2066400 cells requested"):
-        reach(destination, [[3.0, 3.0, 0.0]], obstacles, domain, max_bytes=82655999)
+        reach(destination, [[3.0, 3.0, 0.0]], obstacles, BOX, max_bytes=82655999)
 
 
 def test_a_destination_that_is_not_free_is_refused(parking):

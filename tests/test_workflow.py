@@ -17,6 +17,9 @@ import h5py
 import numpy as np
 import pytest
 
+from mosys.io.controller_table import read_controller_table
+from mosys.io.start_grid import NO_WAY, NOT_FREE, read_start_grid
+
 ROOT = Path(__file__).resolve().parents[1]
 PENDULUM_CONTROLLERS = "ABCDEF"
 
@@ -168,14 +171,21 @@ CAR_SCRIPTS = [f"park_{k}" for k in range(1, 7)]
 def test_the_car_parks_from_every_figure_19_start(workflow):
     """The car's targets (README): every Figure 19 case parks (within 0.15 m and 5 deg, at rest, no
     collision at any instant) within 20 s, and some case backs up past the destination and
-    then pulls forward into it."""
-    snakemake(workflow, "results/car_all")
+    then pulls forward into it; no sample of a run lies beyond an end of the table's axes by
+    more than 1 % of a grid step. The start grid (CI's, every 1 m): no run collides, the
+    excluded starts carry a reason, and every counted start has a cost-to-go."""
+    snakemake(workflow, "results/car_all", *CI)
+    table = read_controller_table(workflow / "results/controllers/car/park.h5")
     backed_past = []
     for script in CAR_SCRIPTS:
         with h5py.File(workflow / f"results/trajectories/{script}.h5") as h5:
             attrs = dict(h5.attrs)
             order = [str(name) for name in attrs["state_order"]]
             state = h5["state"][:]
+        for k, axis in enumerate(table.axes):
+            slack = 0.01 * (axis[1] - axis[0])
+            column = state[:, order.index(table.state_order[k])]
+            assert column.min() >= axis[0] - slack and column.max() <= axis[-1] + slack, script
         assert attrs["parked"], script
         assert attrs["collision_index"] == -1, script
         assert attrs["parking_seconds"] <= 20.0, script
@@ -188,11 +198,16 @@ def test_the_car_parks_from_every_figure_19_start(workflow):
         if x[deepest] < destination["x"] - 0.5 and x[-1] > x[deepest] + 0.5:
             backed_past.append(script)
     assert backed_past
+    grid = read_start_grid(workflow / "results/car/start_grid.h5")
+    assert not grid.collided.any()
+    assert set(grid.excluded) <= {"", NOT_FREE, NO_WAY}
+    assert np.isfinite(grid.cost_to_go[grid.counted]).all()
+    assert grid.counted.sum() >= 40 and grid.success_rate >= 0.5
 
 
 @pytest.mark.slow
 def test_editing_an_obstacle_rebuilds_the_car_and_nothing_else(workflow):
-    snakemake(workflow, "results/car_all")
+    snakemake(workflow, "results/car_all", *CI)
     index = (workflow / "results/car_all").read_text().split()
     assert "results/plots/car/figure19_frames.png" in index
     assert all(f"results/trajectories/{s}.h5" in index for s in CAR_SCRIPTS)
@@ -201,7 +216,7 @@ def test_editing_an_obstacle_rebuilds_the_car_and_nothing_else(workflow):
     text = spec.read_text()
     assert "obstacle front_car 2.3,0.15" in text
     spec.write_text(text.replace("obstacle front_car 2.3,0.15", "obstacle front_car 2.4,0.15"))
-    assert planned_jobs(workflow, "results/car_all") == {
+    assert planned_jobs(workflow, "results/car_all", *CI) == {
         "dp_controller": 1,
         "run_script": len(CAR_SCRIPTS),
         "car_start_grid": 1,

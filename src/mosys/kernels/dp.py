@@ -28,6 +28,9 @@ from mosys.kernels.specialise import model_derivative
 
 UNKNOWN = 1.0e9  # s: cost-to-go of a reachable node whose value is not known yet (the paper's
 # upper bound, from which value iteration decreases)
+DEAD_END_BOUND = 1.0e4  # s: that bound for a spec with known_weight, whose dead ends keep it (far
+# above any path's seconds, and low enough that values resting partly on it settle in fewer sweeps)
+DEAD_END_SECONDS = 1.0e3  # s: a cost-to-go this long rests on a dead end
 
 
 @njit(cache=True)

@@ -105,7 +105,7 @@ class Controller:
     def cost_to_go(self, state: np.ndarray) -> float:
         """The table's cost-to-go (s) at a controller state (d,) in spec units, interpolated as
         the lookahead runtime does: over the corners whose value is known (a dead end's at the
-        DP's bound ``generate.UNKNOWN``), inf where those carry less than the table's
+        DP's bound ``dp.DEAD_END_BOUND``), inf where those carry less than the table's
         ``minimum_known_weight`` (0 when absent) of the weight; beyond the axes, at the nearest
         covered state."""
         grid = self.grid

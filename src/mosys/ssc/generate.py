@@ -21,6 +21,8 @@ from mosys import __version__
 from mosys.io.controller_table import ControllerTable, write_controller_table
 from mosys.io.progress import Progress
 from mosys.kernels.dp import (
+    DEAD_END_BOUND,
+    DEAD_END_SECONDS,
     UNKNOWN,
     best_controls,
     exit_transitions_template,
@@ -37,7 +39,6 @@ from mosys.ssc.grid import FigureGrid, control_scale, figure_grid, figure_state_
 from mosys.ssc.lookahead import vehicle_arrival
 from mosys.ssc.obstacles import Obstacles, blocked_reason, spec_obstacles
 
-DEAD_END_SECONDS = 1.0e6  # s: a cost-to-go this long rests on nodes still at UNKNOWN
 PROGRESS_CHUNKS = 20  # at most; fewer for small grids (each chunk wakes numba's threads)
 SIMULATIONS_PER_CHUNK = 20_000  # at least, but for the last chunk
 SWEEPS_PER_CALL = 8  # value-iteration sweeps between progress updates
@@ -343,7 +344,8 @@ def value_iteration(
     the largest decrease < tolerance (s) or ``max_iterations`` sweeps, from the paper's upper
     bound; returns the cost-to-go (N,) s, the sweeps and the last sweep's largest decrease."""
     grid = problem.grid
-    value = np.where(problem.is_destination, 0.0, np.where(reachable, UNKNOWN, np.inf))
+    bound = DEAD_END_BOUND if problem.spec.known_weight else UNKNOWN
+    value = np.where(problem.is_destination, 0.0, np.where(reachable, bound, np.inf))
     order = np.empty(grid.node_count, dtype=np.int64)
     progress = Progress("value iteration", max_iterations, "sweeps")
     residual = np.inf

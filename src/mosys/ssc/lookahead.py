@@ -12,7 +12,7 @@ import numpy as np
 
 from mosys.io.car_scene import controller_table_scene, has_car_scene
 from mosys.io.controller_table import ControllerTable
-from mosys.kernels.dp import UNKNOWN
+from mosys.kernels.dp import DEAD_END_BOUND
 from mosys.kernels.geometry import pack_polygons
 from mosys.ssc.grid import FigureGrid, control_scale, figure_state_names
 
@@ -128,8 +128,8 @@ def lookahead_runtime(table: ControllerTable, dynamics: ModuleType, grid: Figure
         min(abs(table.control_min[brake_control]), abs(table.control_max[brake_control])),
     )
     value = table.value.reshape(-1)
-    if table.dead_end is not None:  # dead ends cost the DP's 'not yet known' bound, as in the DP
-        value = np.where(table.dead_end.reshape(-1), UNKNOWN, value)
+    if table.dead_end is not None:  # dead ends cost the DP's bound, as in the DP
+        value = np.where(table.dead_end.reshape(-1), DEAD_END_BOUND, value)
     return Lookahead(
         value=np.ascontiguousarray(value[:, None]),
         known=np.ascontiguousarray(np.isfinite(value)),
