@@ -233,3 +233,21 @@ def test_the_dp_ends_a_segment_where_the_runtime_would_brake_into_the_arrival_bo
     table = generate_controller(plain, car, tmp_path / "plain.h5", quiet=True)
     without = Controller("plain", table, car)
     assert without.cost_to_go(np.array([-0.5, 1.0, 0.0, 0.0, 1.0])) > node + 0.1
+
+
+def test_known_weight_only_drops_exits_so_values_only_grow(small, car, tmp_path):
+    """known_weight 0.8: an exit whose known corners carry less than 80 % of its weight does not
+    count, so no node's cost-to-go falls below the same table's without it (within the sweeps'
+    tolerance); the nodes left without a trusted way on are dead ends, marked in /dead_end and
+    inf, and the table records the share."""
+    spec = parse_controller_text(SMALL + ARRIVAL + "known_weight 0.8\n", "trusted.ssc")
+    trusted = generate_controller(spec, car, tmp_path / "trusted.h5", quiet=True)
+    assert trusted.attrs["minimum_known_weight"] == 0.8
+    assert trusted.dead_end is not None and trusted.dead_end.shape == trusted.value.shape
+    assert np.isinf(trusted.value[trusted.dead_end]).all()
+    assert trusted.attrs["dead_end_nodes"] == int(trusted.dead_end.sum())
+    both = np.isfinite(trusted.value) & np.isfinite(small.table.value)
+    assert both.sum() > 0.5 * np.isfinite(small.table.value).sum()
+    tolerance = float(trusted.attrs["tolerance"])
+    assert np.all(trusted.value[both] >= small.table.value[both] - 2 * tolerance)
+    assert small.table.dead_end is None  # a table without known_weight has no /dead_end

@@ -383,7 +383,9 @@ def solve(
     """Exit transitions once (integrator steps of at most ``dt`` s), then Bellman sweeps until the
     largest decrease < tolerance (s) or ``max_iterations`` sweeps. ``node_valid``: (N,) bool,
     False for further nodes to remove (on top of ``problem.node_valid``). The kernels are
-    loaded first, outside the DP's timings (``kernel_load_seconds``).
+    loaded first, outside the DP's timings (``kernel_load_seconds``). With the spec's
+    ``known_weight``, exits resting on less of it than that cost inf, values start from
+    DEAD_END_BOUND, and the nodes left at DEAD_END_SECONDS or more are dead ends (inf).
     """
     grid = problem.grid
     valid = problem.node_valid if node_valid is None else problem.node_valid & node_valid
@@ -404,7 +406,7 @@ def solve(
     best_control = np.empty(grid.node_count, dtype=np.int64)
     best_controls(*transitions.arrays(), transitions.row_of, value, best_control)
     iteration_seconds = time.perf_counter() - started - transition_seconds
-    dead_end = reachable & (value >= DEAD_END_SECONDS)
+    dead_end = reachable & (value >= DEAD_END_SECONDS) & bool(problem.spec.known_weight)
     return Solution(
         np.where(reachable & ~dead_end, value, np.inf),
         best_control,
