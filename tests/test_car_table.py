@@ -23,7 +23,7 @@ STATE_ORDER = ("x", "y", "heading", "steer", "speed")
 
 def start_grid(parked_seconds=(8.0, 10.0, 12.0, 6.0)) -> StartGrid:
     """Ten starts: four that park (``parked_seconds`` s from a cost-to-go of 8, 8, 8 s and an
-    unknown one: ratios 1.0, 1.25, 1.5 and 0), one that collides, two that time out, and three
+    unknown one: ratios 1.0, 1.25, 1.5 and NaN), one that collides, two that time out, and three
     not run: two not free, one without a path."""
     parks = len(parked_seconds)
     outcomes = ["parked"] * parks + ["collided", "late", "late"]
@@ -52,8 +52,8 @@ GRID_COLUMNS = {
     "grid_success_rate": 0.571,  # 4 of the 7 counted starts, not of all 10
     "grid_collisions": 1,
     "mean_parking_s": 9.0,
-    "consistency_median": 1.125,  # of 0, 1, 1.25, 1.5
-    "consistency_p90": 1.425,  # 1.25 + 0.7 × (1.5 - 1.25)
+    "consistency_median": 1.25,  # of the known ratios 1, 1.25, 1.5
+    "consistency_p90": 1.45,  # 1.25 + 0.8 × (1.5 - 1.25)
     "consistency_within_25pct": 0.5,  # 1 and 1.25 (the band's edge) of the four
 }
 

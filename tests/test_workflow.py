@@ -173,7 +173,7 @@ def test_the_car_parks_from_every_figure_19_start(workflow):
     collision at any instant) within 20 s, and some case backs up past the destination and
     then pulls forward into it; no sample of a run lies beyond an end of the table's axes by
     more than 1 % of a grid step. The start grid (CI's, every 1 m): no run collides, the
-    excluded starts carry a reason, and every counted start has a cost-to-go."""
+    excluded starts carry a reason, and every start records the table's cost-to-go."""
     snakemake(workflow, "results/car_all", *CI)
     table = read_controller_table(workflow / "results/controllers/car/park.h5")
     backed_past = []
@@ -201,7 +201,7 @@ def test_the_car_parks_from_every_figure_19_start(workflow):
     grid = read_start_grid(workflow / "results/car/start_grid.h5")
     assert not grid.collided.any()
     assert set(grid.excluded) <= {"", NOT_FREE, NO_WAY}
-    assert np.isfinite(grid.cost_to_go[grid.counted]).all()
+    assert not np.isnan(grid.cost_to_go).any()  # recorded for every start (inf: unknown)
     assert grid.counted.sum() >= 40 and grid.success_rate >= 0.5
 
 

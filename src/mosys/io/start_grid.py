@@ -27,14 +27,23 @@ NO_WAY = "no collision-free path to the destination (pose search)"  # excluded (
 CONSISTENCY_BAND = 0.25  # consistent: |parking time / cost-to-go - 1| <= this (within 25 %)
 
 
+def consistency_ratios(parking_seconds: np.ndarray, cost_to_go: np.ndarray) -> np.ndarray:
+    """Parking time / cost-to-go at the start (both (p,) s) of starts that parked; NaN where the
+    table knows no cost-to-go (inf)."""
+    known = np.isfinite(cost_to_go)
+    return np.where(known, parking_seconds / np.where(known, cost_to_go, 1.0), np.nan)
+
+
 def consistency_summary(ratios: np.ndarray) -> tuple[float, float, float]:
     """(median, 90th percentile, share within CONSISTENCY_BAND of 1) of parking time /
-    cost-to-go ratios (p,); NaN for each when there are none. A non-finite ratio is never
-    within the band."""
-    if not len(ratios):
-        return float("nan"), float("nan"), float("nan")
-    within = np.abs(ratios - 1.0) <= CONSISTENCY_BAND
-    return float(np.median(ratios)), float(np.percentile(ratios, 90)), float(within.mean())
+    cost-to-go ratios (p,); the median and percentile over the finite ratios, the share over
+    all (a ratio that is not finite, where the table knows no cost-to-go, is never within the
+    band); NaN where there are none."""
+    finite = ratios[np.isfinite(ratios)]
+    within = float(np.mean(np.abs(ratios - 1.0) <= CONSISTENCY_BAND)) if len(ratios) else np.nan
+    if not len(finite):
+        return float("nan"), float("nan"), within
+    return float(np.median(finite)), float(np.percentile(finite, 90)), within
 
 
 @dataclass(frozen=True)
@@ -63,9 +72,10 @@ class StartGrid:
 
     @property
     def consistency(self) -> np.ndarray:
-        """(p,) parking seconds / cost-to-go at the start, for each start that parked."""
+        """(p,) parking seconds / cost-to-go at the start, for each counted start that parked;
+        NaN where the table knows no cost-to-go at the start (inf)."""
         parked = self.parked & self.counted
-        return self.parking_seconds[parked] / self.cost_to_go[parked]
+        return consistency_ratios(self.parking_seconds[parked], self.cost_to_go[parked])
 
 
 def write_start_grid(path: str | Path, grid: StartGrid) -> None:

@@ -40,6 +40,7 @@ from mosys.io.start_grid import (
     DATASETS,
     NO_WAY,
     NOT_FREE,
+    consistency_ratios,
     consistency_summary,
 )
 from mosys.io.start_grid import read_start_grid as read_start_grid_file
@@ -103,6 +104,7 @@ NOT_FREE_COLOR, NO_WAY_COLOR = "0.2", "0.3"  # the markers of the starts that ca
 MARKER_DIAMETER_RANGE = (3.5, 7.5)  # pt, a start-grid map's markers
 MAP_LEGEND_COLUMNS = 3
 CONSISTENCY_BIN = 0.05  # width of a consistency histogram bin
+CONSISTENCY_CLIP = 3.0  # ratios above this are counted in the title, not drawn
 CONSISTENCY_WIDTH, CONSISTENCY_HEIGHT = 7.5, 4.8  # inches
 TITLE_SIZE = 10.0  # pt, panel titles
 SUPTITLE_SIZE = 12.0  # pt
@@ -238,8 +240,10 @@ class StartGrid:
     @property
     def consistency(self) -> np.ndarray:
         """(p,) parking time / cost-to-go at the start (both s) of each start that parked, in
-        grid order: 1 where the run takes as long as the table predicts."""
-        return self.parking_seconds[self.succeeded] / self.cost_to_go[self.succeeded]
+        grid order: 1 where the run takes as long as the table predicts, NaN where the table
+        knows no cost-to-go there."""
+        succeeded = self.succeeded
+        return consistency_ratios(self.parking_seconds[succeeded], self.cost_to_go[succeeded])
 
 
 def _missing(path, kind: str, names: Sequence[str], present) -> None:
@@ -1069,9 +1073,9 @@ def consistency_figure(start_grid_path: str | Path) -> Figure:
     shaded band between the dashed lines at 1 ± CONSISTENCY_BAND (0.75 and 1.25) is within
     25 %. The title gives how many starts parked, the share of them within the band, the median
     and the 90th percentile (linear interpolation) of the ratio (``consistency_summary``), both
-    also drawn; ratios that are not finite (a zero cost-to-go) count as outside the band and are
-    left off the histogram, the title says how many. Reads the start grid as
-    ``success_map_figure`` does."""
+    also drawn; ratios that are not finite (no cost-to-go known at the start) count as outside
+    the band and are left off the histogram, as are ratios above CONSISTENCY_CLIP; the title
+    says how many. Reads the start grid as ``success_map_figure`` does."""
     grid = read_start_grid(start_grid_path)
     ratios = grid.consistency
     median, p90, within = consistency_summary(ratios)
@@ -1086,8 +1090,14 @@ def consistency_figure(start_grid_path: str | Path) -> Figure:
             f"within ±{100 * CONSISTENCY_BAND:.0f} %: {inside} of {len(ratios)} "
             f"({100 * within:.1f} %); median {median:.2f}, 90th percentile {p90:.2f}"
         )
+        left_off = []
         if len(finite) < len(ratios):
-            details += f"; {len(ratios) - len(finite)} not finite, not drawn"
+            left_off.append(f"{len(ratios) - len(finite)} with no cost-to-go at the start")
+        if np.any(finite > CONSISTENCY_CLIP):
+            left_off.append(f"{int(np.sum(finite > CONSISTENCY_CLIP))} above {CONSISTENCY_CLIP:g}")
+        if left_off:
+            details += f"\nnot drawn: {', '.join(left_off)}"
+        finite = finite[finite <= CONSISTENCY_CLIP]
     else:
         details = "no start parked: nothing to compare"
     upper = max(1.0 + 2 * CONSISTENCY_BAND, float(finite.max()) if len(finite) else 0.0)
@@ -1126,5 +1136,8 @@ def consistency_figure(start_grid_path: str | Path) -> Figure:
         ax.set_ylabel("starts (count)")
         figure.suptitle(f"{headline}\n{details}", fontsize=SUPTITLE_SIZE)
         add_legend(figure, list(zip(*ax.get_legend_handles_labels(), strict=True)), ncols=2)
-        figure.subplots_adjust(top=1 - (0.25 + 2 * SUPTITLE_SIZE * 1.5 / 72) / CONSISTENCY_HEIGHT)
+        lines = 2 + details.count("\n")
+        figure.subplots_adjust(
+            top=1 - (0.25 + lines * SUPTITLE_SIZE * 1.5 / 72) / CONSISTENCY_HEIGHT
+        )
     return figure
