@@ -11,7 +11,7 @@ import pytest
 from test_car import SMALL
 
 from mosys.io.start_grid import read_start_grid, write_start_grid
-from mosys.kernels.geometry import first_colliding_sample, point_in_polygon
+from mosys.kernels.geometry import first_colliding_sample, pack_polygons, point_in_polygon
 from mosys.parsing.controller import parse_controller_text
 from mosys.parsing.tokens import SpecError
 from mosys.ssc.controller import Controller
@@ -251,3 +251,22 @@ def test_known_weight_only_drops_exits_so_values_only_grow(small, car, tmp_path)
     tolerance = float(trusted.attrs["tolerance"])
     assert np.all(trusted.value[both] >= small.table.value[both] - 2 * tolerance)
     assert small.table.dead_end is None  # a table without known_weight has no /dead_end
+
+
+def test_a_step_that_clips_an_obstacle_between_its_ends_is_not_free():
+    """A thin wall 5 cm wide at x 2..2.05: a 4 m body stepping 4.7 m along +x starts clear of
+    it (its nose at 1.8 m) and ends past it (its tail at 2.5 m) — both ends free, the step not
+    (``_swept_free`` tests every 5 mm of travel); a step that stops short of the wall is free."""
+    from mosys.kernels.lookahead import _swept_free
+
+    outline = np.array([[0.8, -0.85], [0.8, 0.85], [-3.2, 0.85], [-3.2, -0.85]])
+    wall = [np.array([[2.0, -5.0], [2.05, -5.0], [2.05, 5.0], [2.0, 5.0]])]
+    vertices, start = pack_polygons(wall)
+    slots = np.arange(3, dtype=np.int64)
+    before, past, short = np.array([1.0, 0.0, 0.0]), np.array([5.7, 0.0, 0.0]), np.zeros(3)
+    short[0] = 1.15
+    body, domain = np.empty_like(outline), np.zeros((0, 2))
+    for pose in (before, past, short):
+        assert first_colliding_sample(pose[None, :], outline, vertices, start)[0] == -1
+    assert not _swept_free(before, past, slots, outline, vertices, start, domain, body)
+    assert _swept_free(before, short, slots, outline, vertices, start, domain, body)

@@ -45,6 +45,8 @@ from mosys.kernels.simulate import (
 )
 
 OUTSIDE_PENALTY = 100.0  # s per grid step beyond the table's axes, added to the cost-to-go
+SWEEP_STEP = 0.005  # m: the collision tests along a lookahead step are this far apart
+_POSE = np.arange(3, dtype=np.int64)  # the slots of x, y and heading in a pose (3,)
 
 LOOKAHEAD_SIGNATURE = types.int64(
     DERIVATIVE_INTO,  # derivative_into
@@ -90,6 +92,33 @@ def _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs):
         inputs[i] = 0.0
     wanted = -state[vehicle_slot[4]] / (wheel_radius * dt)
     inputs[vehicle_slot[6]] = min(max(wanted, -brake), brake)
+
+
+@njit(cache=True)
+def _swept_free(before, after, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body):
+    """True when the body is free (``pose_is_free``) at every pose of a step from model state
+    ``before`` to ``after`` (S,), tested every SWEEP_STEP m of the farthest outline vertex's
+    travel along the straight line between the two poses (their x, y and heading), the step's
+    end included: a body corner that clips an obstacle between two steps is caught."""
+    if pose_slot[0] < 0:
+        return True
+    reach = 0.0
+    for i in range(outline.shape[0]):
+        reach = max(reach, math.hypot(outline[i, 0], outline[i, 1]))
+    start = np.empty(3)
+    change = np.empty(3)
+    for k in range(3):
+        start[k] = before[pose_slot[k]]
+        change[k] = after[pose_slot[k]] - start[k]
+    travel = math.hypot(change[0], change[1]) + reach * abs(change[2])
+    pieces = max(1, math.ceil(travel / SWEEP_STEP))
+    pose = np.empty(3)
+    for j in range(1, pieces + 1):
+        for k in range(3):
+            pose[k] = start[k] + change[k] * j / pieces
+        if not pose_is_free(pose, _POSE, outline, obstacle_vertices, obstacle_start, domain, body):
+            return False
+    return True
 
 
 @njit(cache=True)
@@ -236,12 +265,14 @@ def _segment(
     read_state(start, state_slot, origin)
     inside = within_axes(axis_min, axis_step, axis_count, wrap, origin)
     taken = 0
+    before = np.empty_like(end)
     while taken < max_steps:
         _limit_inputs(end, vehicle_slot, limits, wheel_radius, dt, inputs, limited)
+        before[:] = end
         rk4_step(derivative_into, end, limited, dt, scratch)
         taken += 1
-        if not pose_is_free(
-            end, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
+        if not _swept_free(
+            before, end, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
         ):
             return -1, False
         read_state(end, state_slot, here)
@@ -287,13 +318,15 @@ def _can_brake(
     ``inside``, within the ends of the table's (non-wrap) axes. here: (d,) work array."""
     for i in range(start.shape[0]):
         state[i] = start[i]
+    before = np.empty_like(state)
     for _ in range(max_steps):
         if abs(state[vehicle_slot[4]]) < 1e-9:
             return True
         _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs)
+        before[:] = state
         rk4_step(derivative_into, state, inputs, dt, scratch)
-        if not pose_is_free(
-            state, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
+        if not _swept_free(
+            before, state, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
         ):
             return False
         read_state(state, state_slot, here)
