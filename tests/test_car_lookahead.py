@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from test_car import SMALL
 
+from mosys.errors import InputError
 from mosys.io.start_grid import read_start_grid, write_start_grid
 from mosys.kernels.geometry import first_colliding_sample, pack_polygons, point_in_polygon
 from mosys.parsing.controller import parse_controller_text
@@ -270,3 +271,15 @@ def test_a_step_that_clips_an_obstacle_between_its_ends_is_not_free():
         assert first_colliding_sample(pose[None, :], outline, vertices, start)[0] == -1
     assert not _swept_free(before, past, slots, outline, vertices, start, domain, body)
     assert _swept_free(before, short, slots, outline, vertices, start, domain, body)
+
+
+def test_a_start_grid_whose_pose_search_would_not_fit_in_memory_is_refused(car, tmp_path):
+    """A domain 6 km wide needs a pose lattice of terabytes: ``evaluate_starts`` says so, as an
+    InputError naming the controller (exit 2 at the command line), before allocating."""
+    text = SMALL.replace(
+        "domain -3,0.5 3,0.5 3,2.5 -3,2.5", "domain -3000,0.5 3000,0.5 3000,2500 -3000,2500"
+    )
+    spec = parse_controller_text(text + ARRIVAL, "wide.ssc")
+    wide = Controller("wide", generate_controller(spec, car, tmp_path / "wide.h5", quiet=True), car)
+    with pytest.raises(InputError, match=r"^controller wide: the pose search: the lattice would"):
+        evaluate_starts(wide, np.array([[1.5, 2.0, 0.0, 0.0, 0.0]]), 1.0, DT)

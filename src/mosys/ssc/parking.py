@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mosys.errors import InputError
 from mosys.io.car_scene import CarScene, car_scene_attributes, controller_table_scene
 from mosys.io.start_grid import NO_WAY, NOT_FREE, StartGrid
 from mosys.kernels.geometry import first_colliding_sample, pack_polygons
@@ -87,16 +88,19 @@ def classify_starts(controller: Controller, starts: np.ndarray) -> tuple[np.ndar
     poses[:, 2] = np.radians(poses[:, 2])
     destination = scene.destination
     vertices, start = pack_polygons(list(scene.obstacles))
-    reach = pose_reach(
-        np.array([destination["x"], destination["y"], math.radians(destination["heading"])]),
-        poses,
-        scene.body_outline,
-        vertices,
-        start,
-        scene.domain,
-        float(controller.table.attrs["wheelbase"]),
-        math.radians(float(np.max(np.abs(controller.table.axes[order.index("steer")])))),
-    )
+    try:
+        reach = pose_reach(
+            np.array([destination["x"], destination["y"], math.radians(destination["heading"])]),
+            poses,
+            scene.body_outline,
+            vertices,
+            start,
+            scene.domain,
+            float(controller.table.attrs["wheelbase"]),
+            math.radians(float(np.max(np.abs(controller.table.axes[order.index("steer")])))),
+        )
+    except ValueError as error:  # a lattice too big for memory, a destination in collision
+        raise InputError(f"controller {controller.name}: the pose search: {error}") from None
     reason = np.where(~reach.free, NOT_FREE, np.where(~reach.reachable, NO_WAY, ""))
     return reason.astype(object), reach.path_length
 
