@@ -25,8 +25,9 @@ VEHICLE_INPUTS = ("steer_rate", "wheel_accel")
 class Lookahead:
     """Everything the lookahead kernel takes besides the grid and the state, SI.
 
-    value: (N, 1) cost-to-go, s; known: (N,) finite values; control_samples: (U, m) every
-    combination of the table's control samples; pose_slot, outline, obstacle_vertices,
+    value: (N, 1) cost-to-go, s (a dead end's: ``dp.DEAD_END_BOUND``); known: (N,) finite
+    values; minimum_known_weight: the table's ``known_weight`` (0: any); control_samples:
+    (U, m) every combination of the table's control samples; pose_slot, outline, obstacle_vertices,
     obstacle_start, domain: the obstacles (``geometry.pose_is_free``; pose_slot -1: none);
     vehicle_slot: (7,) the state slots of x, y, heading, steer and speed, the input slots of
     steer_rate and wheel_accel; wheelbase and wheel_radius, m; brake: the largest wheel
