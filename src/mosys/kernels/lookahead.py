@@ -105,17 +105,15 @@ def _swept_free(before, after, pose_slot, outline, obstacle_vertices, obstacle_s
     reach = 0.0
     for i in range(outline.shape[0]):
         reach = max(reach, math.hypot(outline[i, 0], outline[i, 1]))
-    start = np.empty(3)
-    change = np.empty(3)
-    for k in range(3):
-        start[k] = before[pose_slot[k]]
-        change[k] = after[pose_slot[k]] - start[k]
-    travel = math.hypot(change[0], change[1]) + reach * abs(change[2])
-    pieces = max(1, math.ceil(travel / SWEEP_STEP))
+    x, y, heading = before[pose_slot[0]], before[pose_slot[1]], before[pose_slot[2]]
+    dx, dy = after[pose_slot[0]] - x, after[pose_slot[1]] - y
+    turn = after[pose_slot[2]] - heading
+    pieces = max(1, math.ceil((math.hypot(dx, dy) + reach * abs(turn)) / SWEEP_STEP))
     pose = np.empty(3)
     for j in range(1, pieces + 1):
-        for k in range(3):
-            pose[k] = start[k] + change[k] * j / pieces
+        pose[0] = x + dx * j / pieces
+        pose[1] = y + dy * j / pieces
+        pose[2] = heading + turn * j / pieces
         if not pose_is_free(pose, _POSE, outline, obstacle_vertices, obstacle_start, domain, body):
             return False
     return True
@@ -210,17 +208,6 @@ def _cost_to_go(
 
 
 @njit(cache=True)
-def within_axes(axis_min, axis_step, axis_count, wrap, state):
-    """True when a controller state (d,) lies within the ends of every non-wrap axis."""
-    for k in range(state.shape[0]):
-        if wrap[k]:
-            continue
-        if state[k] < axis_min[k] or state[k] > axis_min[k] + axis_step[k] * (axis_count[k] - 1):
-            return False
-    return True
-
-
-@njit(cache=True)
 def _segment(
     derivative_into,
     start,
@@ -263,7 +250,7 @@ def _segment(
     for i in range(start.shape[0]):
         end[i] = start[i]
     read_state(start, state_slot, origin)
-    inside = within_axes(axis_min, axis_step, axis_count, wrap, origin)
+    inside = clamp_to_domain(axis_min, axis_step, axis_count, wrap, origin, stop)
     taken = 0
     before = np.empty_like(end)
     while taken < max_steps:
@@ -276,7 +263,7 @@ def _segment(
         ):
             return -1, False
         read_state(end, state_slot, here)
-        if inside and not within_axes(axis_min, axis_step, axis_count, wrap, here):
+        if inside and not clamp_to_domain(axis_min, axis_step, axis_count, wrap, here, here):
             return -1, False
         for k in range(axis_step.shape[0]):
             if abs(here[k] - origin[k]) >= axis_step[k]:
@@ -330,7 +317,7 @@ def _can_brake(
         ):
             return False
         read_state(state, state_slot, here)
-        if inside and not within_axes(axis_min, axis_step, axis_count, wrap, here):
+        if inside and not clamp_to_domain(axis_min, axis_step, axis_count, wrap, here, here):
             return False
     return True
 
@@ -393,7 +380,7 @@ def _choose(
     inputs = np.zeros(input_size)
     limited = np.zeros(input_size)
     read_state(state, state_slot, here)
-    inside = within_axes(axis_min, axis_step, axis_count, wrap, here)
+    inside = clamp_to_domain(axis_min, axis_step, axis_count, wrap, here, clamped)
     best = np.inf
     best_sample = -1
     best_steps = 1
