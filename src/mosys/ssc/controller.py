@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING
@@ -112,24 +113,32 @@ class Controller:
         si = np.asarray(state, dtype=np.float64) * grid.scale
         clamped = np.empty_like(si)
         clamp_to_domain(grid.axis_min, grid.axis_step, grid.axis_count, grid.wrap, si, clamped)
-        if self.lookahead is not None:  # dead ends at the DP's bound, as the runtime sees them
-            value, known = self.lookahead.value, self.lookahead.known
-        else:
-            value = self.table.value.reshape(-1, 1)
-            known = np.isfinite(value[:, 0])
+        known_values, known = self._known_values
         out = np.empty(1)
         known_weight = interpolate_into(
             grid.axis_min,
             grid.axis_step,
             grid.axis_count,
             grid.wrap,
-            np.ascontiguousarray(np.where(known[:, None], value, 0.0)),
+            known_values,
             known,
             clamped,
             out,
         )
         minimum = float(self.table.attrs.get("minimum_known_weight", 0.0))
         return float(out[0]) if known_weight > 0.0 and known_weight >= minimum else math.inf
+
+    @cached_property
+    def _known_values(self) -> tuple[np.ndarray, np.ndarray]:
+        """(N, 1) cost-to-go at the nodes, s, 0 where unknown, and (N,) bool known, as
+        ``cost_to_go`` interpolates them (dead ends at the DP's bound, as the runtime sees
+        them); built once, not per state."""
+        if self.lookahead is not None:
+            value, known = self.lookahead.value, self.lookahead.known
+        else:
+            value = self.table.value.reshape(-1, 1)
+            known = np.isfinite(value[:, 0])
+        return np.ascontiguousarray(np.where(known[:, None], value, 0.0)), known
 
     def figure_state(self, state: np.ndarray) -> np.ndarray:
         """A full model state (S,), SI, from a controller state (d,) in spec units; model
