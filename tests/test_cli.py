@@ -161,6 +161,50 @@ def usage_error(message: str) -> str:
             ["plot", "composite", "R.h5"],
             usage_error("plot composite: give --filmstrips, --search and/or --gif"),
         ),
+        *(
+            (
+                [
+                    "starts",
+                    "T.h5",
+                    "--dynamics",
+                    "c.py",
+                    "-o",
+                    "G.h5",
+                    "--x",
+                    "0",
+                    "1",
+                    "2",
+                    "--y",
+                    *y,
+                    *more,
+                ],
+                usage_error(message),
+            )
+            for y, more, message in (
+                (
+                    ("0", "1", "2"),
+                    ("--threads", "0"),
+                    "starts: --threads must be at least 1, got 0",
+                ),
+                (("0", "1", "2"), ("--dt", "0"), "starts: --dt must be a number > 0, got 0.0"),
+                (
+                    ("0", "1", "2"),
+                    ("--seconds", "nan"),
+                    "starts: --seconds must be a number > 0, got nan",
+                ),
+                (
+                    ("0", "1", "0.5"),
+                    (),
+                    "starts: --y's COUNT must be a whole number >= 1, got 0.5",
+                ),
+                (("nan", "1", "2"), (), "starts: --y must be finite numbers, got nan 1.0 2.0"),
+                (
+                    ("0", "1", "1e6"),
+                    (),
+                    "starts: at most 1,000,000 starts, asked for 2,000,000",
+                ),
+            )
+        ),
         ([], usage_error("the following arguments are required: verb")),
         (
             ["compile", "F.fig"],

@@ -4,6 +4,7 @@ run from a grid of start states)."""
 from __future__ import annotations
 
 import argparse
+import math
 
 from mosys.cli.verb import Family, Verb
 
@@ -59,6 +60,30 @@ def _starts_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-o", "--output", required=True)
 
 
+MAX_STARTS = 1_000_000  # a start runs for seconds; a million take days on two cores
+
+
+def _starts_check(args: argparse.Namespace) -> str | None:
+    if args.threads < 1:
+        return f"starts: --threads must be at least 1, got {args.threads}"
+    for name in ("seconds", "dt"):
+        value = getattr(args, name)
+        if not 0 < value < float("inf"):
+            return f"starts: --{name} must be a number > 0, got {value}"
+    for name in ("x", "y", "heading", "steer"):
+        values = getattr(args, name)
+        if not all(math.isfinite(value) for value in values):
+            return f"starts: --{name} must be finite numbers, got {' '.join(map(str, values))}"
+    for axis in ("x", "y"):
+        count = getattr(args, axis)[2]
+        if count < 1 or count != int(count):
+            return f"starts: --{axis}'s COUNT must be a whole number >= 1, got {count:g}"
+    starts = args.x[2] * args.y[2] * len(args.heading) * len(args.steer)
+    if starts > MAX_STARTS:
+        return f"starts: at most {MAX_STARTS:,} starts, asked for {starts:,.0f}"
+    return None
+
+
 def _starts(args: argparse.Namespace) -> None:
     import itertools
 
@@ -98,6 +123,7 @@ FAMILY = Family(
             "a car controller from a grid of start states",
             _starts_arguments,
             _starts,
+            _starts_check,
         ),
     ),
 )
