@@ -85,12 +85,14 @@ def _arc(pose, curvature, s, out):
 
 
 @njit(cache=True)
-def _free_primitive(pose, curvature, s, substeps, outline, vertices, start, domain, body, end):
+def _free_primitive(
+    pose, curvature, s, substeps, outline, vertices, start, domain, body, end, sample
+):
     """True when the primitive from pose (4,) (x, y, heading, steer) over s m (negative:
-    backward) is free at its end and at substeps - 1 samples between; its end (3,) into end."""
+    backward) is free at its end and at substeps - 1 samples between; its end (3,) into end.
+    sample: (3,) work array."""
     _arc(pose, curvature, s, end)
     free = pose_is_free(end, _POSE_SLOT, outline, vertices, start, domain, body)
-    sample = np.empty(3)
     for k in range(1, substeps):
         if not free:
             break
@@ -111,6 +113,7 @@ def search(
     body = np.empty_like(outline)
     here = np.empty(4)  # x, y, heading, steer
     there = np.empty(3)  # a primitive's end
+    sample = np.empty(3)  # a pose along it
     path_length[:] = np.inf
     first = _cell_of(destination[0], destination[1], destination[2], origin, cell, shape)
     poses[first] = destination
@@ -134,7 +137,7 @@ def search(
                     continue
                 if _free_primitive(
                     here, curvature, direction * step, substeps, outline, vertices, start,
-                    domain, body, there,
+                    domain, body, there, sample,
                 ):  # fmt: skip
                     poses[end] = there
                     path_length[end] = (level + 1) * step
@@ -154,6 +157,7 @@ def lookup(
     in ``search``; at the first level some end lands in a reached cell, the shortest
     level × step + that cell's path length."""
     body = np.empty_like(outline)
+    sample = np.empty(3)  # a pose along a primitive
     free = np.zeros(queries.shape[0], dtype=np.bool_)
     branches = 2 * steer_values.shape[0]
     frontier = np.empty((branches**probe_levels, 4))
@@ -180,7 +184,7 @@ def lookup(
                     end = after[grown, :3]
                     if _free_primitive(
                         frontier[f], curvature, s, substeps, outline, vertices, start, domain,
-                        body, end,
+                        body, end, sample,
                     ):  # fmt: skip
                         c = _cell_of(end[0], end[1], end[2], origin, cell, shape)
                         out[i] = min(out[i], level * step + path_length[c])
