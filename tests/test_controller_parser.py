@@ -50,7 +50,7 @@ def values(spec: ControllerSpec) -> tuple:
         spec.figure,
         tuple((d.name, d.minimum, d.maximum, d.samples, d.wrap) for d in spec.state),
         tuple((c.name, c.minimum, c.maximum, c.samples, c.effort_weight) for c in spec.controls),
-        tuple((e.name, e.value, e.index) for e in spec.destination),
+        tuple(tuple((e.name, e.value, e.index) for e in line) for line in spec.destinations),
         spec.tolerance,
         spec.max_iterations,
         spec.dt,
@@ -135,6 +135,38 @@ def test_wrap_destinations_are_wrapped_onto_nodes(written, index):
     spec = parse_controller_text(BASE.replace("angle=0", f"angle={written}"))
     assert spec.destination[0].index == index
     assert spec.destination[0].value == float(written)
+
+
+def test_several_destinations_in_file_order():
+    """Several dest lines (a conditional goal): each parsed as the first is, in file order;
+    ``destination`` stays the first; render writes every one."""
+    spec = parse_controller_text(BASE + "tol 1e-5\ndest angle=-180 omega=500\ndest omega=0\n")
+    assert spec.all_destination_values() == [
+        {"angle": 0.0, "omega": 0.0},
+        {"angle": -180.0, "omega": 500.0},
+        {"omega": 0.0},
+    ]
+    assert spec.destination == spec.destinations[0]
+    assert spec.destination_values() == {"angle": 0.0, "omega": 0.0}
+    assert [[(e.name, e.index) for e in line] for line in spec.further_destinations] == [
+        [("angle", 0), ("omega", 20)],
+        [("omega", 10)],
+    ]
+    text = render_controller_spec(spec)
+    assert [line for line in text.splitlines() if line.startswith("dest")] == [
+        "dest angle=0.0 omega=0.0",
+        "dest angle=-180.0 omega=500.0",
+        "dest omega=0.0",
+    ]
+    assert values(parse_controller_text(text)) == values(spec)
+
+
+def test_pendulum_g_has_two_destinations():
+    spec = parse_controller_spec(PENDULUM / "G.ssc")
+    assert spec.all_destination_values() == [
+        {"angle": 90.0, "omega": 0.0},
+        {"angle": -90.0, "omega": 0.0},
+    ]
 
 
 def test_options_and_order_free_lines():
@@ -298,8 +330,21 @@ ERRORS = [
         "x.ssc:5:5: expected a 'name=value' destination, found end of line",
     ),
     (
-        BASE + "dest angle=10\n",
-        "x.ssc:6:1: expected one 'dest' line only (the first is line 5), found 'dest'",
+        BASE + "dest omega=0 angle=0\n",
+        "x.ssc:6:1: expected a destination different from line 5's, found 'dest'",
+    ),
+    (  # the same node: 360 deg is 0 deg on the wrapped angle axis
+        BASE + "dest angle=90\n  dest angle=360 omega=0\n",
+        "x.ssc:7:3: expected a destination different from line 5's, found 'dest'",
+    ),
+    (  # each further line is checked as the first is
+        BASE + "dest angle=5 omega=0\n",
+        "x.ssc:6:12: expected a grid node of ssd angle (-180 + k * 10) for dest angle, found '5'",
+    ),
+    (
+        BASE + "dest angle=90 omega=0\npolicy lookahead angle=1",
+        "x.ssc:7:8: expected 'interpolate' with several dest lines (lines 5, 6): lookahead "
+        "brakes to rest at one destination, found 'lookahead'",
     ),
     (
         replace_line(1, "dyn link1 link2"),
@@ -366,7 +411,7 @@ def test_file_errors_and_path(tmp_path):
 
 # --- hypothesis -----------------------------------------------------------------------------
 
-SPECS = [(PENDULUM / f"{name}.ssc").read_text() for name in sorted(FIGURE_13)]
+SPECS = [(PENDULUM / f"{name}.ssc").read_text() for name in [*sorted(FIGURE_13), "G"]]
 WORDS = [
     *("dyn", "ssd", "torq", "dest", "tol", "maxiter", "dt", "wrap", "angle", "omega"),
     *("angle=0", "omega=50", "=", "=1", "#", ",", "1e999", "nan", "inf", "-0", "0", "1", "2"),
@@ -433,21 +478,27 @@ def controller_specs(draw) -> ControllerSpec:
         maximum = minimum if samples == 1 else minimum + draw(st.integers(0, 100)) * 0.25
         weight = draw(st.sampled_from([0.0, 0.1, 1.0, 2.5]))
         controls.append(ControlDimension(name, minimum, maximum, samples, weight, token))
-    chosen = draw(st.lists(st.sampled_from(state), min_size=1, unique_by=lambda d: d.name))
-    destination = []
-    for dimension in chosen:
-        index = draw(st.integers(0, dimension.samples - 1))
-        value = dimension.node(index)
-        if dimension.wrap:
-            value += draw(st.integers(-2, 2)) * dimension.period
-        destination.append(Destination(dimension.name, value, index, token))
+    destinations = []
+    for _ in range(draw(st.integers(1, 3))):
+        chosen = draw(st.lists(st.sampled_from(state), min_size=1, unique_by=lambda d: d.name))
+        destination = []
+        for dimension in chosen:
+            index = draw(st.integers(0, dimension.samples - 1))
+            value = dimension.node(index)
+            if dimension.wrap:
+                value += draw(st.integers(-2, 2)) * dimension.period
+            destination.append(Destination(dimension.name, value, index, token))
+        nodes = {(entry.name, entry.index) for entry in destination}
+        if all(nodes != {(e.name, e.index) for e in other} for other in destinations):
+            destinations.append(tuple(destination))  # a repeated destination is an error
     return ControllerSpec(
         path="generated.ssc",
         figure=draw(NAMES),
         figure_token=token,
         state=tuple(state),
         controls=tuple(controls),
-        destination=tuple(destination),
+        destination=destinations[0],
+        further_destinations=tuple(destinations[1:]),
         tolerance=draw(st.sampled_from([DEFAULT_TOLERANCE, 1e-3, 2.5e-8])),
         max_iterations=draw(st.sampled_from([DEFAULT_MAX_ITERATIONS, 1, 20])),
         dt=draw(st.sampled_from([DEFAULT_DT, 0.01, 1e-4])),

@@ -26,6 +26,13 @@ class ControllerTable:
     (n_1, ..., n_d) bool, dataset ``/dead_end``, for a spec with ``known_weight`` (None
     otherwise): the free nodes whose value is inf because no trusted exit leads on from them
     (``ssc.generate``), not because they cannot be reached.
+
+    Several destinations (a spec with two or more ``dest`` lines; None for one, and a file
+    without them reads as None): ``destinations``, root attr ``destinations``, one {name:
+    value} per ``dest`` line in file order (``dest`` is the first), spec units; and
+    ``destination_index`` (n_1, ..., n_d) int64, dataset ``/destination_index``: the index into
+    ``destinations`` of the destination the node's optimal path ends at, -1 where the value is
+    inf (``kernels.dp.destination_indices`` says how it is found).
     """
 
     state_order: tuple[str, ...]
@@ -42,10 +49,23 @@ class ControllerTable:
     figure: str
     attrs: dict
     dead_end: np.ndarray | None = None
+    destinations: tuple[dict[str, float], ...] | None = None
+    destination_index: np.ndarray | None = None
+
+    @property
+    def all_destinations(self) -> tuple[dict[str, float], ...]:
+        """Every destination, {name: value} in spec units: ``destinations``, or ``(dest,)``
+        for a table with one."""
+        return self.destinations if self.destinations is not None else (self.dest,)
 
 
 def write_controller_table(path: str | Path, table: ControllerTable) -> None:
-    """Write ``table`` to ``path`` atomically (a hidden partial file, then a rename)."""
+    """Write ``table`` to ``path`` atomically (a hidden partial file, then a rename).
+    ValueError when only one of ``destinations`` and ``destination_index`` is given."""
+    if (table.destinations is None) != (table.destination_index is None):
+        raise ValueError(
+            "a table with several destinations needs both destinations and destination_index"
+        )
 
     def write(partial: Path) -> None:
         with h5py.File(partial, "w") as h5:
@@ -60,6 +80,10 @@ def write_controller_table(path: str | Path, table: ControllerTable) -> None:
             h5.create_dataset("value", data=table.value.astype(np.float64))
             if table.dead_end is not None:
                 h5.create_dataset("dead_end", data=np.asarray(table.dead_end, dtype=np.bool_))
+            if table.destination_index is not None:
+                h5.create_dataset(
+                    "destination_index", data=np.asarray(table.destination_index, dtype=np.int64)
+                )
             h5.attrs["format_version"] = FORMAT_VERSION
             h5.attrs["state_order"] = list(table.state_order)
             h5.attrs["control_names"] = list(table.control_names)
@@ -67,6 +91,8 @@ def write_controller_table(path: str | Path, table: ControllerTable) -> None:
             h5.attrs["control_max"] = np.asarray(table.control_max, dtype=np.float64)
             h5.attrs["K"] = np.asarray(table.effort_weight, dtype=np.float64)
             h5.attrs["dest"] = json.dumps(table.dest)
+            if table.destinations is not None:
+                h5.attrs["destinations"] = json.dumps(list(table.destinations))
             h5.attrs["figure"] = table.figure
             for key, value in table.attrs.items():
                 h5.attrs[key] = value
@@ -82,7 +108,15 @@ def read_controller_table(path: str | Path) -> ControllerTable:
         axes = tuple(np.asarray(h5["axes"][name][()], dtype=np.float64) for name in state_order)
         units = tuple(str(h5["axes"][name].attrs["unit"]) for name in state_order)
         wrap = tuple(bool(h5["axes"][name].attrs["wrap"]) for name in state_order)
-        known = {"state_order", "control_names", "control_min", "control_max", "K", "dest"}
+        known = {
+            "state_order",
+            "control_names",
+            "control_min",
+            "control_max",
+            "K",
+            "dest",
+            "destinations",
+        }
         attrs = {key: h5.attrs[key] for key in h5.attrs if key not in known}
         return ControllerTable(
             state_order=state_order,
@@ -99,4 +133,10 @@ def read_controller_table(path: str | Path) -> ControllerTable:
             figure=str(h5.attrs["figure"]),
             attrs=attrs,
             dead_end=np.asarray(h5["dead_end"][()], dtype=np.bool_) if "dead_end" in h5 else None,
+            destinations=tuple(json.loads(h5.attrs["destinations"]))
+            if "destinations" in h5.attrs
+            else None,
+            destination_index=np.asarray(h5["destination_index"][()], dtype=np.int64)
+            if "destination_index" in h5
+            else None,
         )

@@ -10,7 +10,9 @@ V(corner)]`` until the largest change is below a tolerance (``gauss_seidel_sweep
 is difficult to sequence local optimizations such that each local optimization always uses accurate
 information. It is simpler to approximate this order and repeat this for several iterations" —
 the sweeps run through the grid in the 2**d orders of the fast sweeping method in turn
-(``sweep_order``), each node using the values the sweep has just updated.
+(``sweep_order``), each node using the values the sweep has just updated. For a spec with
+several destinations (the paper's "conditional" goals), ``destination_indices`` then finds
+which destination each node's optimal path ends at, by the same sweeps over the exits.
 
 All quantities here are SI (rad, rad/s, m, m/s, s, N·m); grids follow ``kernels.interpolate``.
 """
@@ -621,3 +623,107 @@ def free_nodes(
         out[node] = pose_is_free(
             state, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
         )
+
+
+DESTINATION_TOLERANCE = 1e-9  # the largest change of a destination share that ends the sweeps
+DESTINATION_MAX_SWEEPS = 10_000  # a cap on them (a converged table needs tens)
+
+
+@njit(cache=True)
+def destination_share_sweep(exit_index, exit_weight, row_of, best_control, active, share, order):
+    """One Gauss–Seidel sweep, in ``order`` (``sweep_order``), of the destination shares
+    (``destination_indices``): each ``active`` node's share of every destination becomes the
+    weighted sum of its best exit's corners' shares, at once, so that the nodes after it in
+    the sweep use it. active: (N,) bool; share: (N, D) float64, in place. Returns the largest
+    change of a share."""
+    largest = 0.0
+    for p in range(order.shape[0]):
+        node = order[p]
+        if not active[node]:
+            continue
+        row = row_of[node]
+        u = best_control[node]
+        for k in range(share.shape[1]):
+            total = 0.0
+            for i in range(exit_index.shape[2]):
+                w = exit_weight[row, u, i]
+                if w != 0.0:
+                    total += w * share[exit_index[row, u, i], k]
+            change = abs(total - share[node, k])
+            if change > largest:
+                largest = change
+            share[node, k] = total
+    return largest
+
+
+@njit(cache=True)
+def destination_indices(
+    exit_index,
+    exit_weight,
+    row_of,
+    best_control,
+    value,
+    destination_label,
+    axis_count,
+    tolerance,
+    max_sweeps,
+    order,
+    share,
+    out,
+):
+    """Which destination each node's optimal path ends at, for a spec with several ``dest``
+    lines (the contract's ``/destination_index``), written into out (N,) int64; returns the
+    sweeps run.
+
+    exit_index (R, U, 2**(d-1)) int32, exit_weight (R, U, 2**(d-1)) float32: the exit
+    transitions as the value sweeps use them (after ``interpolate_known_values_only``); row_of
+    (N,) int64 (-1: removed); best_control (N,) int64 (``best_controls``); value (N,) float64,
+    the table's cost-to-go, s (inf: unreachable or dead end); destination_label (N,) int64,
+    the ``dest`` line (0 .. D-1) a destination node matches (the first, if several), -1 for
+    the other nodes; axis_count (d,) int64; order (N,) int64 work space; share (N, D) float64
+    out: the destination shares below.
+
+    The rule. The DP reads an exit as going on to the corners of the face it crosses in the
+    proportions of their interpolation weights: the cost-to-go is the expected cost of that
+    path. The share of destination k at a node is the probability that this path ends at k:
+    1 for k's own nodes (0 for the other destinations), and elsewhere the weighted sum of the
+    shares of the best control's exit corners, ``share(S) = Σ w_i share(corner_i)`` — a
+    weight vote over the exit's corners, repeated until it is a fixed point. That is solved
+    by Gauss–Seidel sweeps in the orders of ``sweep_order`` until no share changes by more
+    than ``tolerance`` (or ``max_sweeps``); chains of exits that loop back are part of the
+    linear system and need no special case. A node's index is the destination with the
+    largest share (ties: the lowest index); -1 where the value is inf. A finite-valued node
+    whose shares are all 0 (its path never reaches a destination: not seen in a converged
+    table, since every exit costs time) takes 0, the first destination. One thread, fixed
+    orders: deterministic.
+    """
+    n = value.shape[0]
+    active = np.zeros(n, np.bool_)
+    for node in range(n):
+        for k in range(share.shape[1]):
+            share[node, k] = 0.0
+        if not value[node] < np.inf:
+            continue
+        if destination_label[node] >= 0:
+            share[node, destination_label[node]] = 1.0
+        elif row_of[node] >= 0:
+            active[node] = True
+    sweeps = 0
+    while sweeps < max_sweeps:
+        sweep_order(axis_count, sweeps, order)
+        largest = destination_share_sweep(
+            exit_index, exit_weight, row_of, best_control, active, share, order
+        )
+        sweeps += 1
+        if largest <= tolerance:
+            break
+    for node in range(n):
+        if not value[node] < np.inf:
+            out[node] = -1
+            continue
+        choice = 0
+        for k in range(1, share.shape[1]):
+            if share[node, k] > share[node, choice]:
+                choice = k
+        out[node] = choice
+    return sweeps

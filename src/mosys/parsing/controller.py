@@ -6,7 +6,7 @@
     ssd omega -500.0 500.0 21          # state dimension: name min max samples
     ssd angle -180 170 36 wrap         # 'wrap': periodic dimension (period samples * step)
     torq torque -10.0 10.0 11 0.1      # control: name min max samples K
-    dest angle=0 omega=0               # destination state (grid nodes)
+    dest angle=0 omega=0               # destination state (grid nodes); may be repeated
     tol 1e-6                           # optional: convergence tolerance, s (default 1e-6)
     maxiter 1000                       # optional: iteration cap (default 1000)
     dt 0.05                            # optional: longest DP step, s (default 0.05; >= 1e-5)
@@ -15,6 +15,13 @@
     domain -4,0.5 8,0.5 8,4 -4,4       # optional: a polygon the reference point stays in, m
     hold                               # optional: the destination nodes hold the figure at rest
     policy lookahead x=0.1 y=0.1 heading=4  # optional: the runtime (default 'interpolate')
+
+Several ``dest`` lines make a "conditional" goal (the paper's §3: "given more than one
+destination state, perform the easiest motion"): the DP drives each state to whichever
+destination is cheapest from it. Each line is checked as a single one is; two lines naming the
+same dimensions at the same nodes are an error at the second one's keyword. ``hold`` then holds
+the figure at the nodes of every destination; ``policy lookahead`` (a vehicle braking at one
+destination) takes a single ``dest`` line.
 
 ``obstacle`` and ``domain`` are for figures with a body outline (the car): their vertices are in
 metres in the frame of the figure's ``x``/``y`` state variables. ``hold`` is for a destination at
@@ -140,7 +147,7 @@ class ControlDimension:
 
 @dataclass(frozen=True)
 class Destination:
-    """One ``name=value`` of the ``dest`` line: the destination of one state dimension.
+    """One ``name=value`` of a ``dest`` line: the destination of one state dimension.
 
     ``value`` is the number as written (spec units); ``index`` is the grid node it lies on
     (after wrapping, for a wrap dimension). ``token`` is the whole ``name=value`` token;
@@ -185,12 +192,14 @@ class ControllerSpec:
     """A parsed ``.ssc`` file.
 
     ``state`` is in file order; the controller's state order (its table's axes) is the figure's
-    state order restricted to these dimensions: see ``ordered_state``. ``destination`` is in
-    ``dest`` order; dimensions it does not name are free. ``tolerance`` (s) stops the DP when
-    no cost-to-go changes by more than it in one sweep; ``max_iterations`` caps the sweeps;
-    ``dt`` (s) is the longest step of the DP's integrator. ``known_weight``: the share of an
-    exit's interpolation weight on corners with a known cost-to-go below which the exit does
-    not count (0: any share above 0, the paper's rule). ``spec_sha256`` is the hex
+    state order restricted to these dimensions: see ``ordered_state``. ``destination`` is the
+    first ``dest`` line, in its order; dimensions it does not name are free.
+    ``further_destinations`` holds the ``dest`` lines after the first, in file order (empty for
+    the usual single destination): ``destinations`` lists them all. ``tolerance`` (s) stops
+    the DP when no cost-to-go changes by more than it in one sweep; ``max_iterations`` caps
+    the sweeps; ``dt`` (s) is the longest step of the DP's integrator. ``known_weight``: the
+    share of an exit's interpolation weight on corners with a known cost-to-go below which the
+    exit does not count (0: any share above 0, the paper's rule). ``spec_sha256`` is the hex
     SHA-256 of the file's bytes. ``obstacles`` and ``domain`` (None: no such line) restrict a
     figure with a body outline: states whose body overlaps an obstacle or whose reference point
     lies outside the domain are removed from the table. ``hold`` (the keyword's token, None
@@ -213,6 +222,12 @@ class ControllerSpec:
     hold: Token | None = None
     policy: Policy | None = None
     known_weight: float = 0.0
+    further_destinations: tuple[tuple[Destination, ...], ...] = ()
+
+    @property
+    def destinations(self) -> tuple[tuple[Destination, ...], ...]:
+        """Every ``dest`` line in file order, the first being ``destination``."""
+        return (self.destination, *self.further_destinations)
 
     @property
     def name(self) -> str:
@@ -227,8 +242,12 @@ class ControllerSpec:
         raise KeyError(name)
 
     def destination_values(self) -> dict[str, float]:
-        """``dest`` as {name: value}, spec units, as written."""
+        """The first ``dest`` line as {name: value}, spec units, as written."""
         return {entry.name: entry.value for entry in self.destination}
+
+    def all_destination_values(self) -> list[dict[str, float]]:
+        """Every ``dest`` line as {name: value}, spec units, as written, in file order."""
+        return [{entry.name: entry.value for entry in line} for line in self.destinations]
 
     def error(self, token: Token, expected: str) -> SpecError:
         """A SpecError at ``token`` of this spec, found its text: for checks made after
@@ -278,7 +297,7 @@ class _Parser:
         self.figure: Token | None = None
         self.state: list[StateDimension] = []
         self.controls: list[ControlDimension] = []
-        self.dest_line: Line | None = None
+        self.dest_lines: list[Line] = []
         self.options: dict[str, float | int] = {}
         self.first_line: dict[str, int] = {}  # once-only keyword -> its line number
         self.names: dict[str, int] = {}  # ssd/torq name -> its line number
@@ -297,7 +316,6 @@ class _Parser:
                 raise unknown_keyword(line, KEYWORDS)
             if keyword in (
                 "dyn",
-                "dest",
                 "tol",
                 "maxiter",
                 "dt",
@@ -312,12 +330,13 @@ class _Parser:
             ("dyn", self.figure),
             ("ssd", self.state),
             ("torq", self.controls),
-            ("dest", self.dest_line),
+            ("dest", self.dest_lines),
         ):
             if not given:
                 raise missing_line(self.path, lines, keyword)
-        assert self.figure is not None and self.dest_line is not None
-        destination = self.destination(self.dest_line)
+        assert self.figure is not None
+        destinations = self.destinations()
+        destination = destinations[0]
         return ControllerSpec(
             path=self.path,
             figure=self.figure.text,
@@ -334,6 +353,7 @@ class _Parser:
             domain=self.domain,
             hold=self.hold,
             policy=None if self.policy_line is None else self.policy(self.policy_line, destination),
+            further_destinations=destinations[1:],
         )
 
     def new_name(self, reader: LineReader, what: str) -> Token:
@@ -428,7 +448,26 @@ class _Parser:
             raise SpecError(
                 self.path, line.number, line.end_column, "a 'name=value' destination", None
             )
-        self.dest_line = line  # checked against the ssd lines once all are read
+        self.dest_lines.append(line)  # checked against the ssd lines once all are read
+
+    def destinations(self) -> tuple[tuple[Destination, ...], ...]:
+        """Every ``dest`` line, in file order; a line that names the same dimensions at the
+        same grid nodes as an earlier one (``angle=-180`` and ``angle=180`` on a wrap axis of
+        period 360 are the same node) is an error at its keyword."""
+        parsed: list[tuple[Destination, ...]] = []
+        seen: dict[frozenset[tuple[str, int]], int] = {}
+        for line in self.dest_lines:
+            entries = self.destination(line)
+            nodes = frozenset((entry.name, entry.index) for entry in entries)
+            if nodes in seen:
+                raise self.error(
+                    line.keyword,
+                    f"a destination different from line {seen[nodes]}'s",
+                    line.keyword.text,
+                )
+            seen[nodes] = line.number
+            parsed.append(entries)
+        return tuple(parsed)
 
     def destination(self, line: Line) -> tuple[Destination, ...]:
         dimensions = {dimension.name: dimension for dimension in self.state}
@@ -564,6 +603,14 @@ class _Parser:
         if kind.text not in POLICIES:
             choices = ", ".join(f"'{k}'" for k in POLICIES)
             raise self.error(kind, f"one of {choices}", kind.text)
+        if kind.text == "lookahead" and len(self.dest_lines) > 1:
+            numbers = ", ".join(str(dest.number) for dest in self.dest_lines)
+            raise self.error(
+                kind,
+                f"'interpolate' with several dest lines (lines {numbers}): lookahead brakes "
+                "to rest at one destination",
+                kind.text,
+            )
         if kind.text == "interpolate" and len(line.tokens) > 2:
             raise self.error(
                 line.tokens[2], "the end of the line after 'interpolate'", line.tokens[2].text
@@ -653,9 +700,10 @@ def render_controller_spec(spec: ControllerSpec) -> str:
             f"torq {control.name} {number(control.minimum)} {number(control.maximum)} "
             f"{control.samples} {number(control.effort_weight)}"
         )
-    lines.append(
-        "dest " + " ".join(f"{entry.name}={number(entry.value)}" for entry in spec.destination)
-    )
+    for destination in spec.destinations:
+        lines.append(
+            "dest " + " ".join(f"{entry.name}={number(entry.value)}" for entry in destination)
+        )
     if spec.tolerance != DEFAULT_TOLERANCE:
         lines.append(f"tol {number(spec.tolerance)}")
     if spec.max_iterations != DEFAULT_MAX_ITERATIONS:

@@ -23,8 +23,11 @@ from mosys.io.progress import Progress
 from mosys.kernels.dp import (
     DEAD_END_BOUND,
     DEAD_END_SECONDS,
+    DESTINATION_MAX_SWEEPS,
+    DESTINATION_TOLERANCE,
     UNKNOWN,
     best_controls,
+    destination_indices,
     exit_transitions_template,
     free_nodes,
     gauss_seidel_sweeps,
@@ -55,7 +58,8 @@ class Problem:
     control_scale: np.ndarray  # (m,) spec unit -> SI factor of each control
     control_slot: np.ndarray  # (m,) entry of the model's inputs each control drives
     input_size: int  # how many inputs the model takes
-    is_destination: np.ndarray  # (N,) bool
+    is_destination: np.ndarray  # (N,) bool: the nodes of any dest line
+    destination_label: np.ndarray  # (N,) int64: the first dest line a node matches, else -1
     obstacles: Obstacles
     node_valid: np.ndarray  # (N,) bool: False for nodes removed (collision, outside the domain)
 
@@ -92,15 +96,8 @@ def build_problem(spec: ControllerSpec, dynamics: ModuleType) -> Problem:
         list(itertools.product(*(control.values() for control in spec.controls))),
         dtype=np.float64,
     ).reshape(-1, len(spec.controls))
-    destination = np.ones(grid.shape, dtype=bool)
-    for entry in spec.destination:
-        axis = grid.names.index(entry.name)
-        on_node = np.zeros(grid.shape[axis], dtype=bool)
-        on_node[entry.index] = True
-        broadcast = [1] * len(grid.names)
-        broadcast[axis] = grid.shape[axis]
-        destination &= on_node.reshape(broadcast)
-    is_destination = np.ascontiguousarray(destination.reshape(-1))
+    destination_label = destination_labels(spec, grid)
+    is_destination = np.ascontiguousarray(destination_label >= 0)
     base_state = np.zeros(len(names))
     obstacles = spec_obstacles(spec, dynamics, grid)
     node_valid = np.ones(grid.node_count, dtype=np.bool_)
@@ -116,13 +113,12 @@ def build_problem(spec: ControllerSpec, dynamics: ModuleType) -> Problem:
         )
         blocked = np.flatnonzero(is_destination & ~node_valid)
         if blocked.size:
+            line = spec.destinations[int(destination_label[blocked[0]])]
             state = np.empty(len(grid.names))
             node_coordinates(grid.axis_min, grid.axis_step, grid.axis_count, blocked[0], state)
             pose = np.array([state[grid.names.index(n)] for n in ("x", "y", "heading")])
             reason = blocked_reason(spec, obstacles, pose)
-            raise spec.error(
-                spec.destination[0].token, f"a destination the car can occupy ({reason})"
-            )
+            raise spec.error(line[0].token, f"a destination the car can occupy ({reason})")
     return Problem(
         spec=spec,
         grid=grid,
@@ -132,9 +128,28 @@ def build_problem(spec: ControllerSpec, dynamics: ModuleType) -> Problem:
         control_slot=np.array(control_slot, dtype=np.int64),
         input_size=len(actuators),
         is_destination=is_destination,
+        destination_label=destination_label,
         obstacles=obstacles,
         node_valid=node_valid,
     )
+
+
+def destination_labels(spec: ControllerSpec, grid: FigureGrid) -> np.ndarray:
+    """(N,) int64: for each node, the index of the first ``dest`` line (file order) whose
+    coordinates it matches (dimensions a line does not name are free), -1 for the other nodes.
+    The DP's destination is the union of these node sets."""
+    label = np.full(grid.shape, -1, dtype=np.int64)
+    for number, line in enumerate(spec.destinations):
+        destination = np.ones(grid.shape, dtype=bool)
+        for entry in line:
+            axis = grid.names.index(entry.name)
+            on_node = np.zeros(grid.shape[axis], dtype=bool)
+            on_node[entry.index] = True
+            broadcast = [1] * len(grid.names)
+            broadcast[axis] = grid.shape[axis]
+            destination &= on_node.reshape(broadcast)
+        label[destination & (label < 0)] = number
+    return np.ascontiguousarray(label.reshape(-1))
 
 
 def check_policy(spec: ControllerSpec, dynamics: ModuleType) -> None:
@@ -190,7 +205,10 @@ def reachable_nodes(
 class Solution:
     """The DP's result: cost-to-go (N,) s, inf where unreachable or a dead end; best control
     index (N,); dead_end (N,) bool: reachable nodes from which no exit that ``known_weight``
-    trusts leads to the destination (none when the spec has no ``known_weight``)."""
+    trusts leads to the destination (none when the spec has no ``known_weight``).
+    destination_index (N,) int64, for a spec with several ``dest`` lines (None otherwise): the
+    line each node's optimal path ends at, -1 where the value is inf
+    (``dp.destination_indices``)."""
 
     value: np.ndarray
     best_control: np.ndarray
@@ -200,6 +218,7 @@ class Solution:
     transition_seconds: float
     iteration_seconds: float
     kernel_load_seconds: float
+    destination_index: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -304,6 +323,21 @@ def load_kernels(
     )
     best_controls(*empty.arrays(), none, np.empty(0), none)
     sweep_order(problem.grid.axis_count, 0, none)
+    if len(problem.spec.destinations) > 1:
+        destination_indices(
+            empty.exit_index,
+            empty.exit_weight,
+            none,
+            none,
+            np.empty(0),
+            none,
+            problem.grid.axis_count,
+            DESTINATION_TOLERANCE,
+            1,
+            none,
+            np.empty((0, 2)),
+            none,
+        )
     return time.perf_counter() - started
 
 
@@ -407,8 +441,26 @@ def solve(
     best_controls(*transitions.arrays(), transitions.row_of, value, best_control)
     iteration_seconds = time.perf_counter() - started - transition_seconds
     dead_end = reachable & (value >= DEAD_END_SECONDS) & bool(problem.spec.known_weight)
+    value = np.where(reachable & ~dead_end, value, np.inf)
+    destination_index = None
+    if len(problem.spec.destinations) > 1:
+        destination_index = np.empty(grid.node_count, dtype=np.int64)
+        destination_indices(
+            transitions.exit_index,
+            transitions.exit_weight,
+            transitions.row_of,
+            best_control,
+            value,
+            problem.destination_label,
+            grid.axis_count,
+            DESTINATION_TOLERANCE,
+            DESTINATION_MAX_SWEEPS,
+            np.empty(grid.node_count, dtype=np.int64),
+            np.empty((grid.node_count, len(problem.spec.destinations))),
+            destination_index,
+        )
     return Solution(
-        np.where(reachable & ~dead_end, value, np.inf),
+        value,
         best_control,
         dead_end,
         iterations,
@@ -416,25 +468,32 @@ def solve(
         transition_seconds,
         iteration_seconds,
         kernel_load_seconds,
+        destination_index,
     )
 
 
 def holding_torques(problem: Problem, dynamics: ModuleType) -> np.ndarray:
     """(D, m) controls, spec units, that hold the figure at rest at each of the D destination
-    nodes (``hold``): with every rate 0, the actuators cancel the generalised forces of gravity,
-    joint stops and contacts, ``-forcing(q, 0, 0)``. SpecError at the ``hold`` line when the
-    figure has no equations of motion (a vehicle), the destination is not at rest, a coordinate
-    without an actuator would need a force, or a torque lies outside its ``torq`` range."""
+    nodes (``hold``; the nodes of every ``dest`` line): with every rate 0, the actuators
+    cancel the generalised forces of gravity, joint stops and contacts, ``-forcing(q, 0, 0)``.
+    SpecError at the ``hold`` line when the figure has no equations of motion (a vehicle), a
+    destination is not at rest, a coordinate without an actuator would need a force, or a
+    torque lies outside its ``torq`` range."""
     spec, grid = problem.spec, problem.grid
     assert spec.hold is not None
     if not hasattr(dynamics, "forcing"):
         raise spec.error(spec.hold, "no 'hold' line: a vehicle is held by braking, not torques")
     n = dynamics.COORDINATE_COUNT
     coordinates = grid.state_slot < n
-    rates_named = {entry.name for entry in spec.destination}
-    for k, name in enumerate(grid.names):
-        if not coordinates[k] and name not in rates_named:
-            raise spec.error(spec.hold, f"a 'dest' that names the rate '{name}' (= 0) for 'hold'")
+    several = len(spec.destinations) > 1
+    for line in spec.destinations:
+        rates_named = {entry.name for entry in line}
+        for k, name in enumerate(grid.names):
+            if not coordinates[k] and name not in rates_named:
+                where = f" (line {line[0].token.line} does not)" if several else ""
+                raise spec.error(
+                    spec.hold, f"a 'dest' that names the rate '{name}' (= 0) for 'hold'{where}"
+                )
     lower = np.array([c.minimum for c in spec.controls])
     upper = np.array([c.maximum for c in spec.controls])
     nodes = np.flatnonzero(problem.is_destination)
@@ -532,6 +591,12 @@ def generate_controller(
         dest=spec.destination_values(),
         figure=spec.figure,
         dead_end=solution.dead_end.reshape(grid.shape) if spec.known_weight else None,
+        destinations=None
+        if solution.destination_index is None
+        else tuple(spec.all_destination_values()),
+        destination_index=None
+        if solution.destination_index is None
+        else solution.destination_index.reshape(grid.shape),
         attrs={
             "spec_sha256": spec.spec_sha256,
             "generation_seconds": generation_seconds,
