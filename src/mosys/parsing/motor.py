@@ -1,5 +1,8 @@
 """The motor program (``.mot``): a procedural function of joint torques over time, as van de
-Panne, Fiume & Vranesic (1990) drive Luxo the lamp through its airborne motions.
+Panne, Fiume & Vranesic (1990) drive Luxo the lamp through its airborne motions. Two kinds: a
+program of ``phase`` lines (servo targets and constant torques held phase after phase), or a
+keyframed program of ``key`` lines (joint targets at times, interpolated smoothly between them:
+the key-framing the paper concatenates with its controllers, section 3).
 
 ::
 
@@ -12,22 +15,41 @@ Panne, Fiume & Vranesic (1990) drive Luxo the lamp through its airborne motions.
     phase 0.30 hip_torque=-2 elbow_torque=1.5 # constant torques, N m
     phase 0.2 hip=0 elbow_torque=0.5          # mixed: hip servoed, elbow a constant torque
 
+    # swing: a keyframed pendulum swing
+    figure link1
+    limit torque=10
+    gains kp=200 kd=15
+    key 0.0 angle=-90                         # at 0 s the target is -90 deg (hanging)
+    key 0.6 angle=-30                         # ... -30 deg at 0.6 s
+    key 1.4 angle=-150
+    key 2.0 angle=-90                         # the program ends at its last key: 2 s
+
 Grammar (one line each; ``#`` comments and blank lines are ignored)::
 
-    figure NAME                     exactly once, before the first phase
-    limit ACTUATOR=N_M ...          at most once, before the first phase; each value > 0
+    figure NAME                     exactly once, before the first phase or key
+    limit ACTUATOR=N_M ...          at most once, before the first phase or key; each value > 0
                                     (default: no cap)
-    gains [kp=KP] [kd=KD]           at most once, before the first phase; at least one of the
-                                    two, each >= 0, N m/rad and N m s/rad (default: 0 and 0)
-    phase SECONDS [NAME=VALUE ...]  at least one; SECONDS > 0. kp= and kd= (>= 0) override the
-                                    gains for this phase; any other NAME is a joint coordinate
-                                    (VALUE: its target angle, degrees) or an actuator (VALUE: a
-                                    constant torque, N m), each NAME once per phase
+    gains [kp=KP] [kd=KD]           at most once, before the first phase or key; at least one
+                                    of the two, each >= 0, N m/rad and N m s/rad (default: 0
+                                    and 0)
+    phase SECONDS [NAME=VALUE ...]  SECONDS > 0. kp= and kd= (>= 0) override the gains for this
+                                    phase; any other NAME is a joint coordinate (VALUE: its
+                                    target angle, degrees) or an actuator (VALUE: a constant
+                                    torque, N m), each NAME once per phase
+    key TIME JOINT=DEGREES ...      TIME in s, finite: the first key's 0, each later one greater
+                                    than the one before; at least one JOINT=DEGREES, each joint
+                                    once per key, and every key names the same joints as the
+                                    first (in any order). kp=/kd= are not allowed on a key.
+
+A program has one or more ``phase`` lines or two or more ``key`` lines, never both.
 
 The phases run one after another from time 0; an actuator that a phase does not mention is limp
-(zero torque) for that phase. The parser does not know the figure, so it keeps each phase's
-settings as written; ``bind_motor_program`` classifies them against the figure's coordinates
-and actuators and lays the program out as arrays for a numeric kernel.
+(zero torque) for that phase. A keyframed program lasts until its last key; a joint it names is
+servoed, with the program's gains, towards a C1 cubic through the keys (the rule is
+``animation.motor_program.keyframe_curve``), and an actuator whose joint it does not name is limp
+throughout. The parser does not know the figure, so it keeps each line's settings as written;
+``bind_motor_program`` classifies them against the figure's coordinates and actuators and lays
+the program out as arrays for a numeric kernel.
 """
 
 from __future__ import annotations
@@ -41,11 +63,11 @@ from pathlib import Path
 import numpy as np
 
 from mosys.parsing.tokens import (
+    END_OF_FILE,
     NAME,
     Line,
     SpecError,
     Token,
-    missing_line,
     parse_number,
     read_spec_text,
     record_once,
@@ -54,7 +76,8 @@ from mosys.parsing.tokens import (
     value_token,
 )
 
-KEYWORDS = ("figure", "limit", "gains", "phase")
+KEYWORDS = ("figure", "limit", "gains", "phase", "key")
+BODY = ("phase", "key")  # the lines that make the program; the others go before them
 GAINS = ("kp", "kd")
 DEFAULT_KP = 0.0  # N·m/rad
 DEFAULT_KD = 0.0  # N·m·s/rad
@@ -69,8 +92,8 @@ class Setting:
     """One ``NAME=VALUE`` of a program: on the ``limit`` line, an actuator's torque limit (its
     torque is clipped to ``[-value, value]``, N·m, > 0); on a ``phase`` line (other than
     ``kp=``/``kd=``), a joint coordinate's target angle (degrees) or an actuator's constant torque
-    (N·m), which of the two being settled by ``bind_motor_program``. ``token`` is the whole
-    ``name=value`` token."""
+    (N·m), which of the two being settled by ``bind_motor_program``; on a ``key`` line, a joint
+    coordinate's target angle (degrees). ``token`` is the whole ``name=value`` token."""
 
     name: str
     value: float
@@ -102,13 +125,26 @@ class Phase:
 
 
 @dataclass(frozen=True)
+class Key:
+    """One ``key`` line: at ``time`` (s from the program's start, >= 0) the named joints' target
+    angles ``settings`` (degrees, file order). ``token`` is the keyword; ``time_token`` the
+    time."""
+
+    time: float
+    settings: tuple[Setting, ...]
+    token: Token
+    time_token: Token
+
+
+@dataclass(frozen=True)
 class MotorProgram:
     """A parsed ``.mot`` file.
 
     ``figure`` names the figure it drives. ``limits`` (file order) cap actuators' torques, N·m.
     ``kp`` (N·m/rad) and ``kd`` (N·m·s/rad) are the default servo gains (0 unless a ``gains``
-    line sets them). ``phases`` run in file order from time 0. ``spec_sha256`` is the hex
-    SHA-256 of the file's bytes.
+    line sets them). ``phases`` run in file order from time 0. ``keys`` (time order) are a
+    keyframed program's keyframes; a program has phases or keys, the other being empty.
+    ``spec_sha256`` is the hex SHA-256 of the file's bytes.
     """
 
     path: str
@@ -119,6 +155,12 @@ class MotorProgram:
     kd: float
     phases: tuple[Phase, ...]
     spec_sha256: str
+    keys: tuple[Key, ...] = ()
+
+    @property
+    def keyframed(self) -> bool:
+        """Whether the program is keyframed (``key`` lines) rather than phased."""
+        return bool(self.keys)
 
     @property
     def name(self) -> str:
@@ -126,7 +168,9 @@ class MotorProgram:
         return Path(self.path).stem
 
     def duration(self) -> float:
-        """Total time of all phases, s."""
+        """The program's length, s: the total time of its phases, or its last key's time."""
+        if self.keys:
+            return self.keys[-1].time
         return sum(phase.seconds for phase in self.phases)
 
     def error(self, token: Token, expected: str) -> SpecError:
@@ -147,6 +191,12 @@ class BoundProgram:
     (else the program's). ``limit``: (A,) float64, the torque cap, N·m (inf: none).
     ``coordinate``: (A,) int64, the index of each actuator's coordinate among the figure's.
     ``actuator_names``: (A,) the actuators' names.
+
+    A keyframed program (K keys) has ``key_times``: (K,) float64, s, increasing from 0, and its
+    rows are keys, not phases: ``mode``, ``value``, ``kp``, ``kd`` are (K, A), ``value`` the
+    key's target angle (rad) where ``mode`` is ``SERVO`` (the same actuators in every row; the
+    others ``LIMP``), and ``durations`` (K - 1,) the intervals between keys. ``key_times`` is
+    None for a phase program.
     """
 
     durations: np.ndarray
@@ -157,6 +207,18 @@ class BoundProgram:
     limit: np.ndarray
     coordinate: np.ndarray
     actuator_names: tuple[str, ...]
+    key_times: np.ndarray | None = None
+
+    @property
+    def keyframed(self) -> bool:
+        """Whether the rows are keys (``key_times`` given) rather than phases."""
+        return self.key_times is not None
+
+    def duration(self) -> float:
+        """The program's length, s: its phases' total, or its last key's time."""
+        if self.key_times is not None:
+            return float(self.key_times[-1])
+        return float(self.durations.sum())
 
 
 def parse_motor_program(path: str | Path) -> MotorProgram:
@@ -182,6 +244,7 @@ class _Parser:
         self.limits: tuple[Setting, ...] = ()
         self.gains: dict[str, float] = {}
         self.phases: list[Phase] = []
+        self.keys: list[Key] = []
         self.first_line: dict[str, int] = {}  # once-only keyword -> its line number
         self.total = 0.0  # s, the phases so far
 
@@ -193,24 +256,43 @@ class _Parser:
             keyword = line.keyword
             if keyword.text not in KEYWORDS:
                 raise unknown_keyword(line, KEYWORDS)
-            if keyword.text == "phase":
+            body = self.body()
+            if keyword.text in BODY:
                 if self.figure is None:
                     raise self.error(
-                        keyword, "a 'figure' line before the first 'phase'", keyword.text
+                        keyword, f"a 'figure' line before the first '{keyword.text}'", keyword.text
+                    )
+                if body is not None and body.text != keyword.text:
+                    raise self.error(
+                        keyword,
+                        f"a '{body.text}' line (a program has 'phase' lines or 'key' lines, "
+                        f"not both; the first '{body.text}' is line {body.line})",
+                        keyword.text,
                     )
             else:
                 record_once(line, self.first_line)
-                if self.phases:
+                if body is not None:
                     raise self.error(
                         keyword,
-                        f"a 'phase' line ('{keyword.text}' goes before the first 'phase', "
-                        f"line {self.phases[0].token.line})",
+                        f"a '{body.text}' line ('{keyword.text}' goes before the first "
+                        f"'{body.text}', line {body.line})",
                         keyword.text,
                     )
             getattr(self, f"line_{keyword.text}")(line)
-        if not self.phases:
-            raise missing_line(self.path, lines, "figure" if self.figure is None else "phase")
-        assert self.figure is not None
+        last = lines[-1].number + 1 if lines else 1
+        if self.figure is None:
+            raise SpecError(self.path, last, 1, "a 'figure' line", END_OF_FILE)
+        if not self.phases and not self.keys:
+            raise SpecError(self.path, last, 1, "a 'phase' or 'key' line", END_OF_FILE)
+        if len(self.keys) == 1:
+            raise SpecError(
+                self.path,
+                last,
+                1,
+                f"a second 'key' line (a keyframed program needs 2 or more; the first is line "
+                f"{self.keys[0].token.line})",
+                END_OF_FILE,
+            )
         return MotorProgram(
             path=self.path,
             figure=self.figure.text,
@@ -220,7 +302,16 @@ class _Parser:
             kd=self.gains.get("kd", DEFAULT_KD),
             phases=tuple(self.phases),
             spec_sha256=spec_sha256,
+            keys=tuple(self.keys),
         )
+
+    def body(self) -> Token | None:
+        """The keyword of the program's first 'phase' or 'key' line, None before it."""
+        if self.phases:
+            return self.phases[0].token
+        if self.keys:
+            return self.keys[0].token
+        return None
 
     def assignment(self, token: Token, expected: str) -> tuple[str, Token]:
         """A ``name=value`` token: the name and the value part (its own column)."""
@@ -309,6 +400,65 @@ class _Parser:
             )
         )
 
+    def line_key(self, line: Line) -> None:
+        reader = line.reader()
+        time_token = reader.peek()
+        time = reader.number("the key time")
+        assert time_token is not None
+        if time < 0:
+            raise self.error(time_token, "a number >= 0 for the key time", time_token.text)
+        if not self.keys and time != 0:
+            raise self.error(
+                time_token,
+                "0 for the first key's time (a keyframed program starts at its first key)",
+                time_token.text,
+            )
+        if self.keys and not time > self.keys[-1].time:
+            previous = self.keys[-1]
+            raise self.error(
+                time_token,
+                f"a time after {previous.time_token.text} s, the previous key's (line "
+                f"{previous.token.line}; keyframes out of order)",
+                time_token.text,
+            )
+        expected = "a joint target 'joint=degrees'"
+        settings: dict[str, Setting] = {}
+        for token in reader.remaining():
+            name, part = self.assignment(token, expected)
+            if name in GAINS:
+                raise self.error(
+                    token, f"{expected} (gains go on the 'gains' line, not on keys)", token.text
+                )
+            if name in settings:
+                raise self.error(token, f"'{name}=' only once", token.text)
+            if self.keys and name not in {setting.name for setting in self.keys[0].settings}:
+                raise self.error(
+                    token,
+                    f"a joint the first key names (line {self.keys[0].token.line}: "
+                    f"{_quoted(setting.name for setting in self.keys[0].settings)})",
+                    token.text,
+                )
+            settings[name] = Setting(name, parse_number(part, self.path, name), token)
+        if not settings:
+            raise SpecError(self.path, line.number, line.end_column, expected, None)
+        if self.keys:
+            for setting in self.keys[0].settings:
+                if setting.name not in settings:
+                    raise SpecError(
+                        self.path,
+                        line.number,
+                        line.end_column,
+                        f"a target for '{setting.name}' (every key names the joints of the "
+                        f"first, line {self.keys[0].token.line})",
+                        None,
+                    )
+        self.keys.append(Key(time, tuple(settings.values()), line.keyword, time_token))
+
+
+def _quoted(names) -> str:
+    """``'a', 'b'`` for an error message."""
+    return ", ".join(f"'{name}'" for name in names)
+
 
 def render_motor_program(program: MotorProgram) -> str:
     """The ``.mot`` text of ``program`` (parsing it gives back the same values). ``limit`` and
@@ -333,6 +483,10 @@ def render_motor_program(program: MotorProgram) -> str:
             if gain is not None
         ]
         lines.append(" ".join(words))
+    for key in program.keys:
+        words = [f"key {number(key.time)}"]
+        words += [f"{setting.name}={number(setting.value)}" for setting in key.settings]
+        lines.append(" ".join(words))
     return "\n".join(lines) + "\n"
 
 
@@ -348,13 +502,14 @@ def bind_motor_program(
     coordinate_names: Sequence[str],
     actuator_names: Sequence[str],
 ) -> BoundProgram:
-    """Classify each phase setting against a figure and lay the program out as arrays.
+    """Classify each phase (or key) setting against a figure and lay the program out as arrays.
 
     ``coordinate_names``: (n,) the figure's coordinates (``Figure.q_names``);
     ``actuator_names``: (n,) aligned with them, the actuator of each, ``""`` where unactuated
     (``Figure.tau_names``). Luxo: ``('x', 'y', 'base', 'hip', 'elbow')`` and
     ``('', '', '', 'hip_torque', 'elbow_torque')``. A setting named after an actuated coordinate
-    servos it (target degrees -> radians); one named after an actuator sets a constant torque.
+    servos it (target degrees -> radians); one named after an actuator sets a constant torque
+    (on a phase; a key sets joint targets only).
 
     A setting or ``limit`` naming nothing the figure can drive, a phase that drives one actuator
     twice (its joint's target and its torque), and a servo with kp = kd = 0 raise SpecError at
@@ -383,6 +538,9 @@ def bind_motor_program(
                 entry.name_token, f"an actuator of figure '{figure}' ({_choices(names)})"
             )
         limit[actuators[entry.name]] = entry.value
+    coordinate = np.array(actuated, dtype=np.int64)
+    if program.keys:
+        return _bind_keys(program, names, joints, unactuated, limit, coordinate)
 
     shape = (len(program.phases), len(names))
     mode = np.full(shape, LIMP, dtype=np.int64)
@@ -432,6 +590,54 @@ def bind_motor_program(
         kp=kp,
         kd=kd,
         limit=limit,
-        coordinate=np.array(actuated, dtype=np.int64),
+        coordinate=coordinate,
         actuator_names=names,
+    )
+
+
+def _bind_keys(
+    program: MotorProgram,
+    names: tuple[str, ...],
+    joints: dict[str, int],
+    unactuated: set[str],
+    limit: np.ndarray,
+    coordinate: np.ndarray,
+) -> BoundProgram:
+    """``bind_motor_program`` for a keyframed program: ``names`` (A,) the actuators, ``joints``
+    each actuated coordinate's actuator index, ``unactuated`` the other coordinates; ``limit``
+    and ``coordinate`` (A,) already bound."""
+    figure = program.figure
+    servoable = _choices(list(joints))
+    shape = (len(program.keys), len(names))
+    mode = np.full(shape, LIMP, dtype=np.int64)
+    value = np.zeros(shape)
+    for k, key in enumerate(program.keys):
+        for setting in key.settings:
+            if setting.name not in joints:
+                if setting.name in names:
+                    why = f"a key sets joint targets, not torques; {servoable}"
+                elif setting.name in unactuated:
+                    why = f"coordinate '{setting.name}' has no actuator; {servoable}"
+                else:
+                    why = servoable
+                kind = "an actuated joint angle" if setting.name in unactuated else "a joint angle"
+                raise program.error(setting.name_token, f"{kind} of figure '{figure}' ({why})")
+            if program.kp == 0 and program.kd == 0:
+                raise program.error(
+                    setting.token,
+                    f"servo gains kp > 0 or kd > 0 to servo '{setting.name}' (set 'gains')",
+                )
+            mode[k, joints[setting.name]] = SERVO
+            value[k, joints[setting.name]] = math.radians(setting.value)
+    times = np.array([key.time for key in program.keys], dtype=np.float64)
+    return BoundProgram(
+        durations=np.diff(times),
+        mode=mode,
+        value=value,
+        kp=np.full(shape, program.kp),
+        kd=np.full(shape, program.kd),
+        limit=limit,
+        coordinate=coordinate,
+        actuator_names=names,
+        key_times=times,
     )
