@@ -254,6 +254,10 @@ TOP_LEVEL_HELP = (
     "plots (mosys plot KIND):\n"
     "  plot controller    a controller's portrait and torque map\n"
     "  plot script        a script's path (Figure 16 style) and its GIF\n"
+    "  plot controls      a control against time in several scripts, with slew\n"
+    "                     limits\n"
+    "  plot free-swing    Figure 5: free-swing orbits and separatrix of a 1-joint\n"
+    "                     figure\n"
     "  plot car           car frames (Figure 19 style), a GIF, the success map\n"
     "  plot luxo          Luxo: a motion's strip (Figure 22), forces, a GIF\n"
     "  plot bsr           a BSR search: learning curves, filmstrip, GIF\n"
@@ -306,6 +310,8 @@ VERBS = [
     "edit",
     "plot controller",
     "plot script",
+    "plot controls",
+    "plot free-swing",
     "plot car",
     "plot luxo",
     "plot bsr",

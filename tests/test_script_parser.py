@@ -203,7 +203,7 @@ ERRORS = [
     (
         BASE + "simulate 0.4\n",
         "x.anim:4:1: expected one of 'object', 'state', 'swapcon', 'sim', 'motor', 'when', "
-        "found 'simulate'",
+        "'slew', found 'simulate'",
     ),
     ("", "x.anim:1:1: expected a 'state' line, found end of file"),
     ("# nothing\n\n", "x.anim:1:1: expected a 'state' line, found end of file"),

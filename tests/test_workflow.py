@@ -21,7 +21,7 @@ from mosys.io.controller_table import read_controller_table
 from mosys.io.start_grid import NO_WAY, NOT_FREE, read_start_grid
 
 ROOT = Path(__file__).resolve().parents[1]
-PENDULUM_CONTROLLERS = "ABCDEF"
+PENDULUM_CONTROLLERS = "ABCDEFG"
 
 
 def copy_workflow(work: Path) -> Path:
@@ -98,6 +98,17 @@ def test_pendulum_all_lists_every_output(workflow):
         "results/plots/pendulum/pendulum.gif",
         "results/plots/pendulum/pendulum_path.png",
         "results/tables/pendulum_controllers.md",
+        "results/plots/pendulum/slew_torque.png",
+        "results/plots/pendulum/free_swing.png",
+        *(
+            path
+            for script in ("pendulum_slew", "pendulum_catch", "pendulum_swing")
+            for path in (
+                f"results/trajectories/{script}.h5",
+                f"results/plots/pendulum/{script}_path.png",
+                f"results/plots/pendulum/{script}.gif",
+            )
+        ),
     ):
         assert path in index
     for path in index:
@@ -125,9 +136,16 @@ def test_editing_one_controller_rebuilds_only_its_dependents(workflow):
         "results/controllers/pendulum/B.h5",
         "results/plots/pendulum/B_portrait.png",
         "results/plots/pendulum/B_torque.png",
-        "results/trajectories/pendulum.h5",  # the script uses B
-        "results/plots/pendulum/pendulum_path.png",
-        "results/plots/pendulum/pendulum.gif",
+        *(  # every pendulum script uses B
+            path
+            for script in ("pendulum", "pendulum_slew", "pendulum_catch", "pendulum_swing")
+            for path in (
+                f"results/trajectories/{script}.h5",
+                f"results/plots/pendulum/{script}_path.png",
+                f"results/plots/pendulum/{script}.gif",
+            )
+        ),
+        "results/plots/pendulum/slew_torque.png",
         "results/tables/pendulum_controllers.csv",
         "results/tables/pendulum_controllers.md",
         "results/pendulum_all",
@@ -136,7 +154,48 @@ def test_editing_one_controller_rebuilds_only_its_dependents(workflow):
 
 
 @pytest.mark.slow
-def test_editing_the_figure_rebuilds_all_six_controllers(workflow):
+@pytest.mark.parametrize(
+    ("spec", "edit", "rebuilt"),
+    [
+        (
+            "specs/scripts/pendulum_catch.anim",
+            ("angle>75 angle<105", "angle>70 angle<110"),
+            {"run_script": 1, "script_plots": 1, "pendulum_all": 1},
+        ),
+        (
+            "specs/motor/link1/swing.mot",
+            ("key 0.6 angle=-30", "key 0.6 angle=-40"),
+            {"run_script": 1, "script_plots": 1, "pendulum_all": 1},
+        ),
+        (
+            "specs/scripts/pendulum_slew.anim",
+            ("torque=100", "torque=120"),
+            {"run_script": 1, "script_plots": 1, "compared_controls": 1, "pendulum_all": 1},
+        ),
+        (
+            "specs/controllers/pendulum/G.ssc",
+            ("dest angle=-90 omega=0", "dest angle=-100 omega=0"),
+            {"dp_controller": 1, "controller_plots": 1, "pendulum_table": 1, "pendulum_all": 1},
+        ),
+    ],
+)
+def test_editing_a_new_pendulum_spec_reruns_only_its_chain(workflow, spec, edit, rebuilt):
+    """The slew, breakpoint and keyframe scripts, the keyframed program and the two-destination
+    controller each rerun only what is made from them (a dry run: the edit is undone)."""
+    path = workflow / spec
+    text = path.read_text()
+    assert edit[0] in text
+    try:
+        path.write_text(text.replace(edit[0], edit[1]))
+        assert planned_jobs(workflow) == rebuilt
+    finally:
+        path.write_text(text)
+        os.utime(path, ns=(0, 0))  # older than every output again
+    assert planned_jobs(workflow) == {}
+
+
+@pytest.mark.slow
+def test_editing_the_figure_rebuilds_every_controller(workflow):
     figure = workflow / "specs/figures/link1.fig"
     figure.write_text(figure.read_text() + "\n# an edit\n")
     jobs = planned_jobs(workflow)

@@ -221,7 +221,7 @@ def script_figure(script):
 def script_group(script):
     """The controller directory a script draws on: the configured one for the pendulum script,
     the car's scripts and every script of Luxo's figure, else the script's own name."""
-    if script == config["pendulum"]["script"]:
+    if script == config["pendulum"]["script"] or script in config["pendulum"]["scripts"]:
         return config["pendulum"]["group"]
     if script in config["car"]["scripts"]:
         return config["car"]["group"]
@@ -245,10 +245,11 @@ def script_inputs(wildcards):
     'object' and 'motor' lines)."""
     script = f"specs/scripts/{wildcards.script}.anim"
     group = script_group(wildcards.script)
-    words = spec_words(script, "swapcon")
-    for line in spec_words(script, "when"):
-        words += [line[line.index("swapcon"):]] if "swapcon" in line else []
-    names = dict.fromkeys(table_controller(w[-1]) for w in words if len(w) > 1)
+    references = [w[2] for w in spec_words(script, "swapcon") if len(w) > 2]
+    for line in spec_words(script, "when"):  # when OBJECT COND... swapcon TABLE [once]
+        if "swapcon" in line and line.index("swapcon") + 1 < len(line):
+            references.append(line[line.index("swapcon") + 1])
+    names = dict.fromkeys(table_controller(reference) for reference in references)
     tables = [f"results/controllers/{group}/{name}.h5" for name in names
               if re.fullmatch(r"\w+", name)]
     figures = set()
@@ -279,7 +280,12 @@ def pendulum_targets():
         + [f"results/trajectories/{script}.h5"]
         + [f"results/plots/{group}/{name}_portrait.png" for name in names]
         + [f"results/plots/{group}/{name}_torque.png" for name in names]
-        + [f"results/plots/{group}/{script}_path.png", f"results/plots/{group}/{script}.gif"]
+        + [f"results/trajectories/{name}.h5" for name in config["pendulum"]["scripts"]]
+        + [f"results/plots/{group}/{name}_path.png"
+           for name in [script] + config["pendulum"]["scripts"]]
+        + [f"results/plots/{group}/{name}.gif"
+           for name in [script] + config["pendulum"]["scripts"]]
+        + [f"results/plots/{group}/slew_torque.png", f"results/plots/{group}/free_swing.png"]
         + paper_table_targets()
     )
 

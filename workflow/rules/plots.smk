@@ -35,3 +35,37 @@ rule script_plots:
         "NUMBA_NUM_THREADS={threads} mosys plot script {input.trajectory} {input.tables}"
         " --path {output.path}"
         " --gif {output.gif} 2> {log} || (cat {log} >&2; exit 1)"
+
+
+rule compared_controls:
+    input:
+        trajectories=lambda wildcards: [
+            f"results/trajectories/{name}.h5" for name in config["pendulum"]["compare_controls"]
+        ],
+        code=code_inputs("mosys.cli.plots", "mosys.plots.controls"),  # mosys plot controls
+    output:
+        "results/plots/{group}/slew_torque.png",
+    log:
+        "results/logs/plots/{group}/slew_torque.log",
+    benchmark:
+        "results/benchmarks/plots/{group}/slew_torque.tsv"
+    threads: 1
+    shell:
+        "mosys plot controls {input.trajectories} -o {output} 2> {log}"
+        " || (cat {log} >&2; exit 1)"
+
+
+rule free_swing:
+    input:
+        dynamics=lambda wildcards: f"results/dynamics/{config['pendulum']['figure']}.py",
+        code=code_inputs("mosys.cli.plots", "mosys.plots.free_swing"),  # mosys plot free-swing
+    output:
+        "results/plots/{group}/free_swing.png",
+    log:
+        "results/logs/plots/{group}/free_swing.log",
+    benchmark:
+        "results/benchmarks/plots/{group}/free_swing.tsv"
+    threads: 1
+    shell:
+        "NUMBA_NUM_THREADS={threads} mosys plot free-swing --dynamics {input.dynamics} -o {output}"
+        " 2> {log} || (cat {log} >&2; exit 1)"

@@ -5,13 +5,21 @@ motor programs it names → one motion.
 before any ``swapcon``, of the script's first controller); figure state variables that order
 leaves out start at 0. ``swapcon`` switches controller at once; ``sim`` runs the active
 controller for that many seconds in whole steps of ``dt`` (with ``until=dest``, it stops at the
-first step in the controller's arrival box, ``Controller.arrival_box``); during a ``sim``, the
+first step in an arrival box of the controller's, ``Controller.arrival_boxes``: one per
+destination); during a ``sim``, the
 first breakpoint (``when``) whose box holds the state drives instead, switching as the state
-crosses box borders. ``motor`` runs a motor program to its end from the current state.
+crosses box borders; a ``once`` breakpoint instead hands over for good the first time its box
+holds the state. ``motor`` runs a motor program to its end from the current state. ``slew``
+limits how fast each named control changes from then on (the 1990 paper's §5), across every
+exchange, from the controls of the step before (0 at the script's start). Whenever a controller
+takes over, the state is checked against its domain (Figure 7); each violation is recorded and
+warned of on stderr.
 """
 
 from __future__ import annotations
 
+import math
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
@@ -25,6 +33,7 @@ from mosys.parsing.script import (
     RunMotorProgram,
     SetState,
     Simulate,
+    SlewLimit,
     SwapController,
 )
 from mosys.ssc.controller import Controller
@@ -36,12 +45,36 @@ if TYPE_CHECKING:  # motor programs are imported when a script runs one
 
 
 @dataclass(frozen=True)
+class DomainViolation:
+    """A controller took over at time ``t`` (s) outside its domain (``reason``), by the script's
+    line ``line`` (a ``swapcon`` or ``when``)."""
+
+    t: float
+    controller: str
+    line: int
+    reason: str
+
+
+@dataclass(frozen=True)
+class ScriptBreakpoint:
+    """A ``when`` line as run: its box (spec units), controller, ``once`` and line."""
+
+    box: Bounds
+    controller: str
+    once: bool
+    line: int
+
+
+@dataclass(frozen=True)
 class ScriptRun:
     """A script's motion. t: (N,) s; figure_states: (N, S) SI; state: (N, d) in ``state_order``,
     spec units; control: (N, m) in ``control_names``, spec units; source: (N,) int64 index
     into ``sources`` (the controller or motor program driving each step); outside: (N,) bool,
     the state lay outside the active controller's domain; switches: (t, source name) at each
     change of what drives the figure. ``source_kinds`` says 'controller' or 'motor' per source.
+    domain_violations: each controller exchange outside the new controller's domain;
+    breakpoints: the script's ``when`` lines; slew: the slew limits in force at the end, spec
+    units per second, by control (only finite ones).
 
     The state order is the controllers' common one when the script runs no motor program and
     every controller shares it (the pendulum: omega, angle); otherwise every state variable of
@@ -58,6 +91,9 @@ class ScriptRun:
     state_order: tuple[str, ...]
     control_names: tuple[str, ...]
     switches: tuple[tuple[float, str], ...]
+    domain_violations: tuple[DomainViolation, ...] = ()
+    breakpoints: tuple[ScriptBreakpoint, ...] = ()
+    slew: dict[str, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -123,9 +159,11 @@ def load_programs(
 
 
 class _Recorder:
-    """Accumulates the stretches of a run, and what drove each step."""
+    """Accumulates the stretches of a run, what drove each step, and the controls of the step
+    before (``held``: (I,) SI on the model's input slots, 0 before the first step), from which
+    a slew limit starts."""
 
-    def __init__(self, sources: tuple[str, ...]):
+    def __init__(self, sources: tuple[str, ...], input_size: int):
         self.sources = sources
         self.clock = 0.0
         self.t: list[np.ndarray] = []
@@ -134,12 +172,17 @@ class _Recorder:
         self.source: list[np.ndarray] = []
         self.outside: list[np.ndarray] = []
         self.switches: list[tuple[float, str]] = []
+        self.violations: list[DomainViolation] = []
         self.driver: str | None = None
+        self.held = np.zeros(input_size)
 
-    def drive(self, name: str) -> None:
-        if name != self.driver:
-            self.switches.append((self.clock, name))
-            self.driver = name
+    def drive(self, name: str) -> bool:
+        """``name`` drives from now on; True when that is a change."""
+        if name == self.driver:
+            return False
+        self.switches.append((self.clock, name))
+        self.driver = name
+        return True
 
     def add(self, states: np.ndarray, inputs: np.ndarray, outside: np.ndarray, dt: float) -> None:
         """A stretch: states (steps+1, S), the first its start; inputs (steps, I) SI on the
@@ -151,6 +194,21 @@ class _Recorder:
         self.source.append(np.full(steps, self.sources.index(self.driver), dtype=np.int64))
         self.outside.append(outside)
         self.clock += steps * dt
+        if steps:
+            self.held = inputs[-1].copy()
+
+
+@dataclass
+class _Exchange:
+    """What decides which controller drives during a ``sim``: the last ``swapcon`` (``active``,
+    and the line that made it, ``line``), the breakpoints so far (box, controller, the ``when``
+    command; spent ``once`` breakpoints removed), and the slew limits, spec units per second,
+    per actuator (inf: none)."""
+
+    active: Controller | None
+    line: int
+    breakpoints: list[tuple[Bounds, Breakpoint]]
+    slew_rate: np.ndarray
 
 
 def run_script(script: AnimationScript, sources: ScriptSources, dt: float) -> ScriptRun:
@@ -158,46 +216,48 @@ def run_script(script: AnimationScript, sources: ScriptSources, dt: float) -> Sc
     dynamics = sources.dynamics
     names = tuple(sources.controllers) + tuple(sources.programs)
     kinds = ("controller",) * len(sources.controllers) + ("motor",) * len(sources.programs)
-    recorder = _Recorder(names)
     input_size = len(dynamics.INPUT_NAMES)
+    recorder = _Recorder(names, input_size)
     pending: SetState | None = None
     figure_state: np.ndarray | None = None
-    active: Controller | None = None
-    breakpoints: list[tuple[Bounds, str]] = []
+    exchange = _Exchange(None, 0, [], np.full(input_size, np.inf))
+    slew: dict[str, float] = {}
     for command in script.commands:
         if isinstance(command, SetState):
             pending = command
         elif isinstance(command, SwapController):
-            active = sources.controllers[command.controller]
+            exchange.active = sources.controllers[command.controller]
+            exchange.line = command.token.line
         elif isinstance(command, Breakpoint):
             try:
-                breakpoints.append((_checked_box(dynamics, command), command.controller))
+                box = _checked_box(dynamics, command)
             except ValueError as error:
                 raise script.error(command.conditions[0].token, str(error)) from None
+            exchange.breakpoints.append((box, command))
+        elif isinstance(command, SlewLimit):
+            _set_slew(script, command, dynamics, exchange.slew_rate, slew)
         elif isinstance(command, RunMotorProgram | Simulate):
             if pending is not None:
-                figure_state = _figure_state(script, pending, active, sources)
+                figure_state = _figure_state(script, pending, exchange.active, sources)
                 pending = None
             assert figure_state is not None  # the parser puts a 'state' first
             if isinstance(command, RunMotorProgram):
-                program = sources.programs[command.program]
-                recorder.drive(command.program)
-                run = program.run(figure_state, dt)
-                inputs = np.zeros((run.controls.shape[0], input_size))
-                inputs[:, program.coordinate] = run.controls
-                recorder.add(run.states, inputs, np.zeros(len(inputs), dtype=bool), dt)
-                figure_state = run.states[-1]
-            else:
-                assert active is not None  # the parser puts a 'swapcon' first
-                figure_state = _simulate(
-                    command, active, breakpoints, sources, figure_state, dt, recorder
+                figure_state = _run_motor_program(
+                    command, sources, exchange, figure_state, dt, recorder
                 )
-    assert figure_state is not None and recorder.driver is not None
+            else:
+                assert exchange.active is not None  # the parser puts a 'swapcon' first
+                figure_state = _simulate(
+                    script, command, exchange, sources, figure_state, dt, recorder
+                )
+    assert figure_state is not None
+    if recorder.driver is None:  # every 'sim' ended at once: the figure was at the destination
+        assert exchange.active is not None
+        recorder.drive(exchange.active.name)
     # the final state, with the input of the last step held
-    last_inputs = (
-        recorder.inputs[-1][-1:] if recorder.inputs[-1].size else np.zeros((1, input_size))
+    recorder.add(
+        np.stack([figure_state, figure_state]), recorder.held[None, :], np.zeros(1, bool), 0.0
     )
-    recorder.add(np.stack([figure_state, figure_state]), last_inputs, np.zeros(1, bool), 0.0)
     figure_states = np.concatenate(recorder.states)
     inputs = np.concatenate(recorder.inputs)
     state_order, state = _state_columns(sources, figure_states)
@@ -214,7 +274,61 @@ def run_script(script: AnimationScript, sources: ScriptSources, dt: float) -> Sc
         state_order=state_order,
         control_names=control_names,
         switches=tuple(recorder.switches),
+        domain_violations=tuple(recorder.violations),
+        breakpoints=tuple(
+            ScriptBreakpoint(command.box(), command.controller, command.once, command.token.line)
+            for command in script.commands
+            if isinstance(command, Breakpoint)
+        ),
+        slew={name: rate for name, rate in slew.items() if math.isfinite(rate)},
     )
+
+
+def _set_slew(
+    script: AnimationScript,
+    command: SlewLimit,
+    dynamics: ModuleType,
+    slew_rate: np.ndarray,
+    slew: dict[str, float],
+) -> None:
+    """Apply a ``slew`` line: ``slew_rate`` (I,) per input slot and ``slew`` (name -> rate),
+    spec units per second, in place; SpecError at a name that is not an actuator."""
+    actuators = tuple(dynamics.INPUT_NAMES)
+    for (name, rate), token in zip(command.rates, command.name_tokens, strict=True):
+        if not name or name not in actuators:
+            known = ", ".join(a for a in actuators if a)
+            raise script.error(token, f"a control of the object's figure (one of {known})")
+        slew_rate[actuators.index(name)] = rate
+        slew[name] = rate
+
+
+def _run_motor_program(
+    command: RunMotorProgram,
+    sources: ScriptSources,
+    exchange: _Exchange,
+    figure_state: np.ndarray,
+    dt: float,
+    recorder: _Recorder,
+) -> np.ndarray:
+    """One ``motor`` line: the program to its end, slew-limited from the controls before it."""
+    program = sources.programs[command.program]
+    recorder.drive(command.program)
+    scale = np.array(
+        [
+            control_scale(sources.dynamics, sources.dynamics.INPUT_NAMES[c])
+            for c in program.coordinate
+        ]
+    )
+    run = program.run(
+        figure_state,
+        dt,
+        slew_rate=exchange.slew_rate[program.coordinate] * scale,
+        previous=recorder.held[program.coordinate],
+    )
+    inputs = np.zeros((run.controls.shape[0], len(recorder.held)))
+    inputs[:, program.coordinate] = run.controls
+    recorder.add(run.states, inputs, np.zeros(len(inputs), dtype=bool), dt)
+    return run.states[-1]
 
 
 def _checked_box(dynamics: ModuleType, command: Breakpoint) -> Bounds:
@@ -230,38 +344,86 @@ def _checked_box(dynamics: ModuleType, command: Breakpoint) -> Bounds:
 
 
 def _simulate(
+    script: AnimationScript,
     command: Simulate,
-    active: Controller,
-    breakpoints: list[tuple[Bounds, str]],
+    exchange: _Exchange,
     sources: ScriptSources,
     figure_state: np.ndarray,
     dt: float,
     recorder: _Recorder,
 ) -> np.ndarray:
     """One ``sim``: the active controller, or a breakpoint's where its box holds the state, in
-    stretches that end where the state crosses a box border; stops early in the arrival box."""
-    boxes = [box for box, _ in breakpoints]
-    if command.until_dest:
-        boxes.append(active.arrival_box())
-    boxes_si = regions(sources.dynamics, boxes)
+    stretches that end where the state crosses a box border; stops early in the arrival box.
+    A ``once`` breakpoint whose box holds the state makes its controller the active one and is
+    spent. Each change of controller is checked against the new one's domain."""
     remaining = int(round(command.seconds / dt))
     while remaining > 0:
+        boxes = [box for box, _ in exchange.breakpoints]
+        breakpoints = len(boxes)
+        if command.until_dest:  # back at any of the active controller's destinations
+            boxes += exchange.active.arrival_boxes()
+        boxes_si = regions(sources.dynamics, boxes)
         inside = boxes_si.membership(figure_state)
-        if command.until_dest and inside[-1]:
+        if inside[breakpoints:].any():
             break
-        driver = active
-        for k, (_, name) in enumerate(breakpoints):
+        fired = next(
+            (k for k, (_, when) in enumerate(exchange.breakpoints) if when.once and inside[k]),
+            None,
+        )
+        if fired is not None:  # the state hands over: a swapcon made by the state
+            when = exchange.breakpoints.pop(fired)[1]
+            exchange.active = sources.controllers[when.controller]
+            exchange.line = when.token.line
+            continue
+        driver, line = exchange.active, exchange.line
+        for k, (_, when) in enumerate(exchange.breakpoints):
             if inside[k]:
-                driver = sources.controllers[name]
+                driver, line = sources.controllers[when.controller], when.token.line
                 break
-        recorder.drive(driver.name)
-        run = driver.simulate(figure_state, remaining * dt, dt, boxes_si)
-        inputs = np.zeros((run.controls.shape[0], len(sources.dynamics.INPUT_NAMES)))
-        inputs[:, driver.control_slot] = run.controls * driver.control_scale
+        if recorder.drive(driver.name):
+            _check_domain(script, driver, line, figure_state, recorder)
+        slots = driver.control_slot
+        try:
+            run = driver.simulate(
+                figure_state,
+                remaining * dt,
+                dt,
+                boxes_si,
+                slew_rate=exchange.slew_rate[slots],
+                previous=recorder.held[slots] / driver.control_scale,
+            )
+        except ValueError as error:  # a slew limit on a lookahead controller
+            raise script.error(command.token, f"a run the controller can make ({error})") from None
+        inputs = np.zeros((run.controls.shape[0], len(recorder.held)))
+        inputs[:, slots] = run.controls * driver.control_scale
         recorder.add(run.states, inputs, run.outside, dt)
         figure_state = run.states[-1]
         remaining -= run.controls.shape[0]
     return figure_state
+
+
+def _check_domain(
+    script: AnimationScript,
+    controller: Controller,
+    line: int,
+    figure_state: np.ndarray,
+    recorder: _Recorder,
+) -> None:
+    """Record, and warn on stderr, when ``controller`` takes over outside its domain."""
+    reason = controller.domain_violation(figure_state)
+    if reason is None:
+        return
+    state = controller.controller_states(figure_state[None, :])[0]
+    described = ", ".join(
+        f"{name}={value:.6g}" for name, value in zip(controller.state_order, state, strict=True)
+    )
+    violation = DomainViolation(recorder.clock, controller.name, line, reason)
+    recorder.violations.append(violation)
+    print(
+        f"warning: {script.path}:{line}: at t={recorder.clock:.6g} s controller "
+        f"{controller.name} takes over at ({described}), {reason}: outside its domain",
+        file=sys.stderr,
+    )
 
 
 def _figure_state(

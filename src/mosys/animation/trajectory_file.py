@@ -3,6 +3,7 @@ that is more than a single call)."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 from mosys import __version__
@@ -79,6 +80,20 @@ def run_animation_script(
             "switch_times": [time for time, _ in run.switches],
             "switch_controllers": [name for _, name in run.switches],
             "samples_outside_domain": int(run.outside.sum()),
+            "domain_violation_times": [v.t for v in run.domain_violations],
+            "domain_violation_controllers": [v.controller for v in run.domain_violations],
+            "breakpoints": json.dumps(
+                [
+                    {
+                        "box": {name: list(bounds) for name, bounds in b.box.items()},
+                        "controller": b.controller,
+                        "once": b.once,
+                        "line": b.line,
+                    }
+                    for b in run.breakpoints
+                ]
+            ),
+            "slew": json.dumps(run.slew or {}),
             "simulated_seconds": float(run.t[-1] - run.t[0]),
             "mosys_version": __version__,
             **extra,

@@ -55,6 +55,30 @@ def _script(args: argparse.Namespace) -> None:
         write_script_gif(args.trajectory, args.gif)
 
 
+def _controls_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("trajectories", nargs="+", help="trajectories (.h5) to compare")
+    parser.add_argument("--control", help="the control drawn (default: the first)")
+    parser.add_argument("-o", "--output", required=True, help="PNG")
+
+
+def _controls(args: argparse.Namespace) -> None:
+    from mosys.plots.controls import plot_controls
+
+    plot_controls(args.trajectories, args.output, args.control)
+
+
+def _free_swing_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--dynamics", required=True, help="generated dynamics of a 1-joint figure")
+    parser.add_argument("-o", "--output", required=True, help="PNG")
+
+
+def _free_swing(args: argparse.Namespace) -> None:
+    from mosys.dynamics.load import load_dynamics
+    from mosys.plots.free_swing import plot_free_swing
+
+    plot_free_swing(load_dynamics(args.dynamics), args.output)
+
+
 def _car_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("trajectories", nargs="*", help="car trajectories (.h5)")
     parser.add_argument("--frames", help="PNG: one panel per trajectory, the car every 0.3 s")
@@ -263,6 +287,18 @@ FAMILY = Family(
             _script_arguments,
             _script,
             _script_check,
+        ),
+        Verb(
+            "plot controls",
+            "a control against time in several scripts, with slew limits",
+            _controls_arguments,
+            _controls,
+        ),
+        Verb(
+            "plot free-swing",
+            "Figure 5: free-swing orbits and separatrix of a 1-joint figure",
+            _free_swing_arguments,
+            _free_swing,
         ),
         Verb(
             "plot car",

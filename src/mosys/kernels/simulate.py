@@ -33,6 +33,8 @@ SIMULATE_SIGNATURE = types.int64(
     FLAGS,  # known
     VECTOR,  # control_min
     VECTOR,  # control_max
+    VECTOR,  # slew_step
+    VECTOR,  # previous (in/out)
     INDICES,  # state_slot
     INDICES,  # control_slot
     types.int64,  # input_size
@@ -89,6 +91,8 @@ def simulate_controlled(
     known,
     control_min,
     control_max,
+    slew_step,
+    previous,
     state_slot,
     control_slot,
     input_size,
@@ -162,7 +166,29 @@ def simulate_controlled(
             inputs[i] = 0.0
         for j in range(m):
             value = min(max(control[j], control_min[j]), control_max[j])
+            value = min(max(value, previous[j] - slew_step[j]), previous[j] + slew_step[j])
+            previous[j] = value
             record_control[step, j] = value
             inputs[control_slot[j]] += value
         rk4_step(derivative_into, state, inputs, dt, scratch)
+    return record_state.shape[0]
+
+
+@njit(cache=True)
+def simulate_unpowered(derivative_into, state, input_size, dt, record_state):
+    """Simulate ``record_state.shape[0] - 1`` RK4 steps of dt seconds with every input 0 (the
+    figure swinging freely). state: (S,) SI, advanced in place; record_state (steps+1, S): the
+    start, then the state after each step. Stops early, returning the rows filled, if the state
+    becomes non-finite."""
+    size = state.shape[0]
+    inputs = np.zeros(input_size)
+    scratch = rk4_scratch(size)
+    for i in range(size):
+        record_state[0, i] = state[i]
+    for step in range(1, record_state.shape[0]):
+        rk4_step(derivative_into, state, inputs, dt, scratch)
+        for i in range(size):
+            if not math.isfinite(state[i]):
+                return step
+            record_state[step, i] = state[i]
     return record_state.shape[0]

@@ -11,6 +11,8 @@ the destination and state-space breakpoints (§3.1, §7).
     sim 3 until=dest         # at most 3 s: stop once back at the controller's destination
     motor luxo hop           # run the motor program 'hop' (a .mot spec of the figure) to its end
     when link angle>-20 angle<20 swapcon conA.ctab   # breakpoint: in this box, A drives
+    when link angle>75 angle<105 swapcon conB.ctab once   # on entering this box, B takes over
+    slew link torque=40      # from here on, the torque changes at most 40 N m per second
 
 A script animates one object. The state order of a controller is the figure's state order
 (coordinates, then rates) restricted to the controller's ``ssd`` dimensions: for the pendulum
@@ -40,7 +42,7 @@ from mosys.parsing.tokens import (
     value_token,
 )
 
-KEYWORDS = ("object", "state", "swapcon", "sim", "motor", "when")
+KEYWORDS = ("object", "state", "swapcon", "sim", "motor", "when", "slew")
 TABLE = re.compile(r"con([A-Za-z_][A-Za-z0-9_]*)\.ctab")  # the paper's table names: conB.ctab
 CONDITION = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)([<>])(.*)")  # a breakpoint's 'name<value'
 
@@ -126,10 +128,12 @@ class Condition:
 
 @dataclass(frozen=True)
 class Breakpoint:
-    """``when OBJECT CONDITION... swapcon TABLE``: a state-space breakpoint (§3.1). From this
-    line on, during every ``sim``, ``controller`` drives the object whenever its state lies in
-    the box the conditions bound (all of them hold); the first breakpoint whose box holds the
-    state wins, and outside every box the last ``swapcon`` drives."""
+    """``when OBJECT CONDITION... swapcon TABLE [once]``: a state-space breakpoint (§3.1). From
+    this line on, during every ``sim``, ``controller`` drives the object whenever its state lies
+    in the box the conditions bound (all of them hold); the first breakpoint whose box holds the
+    state wins, and outside every box the last ``swapcon`` drives. With ``once``, the first time
+    the state lies in the box, ``controller`` takes over for good, as a ``swapcon`` at that
+    moment would, and the breakpoint is spent."""
 
     object: str
     conditions: tuple[Condition, ...]
@@ -138,6 +142,7 @@ class Breakpoint:
     token: Token
     object_token: Token
     table_token: Token
+    once: bool = False
 
     def box(self) -> dict[str, tuple[float, float]]:
         """The conditions as {name: (low, high)}, spec units (±inf where unbounded)."""
@@ -152,7 +157,24 @@ class Breakpoint:
         return box
 
 
-Command = DeclareObject | SetState | SwapController | Simulate | RunMotorProgram | Breakpoint
+@dataclass(frozen=True)
+class SlewLimit:
+    """``slew OBJECT CONTROL=RATE ...``: from this line on, each named control (an actuator of
+    the object's figure) changes by at most ``RATE`` of its unit per second (N m/s for a torque),
+    across controller exchanges and inside controllers and motor programs (the 1990 paper's §5).
+    ``rates`` maps control -> rate (> 0; inf for ``CONTROL=off``, which lifts the limit);
+    ``name_tokens`` the controls' names, for errors found when the figure is known."""
+
+    object: str
+    rates: tuple[tuple[str, float], ...]
+    token: Token
+    object_token: Token
+    name_tokens: tuple[Token, ...]
+
+
+Command = (
+    DeclareObject | SetState | SwapController | Simulate | RunMotorProgram | Breakpoint | SlewLimit
+)
 
 
 @dataclass(frozen=True)
@@ -239,10 +261,13 @@ def parse_script_text(
                 declared = command.object_token
             _same_object(line, command.object_token, declared)
             stated = True
-        elif keyword in ("swapcon", "when", "motor"):
-            command = {"swapcon": _swap_controller, "when": _breakpoint, "motor": _motor}[keyword](
-                line
-            )
+        elif keyword in ("swapcon", "when", "motor", "slew"):
+            command = {
+                "swapcon": _swap_controller,
+                "when": _breakpoint,
+                "motor": _motor,
+                "slew": _slew,
+            }[keyword](line)
             if declared is None:
                 raise SpecError(
                     path,
@@ -397,7 +422,7 @@ def _swap_controller(line: Line) -> SwapController:
 
 
 def _breakpoint(line: Line) -> Breakpoint:
-    """``when OBJECT name<value name>value ... swapcon TABLE``."""
+    """``when OBJECT name<value name>value ... swapcon TABLE [once]``."""
     name = _object(line)
     reader = line.reader()
     reader.word("the object")
@@ -443,10 +468,22 @@ def _breakpoint(line: Line) -> Breakpoint:
             "swapcon",
         )
     table = reader.word("a controller table 'conX.ctab' or a controller name")
-    reader.end()
+    once = reader.peek()
+    if once is not None:
+        if once.text != "once":
+            raise SpecError(line.path, once.line, once.column, "'once' or end of line", once.text)
+        reader.word("'once'")
+        reader.end()
     controller = _table_reference(line, table)
     breakpoint_ = Breakpoint(
-        name.text, tuple(conditions), table.text, controller, line.keyword, name, table
+        name.text,
+        tuple(conditions),
+        table.text,
+        controller,
+        line.keyword,
+        name,
+        table,
+        once is not None,
     )
     for variable, (low, high) in breakpoint_.box().items():
         if not low < high:
@@ -470,6 +507,37 @@ def _motor(line: Line) -> RunMotorProgram:
     reader.end()
     assert program is not None
     return RunMotorProgram(name.text, program.text, line.keyword, name, program)
+
+
+def _slew(line: Line) -> SlewLimit:
+    """``slew OBJECT CONTROL=RATE ...``: at least one pair, each control once, each rate a number
+    > 0 (its unit per second) or ``off``."""
+    name = _object(line)
+    rates: list[tuple[str, float]] = []
+    name_tokens: list[Token] = []
+    for token in line.tokens[2:]:
+        key, sep, _ = token.text.partition("=")
+        if not sep:
+            raise SpecError(line.path, token.line, token.column, "'CONTROL=RATE'", token.text)
+        key_token = Token(key, token.line, token.column)
+        parse_name(key_token, line.path, "a control")
+        if any(key == named for named, _ in rates):
+            raise SpecError(line.path, token.line, token.column, f"'{key}=' only once", token.text)
+        value = value_token(token, key)
+        what = f"a rate > 0 (per second) or 'off' for '{key}'"
+        if not value.text:
+            raise SpecError(line.path, value.line, value.column, what, None)
+        if value.text == "off":
+            rate = math.inf
+        else:
+            rate = parse_number(value, line.path, f"the slew rate of '{key}'")
+            if not rate > 0:
+                raise SpecError(line.path, value.line, value.column, what, value.text)
+        rates.append((key, rate))
+        name_tokens.append(key_token)
+    if not rates:
+        raise SpecError(line.path, line.number, line.end_column, "'CONTROL=RATE'", None)
+    return SlewLimit(name.text, tuple(rates), line.keyword, name, tuple(name_tokens))
 
 
 def _simulate(line: Line) -> Simulate:
@@ -508,7 +576,14 @@ def render_script(script: AnimationScript) -> str:
             lines.append(f"swapcon {command.object} {command.table}")
         elif isinstance(command, Breakpoint):
             bounds = " ".join(f"{c.name}{c.operator}{c.value!r}" for c in command.conditions)
-            lines.append(f"when {command.object} {bounds} swapcon {command.table}")
+            once = " once" if command.once else ""
+            lines.append(f"when {command.object} {bounds} swapcon {command.table}{once}")
+        elif isinstance(command, SlewLimit):
+            rates = " ".join(
+                f"{name}={'off' if math.isinf(rate) else repr(rate)}"
+                for name, rate in command.rates
+            )
+            lines.append(f"slew {command.object} {rates}")
         elif isinstance(command, RunMotorProgram):
             lines.append(f"motor {command.object} {command.program}")
         else:

@@ -1,6 +1,8 @@
 """The pendulum plots of the 1990 paper (§5.2), regenerated: ``mosys plot KIND INPUTS -o OUT``.
 
-- ``portrait``: state-space paths under one controller from a spread of start states (Figure 14).
+- ``portrait``: state-space paths under one controller from a spread of start states (Figure 14);
+  for a table with several destinations, each destination's basin (the nodes whose
+  ``/destination_index`` names it) is tinted behind the paths.
 - ``torque``: a controller's torque table as a heat map, with cost-to-go contours.
 - ``script``: an animation script's path through state space, controller by controller (Figure 16).
 - ``gif``: the pendulum swinging through a script, drawn from the trajectory's ``figure_motion``.
@@ -12,6 +14,7 @@ the same angle, and a path that crosses them leaves at one edge and comes back a
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -22,8 +25,10 @@ import matplotlib
 import numpy as np
 from matplotlib import patheffects
 from matplotlib.axes import Axes
+from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
+from matplotlib.patches import Patch, Rectangle
 from matplotlib.ticker import MultipleLocator
 from matplotlib.transforms import Bbox
 
@@ -53,6 +58,10 @@ from mosys.plots.style import (
 PORTRAIT_STARTS = 8  # start states per portrait
 PORTRAIT_SECONDS = 3.0  # s simulated from each start
 CYCLE_SECONDS = (3.0, 5.0)  # s: a periodic destination's cycle is drawn over this window
+# pale tints of the basins of a table with several destinations, one per destination in order
+# (ColorBrewer's Paired, light members), drawn at BASIN_ALPHA behind the paths
+BASIN_COLORS = ("#a6cee3", "#fdbf6f", "#b2df8a", "#cab2d6", "#fb9a99", "#ffff99")
+BASIN_ALPHA = 0.45
 
 
 @dataclass(frozen=True)
@@ -205,22 +214,29 @@ def describe_state(values: dict[str, float], units: dict[str, str]) -> str:
     )
 
 
-def destination_point(table: ControllerTable, axes: Sequence[StateAxis]) -> list[float | None]:
+def destination_point(
+    table: ControllerTable, axes: Sequence[StateAxis], destination: dict | None = None
+) -> list[float | None]:
     """The destination's coordinate along each plot axis (None: the destination leaves that
-    state variable free), wrapped into the plotted range."""
+    state variable free), wrapped into the plotted range. ``destination``: one of the table's
+    destinations ({name: value}, spec units); None: its ``dest`` (the first)."""
+    destination = table.dest if destination is None else destination
     point: list[float | None] = []
     for axis in axes:
-        value = table.dest.get(axis.name)
+        value = destination.get(axis.name)
         if value is not None and axis.period:
             value = axis.low + (value - axis.low) % axis.period
         point.append(None if value is None else float(value))
     return point
 
 
-def _mark_table_destination(ax: Axes, table: ControllerTable, axes, color=DESTINATION_COLOR):
+def _mark_table_destination(
+    ax: Axes, table: ControllerTable, axes, color=DESTINATION_COLOR, destination=None
+):
     """Mark the destination (a line if it leaves one plotted variable free); returns its legend
-    handle, or None if it names neither plotted variable."""
-    x, y = destination_point(table, axes)
+    handle, or None if it names neither plotted variable. ``destination``: as in
+    ``destination_point``."""
+    x, y = destination_point(table, axes, destination)
     if x is not None and y is not None:
         mark_destination(ax, x, y, color=color)
         return destination_handle(color)
@@ -231,10 +247,56 @@ def _mark_table_destination(ax: Axes, table: ControllerTable, axes, color=DESTIN
     return line
 
 
-def _destination_is_periodic(table: ControllerTable) -> bool:
-    """A destination with a non-zero rate is passed through, not held: a periodic motion."""
+def _destination_is_periodic(table: ControllerTable, destination: dict | None = None) -> bool:
+    """A destination with a non-zero rate is passed through, not held: a periodic motion.
+    ``destination``: as in ``destination_point``."""
+    destination = table.dest if destination is None else destination
     units = dict(zip(table.state_order, table.axis_units, strict=True))
-    return any(units.get(name, "").endswith("/s") and value for name, value in table.dest.items())
+    return any(units.get(name, "").endswith("/s") and value for name, value in destination.items())
+
+
+def _node_edges(grid: np.ndarray, axis: StateAxis) -> np.ndarray:
+    """The edges of the cells centred on the nodes of ``grid`` (n,), halfway between nodes;
+    on a periodic axis one more cell, the first node's a period on, so that the cells cover
+    the plotted period."""
+    step = (grid[-1] - grid[0]) / (len(grid) - 1)
+    count = len(grid) + (1 if axis.period else 0)
+    return grid[0] - step / 2 + step * np.arange(count + 1)
+
+
+def draw_basins(
+    ax: Axes, table: ControllerTable, axes: Sequence[StateAxis], units: dict[str, str]
+) -> list[tuple[Patch, str]]:
+    """Tint each node's cell with its destination's colour (``BASIN_COLORS``, from the
+    table's ``/destination_index``; nodes with -1 stay clear) behind everything else; returns
+    a legend entry per destination, ``basin → θ = 90 deg, ω = 0 deg/s``."""
+    index = np.asarray(table.destination_index)
+    destinations = table.all_destinations
+    colors = [BASIN_COLORS[k % len(BASIN_COLORS)] for k in range(len(destinations))]
+    shown = np.ma.masked_less(index.astype(np.float64), 0.0)
+    if axes[0].period:
+        shown = np.ma.concatenate([shown, shown[:1]], axis=0)
+    if axes[1].period:
+        shown = np.ma.concatenate([shown, shown[:, :1]], axis=1)
+    ax.pcolormesh(
+        _node_edges(table.axes[0], axes[0]),
+        _node_edges(table.axes[1], axes[1]),
+        shown.T,
+        cmap=ListedColormap(colors),
+        vmin=-0.5,
+        vmax=len(destinations) - 0.5,
+        alpha=BASIN_ALPHA,
+        shading="flat",
+        linewidth=0,
+        zorder=0,
+    )
+    return [
+        (
+            Patch(facecolor=color, alpha=BASIN_ALPHA, edgecolor="0.55", linewidth=0.6),
+            f"basin → {describe_state(destination, units)}",
+        )
+        for color, destination in zip(colors, destinations, strict=True)
+    ]
 
 
 def _halton(index: int, base: int) -> float:
@@ -283,7 +345,8 @@ def portrait_figure(
     """Figure 14: closed-loop paths in state space under the controller in ``table_path``, from
     ``starts`` start states (small squares) for ``seconds`` each, to the destination (encircled
     X). A periodic destination's cycle (the path from the destination itself, between
-    ``CYCLE_SECONDS``) is drawn as a thick grey line."""
+    ``CYCLE_SECONDS``) is drawn as a thick grey line. A table with several destinations has
+    every one marked and each one's basin tinted (``draw_basins``), the legend naming them."""
     from mosys.ssc.controller import CLOSED_LOOP_DT, Controller
 
     controller = Controller.load(table_path, dynamics)
@@ -292,20 +355,24 @@ def portrait_figure(
     dt = CLOSED_LOOP_DT
     units = dict(zip(table.state_order, table.axis_units, strict=True))
     palette = matplotlib.colormaps["tab10"]
+    destinations = table.all_destinations
     with plot_style():
         figure = new_figure(7.0, 5.8)
         ax = figure.add_subplot()
         legend = []
         drawn = []
-        if _destination_is_periodic(table):
-            dest_state = np.array([table.dest.get(name, 0.0) for name in table.state_order])
+        periodic = [d for d in destinations if _destination_is_periodic(table, d)]
+        for destination in periodic:
+            dest_state = np.array([destination.get(name, 0.0) for name in table.state_order])
             first, last = (int(round(s / dt)) for s in CYCLE_SECONDS)
             run = controller.simulate(controller.figure_state(dest_state), last * dt, dt)
             cycle = controller.controller_states(run.states[first:])
             cycle_style = {"color": "0.45", "linewidth": 5.0, "alpha": 0.5}
             _plot_path(ax, cycle, axes, zorder=1, solid_capstyle="round", **cycle_style)
-            legend.append((Line2D([], [], **cycle_style), "cycle through the destination"))
             drawn.append(cycle)
+        if periodic:
+            label = "cycle through the destination" + ("s" if len(periodic) > 1 else "")
+            legend.append((Line2D([], [], **cycle_style), label))
         for k, start in enumerate(portrait_starts(axes, starts)):
             run = controller.simulate(controller.figure_state(start), seconds, dt)
             path = controller.controller_states(run.states)
@@ -314,15 +381,25 @@ def portrait_figure(
             mark_start(ax, start[0], start[1], color)
             drawn.append(path)
         legend.append((Line2D([], [], **start_style("white")), "start state (one colour per path)"))
-        handle = _mark_table_destination(ax, table, axes)
+        handle = None
+        for destination in destinations:
+            handle = _mark_table_destination(ax, table, axes, destination=destination) or handle
         if handle is not None:
-            legend.append((handle, "destination"))
+            legend.append((handle, "destination" + ("s" if len(destinations) > 1 else "")))
         _format_state_axes(ax, axes, np.concatenate(drawn))
+        if len(destinations) == 1:
+            heading = f"destination {describe_state(table.dest, units)}"
+        else:
+            heading = f"{len(destinations)} destinations, the cheapest from each state"
         ax.set_title(
-            f"Controller {controller.name}: destination {describe_state(table.dest, units)}\n"
+            f"Controller {controller.name}: {heading}\n"
             f"closed-loop paths, {seconds:g} s from each of {starts} start states"
         )
-        add_legend(figure, legend)
+        if table.destination_index is not None:
+            legend.extend(draw_basins(ax, table, axes, units))
+            add_legend(figure, legend, ncols=2)
+        else:
+            add_legend(figure, legend)
     return figure
 
 
@@ -546,7 +623,17 @@ def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | 
     else:
         axes = trajectory_axes(trajectory)
     colors = controller_colors(trajectory.controllers)
-    state = trajectory.state
+    kinds = dict(
+        zip(
+            trajectory.controllers,
+            string_tuple(trajectory.attrs.get("controller_kinds", ())),
+            strict=False,
+        )
+    )
+    state = trajectory.state.copy()
+    for k, axis in enumerate(axes):  # a motor program's stretch keeps the angle unwrapped
+        if axis.period:
+            state[:, k] = axis.low + np.mod(state[:, k] - axis.low, axis.period)
     switches = _switches(trajectory)
     with plot_style():
         figure = new_figure(7.6, 6.4)
@@ -555,7 +642,8 @@ def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | 
         for first, stop, name in _controller_runs(trajectory):
             _plot_path(ax, state[first:stop], axes, color=colors[name], linewidth=1.8, zorder=3)
         for name in dict.fromkeys(trajectory.controllers):
-            legend.append((Line2D([], [], color=colors[name], linewidth=2), f"controller {name}"))
+            kind = kinds.get(name, "controller").replace("motor", "motor program")
+            legend.append((Line2D([], [], color=colors[name], linewidth=2), f"{kind} {name}"))
         labels, obstacles = [], []
         for i, name in switches:
             mark_start(ax, state[i, 0], state[i, 1], colors[name], zorder=6.5)  # over dX
@@ -571,6 +659,7 @@ def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | 
             obstacles.append((x, y, 7.0))
         if used:
             legend.append((destination_handle(), "dX: destination of controller X"))
+        legend += _shade_breakpoints(ax, trajectory, axes, colors)
         ax.plot(state[-1, 0], state[-1, 1], marker="o", markersize=5, color="black", zorder=6)
         obstacles.append((state[-1, 0], state[-1, 1], 3.0))
         legend.append(
@@ -586,9 +675,48 @@ def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | 
             f"{len(switches)} controller invocations over "
             f"{trajectory.t[-1] - trajectory.t[0]:.2f} s"
         )
-        add_legend(figure, legend, ncols=4)
+        add_legend(figure, legend, ncols=3 if len(legend) > 4 else 4)
         place_labels(figure, ax, labels, obstacles)
     return figure
+
+
+def _shade_breakpoints(
+    ax: Axes, trajectory: Trajectory, axes: Sequence[StateAxis], colors: dict
+) -> list[tuple[object, str]]:
+    """Shade each state-space breakpoint's box (the trajectory's root attr ``breakpoints``) in
+    its controller's colour; bounds on variables other than the plot's two span the plot.
+    Returns the legend entries."""
+    entries = []
+    for breakpoint_ in json.loads(str(trajectory.attrs.get("breakpoints", "[]"))):
+        box = breakpoint_["box"]
+        color = colors.get(breakpoint_["controller"], "0.5")
+        limits = []
+        for axis in axes:
+            low, high = box.get(axis.name, (-math.inf, math.inf))
+            limits.append(
+                (
+                    max(low, axis.low - 1e9 if not axis.period else axis.low),
+                    min(high, axis.high + 1e9 if not axis.period else axis.high),
+                )
+            )
+        (x0, x1), (y0, y1) = limits
+        patch = Rectangle(
+            (x0, y0),
+            x1 - x0,
+            y1 - y0,
+            facecolor=color,
+            alpha=0.18,
+            edgecolor=color,
+            linestyle="--",
+            linewidth=1.0,
+            zorder=1,
+        )
+        ax.add_patch(patch)
+        bounds = ", ".join(f"{low:g} < {name} < {high:g}" for name, (low, high) in box.items())
+        how = " (once)" if breakpoint_["once"] else ""
+        handle = Rectangle((0, 0), 1, 1, facecolor=color, alpha=0.3, edgecolor=color)
+        entries.append((handle, f"breakpoint: {bounds} → {breakpoint_['controller']}{how}"))
+    return entries
 
 
 def write_script_gif(trajectory_path: str | Path, out_path: str | Path, fps: int = GIF_FPS):

@@ -128,6 +128,23 @@ class Controller:
         minimum = float(self.table.attrs.get("minimum_known_weight", 0.0))
         return float(out[0]) if known_weight > 0.0 and known_weight >= minimum else math.inf
 
+    def domain_violation(self, figure_state: np.ndarray) -> str | None:
+        """Why the model state ``figure_state`` (S,) SI lies outside this controller's domain
+        (the 1990 paper's Figure 7: beyond a non-wrap axis of the table, or where its
+        interpolated cost-to-go is inf), or None inside it."""
+        grid = self.grid
+        state = self.controller_states(np.asarray(figure_state, dtype=np.float64)[None, :])[0]
+        si = state * grid.scale
+        clamped = np.empty_like(si)
+        inside = clamp_to_domain(
+            grid.axis_min, grid.axis_step, grid.axis_count, grid.wrap, si, clamped
+        )
+        if not inside:
+            return "beyond the table's axes"
+        if not math.isfinite(self.cost_to_go(state)):
+            return "where the table's cost-to-go is inf"
+        return None
+
     @cached_property
     def _known_values(self) -> tuple[np.ndarray, np.ndarray]:
         """(N, 1) cost-to-go at the nodes, s, 0 where unknown, and (N,) bool known, as
@@ -158,17 +175,77 @@ class Controller:
             states[:, k] = first + np.mod(states[:, k] - first, period)
         return states
 
-    def arrival_box(self) -> Bounds:
+    @property
+    def destinations(self) -> tuple[dict[str, float], ...]:
+        """Every destination of the table, {name: value} in spec units, in ``dest`` line order
+        (one for the usual table)."""
+        return self.table.all_destinations
+
+    @cached_property
+    def _destination_votes(self) -> tuple[np.ndarray, np.ndarray]:
+        """(N, D) float64, 1 in the column of each node's ``/destination_index``, and (N,)
+        bool, the nodes whose index is known (>= 0); built once, not per state."""
+        index = self.table.destination_index
+        assert index is not None
+        flat = index.reshape(-1)
+        votes = np.zeros((flat.shape[0], len(self.destinations)))
+        known = flat >= 0
+        votes[np.flatnonzero(known), flat[known]] = 1.0
+        return votes, np.ascontiguousarray(known)
+
+    def heading_for(self, state: np.ndarray) -> int:
+        """The index into ``destinations`` of the destination a controller state (d,), spec
+        units, heads for: 0 for a table with one destination; with several, the index that
+        the state's interpolation corners with a known ``/destination_index`` carry the most
+        weight of (ties: the lowest), -1 where none of them is known. Beyond the axes, at the
+        nearest covered state."""
+        if self.table.destination_index is None:
+            return 0
+        grid = self.grid
+        si = np.asarray(state, dtype=np.float64) * grid.scale
+        clamped = np.empty_like(si)
+        clamp_to_domain(grid.axis_min, grid.axis_step, grid.axis_count, grid.wrap, si, clamped)
+        votes, known = self._destination_votes
+        out = np.empty(votes.shape[1])
+        weight = interpolate_into(
+            grid.axis_min, grid.axis_step, grid.axis_count, grid.wrap, votes, known, clamped, out
+        )
+        return int(np.argmax(out)) if weight > 0.0 else -1
+
+    def arrival_boxes(self) -> list[Bounds]:
+        """One ``arrival_box`` per destination, in ``destinations`` order: with several
+        destinations, the figure has arrived when it is in any of them."""
+        return [self._arrival_box(destination) for destination in self.destinations]
+
+    def arrival_box(self, figure_state: np.ndarray | None = None) -> Bounds:
         """The box, spec units, in which the figure counts as back at the destination: each
         dimension ``dest`` names within ARRIVAL_STEPS grid steps of it, and every rate of the
         figure, whether the controller sees it or not, below REST_RATE (SI) in size as well:
-        at rest, so that what follows starts from (nearly) the same state every time."""
+        at rest, so that what follows starts from (nearly) the same state every time.
+
+        With several destinations one box is the box of the destination that
+        ``figure_state`` (S,) SI heads for (``heading_for``; the first destination where no
+        node around it leads anywhere); without ``figure_state`` that is a ValueError, since
+        no single box holds them all: ``arrival_boxes`` gives one per destination."""
+        destinations = self.destinations
+        if len(destinations) == 1:
+            return self._arrival_box(destinations[0])
+        if figure_state is None:
+            raise ValueError(
+                f"controller {self.name} has {len(destinations)} destinations: its arrival box "
+                "depends on the state (pass figure_state, or use arrival_boxes)"
+            )
+        state = self.controller_states(np.asarray(figure_state, dtype=np.float64)[None])[0]
+        return self._arrival_box(destinations[max(self.heading_for(state), 0)])
+
+    def _arrival_box(self, destination: dict[str, float]) -> Bounds:
+        """``arrival_box`` around one destination, {name: value} in spec units."""
         grid = self.grid
         box: dict[str, tuple[float, float]] = {}
         for k, name in enumerate(grid.names):
-            if name in self.table.dest:
+            if name in destination:
                 reach = ARRIVAL_STEPS * grid.axis_step[k] / grid.scale[k]
-                box[name] = (self.table.dest[name] - reach, self.table.dest[name] + reach)
+                box[name] = (destination[name] - reach, destination[name] + reach)
         coordinates = len(getattr(self.dynamics, "Q_NAMES", ()))
         for name in figure_state_names(self.dynamics)[coordinates:]:
             rest = REST_RATE / state_unit(self.dynamics, name)[1]
@@ -182,13 +259,27 @@ class Controller:
         seconds: float,
         dt: float,
         regions: Regions | None = None,
+        slew_rate: np.ndarray | None = None,
+        previous: np.ndarray | None = None,
     ) -> ClosedLoopRun:
         """Run the model from ``figure_state`` (S,) SI under this controller for ``seconds``
         (rounded to whole steps of ``dt``), or until the state enters or leaves one of
         ``regions`` (``kernels.simulate.simulate_controlled``, or
         ``kernels.lookahead.simulate_lookahead`` for a table made with ``policy lookahead``).
-        The run's controls are in spec units."""
+        The run's controls are in spec units.
+
+        ``slew_rate`` (m,): the largest rate of change of each control, spec units per second
+        (inf, or None for all: no limit), from ``previous`` (m,), the controls just before the
+        run, spec units (None: 0). A ``policy lookahead`` table plans its own controls and
+        takes no slew limit (ValueError)."""
         steps = int(round(seconds / dt))
+        m = len(self.table.control_names)
+        slew_step = np.full(m, np.inf)
+        if slew_rate is not None:
+            slew_step = np.ascontiguousarray(slew_rate * self.control_scale * dt, dtype=float)
+        held = np.zeros(m)
+        if previous is not None:
+            held = np.ascontiguousarray(previous * self.control_scale, dtype=float)
         n2 = len(figure_state)
         if regions is None:
             regions = Regions(np.empty((0, n2)), np.empty((0, n2)), state_periods(self.dynamics))
@@ -198,6 +289,10 @@ class Controller:
         outside = np.empty(steps, dtype=np.bool_)
         grid = self.grid
         if self.lookahead is not None:
+            if np.isfinite(slew_step).any():
+                raise ValueError(
+                    f"controller {self.name} plans its controls by lookahead: no slew limit"
+                )
             from mosys.kernels.lookahead import simulate_lookahead
             from mosys.ssc.lookahead import MAX_SEGMENT_SECONDS
 
@@ -247,6 +342,8 @@ class Controller:
                 self.known,
                 self.control_min_si,
                 self.control_max_si,
+                slew_step,
+                held,
                 grid.state_slot,
                 self.control_slot,
                 len(self.dynamics.INPUT_NAMES),
