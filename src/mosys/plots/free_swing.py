@@ -13,7 +13,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from mosys.dynamics.free_swing import free_swing
-from mosys.plots.pendulum import StateAxis, _format_state_axes, _plot_path
+from mosys.plots.pendulum import StateAxis, format_state_axes, plot_state_path
 from mosys.plots.style import add_legend, new_figure, plot_style, save_png
 
 LIBRATION_COLOR = "tab:blue"
@@ -42,17 +42,17 @@ def free_swing_figure(dynamics: ModuleType) -> Figure:
         figure = new_figure(7.6, 6.0)
         ax = figure.add_subplot()
         for orbit in swing.librations:
-            _plot_path(ax, wrapped(orbit), axes, color=LIBRATION_COLOR, linewidth=1.3)
+            plot_state_path(ax, wrapped(orbit), axes, color=LIBRATION_COLOR, linewidth=1.3)
         for orbit in swing.rotations:
-            _plot_path(ax, wrapped(orbit), axes, color=ROTATION_COLOR, linewidth=1.3)
+            plot_state_path(ax, wrapped(orbit), axes, color=ROTATION_COLOR, linewidth=1.3)
         for half in swing.separatrix:  # and its mirror image: the swing run backwards in time
             for points in (wrapped(half), wrapped(half * np.array([1.0, -1.0]))):
-                _plot_path(ax, points, axes, color=SEPARATRIX_COLOR, linewidth=2.2)
+                plot_state_path(ax, points, axes, color=SEPARATRIX_COLOR, linewidth=2.2)
         hanging, upright = degrees(swing.hanging), degrees(swing.upright)
         ax.plot([hanging], [0.0], marker="o", color="tab:red", markersize=7, linestyle="none")
         for angle in (upright, upright - 360.0 if upright > 0 else upright + 360.0):
             ax.plot([angle], [0.0], marker="x", color="tab:red", markersize=9, mew=2)
-        _format_state_axes(ax, axes)
+        format_state_axes(ax, axes)
         ax.set_title(
             "Figure 5: free swing of the unpowered pendulum\n"
             f"separatrix through upright ({upright:.0f}°), "

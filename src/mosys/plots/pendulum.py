@@ -131,7 +131,7 @@ def cylinder_pieces(points: np.ndarray, axes: Sequence[StateAxis]) -> list[np.nd
     return pieces
 
 
-def _plot_path(ax: Axes, points: np.ndarray, axes: Sequence[StateAxis], **style) -> None:
+def plot_state_path(ax: Axes, points: np.ndarray, axes: Sequence[StateAxis], **style) -> None:
     """Plot a path on cylindrical axes; ``label`` (if any) goes on the first piece only."""
     for piece in cylinder_pieces(points, axes):
         ax.plot(piece[:, 0], piece[:, 1], **style)
@@ -176,7 +176,7 @@ def trajectory_axes(trajectory: Trajectory) -> tuple[StateAxis, StateAxis]:
     )
 
 
-def _format_state_axes(ax: Axes, axes: Sequence[StateAxis], data: np.ndarray | None = None):
+def format_state_axes(ax: Axes, axes: Sequence[StateAxis], data: np.ndarray | None = None):
     """Limits, labels and ticks of a state-space plot. A periodic axis spans exactly one period;
     a non-periodic one its range (widened to ``data`` (N, 2) if that strays outside, the
     range's edges then dashed) plus a 2 % margin so that lines along the edge stay visible."""
@@ -368,7 +368,7 @@ def portrait_figure(
             run = controller.simulate(controller.figure_state(dest_state), last * dt, dt)
             cycle = controller.controller_states(run.states[first:])
             cycle_style = {"color": "0.45", "linewidth": 5.0, "alpha": 0.5}
-            _plot_path(ax, cycle, axes, zorder=1, solid_capstyle="round", **cycle_style)
+            plot_state_path(ax, cycle, axes, zorder=1, solid_capstyle="round", **cycle_style)
             drawn.append(cycle)
         if periodic:
             label = "cycle through the destination" + ("s" if len(periodic) > 1 else "")
@@ -377,7 +377,7 @@ def portrait_figure(
             run = controller.simulate(controller.figure_state(start), seconds, dt)
             path = controller.controller_states(run.states)
             color = palette(k % palette.N)
-            _plot_path(ax, path, axes, color=color, linewidth=1.3, zorder=3)
+            plot_state_path(ax, path, axes, color=color, linewidth=1.3, zorder=3)
             mark_start(ax, start[0], start[1], color)
             drawn.append(path)
         legend.append((Line2D([], [], **start_style("white")), "start state (one colour per path)"))
@@ -386,7 +386,7 @@ def portrait_figure(
             handle = _mark_table_destination(ax, table, axes, destination=destination) or handle
         if handle is not None:
             legend.append((handle, "destination" + ("s" if len(destinations) > 1 else "")))
-        _format_state_axes(ax, axes, np.concatenate(drawn))
+        format_state_axes(ax, axes, np.concatenate(drawn))
         if len(destinations) == 1:
             heading = f"destination {describe_state(table.dest, units)}"
         else:
@@ -477,7 +477,7 @@ def torque_figure(table_path: str | Path, contours: bool = True) -> Figure:
             handle = _mark_table_destination(ax, table, axes)
             if handle is not None:
                 legend.append((handle, "destination"))
-            _format_state_axes(ax, axes)
+            format_state_axes(ax, axes)
             ax.set_title(
                 f"Controller {name}: {control} table, "
                 f"{' × '.join(str(len(g)) for g in table.axes)} nodes\n"
@@ -640,7 +640,9 @@ def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | 
         ax = figure.add_subplot()
         legend = []
         for first, stop, name in _controller_runs(trajectory):
-            _plot_path(ax, state[first:stop], axes, color=colors[name], linewidth=1.8, zorder=3)
+            plot_state_path(
+                ax, state[first:stop], axes, color=colors[name], linewidth=1.8, zorder=3
+            )
         for name in dict.fromkeys(trajectory.controllers):
             kind = kinds.get(name, "controller").replace("motor", "motor program")
             legend.append((Line2D([], [], color=colors[name], linewidth=2), f"{kind} {name}"))
@@ -668,7 +670,7 @@ def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | 
                 f"end, t = {trajectory.t[-1]:.2f} s",
             )
         )
-        _format_state_axes(ax, axes, state)
+        format_state_axes(ax, axes, state)
         script = str(trajectory.attrs.get("script", Path(trajectory_path).name))
         ax.set_title(
             f"State-space path of the animation script {Path(script).name}\n"
