@@ -99,6 +99,18 @@ def two_goals(free_rod, tmp_path_factory) -> Path:
 # --------------------------------------------------------------------------- 1. known answer
 
 
+def analytic_answer(two_goals):
+    """The table, and at each node: the two goals' exact minimum times (2, n, m), the index of
+    the quicker, the shorter and longer time, and whether the quicker path stays inside the
+    domain."""
+    table = read_controller_table(two_goals)
+    x, v = np.meshgrid(*table.axes, indexing="ij")
+    times = np.stack([minimum_time(x, v, goal) for goal in GOALS])
+    quicker = np.argmin(times, axis=0)
+    fair = np.where(quicker == 0, stays_inside(x, v, GOALS[0]), stays_inside(x, v, GOALS[1]))
+    return table, times, quicker, times.min(axis=0), times.max(axis=0), fair
+
+
 def test_each_node_heads_for_the_analytically_quicker_goal(two_goals):
     """Where the two bang-bang times differ by more than 15 % of the shorter, destination_index
     names the quicker goal. The DP reaches a single node with an interpolation error of the
@@ -106,12 +118,7 @@ def test_each_node_heads_for_the_analytically_quicker_goal(two_goals):
     goals' errors largely cancel in the comparison: measured, no node disagrees above a 10 %
     difference and about a dozen (on the basin border) between 5 and 10 %. Nodes whose quicker
     path would leave the domain are left out (the DP must take a slower way there)."""
-    table = read_controller_table(two_goals)
-    x, v = np.meshgrid(*table.axes, indexing="ij")
-    times = np.stack([minimum_time(x, v, goal) for goal in GOALS])
-    quicker = np.argmin(times, axis=0)
-    shorter, longer = times.min(axis=0), times.max(axis=0)
-    fair = np.where(quicker == 0, stays_inside(x, v, GOALS[0]), stays_inside(x, v, GOALS[1]))
+    table, times, quicker, shorter, longer, fair = analytic_answer(two_goals)
     compared = fair & np.isfinite(table.value) & (longer - shorter > 0.15 * shorter)
     assert compared.sum() > 5000  # most of the 121 x 73 nodes
     np.testing.assert_array_equal(table.destination_index[compared], quicker[compared])
@@ -125,12 +132,7 @@ def test_value_is_the_quicker_goals_time(two_goals):
     more than 2 % below the exact minimum, over it by < 35 % (median) and < 50 % (95th
     percentile) where the exact time is over 0.5 s; and where one goal takes at least 1.5 times
     the other, below the slower goal's exact time (a DP towards one goal alone could not)."""
-    table = read_controller_table(two_goals)
-    x, v = np.meshgrid(*table.axes, indexing="ij")
-    times = np.stack([minimum_time(x, v, goal) for goal in GOALS])
-    quicker = np.argmin(times, axis=0)
-    shorter, longer = times.min(axis=0), times.max(axis=0)
-    fair = np.where(quicker == 0, stays_inside(x, v, GOALS[0]), stays_inside(x, v, GOALS[1]))
+    table, times, quicker, shorter, longer, fair = analytic_answer(two_goals)
     fair &= np.isfinite(table.value)
     inner = fair & (shorter > 0.5)
     relative = (table.value[inner] - shorter[inner]) / shorter[inner]

@@ -156,6 +156,17 @@ class BoundMotorProgram:
         """The program one row per step of dt seconds (``step_rows``)."""
         return step_rows(self.bound, dt)
 
+    def _per_actuator(self, name: str, values: np.ndarray) -> np.ndarray:
+        """``values`` as a new (A,) float64 array, one per actuator; ValueError naming
+        ``name`` for any other shape."""
+        array = np.array(values, dtype=np.float64)
+        if array.shape != (len(self.coordinate),):
+            raise ValueError(
+                f"{name} has shape {array.shape}, expected ({len(self.coordinate)},): one per "
+                f"actuator of {self.bound.actuator_names}"
+            )
+        return array
+
     def run(
         self,
         figure_state: np.ndarray,
@@ -178,23 +189,13 @@ class BoundMotorProgram:
         actuators = len(self.coordinate)
         slew_step = np.full(actuators, np.inf)
         if slew_rate is not None:
-            slew_rate = np.asarray(slew_rate, dtype=np.float64)
-            if slew_rate.shape != (actuators,):
-                raise ValueError(
-                    f"slew_rate has shape {slew_rate.shape}, expected ({actuators},): one per "
-                    f"actuator of {self.bound.actuator_names}"
-                )
+            slew_rate = self._per_actuator("slew_rate", slew_rate)
             if not (slew_rate >= 0).all():  # NaN fails too
                 raise ValueError(f"slew_rate must be >= 0 N m/s, got {slew_rate.tolist()}")
             slew_step = slew_rate * float(dt)
         torque = np.zeros(actuators)
         if previous is not None:
-            torque = np.array(previous, dtype=np.float64)
-            if torque.shape != (actuators,):
-                raise ValueError(
-                    f"previous has shape {torque.shape}, expected ({actuators},): one per "
-                    f"actuator of {self.bound.actuator_names}"
-                )
+            torque = self._per_actuator("previous", previous)
             if not np.isfinite(torque).all():
                 raise ValueError(f"previous must be finite N m, got {torque.tolist()}")
         rows = self.step_rows(dt)
