@@ -440,3 +440,31 @@ def test_animation_steps_are_whole_hundredths_so_gifs_play_in_real_time(span, ma
     assert round(step * 100) == pytest.approx(step * 100, abs=1e-9)  # a GIF stores centiseconds
     assert step >= 1 / 25 and len(samples) <= max_frames
     assert samples[-1] == len(t) - 1
+
+
+@pytest.mark.parametrize(
+    ("suffix", "magic"), [(".png", b"\x89PNG"), (".pdf", b"%PDF"), (".svg", b"<?xml")]
+)
+def test_a_plot_is_written_in_the_format_its_file_name_names(tmp_path, suffix, magic):
+    from matplotlib.figure import Figure
+
+    from mosys.plots.style import save_figure
+
+    figure = Figure()
+    figure.add_subplot().plot([0, 1], [1, 0])
+    out = tmp_path / f"plot{suffix}"
+    save_figure(figure, out)
+    assert out.read_bytes().startswith(magic)
+
+
+def test_a_plot_file_name_without_a_known_format_is_refused(tmp_path):
+    """A ``.jpg`` (or no extension) is a PlotInputError (the CLI's exit 2) naming the formats
+    taken, and nothing is written."""
+    from matplotlib.figure import Figure
+
+    from mosys.plots.style import PlotInputError, save_figure
+
+    for name in ("plot.jpg", "plot"):
+        with pytest.raises(PlotInputError, match=r"ends in \.png, \.pdf, \.svg"):
+            save_figure(Figure(), tmp_path / name)
+    assert list(tmp_path.iterdir()) == []

@@ -24,7 +24,8 @@ from PIL import Image, ImageSequence
 
 # names of values that measure the machine, not the motion (attributes and CSV columns)
 TIMING = re.compile(
-    r"wall|generation_s|iteration_seconds|transition_seconds|peak_rss|speed-?up|ms per|"
+    r"wall|generation_s|iteration_seconds|transition_seconds|load_seconds|peak_rss|speed-?up|"
+    r"ms per|"
     r"per[ _]second|40k evaluations",
     re.IGNORECASE,
 )
@@ -44,17 +45,30 @@ def same(a, b) -> bool:
     return bool(np.array_equal(a, b))
 
 
+def dereferenced(h5file: h5py.File, value):
+    """An attribute's value with every object reference (the bookkeeping of HDF5 dimension
+    scales: DIMENSION_LIST, REFERENCE_LIST) replaced by the name of the object it points to, so
+    that two files' references compare by what they point at."""
+    if isinstance(value, h5py.Reference):
+        return h5file[value].name if value else ""
+    if isinstance(value, np.void) and value.dtype.names:
+        return tuple(dereferenced(h5file, value[field]) for field in value.dtype.names)
+    if isinstance(value, np.ndarray) and value.dtype.kind in "OV":
+        return repr([dereferenced(h5file, item) for item in value])  # ragged: compared as text
+    return value
+
+
 def compare_h5(old: Path, new: Path) -> tuple[list[str], list[str]]:
     """(differences, timing differences) between two HDF5 files."""
     differences: list[str] = []
     timings: list[str] = []
 
-    def attrs(name: str, a, b) -> None:
+    def attrs(name: str, a, b, file_a: h5py.File, file_b: h5py.File) -> None:
         for key in sorted(set(a) | set(b)):
             where = f"{name}@{key}"
             if key not in a or key not in b:
                 differences.append(f"{where}: only in {'new' if key in b else 'old'}")
-            elif not same(a[key], b[key]):
+            elif not same(dereferenced(file_a, a[key]), dereferenced(file_b, b[key])):
                 (timings if TIMING.search(key) else differences).append(f"{where} differs")
 
     with h5py.File(old, "r") as a, h5py.File(new, "r") as b:
@@ -70,8 +84,8 @@ def compare_h5(old: Path, new: Path) -> tuple[list[str], list[str]]:
             both_datasets = isinstance(x, h5py.Dataset) and isinstance(y, h5py.Dataset)
             if both_datasets and not same(x[()], y[()]):
                 (timings if TIMING.search(name) else differences).append(f"/{name} differs")
-            attrs(f"/{name}", x.attrs, y.attrs)
-        attrs("/", a.attrs, b.attrs)
+            attrs(f"/{name}", x.attrs, y.attrs, a, b)
+        attrs("/", a.attrs, b.attrs, a, b)
     return differences, timings
 
 

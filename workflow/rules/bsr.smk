@@ -21,8 +21,7 @@ rule bsr_search:
     shell:
         "mosys bsr-search {input.spec} --seed {wildcards.seed} --figures specs/figures"
         " {params.generations} --budget {params.budget} {params.chain} --threads {threads}"
-        " -o {output}"
-        " 2> {log} || (cat {log} >&2; exit 1)"
+        " -o {output} > {log} 2>&1"
 
 
 rule bsr_plots:
@@ -30,40 +29,45 @@ rule bsr_plots:
         results=bsr_seed_results,
         code=code_inputs("mosys.cli.plots", "mosys.plots.bsr"),  # mosys plot bsr
     output:
-        learning="results/plots/bsr/{name}/learning.png",
-        filmstrip="results/plots/bsr/{name}/filmstrip.png",
-        gif="results/plots/bsr/{name}/motion.gif",
+        learning=report("results/plots/bsr/{name}/learning.png", caption="../report/bsr_learning.rst", category="1995 paper: BSR controllers (2-D)", subcategory="{name}"),
+        filmstrip=report("results/plots/bsr/{name}/filmstrip.png", caption="../report/bsr_filmstrip.rst", category="1995 paper: BSR controllers (2-D)", subcategory="{name}"),
+        gif=report("results/plots/bsr/{name}/motion.gif", caption="../report/bsr_gif.rst", category="1995 paper: BSR controllers (2-D)", subcategory="{name}"),
     log:
         "results/logs/plots/bsr/{name}.log",
+    benchmark:
+        "results/benchmarks/plots/bsr/{name}.tsv"
     threads: 1
     shell:
         "mosys plot bsr {input.results} --learning {output.learning}"
-        " --filmstrip {output.filmstrip} --gif {output.gif} 2> {log} || (cat {log} >&2; exit 1)"
+        " --filmstrip {output.filmstrip} --gif {output.gif} > {log} 2>&1"
 
 
 rule bsr_learning_curves:
     input:
-        results=bsr_all_results(),
+        results=lambda wildcards: bsr_all_results(),
         code=code_inputs("mosys.cli.plots", "mosys.plots.bsr"),  # mosys plot bsr-learning
     output:
-        "results/plots/bsr/learning_curves.png",
+        report("results/plots/bsr/learning_curves.png", caption="../report/bsr_curves.rst", category="1995 paper: BSR controllers (2-D)", subcategory="all searches"),
     log:
         "results/logs/plots/bsr/learning_curves.log",
+    benchmark:
+        "results/benchmarks/plots/bsr/learning_curves.tsv"
     threads: 1
     shell:
-        "mosys plot bsr-learning {input.results} -o {output} 2> {log} || (cat {log} >&2; exit 1)"
+        "mosys plot bsr-learning {input.results} -o {output} > {log} 2>&1"
 
 
 rule bsr_runs_table:
     input:
-        results=bsr_all_results(),
+        results=lambda wildcards: bsr_all_results(),
         code=code_inputs("mosys.cli.paper_tables", "mosys.paper_tables.bsr"),  # mosys bsr-table
     output:
-        csv="results/tables/bsr_runs.csv",
+        csv=report("results/tables/bsr_runs.csv", caption="../report/bsr_table.rst", category="1995 paper: BSR controllers (2-D)", subcategory="all searches"),
         md="results/tables/bsr_runs.md",
     log:
         "results/logs/tables/bsr_runs.log",
+    benchmark:
+        "results/benchmarks/tables/bsr_runs.tsv"
     threads: 1
     shell:
-        "mosys bsr-table {input.results} --csv {output.csv} --md {output.md}"
-        " 2> {log} || (cat {log} >&2; exit 1)"
+        "mosys bsr-table {input.results} --csv {output.csv} --md {output.md} > {log} 2>&1"

@@ -17,6 +17,9 @@ rule car_start_grid:
         "results/logs/car/start_grid.log",
     benchmark:
         "results/benchmarks/car/start_grid.tsv"
+    resources:
+        mem_mb=2500,  # MiB: the car's table and its lookahead arrays (README)
+        runtime=20,  # min: the paper-size grid takes about 2 min on 2 cores
     params:
         x=" ".join(str(v) for v in config["car"]["start_grid"]["x"]),
         y=" ".join(str(v) for v in config["car"]["start_grid"]["y"]),
@@ -28,8 +31,7 @@ rule car_start_grid:
     shell:
         "NUMBA_NUM_THREADS=1 mosys starts {input.table} --dynamics {input.dynamics}"
         " --x {params.x} --y {params.y} --heading {params.heading} --steer {params.steer}"
-        " --seconds {params.seconds} --dt {params.dt} --threads {threads} -o {output} 2> {log}"
-        " || (cat {log} >&2; exit 1)"
+        " --seconds {params.seconds} --dt {params.dt} --threads {threads} -o {output} > {log} 2>&1"
 
 
 rule car_frames:
@@ -37,15 +39,14 @@ rule car_frames:
         trajectories=car_trajectories(),
         code=code_inputs("mosys.cli.plots", "mosys.plots.car"),  # mosys plot car
     output:
-        "results/plots/car/figure19_frames.png",
+        report("results/plots/car/figure19_frames.png", caption="../report/car_frames.rst", category="1990 paper: the self-parking car"),
     log:
         "results/logs/plots/car/figure19_frames.log",
     benchmark:
         "results/benchmarks/plots/car/figure19_frames.tsv"
     threads: 1
     shell:
-        "mosys plot car {input.trajectories} --frames {output} 2> {log}"
-        " || (cat {log} >&2; exit 1)"
+        "mosys plot car {input.trajectories} --frames {output} > {log} 2>&1"
 
 
 rule car_gif:
@@ -53,14 +54,14 @@ rule car_gif:
         trajectory=f"results/trajectories/{config['car']['gif_script']}.h5",
         code=code_inputs("mosys.cli.plots", "mosys.plots.car"),  # mosys plot car
     output:
-        "results/plots/car/manoeuvre.gif",
+        report("results/plots/car/manoeuvre.gif", caption="../report/car_gif.rst", category="1990 paper: the self-parking car"),
     log:
         "results/logs/plots/car/manoeuvre.log",
     benchmark:
         "results/benchmarks/plots/car/manoeuvre.tsv"
     threads: 1
     shell:
-        "mosys plot car {input.trajectory} --gif {output} 2> {log} || (cat {log} >&2; exit 1)"
+        "mosys plot car {input.trajectory} --gif {output} > {log} 2>&1"
 
 
 rule car_start_map:
@@ -68,14 +69,14 @@ rule car_start_map:
         grid="results/car/start_grid.h5",
         code=code_inputs("mosys.cli.plots", "mosys.plots.car"),  # mosys plot car
     output:
-        "results/plots/car/start_map.png",
+        report("results/plots/car/start_map.png", caption="../report/car_map.rst", category="1990 paper: the self-parking car"),
     log:
         "results/logs/plots/car/start_map.log",
     benchmark:
         "results/benchmarks/plots/car/start_map.tsv"
     threads: 1
     shell:
-        "mosys plot car --map {input.grid} {output} 2> {log} || (cat {log} >&2; exit 1)"
+        "mosys plot car --map {input.grid} {output} > {log} 2>&1"
 
 
 rule car_consistency:
@@ -83,14 +84,14 @@ rule car_consistency:
         grid="results/car/start_grid.h5",
         code=code_inputs("mosys.cli.plots", "mosys.plots.car"),  # mosys plot car
     output:
-        "results/plots/car/consistency.png",
+        report("results/plots/car/consistency.png", caption="../report/car_consistency.rst", category="1990 paper: the self-parking car"),
     log:
         "results/logs/plots/car/consistency.log",
     benchmark:
         "results/benchmarks/plots/car/consistency.tsv"
     threads: 1
     shell:
-        "mosys plot car --consistency {input.grid} {output} 2> {log} || (cat {log} >&2; exit 1)"
+        "mosys plot car --consistency {input.grid} {output} > {log} 2>&1"
 
 
 rule car_controller_table:
@@ -100,7 +101,7 @@ rule car_controller_table:
         trajectories=car_trajectories(),
         code=code_inputs("mosys.cli.paper_tables", "mosys.paper_tables.car"),  # mosys car-table
     output:
-        csv="results/tables/car_controller.csv",
+        csv=report("results/tables/car_controller.csv", caption="../report/car_table.rst", category="1990 paper: the self-parking car"),
         md="results/tables/car_controller.md",
     log:
         "results/logs/tables/car_controller.log",
@@ -111,5 +112,4 @@ rule car_controller_table:
     threads: 1
     shell:
         "mosys car-table {input.table} --starts {input.grid} --trajectories {input.trajectories}"
-        " --budget {params.budget} --csv {output.csv} --md {output.md} 2> {log}"
-        " || (cat {log} >&2; exit 1)"
+        " --budget {params.budget} --csv {output.csv} --md {output.md} > {log} 2>&1"

@@ -1,5 +1,5 @@
 # Config validation and the only helpers of the workflow: target lists, the package modules each
-# rule's verb runs, and the light look-ups of spec lines that decide a rule's inputs.
+# rule's verb runs, and the specs (read by mosys's own parsers) that decide a rule's inputs.
 import ast
 import functools
 import importlib.util
@@ -185,37 +185,39 @@ def code_inputs(*entries):
     return sorted(files)
 
 
-def spec_words(path, keyword):
-    """Every line of a spec that starts with keyword, as its list of words (comments removed);
-    a missing file gives none, and mosys itself reports the error."""
+# The parser of each kind of spec, by file suffix: the one the spec's job runs (mosys.parsing).
+SPEC_PARSERS = {
+    ".ssc": ("mosys.parsing.controller", "parse_controller_spec"),
+    ".anim": ("mosys.parsing.script", "parse_script"),
+    ".bsr": ("mosys.parsing.bsr", "parse_bsr_spec"),
+    ".comp": ("mosys.parsing.composite", "parse_composite_script"),
+}
+
+
+@functools.cache
+def parsed_spec(path):
+    """The spec at path, parsed by mosys's own parser: a missing or malformed spec stops the
+    DAG, before any job runs, with the parser's file:line:column message."""
+    from mosys.parsing.tokens import SpecError
+
+    parser_module, function = SPEC_PARSERS[Path(path).suffix]
+    parse = getattr(importlib.import_module(parser_module), function)
     try:
-        text = Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError):
-        return []
-    lines = (line.split("#", 1)[0].split() for line in text.splitlines())
-    return [words for words in lines if words and words[0] == keyword]
+        return parse(path)
+    except SpecError as error:
+        raise WorkflowError(str(error)) from None
 
 
 def controller_dynamics(wildcards):
     """The generated dynamics a controller spec names in its 'dyn' line."""
-    spec = f"specs/controllers/{wildcards.group}/{wildcards.name}.ssc"
-    return [f"results/dynamics/{words[1]}.py" for words in spec_words(spec, "dyn")[:1]
-            if len(words) > 1 and re.fullmatch(r"\w+", words[1])]
-
-
-def table_controller(reference):
-    """The controller a 'swapcon' table reference names: conX.ctab -> X, X -> X."""
-    match = re.fullmatch(r"con(\w+)\.ctab", reference)
-    return match.group(1) if match else reference
+    spec = parsed_spec(f"specs/controllers/{wildcards.group}/{wildcards.name}.ssc")
+    return [f"results/dynamics/{spec.figure}.py"]
 
 
 def script_figure(script):
     """The figure a script's 'object' line names (figure=NAME), or None."""
-    for words in spec_words(f"specs/scripts/{script}.anim", "object")[:1]:
-        for word in words[2:]:
-            if word.startswith("figure=") and re.fullmatch(r"\w+", word[len("figure="):]):
-                return word[len("figure="):]
-    return None
+    declared = parsed_spec(f"specs/scripts/{script}.anim").declared_figure
+    return None if declared is None else declared.figure
 
 
 def script_group(script):
@@ -241,29 +243,19 @@ def script_dt(script):
 
 
 def script_inputs(wildcards):
-    """The tables, dynamics and motor programs a script needs (from its 'swapcon', 'when',
-    'object' and 'motor' lines)."""
-    script = f"specs/scripts/{wildcards.script}.anim"
+    """The tables, dynamics and motor programs a script needs (its 'swapcon', 'when', 'object'
+    and 'motor' lines), and the controller specs they are made from."""
+    script = parsed_spec(f"specs/scripts/{wildcards.script}.anim")
     group = script_group(wildcards.script)
-    references = [w[2] for w in spec_words(script, "swapcon") if len(w) > 2]
-    for line in spec_words(script, "when"):  # when OBJECT COND... swapcon TABLE [once]
-        if "swapcon" in line and line.index("swapcon") + 1 < len(line):
-            references.append(line[line.index("swapcon") + 1])
-    names = dict.fromkeys(table_controller(reference) for reference in references)
-    tables = [f"results/controllers/{group}/{name}.h5" for name in names
-              if re.fullmatch(r"\w+", name)]
-    figures = set()
-    for name in names:
-        for words in spec_words(f"specs/controllers/{group}/{name}.ssc", "dyn")[:1]:
-            if len(words) > 1:
-                figures.add(f"results/dynamics/{words[1]}.py")
+    names = script.controllers()
+    figures = {f"results/dynamics/{parsed_spec(f'specs/controllers/{group}/{name}.ssc').figure}.py"
+               for name in names}
     figure = script_figure(wildcards.script)
     programs = []
     if figure is not None:
         figures.add(f"results/dynamics/{figure}.py")
-        programs = [f"specs/motor/{figure}/{w[2]}.mot" for w in spec_words(script, "motor")
-                    if len(w) > 2 and re.fullmatch(r"\w+", w[2])]
-    return tables + sorted(figures) + list(dict.fromkeys(programs))
+        programs = [f"specs/motor/{figure}/{name}.mot" for name in script.motor_programs()]
+    return [f"results/controllers/{group}/{name}.h5" for name in names] + sorted(figures) + programs
 
 
 def pendulum_controller_tables():
@@ -345,16 +337,14 @@ def bsr_settings(name):
 def bsr_seeds(name):
     """The seeds of a search: its spec's 'seeds' line, the first config bsr.seeds (bsr3d.seeds
     for a 3-D search) of them if that is set (a reduced budget)."""
-    seeds = [word for words in spec_words(f"specs/bsr/{name}.bsr", "seeds")[:1]
-             for word in words[1:] if re.fullmatch(r"\d+", word)]
+    seeds = list(parsed_spec(f"specs/bsr/{name}.bsr").seeds)
     limit = bsr_settings(name)["seeds"]
     return seeds if limit is None else seeds[:limit]
 
 
 def bsr_chain(name):
     """The search a 3-D search continues (its 'chain' line), or None."""
-    return next((words[1] for words in spec_words(f"specs/bsr/{name}.bsr", "chain")[:1]
-                 if len(words) > 1 and re.fullmatch(r"\w+", words[1])), None)
+    return parsed_spec(f"specs/bsr/{name}.bsr").chain or None
 
 
 def bsr_chain_results(wildcards):
@@ -381,9 +371,7 @@ def bsr_all_results():
 
 def bsr_figure_spec(wildcards):
     """The figure spec a search names in its 'figure' line."""
-    return [f"specs/figures/{words[1]}.fig"
-            for words in spec_words(f"specs/bsr/{wildcards.name}.bsr", "figure")[:1]
-            if len(words) > 1 and re.fullmatch(r"\w+", words[1])]
+    return [f"specs/figures/{parsed_spec(f'specs/bsr/{wildcards.name}.bsr').figure}.fig"]
 
 
 def bsr_full_budget(name):
@@ -449,22 +437,18 @@ def bsr3d_targets():
 
 def composite_searches(name):
     """The BSR searches a composite script's phases name (controller=SEARCH), in order."""
-    words = spec_words(f"specs/composite/{name}.comp", "phase")
-    found = [match.group(1) for line in words for word in line[2:]
-             for match in [re.fullmatch(r"controller=(\w+)", word)] if match]
-    return list(dict.fromkeys(found))
+    phases = parsed_spec(f"specs/composite/{name}.comp").phases
+    return list(dict.fromkeys(phase.controller for phase in phases))
 
 
 def composite_inputs(wildcards):
     """A composite search's inputs: the script, its figure, its phases' search specs (the first
     one's start pose starts the motion) and their seed files."""
     searches = composite_searches(wildcards.name)
-    figure = [f"specs/figures/{words[1]}.fig"
-              for words in spec_words(f"specs/composite/{wildcards.name}.comp", "figure")[:1]
-              if len(words) > 1 and re.fullmatch(r"\w+", words[1])]
+    figure = parsed_spec(f"specs/composite/{wildcards.name}.comp").figure
     return {
         "script": f"specs/composite/{wildcards.name}.comp",
-        "figure": figure,
+        "figure": [f"specs/figures/{figure}.fig"],
         "specs": [f"specs/bsr/{search}.bsr" for search in searches],
         "controllers": [f"results/bsr/{search}/seed{seed}.h5"
                         for search in searches for seed in bsr_seeds(search)],

@@ -24,7 +24,7 @@ rule composite_search:
     shell:
         "mosys composite {input.script} --controllers {input.controllers}"
         " --figures specs/figures --bsr-specs specs/bsr {params.sizes}"
-        " --budget {params.budget} -o {output} 2> {log} || (cat {log} >&2; exit 1)"
+        " --budget {params.budget} -o {output} > {log} 2>&1"
 
 
 rule composite_plots:
@@ -32,15 +32,17 @@ rule composite_plots:
         result="results/composite/{name}.h5",
         code=code_inputs("mosys.cli.plots", "mosys.plots.composite"),  # mosys plot composite
     output:
-        filmstrips="results/plots/composite/{name}/filmstrips.png",
-        search="results/plots/composite/{name}/search.png",
-        gif="results/plots/composite/{name}/motion.gif",
+        filmstrips=report("results/plots/composite/{name}/filmstrips.png", caption="../report/composite_filmstrips.rst", category="1995 paper: composite motion", subcategory="{name}"),
+        search=report("results/plots/composite/{name}/search.png", caption="../report/composite_search.rst", category="1995 paper: composite motion", subcategory="{name}"),
+        gif=report("results/plots/composite/{name}/motion.gif", caption="../report/composite_gif.rst", category="1995 paper: composite motion", subcategory="{name}"),
     log:
         "results/logs/plots/composite/{name}.log",
+    benchmark:
+        "results/benchmarks/plots/composite/{name}.tsv"
     threads: 1
     shell:
         "mosys plot composite {input.result} --filmstrips {output.filmstrips}"
-        " --search {output.search} --gif {output.gif} 2> {log} || (cat {log} >&2; exit 1)"
+        " --search {output.search} --gif {output.gif} > {log} 2>&1"
 
 
 rule composite_table:
@@ -48,30 +50,32 @@ rule composite_table:
         results=expand("results/composite/{name}.h5", name=config["composite"]["scripts"]),
         code=code_inputs("mosys.cli.paper_tables", "mosys.paper_tables.composite"),  # mosys composite-table
     output:
-        csv="results/tables/composite.csv",
+        csv=report("results/tables/composite.csv", caption="../report/composite_table.rst", category="1995 paper: composite motion", subcategory="tables"),
         md="results/tables/composite.md",
     log:
         "results/logs/tables/composite.log",
+    benchmark:
+        "results/benchmarks/tables/composite.tsv"
     threads: 1
     shell:
-        "mosys composite-table {input.results} --csv {output.csv} --md {output.md}"
-        " 2> {log} || (cat {log} >&2; exit 1)"
+        "mosys composite-table {input.results} --csv {output.csv} --md {output.md} > {log} 2>&1"
 
 
 rule composite_robustness_table:
     input:
-        results=robustness_results(),
+        results=lambda wildcards: robustness_results(),
         specs=[f"specs/bsr/{search}.bsr" for pair in robustness_pairs() for search in pair],
         code=code_inputs("mosys.cli.paper_tables", "mosys.paper_tables.robustness"),  # mosys robustness-table
     output:
-        csv="results/tables/composite_robustness.csv",
+        csv=report("results/tables/composite_robustness.csv", caption="../report/robustness_table.rst", category="1995 paper: composite motion", subcategory="tables"),
         md="results/tables/composite_robustness.md",
     log:
         "results/logs/tables/composite_robustness.log",
+    benchmark:
+        "results/benchmarks/tables/composite_robustness.tsv"
     params:
         pairs=" ".join(f"--pair {robust} {plain}" for robust, plain in robustness_pairs()),
     threads: 1
     shell:
         "mosys robustness-table {input.results} {params.pairs} --bsr-specs specs/bsr"
-        " --figures specs/figures --csv {output.csv} --md {output.md}"
-        " 2> {log} || (cat {log} >&2; exit 1)"
+        " --figures specs/figures --csv {output.csv} --md {output.md} > {log} 2>&1"

@@ -16,5 +16,4 @@ rule run_script:
     priority: 2  # on the path to the script's plots: schedule first
     shell:
         "NUMBA_NUM_THREADS={threads} mosys run {input.script} --controllers {params.controllers}"
-        " --dynamics-dir results/dynamics --dt {params.dt} -o {output} 2> {log}"
-        " || (cat {log} >&2; exit 1)"
+        " --dynamics-dir results/dynamics --dt {params.dt} -o {output} > {log} 2>&1"

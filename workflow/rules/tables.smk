@@ -4,7 +4,7 @@ rule pendulum_table:
         dynamics=f"results/dynamics/{config['pendulum']['figure']}.py",
         code=code_inputs("mosys.cli.paper_tables", "mosys.paper_tables.pendulum"),  # mosys pendulum-table
     output:
-        csv="results/tables/pendulum_controllers.csv",
+        csv=report("results/tables/pendulum_controllers.csv", caption="../report/pendulum_table.rst", category="1990 paper: the pendulum", subcategory="Figure 13"),
         md="results/tables/pendulum_controllers.md",
     log:
         "results/logs/tables/pendulum_controllers.log",
@@ -17,4 +17,4 @@ rule pendulum_table:
     shell:
         "NUMBA_NUM_THREADS={threads} mosys pendulum-table {input.tables} --dynamics {input.dynamics}"
         " --budget {params.budget}"
-        " --csv {output.csv} --md {output.md} 2> {log} || (cat {log} >&2; exit 1)"
+        " --csv {output.csv} --md {output.md} > {log} 2>&1"

@@ -60,7 +60,7 @@ from mosys.plots.style import (
     minus_signs,
     new_figure,
     plot_style,
-    save_png,
+    save_figure,
     scene_figure,
     scene_limits,
     spread_labels,
@@ -269,7 +269,7 @@ def curves_on_grid(results: Sequence[BsrResult]) -> tuple[np.ndarray, np.ndarray
 def plot_learning(results: Sequence[str | Path], path: str | Path) -> None:
     """Write ``learning_figure`` as a PNG to ``path``."""
     with plot_style():
-        save_png(learning_figure(results), path)
+        save_figure(learning_figure(results), path)
 
 
 def learning_figure(results: Sequence[str | Path]) -> Figure:
@@ -376,7 +376,7 @@ def plot_learning_comparison(
 ) -> None:
     """Write ``learning_comparison_figure`` as a PNG to ``path``."""
     with plot_style():
-        save_png(learning_comparison_figure(results_by_search), path)
+        save_figure(learning_comparison_figure(results_by_search), path)
 
 
 def learning_comparison_figure(results_by_search: Mapping[str, Sequence[str | Path]]) -> Figure:
@@ -568,7 +568,7 @@ def plot_filmstrip(
 ) -> None:
     """Write ``filmstrip_figure`` as a PNG to ``path``."""
     with plot_style():
-        save_png(filmstrip_figure(result_path, interval), path)
+        save_figure(filmstrip_figure(result_path, interval), path)
 
 
 def filmstrip_figure(result_path: str | Path, interval: float | None = None) -> Figure:

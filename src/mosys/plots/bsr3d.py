@@ -95,7 +95,7 @@ from mosys.plots.style import (
     pan,
     plot_style,
     samples_to_the_end,
-    save_png,
+    save_figure,
     scene_figure,
     spread_labels,
     write_real_time_gif,
@@ -531,7 +531,7 @@ def plot_filmstrip(
 ) -> None:
     """Write ``filmstrip_figure`` as a PNG to ``path``."""
     with plot_style():
-        save_png(filmstrip_figure(result_paths, interval), path)
+        save_figure(filmstrip_figure(result_paths, interval), path)
 
 
 def filmstrip_figure(
@@ -774,7 +774,7 @@ def plot_learning_kinds(
 ) -> None:
     """Write ``learning_kinds_figure`` as a PNG to ``path``."""
     with plot_style():
-        save_png(learning_kinds_figure(time_results, sense_results, log_x), path)
+        save_figure(learning_kinds_figure(time_results, sense_results, log_x), path)
 
 
 def learning_kinds_figure(
@@ -880,7 +880,7 @@ def learning_kinds_figure(
 def plot_seeds(results: Sequence[str | Path], path: str | Path) -> None:
     """Write ``seeds_figure`` as a PNG to ``path``."""
     with plot_style():
-        save_png(seeds_figure(results), path)
+        save_figure(seeds_figure(results), path)
 
 
 def seeds_figure(results: Sequence[str | Path]) -> Figure:
@@ -912,7 +912,7 @@ FOOT_MARKER = "^"
 def plot_figure_at_rest(motion: FigureMotion, path: str | Path, name: str = "") -> None:
     """Write ``figure_at_rest_figure`` as a PNG to ``path``."""
     with plot_style():
-        save_png(figure_at_rest_figure(motion, name), path)
+        save_figure(figure_at_rest_figure(motion, name), path)
 
 
 def figure_at_rest_figure(motion: FigureMotion, name: str = "") -> Figure:

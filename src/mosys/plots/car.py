@@ -62,7 +62,7 @@ from mosys.plots.style import (
     new_figure,
     plot_style,
     samples_to_the_end,
-    save_png,
+    save_figure,
     write_gif,
 )
 
@@ -752,7 +752,7 @@ def plot_parking_frames(
 ) -> None:
     """Write ``parking_frames_figure`` as a PNG to ``out_path``."""
     with plot_style():
-        save_png(parking_frames_figure(trajectory_paths, interval), out_path)
+        save_figure(parking_frames_figure(trajectory_paths, interval), out_path)
 
 
 def parking_frames_figure(
@@ -960,7 +960,7 @@ def _marker_diameter(xy: np.ndarray, points_per_metre: float) -> float:
 def plot_success_map(start_grid_path: str | Path, out_path: str | Path) -> None:
     """Write ``success_map_figure`` as a PNG to ``out_path``."""
     with plot_style():
-        save_png(success_map_figure(start_grid_path), out_path)
+        save_figure(success_map_figure(start_grid_path), out_path)
 
 
 def success_map_figure(start_grid_path: str | Path) -> Figure:
@@ -1063,7 +1063,7 @@ def success_map_figure(start_grid_path: str | Path) -> Figure:
 def plot_consistency(start_grid_path: str | Path, out_path: str | Path) -> None:
     """Write ``consistency_figure`` as a PNG to ``out_path``."""
     with plot_style():
-        save_png(consistency_figure(start_grid_path), out_path)
+        save_figure(consistency_figure(start_grid_path), out_path)
 
 
 def consistency_figure(start_grid_path: str | Path) -> Figure:

@@ -55,7 +55,7 @@ from mosys.plots.style import (
     minus_signs,
     new_figure,
     plot_style,
-    save_png,
+    save_figure,
     scene_figure,
     scene_limits,
     spread_labels,
@@ -284,7 +284,7 @@ def plot_filmstrips(
 ) -> None:
     """Write ``filmstrips_figure`` as a PNG to ``path``."""
     with plot_style():
-        save_png(filmstrips_figure(result_path, interval), path)
+        save_figure(filmstrips_figure(result_path, interval), path)
 
 
 def filmstrips_figure(result_path: str | Path, interval: float | None = None) -> Figure:
@@ -511,7 +511,7 @@ def search_curve(result: CompositeResult) -> tuple[np.ndarray, np.ndarray]:
 def plot_search(result_path: str | Path, path: str | Path) -> None:
     """Write ``search_figure`` as a PNG to ``path``."""
     with plot_style():
-        save_png(search_figure(result_path), path)
+        save_figure(search_figure(result_path), path)
 
 
 def search_figure(result_path: str | Path) -> Figure:

@@ -20,7 +20,7 @@ from mosys.plots.style import (
     axis_label,
     new_figure,
     plot_style,
-    save_png,
+    save_figure,
 )
 
 SCRIPT_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple")
@@ -101,4 +101,4 @@ def plot_controls(
     trajectory_paths: Sequence[str | Path], out_path: str | Path, control: str | None = None
 ) -> None:
     """Write ``controls_figure`` to ``out_path`` (PNG)."""
-    save_png(controls_figure(trajectory_paths, control), out_path)
+    save_figure(controls_figure(trajectory_paths, control), out_path)

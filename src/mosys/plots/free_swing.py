@@ -14,7 +14,7 @@ from matplotlib.lines import Line2D
 
 from mosys.dynamics.free_swing import free_swing
 from mosys.plots.pendulum import StateAxis, format_state_axes, plot_state_path
-from mosys.plots.style import add_legend, new_figure, plot_style, save_png
+from mosys.plots.style import add_legend, new_figure, plot_style, save_figure
 
 LIBRATION_COLOR = "tab:blue"
 ROTATION_COLOR = "tab:green"
@@ -77,4 +77,4 @@ def free_swing_figure(dynamics: ModuleType) -> Figure:
 
 def plot_free_swing(dynamics: ModuleType, out_path: str | Path) -> None:
     """Write Figure 5 of ``dynamics`` (a one-coordinate figure) to ``out_path`` (PNG)."""
-    save_png(free_swing_figure(dynamics), out_path)
+    save_figure(free_swing_figure(dynamics), out_path)

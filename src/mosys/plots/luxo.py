@@ -54,7 +54,7 @@ from mosys.plots.style import (
     new_figure,
     pan,
     plot_style,
-    save_png,
+    save_figure,
     scene_figure,
     scene_limits,
     write_real_time_gif,
@@ -262,7 +262,7 @@ def plot_motion_strip(
 ) -> None:
     """Write ``motion_strip_figure`` as a PNG to ``out_path``."""
     with plot_style():
-        save_png(motion_strip_figure(trajectory_path, motion, every), out_path)
+        save_figure(motion_strip_figure(trajectory_path, motion, every), out_path)
 
 
 def motion_strip_figure(
@@ -470,7 +470,7 @@ def _mark_motions(
 def plot_torques_and_forces(trajectory_path: str | Path, out_path: str | Path) -> None:
     """Write ``torques_and_forces_figure`` as a PNG to ``out_path``."""
     with plot_style():
-        save_png(torques_and_forces_figure(trajectory_path), out_path)
+        save_figure(torques_and_forces_figure(trajectory_path), out_path)
 
 
 def torques_and_forces_figure(trajectory_path: str | Path) -> Figure:

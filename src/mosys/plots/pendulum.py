@@ -50,7 +50,7 @@ from mosys.plots.style import (
     mark_start,
     new_figure,
     plot_style,
-    save_png,
+    save_figure,
     start_style,
     write_gif,
 )
@@ -333,7 +333,7 @@ def plot_portrait(
 ) -> None:
     """Write ``portrait_figure`` as a PNG to ``out_path``."""
     with plot_style():
-        save_png(portrait_figure(table_path, dynamics, seconds, starts), out_path)
+        save_figure(portrait_figure(table_path, dynamics, seconds, starts), out_path)
 
 
 def portrait_figure(
@@ -406,7 +406,7 @@ def portrait_figure(
 def plot_torque(table_path: str | Path, out_path: str | Path, contours: bool = True) -> None:
     """Write ``torque_figure`` as a PNG to ``out_path``."""
     with plot_style():
-        save_png(torque_figure(table_path, contours), out_path)
+        save_figure(torque_figure(table_path, contours), out_path)
 
 
 def torque_figure(table_path: str | Path, contours: bool = True) -> Figure:
@@ -598,7 +598,7 @@ def plot_script(
 ) -> None:
     """Write ``script_path_figure`` as a PNG to ``out_path``."""
     with plot_style():
-        save_png(script_path_figure(trajectory_path, table_paths), out_path)
+        save_figure(script_path_figure(trajectory_path, table_paths), out_path)
 
 
 def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | Path]) -> Figure:

@@ -93,9 +93,18 @@ def arrange(figure: Figure, legend_rows: int = 0) -> None:
     )
 
 
-def save_png(figure: Figure, path: str | Path) -> None:
-    """Write ``figure`` as a PNG to ``path`` atomically (a hidden partial file, then a rename)."""
-    write_atomically(path, lambda partial: figure.savefig(partial, format="png", dpi=DPI))
+FIGURE_FORMATS = ("png", "pdf", "svg")  # what a plot's file name may end in
+
+
+def save_figure(figure: Figure, path: str | Path) -> None:
+    """Write ``figure`` to ``path`` atomically (a hidden partial file, then a rename), in the
+    format its extension names: PNG (DPI dots per inch), PDF or SVG; PlotInputError for any
+    other extension, before anything is written."""
+    extension = Path(path).suffix.lower().lstrip(".")
+    if extension not in FIGURE_FORMATS:
+        allowed = ", ".join(f".{name}" for name in FIGURE_FORMATS)
+        raise PlotInputError(f"{path}: a plot's file name ends in {allowed}")
+    write_atomically(path, lambda partial: figure.savefig(partial, format=extension, dpi=DPI))
 
 
 def minus_signs(text: str) -> str:

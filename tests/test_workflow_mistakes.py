@@ -1,0 +1,84 @@
+"""Mistakes the workflow catches before any job runs (dry runs of a copy of the workflow, nothing
+built): a config key the schema does not know, a target no rule makes, a spec that is missing
+or malformed (the parser's own file:line:column message), and a controller drawn with its own
+figure's dynamics."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from test_workflow import copy_workflow, run_snakemake
+
+
+@pytest.fixture(scope="module")
+def work(tmp_path_factory) -> Path:
+    return copy_workflow(tmp_path_factory.mktemp("mistakes"))
+
+
+def dry_run(work: Path, *args: str):
+    done = run_snakemake(work, "--dry-run", "--printshellcmds", *args)
+    return done.returncode, done.stdout + done.stderr
+
+
+def test_a_mistyped_config_key_is_refused_before_anything_runs(work):
+    code, output = dry_run(work, "results/pendulum_all", "--config", "bsr={generation: 5}")
+    assert code != 0
+    assert "Additional properties are not allowed ('generation' was unexpected)" in output
+    code, output = dry_run(work, "results/pendulum_all", "--config", "pendulm={group: x}")
+    assert code != 0 and "'pendulm' was unexpected" in output
+    assert not (work / "results").exists()
+
+
+@pytest.mark.parametrize(
+    "target",
+    [
+        "results/plots/car/manoeuvr.gif",  # the car's GIF is manoeuvre.gif
+        "results/controllers/pendulum/sub/A.h5",  # a wildcard never spans a '/'
+        "results/bsr/starman_shuffle/seedX.h5",  # a seed is a number
+        "results/plots/pendulum/A_portrait.jpg",
+    ],
+)
+def test_a_target_no_rule_makes_says_so(work, target):
+    code, output = dry_run(work, target)
+    assert code != 0
+    assert f"No rule to produce {target}" in output
+
+
+def test_a_missing_spec_stops_the_dag_with_the_parsers_message(work):
+    code, output = dry_run(work, "results/trajectories/nosuch.anim.h5")
+    assert code != 0 and "No rule to produce" in output
+    code, output = dry_run(work, "results/trajectories/nosuch.h5")
+    assert code != 0
+    assert "specs/scripts/nosuch.anim:1:1: expected an existing spec file" in output
+
+
+def test_a_script_naming_a_controller_without_a_spec_is_caught_in_the_dag(work):
+    (work / "specs/scripts/q.anim").write_text(
+        "state link -90,0\nswapcon link conQ.ctab\nsim 1\n", encoding="utf-8"
+    )
+    code, output = dry_run(work, "results/trajectories/q.h5")
+    assert code != 0
+    assert "specs/controllers/q/Q.ssc:1:1: expected an existing spec file" in output
+    (work / "specs/scripts/q.anim").unlink()
+
+
+def test_a_malformed_spec_stops_the_dag_with_its_location(work):
+    spec = work / "specs/scripts/pendulum_catch.anim"
+    text = spec.read_text(encoding="utf-8")
+    try:
+        spec.write_text(text.replace("swapcon conB.ctab once", "swapcon conB.ctab twice"))
+        code, output = dry_run(work, "results/pendulum_all")
+        assert code != 0
+        assert "specs/scripts/pendulum_catch.anim:9:" in output
+        assert "expected 'once' or end of line, found 'twice'" in output
+    finally:
+        spec.write_text(text, encoding="utf-8")
+
+
+def test_a_controller_is_drawn_with_its_own_figures_dynamics(work):
+    code, output = dry_run(work, "results/plots/luxo/land_portrait.png")
+    assert code == 0, output
+    assert "mosys plot controller results/controllers/luxo/land.h5" in output
+    assert "--dynamics results/dynamics/luxo_grounded.py" in output
+    assert "results/dynamics/link1.py" not in output
