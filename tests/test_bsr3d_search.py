@@ -72,6 +72,7 @@ def test_a_new_sense_rule_contains_a_point_of_the_parents_sense_trajectory():
         assert active_rule(point, center[1:2], side[1:2], rule_weights(side[1:2]), -1) == 0
 
 
+@pytest.mark.slow  # a minute and more: a whole sense-based search
 def test_a_sense_based_search_enriches_its_first_population_with_three_rounds():
     spec = SPEC.replace("controller time rules=3 period=0.4", "controller sense rules=3")
     outcome = run_search(setup(spec), 1)

@@ -278,6 +278,8 @@ TOP_LEVEL_HELP = (
     "  robustness-table   robust BSR searches against their plain twins\n"
     "pipeline:\n"
     "  index              write an aggregate target: the list of its files\n"
+    "looking inside results:\n"
+    "  info               a result file (.h5): its kind, axes, units and datasets\n"
     "\n"
     "options:\n"
     "  -h, --help  show this help message and exit\n"
@@ -329,6 +331,7 @@ VERBS = [
     "composite-table",
     "robustness-table",
     "index",
+    "info",
 ]
 
 

@@ -19,6 +19,7 @@ from mosys.dynamics.load import figure_dynamics
 from mosys.io.controller_table import read_controller_table
 from mosys.io.trajectory import Trajectory, write_trajectory
 from mosys.parsing.script import SwapController, parse_script
+from mosys.ssc.grid import control_units, state_unit
 
 
 def run_animation_script(
@@ -70,6 +71,8 @@ def run_animation_script(
         controller=run.source,
         state_order=run.state_order,
         control_names=run.control_names,
+        state_units=tuple(state_unit(dynamics, name)[0] for name in run.state_order),
+        control_units=control_units(dynamics, run.control_names),
         controllers=run.sources,
         attrs={
             "script": str(script_path),

@@ -1,8 +1,9 @@
 """The ``mosys`` command line: argument parsing and exit codes, nothing else.
 
 Each verb family has its module here (``dynamics``, ``ssc``, ``animation``, ``bsr``,
-``composite``, ``plots``, ``paper_tables``, ``index``), declaring every verb's arguments, checks
-and handler together (``verb.Verb``); this module assembles them into one parser and runs one.
+``composite``, ``plots``, ``paper_tables``, ``index``, ``info``), declaring every verb's
+arguments, checks and handler together (``verb.Verb``); this module assembles them into one
+parser and runs one.
 
 Exit codes: 0 success; 2 a bad spec or input (a ``file:line:column: expected ..., found ...``
 message, no traceback, no output file) or bad arguments; 1 any other failure.
@@ -15,7 +16,7 @@ import sys
 import textwrap
 
 from mosys import __version__
-from mosys.cli import animation, bsr, composite, dynamics, index, paper_tables, plots, ssc
+from mosys.cli import animation, bsr, composite, dynamics, index, info, paper_tables, plots, ssc
 from mosys.cli.verb import Family
 
 # In `mosys --help` order: the pipeline's steps, then what is drawn and tabulated from them.
@@ -28,6 +29,7 @@ FAMILIES: tuple[Family, ...] = (
     plots.FAMILY,
     paper_tables.FAMILY,
     index.FAMILY,
+    info.FAMILY,
 )
 
 _HELP_WIDTH = 78  # argparse's own width on an 80-column terminal

@@ -4,6 +4,10 @@ Layout of ``best/controller`` (ours; documented in the README): datasets ``targe
 ``tau`` (R,) s; sense-based also ``center`` and ``side`` (R, V) in normalised sense units (the
 hyper-rectangle of rule i spans ``center ± side/2``); time-based also ``segment`` (R,) s. Group
 attrs ``kind``, ``period`` (s, time-based; NaN otherwise), ``joint_names``, ``sense_names``.
+
+Every dataset has a ``unit`` (``1`` for the learning curve and the normalised sense units,
+``index`` for ``best/active_rule``, ``SI`` for ``best/final_state``) and the root the provenance
+attrs (``io.provenance``); docs/formats/bsr_result.md.
 """
 
 from __future__ import annotations
@@ -16,7 +20,8 @@ import h5py
 import numpy as np
 
 from mosys.io.atomic import write_atomically
-from mosys.io.attributes import string_tuple
+from mosys.io.attributes import DIMENSIONLESS, INDEX, SI_STATE, create_with_unit, string_tuple
+from mosys.io.provenance import provenance_attributes
 from mosys.io.trajectory import FigureMotion, read_figure_motion, write_figure_motion
 
 
@@ -99,35 +104,42 @@ def write_bsr_result(path: str | Path, result: BsrResult) -> None:
     def write(partial: Path) -> None:
         with h5py.File(partial, "w") as h5:
             curve = h5.create_group("learning_curve")
-            curve.create_dataset("evaluations", data=np.asarray(result.evaluations, np.int64))
-            curve.create_dataset("best_fitness", data=np.asarray(result.best_fitness, np.float64))
+            evaluations = np.asarray(result.evaluations, np.int64)
+            create_with_unit(curve, "evaluations", evaluations, DIMENSIONLESS)
+            fitness = np.asarray(result.best_fitness, np.float64)
+            create_with_unit(curve, "best_fitness", fitness, DIMENSIONLESS)
             best = h5.create_group("best")
             controller = best.create_group("controller")
             _write_controller(controller, result.controller)
             controller.attrs["joint_names"] = list(result.joint_names)
             controller.attrs["sense_names"] = list(result.sense_names)
             write_figure_motion(best.create_group("figure_motion"), result.motion)
-            best.create_dataset("active_rule", data=np.asarray(result.active_rule, np.int64))
+            create_with_unit(best, "active_rule", np.asarray(result.active_rule, np.int64), INDEX)
             if result.final_state is not None:
-                best.create_dataset("final_state", data=np.asarray(result.final_state, np.float64))
-                best.create_dataset("final_force", data=np.asarray(result.final_force, np.float64))
+                final_state = np.asarray(result.final_state, np.float64)
+                create_with_unit(best, "final_state", final_state, SI_STATE)
+                final_force = np.asarray(result.final_force, np.float64)
+                create_with_unit(best, "final_force", final_force, "N")
             h5.attrs["format_version"] = FORMAT_VERSION
             for key, value in result.attrs.items():
                 h5.attrs[key] = value
+            h5.attrs.update(provenance_attributes())  # this process wrote it, whatever was read
 
     write_atomically(path, write)
 
 
 def _write_controller(group: h5py.Group, controller: BsrController) -> None:
     group.attrs["kind"] = controller.kind
-    group.create_dataset("target", data=np.degrees(controller.target))
-    group.create_dataset("tau", data=np.asarray(controller.tau, np.float64))
+    create_with_unit(group, "target", np.degrees(controller.target), "deg")
+    create_with_unit(group, "tau", np.asarray(controller.tau, np.float64), "s")
     if controller.kind == "sense":
-        group.create_dataset("center", data=np.asarray(controller.center, np.float64))
-        group.create_dataset("side", data=np.asarray(controller.side, np.float64))
+        center = np.asarray(controller.center, np.float64)
+        create_with_unit(group, "center", center, DIMENSIONLESS)
+        create_with_unit(group, "side", np.asarray(controller.side, np.float64), DIMENSIONLESS)
         group.attrs["period"] = float("nan")
     else:
-        group.create_dataset("segment", data=np.asarray(controller.segment, np.float64))
+        segment = np.asarray(controller.segment, np.float64)
+        create_with_unit(group, "segment", segment, "s")
         group.attrs["period"] = float(controller.period)
 
 

@@ -10,6 +10,10 @@ and ``scores_after`` (JSON object: phase -> score), ``seeds`` (P,) the seed of e
 controller, ``controller_files``, ``search_q``, ``search_g``, ``search_h``, ``search_seed``,
 ``budget``, and ``script_text`` (the script as written). Each entry of ``phases`` also names the
 phase (``name``), its ``seed`` and its ``ticks``.
+
+Every dataset has a ``unit`` (``index`` for ``phase`` and ``active_rule``, ``1`` for
+``search/best_score``) and the root the provenance attrs (``io.provenance``);
+docs/formats/composite_result.md.
 """
 
 from __future__ import annotations
@@ -22,6 +26,8 @@ import h5py
 import numpy as np
 
 from mosys.io.atomic import write_atomically
+from mosys.io.attributes import DIMENSIONLESS, INDEX, create_with_unit
+from mosys.io.provenance import provenance_attributes
 from mosys.io.trajectory import FigureMotion, read_figure_motion, write_figure_motion
 
 FORMAT_VERSION = 1
@@ -66,8 +72,8 @@ class CompositeResult:
 
 def _write_motion(group: h5py.Group, stored: CompositeMotion) -> None:
     write_figure_motion(group.create_group("figure_motion"), stored.motion)
-    group.create_dataset("phase", data=np.asarray(stored.phase, np.int64))
-    group.create_dataset("active_rule", data=np.asarray(stored.active_rule, np.int64))
+    create_with_unit(group, "phase", np.asarray(stored.phase, np.int64), INDEX)
+    create_with_unit(group, "active_rule", np.asarray(stored.active_rule, np.int64), INDEX)
 
 
 def _read_motion(group: h5py.Group) -> CompositeMotion:
@@ -86,12 +92,12 @@ def write_composite_result(path: str | Path, result: CompositeResult) -> None:
             _write_motion(h5, result.after)
             _write_motion(h5.create_group("before"), result.before)
             search = h5.create_group("search")
-            search.create_dataset(
-                "best_score", data=np.asarray(result.best_by_generation, np.float64)
-            )
+            best_score = np.asarray(result.best_by_generation, np.float64)
+            create_with_unit(search, "best_score", best_score, DIMENSIONLESS)
             h5.attrs["format_version"] = FORMAT_VERSION
             for key, value in result.attrs.items():
                 h5.attrs[key] = value
+            h5.attrs.update(provenance_attributes())  # this process wrote it, whatever was read
 
     write_atomically(path, write)
 

@@ -1,4 +1,10 @@
-"""The controller table contract (DESIGN.md, ``results/controllers/F/C.h5``): write and read."""
+"""The controller table contract (DESIGN.md, ``results/controllers/F/C.h5``): write and read.
+
+Beyond the contract (docs/formats/controller_table.md): every dataset has a ``unit``
+(``/torque`` also ``units``, one per control); each ``/axes/<name>`` is an HDF5 dimension scale
+named ``<name>``, attached to ``/value``, ``/torque``, ``/dead_end`` and ``/destination_index``
+along its state dimension (labelled ``<name>``; ``/torque``'s last dimension is labelled
+``control``); the root carries the provenance attrs (``io.provenance``)."""
 
 from __future__ import annotations
 
@@ -10,7 +16,16 @@ import h5py
 import numpy as np
 
 from mosys.io.atomic import write_atomically
-from mosys.io.attributes import string_tuple
+from mosys.io.attributes import (
+    INDEX,
+    column_units,
+    create_with_unit,
+    set_column_units,
+    string_tuple,
+)
+from mosys.io.provenance import provenance_attributes
+from mosys.parsing.vehicle import INPUT_NAMES as VEHICLE_CONTROLS
+from mosys.parsing.vehicle import INPUT_UNITS as VEHICLE_CONTROL_UNITS
 
 FORMAT_VERSION = 1
 
@@ -33,6 +48,10 @@ class ControllerTable:
     ``destination_index`` (n_1, ..., n_d) int64, dataset ``/destination_index``: the index into
     ``destinations`` of the destination the node's optimal path ends at, -1 where the value is
     inf (``kernels.dp.destination_indices`` says how it is found).
+
+    control_units: the spec unit of each control ('N*m' for a hinge actuator, 'deg/s' and
+    'deg/s^2' for the car's), written as ``/torque``'s ``units``; None: the writer infers them
+    (``torque_units``), and a file without them reads as None.
     """
 
     state_order: tuple[str, ...]
@@ -51,6 +70,7 @@ class ControllerTable:
     dead_end: np.ndarray | None = None
     destinations: tuple[dict[str, float], ...] | None = None
     destination_index: np.ndarray | None = None
+    control_units: tuple[str, ...] | None = None
 
     @property
     def all_destinations(self) -> tuple[dict[str, float], ...]:
@@ -73,17 +93,23 @@ def write_controller_table(path: str | Path, table: ControllerTable) -> None:
             for name, axis, unit, wrap in zip(
                 table.state_order, table.axes, table.axis_units, table.wrap, strict=True
             ):
-                dataset = axes.create_dataset(name, data=np.asarray(axis, dtype=np.float64))
-                dataset.attrs["unit"] = unit
-                dataset.attrs["wrap"] = bool(wrap)
-            h5.create_dataset("torque", data=table.torque.astype(np.float64))
-            h5.create_dataset("value", data=table.value.astype(np.float64))
+                scale = create_with_unit(axes, name, np.asarray(axis, dtype=np.float64), unit)
+                scale.attrs["wrap"] = bool(wrap)
+                scale.make_scale(name)
+            torque = h5.create_dataset("torque", data=table.torque.astype(np.float64))
+            set_column_units(torque, torque_units(table))
+            torque.dims[len(table.state_order)].label = "control"
+            per_node = [torque, create_with_unit(h5, "value", table.value.astype(float), "s")]
             if table.dead_end is not None:
-                h5.create_dataset("dead_end", data=np.asarray(table.dead_end, dtype=np.bool_))
+                dead_end = np.asarray(table.dead_end, dtype=np.bool_)
+                per_node.append(create_with_unit(h5, "dead_end", dead_end, INDEX))
             if table.destination_index is not None:
-                h5.create_dataset(
-                    "destination_index", data=np.asarray(table.destination_index, dtype=np.int64)
-                )
+                index = np.asarray(table.destination_index, dtype=np.int64)
+                per_node.append(create_with_unit(h5, "destination_index", index, INDEX))
+            for dataset in per_node:
+                for k, name in enumerate(table.state_order):
+                    dataset.dims[k].attach_scale(axes[name])
+                    dataset.dims[k].label = name
             h5.attrs["format_version"] = FORMAT_VERSION
             h5.attrs["state_order"] = list(table.state_order)
             h5.attrs["control_names"] = list(table.control_names)
@@ -96,8 +122,22 @@ def write_controller_table(path: str | Path, table: ControllerTable) -> None:
             h5.attrs["figure"] = table.figure
             for key, value in table.attrs.items():
                 h5.attrs[key] = value
+            h5.attrs.update(provenance_attributes())  # this process wrote it, whatever was read
 
     write_atomically(path, write)
+
+
+def torque_units(table: ControllerTable) -> tuple[str, ...]:
+    """The spec unit of each control: ``table.control_units`` when given; else the car's
+    (parsing.vehicle) for a vehicle's table (root attr ``wheelbase``), and N*m for an
+    articulated figure's (its controls are hinge actuators: a figure spec actuates only
+    hinges)."""
+    if table.control_units is not None:
+        return tuple(table.control_units)
+    vehicle = dict(zip(VEHICLE_CONTROLS, VEHICLE_CONTROL_UNITS, strict=True))
+    if "wheelbase" in table.attrs and all(name in vehicle for name in table.control_names):
+        return tuple(vehicle[name] for name in table.control_names)
+    return tuple("N*m" for _ in table.control_names)
 
 
 def read_controller_table(path: str | Path) -> ControllerTable:
@@ -139,4 +179,5 @@ def read_controller_table(path: str | Path) -> ControllerTable:
             destination_index=np.asarray(h5["destination_index"][()], dtype=np.int64)
             if "destination_index" in h5
             else None,
+            control_units=column_units(h5["torque"]),
         )

@@ -6,7 +6,11 @@ run), ``cost_to_go`` (n,) float64 s (the table's, interpolated at the start as t
 inf: unknown) and ``path_length`` (n,) float64 m (the shortest collision-free path the pose
 search found; inf: none, nan: the start is not free); root attrs ``controller``,
 ``simulated_seconds``, ``dt`` and the scene (``io.car_scene``). The success rate counts the
-starts that are not excluded."""
+starts that are not excluded.
+
+Every dataset also has a ``unit`` (``start`` also ``units``, one per column; booleans ``index``,
+``excluded`` ``text``) and the root the provenance attrs (``io.provenance``);
+docs/formats/start_grid.md."""
 
 from __future__ import annotations
 
@@ -18,7 +22,16 @@ import numpy as np
 
 from mosys.errors import InputError
 from mosys.io.atomic import write_atomically
-from mosys.io.attributes import string_tuple
+from mosys.io.attributes import (
+    INDEX,
+    TEXT,
+    column_units,
+    create_with_unit,
+    set_column_units,
+    string_tuple,
+)
+from mosys.io.provenance import provenance_attributes
+from mosys.parsing import vehicle
 
 STRING = h5py.string_dtype()
 
@@ -48,7 +61,9 @@ def consistency_summary(ratios: np.ndarray) -> tuple[float, float, float]:
 
 @dataclass(frozen=True)
 class StartGrid:
-    """Start states (n, d) spec units in ``state_order`` and their outcomes."""
+    """Start states (n, d) spec units in ``state_order`` and their outcomes. state_units: the
+    spec unit of each column (``start``'s ``units``); None: the car's (parsing.vehicle) for its
+    variables, and a file without them reads as None."""
 
     start: np.ndarray
     state_order: tuple[str, ...]
@@ -59,6 +74,7 @@ class StartGrid:
     cost_to_go: np.ndarray
     path_length: np.ndarray
     attrs: dict
+    state_units: tuple[str, ...] | None = None
 
     @property
     def counted(self) -> np.ndarray:
@@ -83,20 +99,32 @@ def write_start_grid(path: str | Path, grid: StartGrid) -> None:
 
     def write(partial: Path) -> None:
         with h5py.File(partial, "w") as h5:
-            h5.create_dataset("start", data=np.asarray(grid.start, dtype=np.float64))
-            h5.create_dataset("parked", data=np.asarray(grid.parked, dtype=np.bool_))
-            h5.create_dataset("collided", data=np.asarray(grid.collided, dtype=np.bool_))
-            h5.create_dataset("parking_seconds", data=np.asarray(grid.parking_seconds, float))
-            h5.create_dataset(
-                "excluded", data=np.asarray(grid.excluded, dtype=object), dtype=STRING
-            )
-            h5.create_dataset("cost_to_go", data=np.asarray(grid.cost_to_go, float))
-            h5.create_dataset("path_length", data=np.asarray(grid.path_length, float))
+            start = h5.create_dataset("start", data=np.asarray(grid.start, dtype=np.float64))
+            set_column_units(start, start_units(grid))
+            create_with_unit(h5, "parked", np.asarray(grid.parked, dtype=np.bool_), INDEX)
+            create_with_unit(h5, "collided", np.asarray(grid.collided, dtype=np.bool_), INDEX)
+            create_with_unit(h5, "parking_seconds", np.asarray(grid.parking_seconds, float), "s")
+            excluded = np.asarray(grid.excluded, dtype=object)
+            create_with_unit(h5, "excluded", excluded, TEXT, dtype=STRING)
+            create_with_unit(h5, "cost_to_go", np.asarray(grid.cost_to_go, float), "s")
+            create_with_unit(h5, "path_length", np.asarray(grid.path_length, float), "m")
             h5.attrs["state_order"] = list(grid.state_order)
             for key, value in grid.attrs.items():
                 h5.attrs[key] = value
+            h5.attrs.update(provenance_attributes())  # this process wrote it, whatever was read
 
     write_atomically(path, write)
+
+
+def start_units(grid: StartGrid) -> tuple[str, ...] | None:
+    """The spec unit of each start column: ``grid.state_units``, else the car's for the car's
+    variables (parsing.vehicle), else None (unknown: ``unit`` ``spec``)."""
+    if grid.state_units is not None:
+        return tuple(grid.state_units)
+    units = dict(zip(vehicle.STATE_NAMES, vehicle.STATE_UNITS, strict=True))
+    if all(name in units for name in grid.state_order):
+        return tuple(units[name] for name in grid.state_order)
+    return None
 
 
 DATASETS = (
@@ -131,4 +159,5 @@ def read_start_grid(path: str | Path) -> StartGrid:
             cost_to_go=h5["cost_to_go"][()],
             path_length=h5["path_length"][()],
             attrs={k: h5.attrs[k] for k in h5.attrs if k != "state_order"},
+            state_units=column_units(h5["start"]),
         )

@@ -1,5 +1,10 @@
 """The trajectory contract (DESIGN.md, ``results/trajectories/S.h5``) and the ``figure_motion``
-group every moving articulated figure writes."""
+group every moving articulated figure writes.
+
+Beyond the contract (docs/formats/trajectory.md, figure_motion.md): every dataset has a
+``unit``; ``/state`` and ``/control`` also ``units`` (one per column) when the writer is told
+them or can tell (a car's fixed variables), else ``unit`` ``spec``; the root carries the
+provenance attrs (``io.provenance``)."""
 
 from __future__ import annotations
 
@@ -11,7 +16,15 @@ import h5py
 import numpy as np
 
 from mosys.io.atomic import write_atomically
-from mosys.io.attributes import string_tuple
+from mosys.io.attributes import (
+    INDEX,
+    column_units,
+    create_with_unit,
+    set_column_units,
+    string_tuple,
+)
+from mosys.io.provenance import provenance_attributes
+from mosys.parsing import vehicle
 
 FORMAT_VERSION = 1
 
@@ -43,9 +56,9 @@ class FigureMotion:
 
 def write_figure_motion(group: h5py.Group, motion: FigureMotion) -> None:
     """Fill an open HDF5 group with the ``figure_motion`` contract."""
-    group.create_dataset("t", data=np.asarray(motion.t, dtype=np.float64))
-    group.create_dataset("endpoints", data=np.asarray(motion.endpoints, dtype=np.float64))
-    group.create_dataset("com", data=np.asarray(motion.com, dtype=np.float64))
+    create_with_unit(group, "t", np.asarray(motion.t, dtype=np.float64), "s")
+    create_with_unit(group, "endpoints", np.asarray(motion.endpoints, dtype=np.float64), "m")
+    create_with_unit(group, "com", np.asarray(motion.com, dtype=np.float64), "m")
     group.attrs["rod_names"] = list(motion.rod_names)
     group.attrs["rod_mass"] = np.asarray(motion.rod_mass, dtype=np.float64)
     group.attrs["rod_length"] = np.asarray(motion.rod_length, dtype=np.float64)
@@ -100,7 +113,10 @@ class Trajectory:
     """A script's trajectory. t: (N,) s; state: (N, d) spec units in ``state_order``; control:
     (N, m); controller: (N,) int64 index into ``controllers`` (table file stems); attrs: extra
     root attributes; motion: the figure's ``figure_motion`` (None for non-articulated figures);
-    contacts: its contact points (None for a figure without them)."""
+    contacts: its contact points (None for a figure without them). state_units, control_units:
+    the spec unit of each column ('deg', 'deg/s', 'm', 'm/s'; 'N*m', ...), written as the
+    datasets' ``units``; None: the writer infers them where it can (``column_units_of``), and a
+    file without them reads as None."""
 
     t: np.ndarray
     state: np.ndarray
@@ -112,6 +128,8 @@ class Trajectory:
     attrs: dict
     motion: FigureMotion | None
     contacts: Contacts | None = None
+    state_units: tuple[str, ...] | None = None
+    control_units: tuple[str, ...] | None = None
 
 
 def write_trajectory(path: str | Path, trajectory: Trajectory) -> None:
@@ -119,10 +137,14 @@ def write_trajectory(path: str | Path, trajectory: Trajectory) -> None:
 
     def write(partial: Path) -> None:
         with h5py.File(partial, "w") as h5:
-            h5.create_dataset("t", data=np.asarray(trajectory.t, dtype=np.float64))
-            h5.create_dataset("state", data=np.asarray(trajectory.state, dtype=np.float64))
-            h5.create_dataset("control", data=np.asarray(trajectory.control, dtype=np.float64))
-            h5.create_dataset("controller", data=np.asarray(trajectory.controller, np.int64))
+            state_units, control_units = column_units_of(trajectory)
+            create_with_unit(h5, "t", np.asarray(trajectory.t, dtype=np.float64), "s")
+            state = h5.create_dataset("state", data=np.asarray(trajectory.state, np.float64))
+            set_column_units(state, state_units)
+            control = h5.create_dataset("control", data=np.asarray(trajectory.control, float))
+            set_column_units(control, control_units)
+            controller = np.asarray(trajectory.controller, np.int64)
+            create_with_unit(h5, "controller", controller, INDEX)
             h5.attrs["format_version"] = FORMAT_VERSION
             h5.attrs["state_order"] = list(trajectory.state_order)
             h5.attrs["control_names"] = list(trajectory.control_names)
@@ -134,12 +156,36 @@ def write_trajectory(path: str | Path, trajectory: Trajectory) -> None:
             if trajectory.contacts is not None:
                 group = h5.create_group("contacts")
                 contacts = trajectory.contacts
-                group.create_dataset("position", data=np.asarray(contacts.position, np.float64))
-                group.create_dataset("force", data=np.asarray(contacts.force, np.float64))
+                position = np.asarray(contacts.position, np.float64)
+                create_with_unit(group, "position", position, "m")
+                create_with_unit(group, "force", np.asarray(contacts.force, np.float64), "N")
                 group.attrs["rods"] = list(contacts.rods)
                 group.attrs["fraction"] = np.asarray(contacts.fraction, np.float64)
+            h5.attrs.update(provenance_attributes())  # this process wrote it, whatever was read
 
     write_atomically(path, write)
+
+
+def column_units_of(
+    trajectory: Trajectory,
+) -> tuple[tuple[str, ...] | None, tuple[str, ...] | None]:
+    """The spec units of the state and control columns: those the trajectory gives; else, for a
+    car (no ``figure_motion``, the car's fixed variable names: parsing.vehicle), the car's;
+    else None for the state (an articulated figure's variables are named by its spec, which
+    the file does not hold) and N*m for the controls (a figure spec actuates only hinges)."""
+    state_units, control_units = trajectory.state_units, trajectory.control_units
+    is_car = (
+        trajectory.motion is None
+        and set(trajectory.state_order) <= set(vehicle.STATE_NAMES)
+        and set(trajectory.control_names) <= set(vehicle.INPUT_NAMES)
+    )
+    if state_units is None and is_car:
+        units = dict(zip(vehicle.STATE_NAMES, vehicle.STATE_UNITS, strict=True))
+        state_units = tuple(units[name] for name in trajectory.state_order)
+    if control_units is None:
+        units = dict(zip(vehicle.INPUT_NAMES, vehicle.INPUT_UNITS, strict=True))
+        control_units = tuple(units[name] if is_car else "N*m" for name in trajectory.control_names)
+    return state_units, control_units
 
 
 def read_trajectory(path: str | Path) -> Trajectory:
@@ -157,6 +203,8 @@ def read_trajectory(path: str | Path) -> Trajectory:
             attrs={k: h5.attrs[k] for k in h5.attrs if k not in known},
             motion=read_figure_motion(h5["figure_motion"]) if "figure_motion" in h5 else None,
             contacts=_read_contacts(h5["contacts"]) if "contacts" in h5 else None,
+            state_units=column_units(h5["state"]),
+            control_units=column_units(h5["control"]),
         )
 
 

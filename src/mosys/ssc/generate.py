@@ -38,7 +38,13 @@ from mosys.kernels.dp import (
 )
 from mosys.kernels.specialise import specialise
 from mosys.parsing.controller import ControllerSpec
-from mosys.ssc.grid import FigureGrid, control_scale, figure_grid, figure_state_names
+from mosys.ssc.grid import (
+    FigureGrid,
+    control_scale,
+    control_units,
+    figure_grid,
+    figure_state_names,
+)
 from mosys.ssc.lookahead import vehicle_arrival
 from mosys.ssc.obstacles import Obstacles, blocked_reason, spec_obstacles
 
@@ -580,6 +586,7 @@ def generate_controller(
     table = ControllerTable(
         state_order=grid.names,
         control_names=tuple(c.name for c in spec.controls),
+        control_units=control_units(dynamics, tuple(c.name for c in spec.controls)),
         axes=grid.axis_values(),
         axis_units=grid.units,
         wrap=tuple(bool(w) for w in grid.wrap),

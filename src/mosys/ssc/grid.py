@@ -33,6 +33,16 @@ def control_scale(dynamics: ModuleType, name: str) -> float:
     return DEGREE if units[tuple(dynamics.INPUT_NAMES).index(name)].startswith("deg") else 1.0
 
 
+def control_units(dynamics: ModuleType, names: tuple[str, ...]) -> tuple[str, ...] | None:
+    """The spec unit of each named control, from the model's ``INPUT_UNITS`` (None for a
+    model that does not list them: the table then names them from what it can tell)."""
+    units = getattr(dynamics, "INPUT_UNITS", None)
+    if units is None:
+        return None
+    actuators = tuple(dynamics.INPUT_NAMES)
+    return tuple(units[actuators.index(name)] for name in names)
+
+
 @dataclass(frozen=True)
 class FigureGrid:
     """A uniform controller grid over some of a figure's state variables, in SI units, ready for

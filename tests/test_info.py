@@ -1,0 +1,513 @@
+"""Self-describing result files and ``mosys info``: every dataset of every kind of file mosys
+writes has a ``unit``, every root the provenance attrs; a controller table's ``/axes`` are HDF5
+dimension scales of its per-node datasets; ``mosys info`` reports each kind (exit 0) and refuses,
+with a one-line message and exit 2, a file that is not HDF5 or not mosys's.
+
+The files are made by mosys's own code at small sizes: the pendulum's tables (conftest), a
+script run on two of them, three BSR searches of two generations and a composite search of one;
+the start grid is written by ``write_start_grid`` from outcomes given here (evaluating real
+starts needs a car table: about 20 s)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+from conftest import SPECS
+
+from mosys.cli import main
+from mosys.io import info
+from mosys.io.attributes import INDEX, MIXED, SI_STATE, SPEC, TEXT
+from mosys.io.controller_table import (
+    ControllerTable,
+    read_controller_table,
+    write_controller_table,
+)
+from mosys.io.provenance import PROVENANCE_KEYS, checkout_commit, provenance_attributes
+from mosys.io.start_grid import NOT_FREE, StartGrid, read_start_grid, write_start_grid
+from mosys.io.trajectory import Contacts, read_trajectory, write_trajectory
+
+# the vocabulary of docs/formats/README.md
+UNITS = {"s", "m", "m/s", "deg", "deg/s", "deg/s^2", "N", "N*m", "1"}
+UNITS |= {INDEX, TEXT, SI_STATE, SPEC, MIXED}
+ALWAYS = [key for key in PROVENANCE_KEYS if key != "git_commit"]
+BSR_SEARCHES = ("starman_cartwheel_robust", "starman_jump_robust", "starman_shuffle_robust")
+CAR_STATE = ("x", "y", "heading", "steer", "speed")
+
+
+@pytest.fixture(scope="module")
+def made(pendulum_tables, link1, tmp_path_factory) -> dict[str, Path]:
+    """One file of each kind, by kind."""
+    from mosys.animation.trajectory_file import run_animation_script
+    from mosys.bsr.result_file import search_to_file
+    from mosys.composite.result_file import composite_to_file
+    from mosys.composite.session import find_controller_files
+    from mosys.parsing.composite import parse_composite_script
+
+    root = tmp_path_factory.mktemp("info")
+    dynamics = root / "dynamics"
+    dynamics.mkdir()
+    shutil.copy(link1.__file__, dynamics / "link1.py")
+    script = root / "swing.anim"
+    script.write_text("state link -135,350\nswapcon link conB.ctab\nsim 0.4\n")
+    motor = SPECS / "motor"
+    run_animation_script(script, pendulum_tables, dynamics, root / "swing.h5", 0.01, motor)
+    bsr = root / "bsr"
+    for name in BSR_SEARCHES:
+        search_to_file(
+            SPECS / "bsr" / f"{name}.bsr", SPECS / "figures", 1, bsr / name / "seed1.h5", 2
+        )
+    comp = root / "starman_show.comp"
+    shutil.copy(SPECS / "composite" / "starman_show.comp", comp)
+    files = find_controller_files(parse_composite_script(comp), bsr)
+    sizes = {"q": 2, "g": 1, "h": 1}
+    composite_to_file(comp, files, root / "show.h5", SPECS / "figures", SPECS / "bsr", sizes)
+    write_start_grid(root / "grid.h5", start_grid())
+    return {
+        "controller table": pendulum_tables / "A.h5",
+        "trajectory": root / "swing.h5",
+        "BSR search result": bsr / "starman_jump_robust" / "seed1.h5",
+        "composite result": root / "show.h5",
+        "start grid": root / "grid.h5",
+    }
+
+
+def start_grid() -> StartGrid:
+    """Three car starts: one parks in 7.5 s, one times out, one overlaps an obstacle."""
+    return StartGrid(
+        start=np.array([[1.5, 2.0, 0.0, 0.0, 0.0], [-1.0, 1.5, 5.0, 0.0, 0.0], [0, 0.6, 0, 0, 0]]),
+        state_order=CAR_STATE,
+        parked=np.array([True, False, False]),
+        collided=np.array([False, False, False]),
+        parking_seconds=np.array([7.5, math.nan, math.nan]),
+        excluded=np.array(["", "", NOT_FREE], dtype=object),
+        cost_to_go=np.array([7.0, 9.0, math.inf]),
+        path_length=np.array([2.0, 3.0, math.nan]),
+        attrs={"controller": "park", "simulated_seconds": 10.0, "dt": 0.01},
+    )
+
+
+def datasets(path: Path) -> dict[str, dict]:
+    """Every dataset's attributes, by path."""
+    found = {}
+    with h5py.File(path, "r") as h5:
+        h5.visititems(
+            lambda name, item: (
+                found.__setitem__(name, dict(item.attrs))
+                if isinstance(item, h5py.Dataset)
+                else None
+            )
+        )
+    return found
+
+
+@pytest.mark.parametrize(
+    "kind",
+    ["controller table", "trajectory", "BSR search result", "composite result", "start grid"],
+)
+def test_every_dataset_has_a_unit_and_the_root_its_provenance(made, kind):
+    found = datasets(made[kind])
+    assert found
+    for name, attrs in found.items():
+        assert attrs.get("unit") in UNITS, f"{kind} /{name}: unit {attrs.get('unit')!r}"
+    with h5py.File(made[kind], "r") as h5:
+        attrs = dict(h5.attrs)
+    expected = provenance_attributes()
+    assert {key: attrs[key] for key in ALWAYS} == {key: expected[key] for key in ALWAYS}
+    # from a checkout (as the tests run) its commit; elsewhere none
+    assert attrs.get("git_commit") == checkout_commit(Path(info.__file__).resolve().parents[1])
+    if kind != "start grid":  # made from a table, not a spec
+        assert len(attrs["spec_sha256"]) == 64
+
+
+def test_the_units_each_kind_writes(made):
+    units = {kind: {n: a["unit"] for n, a in datasets(path).items()} for kind, path in made.items()}
+    assert units["controller table"] == {
+        "axes/angle": "deg",
+        "axes/omega": "deg/s",
+        "torque": "N*m",
+        "value": "s",
+    }
+    # the pendulum's state (angle, omega): two units, listed per column
+    assert units["trajectory"] == {
+        "t": "s",
+        "state": "mixed",
+        "control": "N*m",
+        "controller": INDEX,
+        "figure_motion/t": "s",
+        "figure_motion/endpoints": "m",
+        "figure_motion/com": "m",
+    }
+    state = datasets(made["trajectory"])["state"]
+    assert state["units"].tolist() == ["deg", "deg/s"]  # the state order: angle, omega
+    assert units["BSR search result"] == {
+        "learning_curve/evaluations": "1",
+        "learning_curve/best_fitness": "1",
+        "best/controller/target": "deg",
+        "best/controller/tau": "s",
+        "best/controller/center": "1",
+        "best/controller/side": "1",
+        "best/figure_motion/t": "s",
+        "best/figure_motion/endpoints": "m",
+        "best/figure_motion/com": "m",
+        "best/active_rule": INDEX,
+        "best/final_state": SI_STATE,
+        "best/final_force": "N",
+    }
+    motion = {"figure_motion/t": "s", "figure_motion/endpoints": "m", "figure_motion/com": "m"}
+    assert units["composite result"] == {
+        **motion,
+        **{f"before/{name}": unit for name, unit in motion.items()},
+        "phase": INDEX,
+        "active_rule": INDEX,
+        "before/phase": INDEX,
+        "before/active_rule": INDEX,
+        "search/best_score": "1",
+    }
+    assert units["start grid"] == {
+        "start": MIXED,
+        "parked": INDEX,
+        "collided": INDEX,
+        "parking_seconds": "s",
+        "excluded": TEXT,
+        "cost_to_go": "s",
+        "path_length": "m",
+    }
+    assert datasets(made["start grid"])["start"]["units"].tolist() == [
+        "m",
+        "m",
+        "deg",
+        "deg",
+        "m/s",
+    ]
+    assert read_start_grid(made["start grid"]).state_units == ("m", "m", "deg", "deg", "m/s")
+
+
+def test_a_trajectory_told_its_units_writes_them_per_column(made, tmp_path):
+    """Given state and control units, ``/state`` and ``/control`` list them (``units``), with
+    the common one or ``mixed`` as ``unit``; contact points are in m and N; they read back."""
+    trajectory = read_trajectory(made["trajectory"])
+    samples = len(trajectory.t)
+    told = dataclasses.replace(
+        trajectory,
+        state_units=("deg", "deg/s"),
+        control_units=("N*m",),
+        contacts=Contacts(np.zeros((samples, 1, 2)), np.zeros((samples, 1, 2)), ("link",), [1.0]),
+    )
+    write_trajectory(tmp_path / "told.h5", told)
+    found = datasets(tmp_path / "told.h5")
+    assert (found["state"]["unit"], found["state"]["units"].tolist()) == (MIXED, ["deg", "deg/s"])
+    assert (found["control"]["unit"], found["control"]["units"].tolist()) == ("N*m", ["N*m"])
+    assert (found["contacts/position"]["unit"], found["contacts/force"]["unit"]) == ("m", "N")
+    back = read_trajectory(tmp_path / "told.h5")
+    assert (back.state_units, back.control_units) == (("deg", "deg/s"), ("N*m",))
+
+
+def test_the_axes_are_dimension_scales_of_every_per_node_dataset(pendulum_tables, tmp_path):
+    """``/axes/<name>`` is a dimension scale named <name>, attached along its state dimension
+    to ``/value``, ``/torque``, ``/dead_end`` and ``/destination_index`` (labelled <name>);
+    ``/torque``'s last dimension is labelled ``control``. The reader is not confused by the
+    scales' attributes."""
+    table = read_controller_table(pendulum_tables / "A.h5")
+    several = dataclasses.replace(
+        table,
+        dead_end=np.zeros(table.value.shape, dtype=bool),
+        destinations=(table.dest, {"angle": 90.0, "omega": 0.0}),
+        destination_index=np.zeros(table.value.shape, dtype=np.int64),
+    )
+    write_controller_table(tmp_path / "several.h5", several)
+    names = table.state_order
+    with h5py.File(tmp_path / "several.h5", "r") as h5:
+        for name in names:
+            assert h5py.h5ds.is_scale(h5["axes"][name].id)
+            assert h5py.h5ds.get_scale_name(h5["axes"][name].id) == name.encode()
+        for dataset in ("value", "torque", "dead_end", "destination_index"):
+            dims = h5[dataset].dims
+            assert [dims[k].label for k in range(len(names))] == list(names), dataset
+            assert [dims[k][0].name for k in range(len(names))] == [f"/axes/{n}" for n in names]
+        assert h5["torque"].dims[len(names)].label == "control"
+        assert len(h5["torque"].dims[len(names)]) == 0
+        assert (h5["dead_end"].attrs["unit"], h5["destination_index"].attrs["unit"]) == (
+            INDEX,
+            INDEX,
+        )
+    back = read_controller_table(tmp_path / "several.h5")
+    assert back.state_order == names and back.axis_units == ("deg", "deg/s")
+    assert back.wrap == table.wrap and back.control_units == ("N*m",)
+    for axis, expected in zip(back.axes, table.axes, strict=True):
+        np.testing.assert_array_equal(axis, expected)
+    np.testing.assert_array_equal(back.value, table.value)
+    np.testing.assert_array_equal(back.destination_index, several.destination_index)
+    assert back.destinations == several.destinations
+
+
+def car_table(**changes) -> ControllerTable:
+    """A 2 x 3 table over the car's x and speed with the car's two controls."""
+    table = ControllerTable(
+        state_order=("x", "speed"),
+        control_names=("steer_rate", "wheel_accel"),
+        axes=(np.array([0.0, 1.0]), np.array([-1.0, 0.0, 1.0])),
+        axis_units=("m", "m/s"),
+        wrap=(False, False),
+        torque=np.zeros((2, 3, 2)),
+        value=np.array([[1.0, 0.0, np.inf], [2.0, 1.0, np.nan]]),
+        control_min=np.array([-60.0, -200.0]),
+        control_max=np.array([60.0, 200.0]),
+        effort_weight=np.zeros(2),
+        dest={"x": 0.0, "speed": 0.0},
+        figure="car",
+        attrs={"wheelbase": 2.5},
+    )
+    return dataclasses.replace(table, **changes)
+
+
+def test_torque_units_are_the_controls_units(tmp_path):
+    """Told (``control_units``): as told; not told: the car's controls for a car's table (root
+    attr ``wheelbase``), N*m for a figure's (hinge actuators)."""
+    for name, table, units, unit in (
+        ("car", car_table(), ["deg/s", "deg/s^2"], MIXED),
+        ("told", car_table(control_units=("N", "N")), ["N", "N"], "N"),
+        ("figure", car_table(attrs={}), ["N*m", "N*m"], "N*m"),
+    ):
+        write_controller_table(tmp_path / f"{name}.h5", table)
+        torque = datasets(tmp_path / f"{name}.h5")["torque"]
+        assert (torque["units"].tolist(), torque["unit"]) == (units, unit), name
+        assert read_controller_table(tmp_path / f"{name}.h5").control_units == tuple(units)
+
+
+def test_a_rewritten_file_records_the_process_that_wrote_it(pendulum_tables, tmp_path):
+    """A table read and written again records the process that wrote it, not the one it was
+    read from."""
+    table = read_controller_table(pendulum_tables / "A.h5")
+    stale = {"git_commit": "0" * 40, "mosys_version": "0.0.1", "numpy_version": "1.0"}
+    write_controller_table(
+        tmp_path / "again.h5", dataclasses.replace(table, attrs={**table.attrs, **stale})
+    )
+    with h5py.File(tmp_path / "again.h5", "r") as h5:
+        written = {key: h5.attrs.get(key) for key in PROVENANCE_KEYS}
+    expected = provenance_attributes()
+    assert written == {key: expected.get(key) for key in PROVENANCE_KEYS}
+
+
+# --- the commit of a checkout -----------------------------------------------------------------
+
+COMMIT = "0123456789abcdef0123456789abcdef01234567"
+
+
+def package_in(root: Path) -> Path:
+    package = root / "src" / "mosys"
+    package.mkdir(parents=True)
+    return package
+
+
+def test_the_commit_of_a_branch_a_packed_ref_a_detached_head_and_a_worktree(tmp_path):
+    loose = tmp_path / "loose"
+    (loose / ".git" / "refs" / "heads").mkdir(parents=True)
+    (loose / ".git" / "HEAD").write_text("ref: refs/heads/main\n")
+    (loose / ".git" / "refs" / "heads" / "main").write_text(COMMIT + "\n")
+    assert checkout_commit(package_in(loose)) == COMMIT
+
+    packed = tmp_path / "packed"
+    (packed / ".git").mkdir(parents=True)
+    (packed / ".git" / "HEAD").write_text("ref: refs/heads/main\n")
+    (packed / ".git" / "packed-refs").write_text(
+        f"# pack-refs with: peeled fully-peeled sorted\n{'f' * 40} refs/heads/other\n"
+        f"{COMMIT} refs/heads/main\n^{'e' * 40}\n"
+    )
+    assert checkout_commit(package_in(packed)) == COMMIT
+
+    detached = tmp_path / "detached"
+    (detached / ".git").mkdir(parents=True)
+    (detached / ".git" / "HEAD").write_text(COMMIT + "\n")
+    assert checkout_commit(package_in(detached)) == COMMIT
+
+    worktree = tmp_path / "worktree"
+    worktree.mkdir()
+    linked = loose / ".git" / "worktrees" / "worktree"
+    linked.mkdir(parents=True)
+    (linked / "HEAD").write_text("ref: refs/heads/main\n")
+    (linked / "commondir").write_text("../..\n")
+    (worktree / ".git").write_text(f"gitdir: {linked}\n")
+    assert checkout_commit(package_in(worktree)) == COMMIT
+
+
+def test_no_commit_outside_a_checkout_in_an_installed_copy_or_an_unborn_branch(tmp_path):
+    assert checkout_commit(package_in(tmp_path / "plain")) is None
+    installed = tmp_path / "repo"
+    (installed / ".git").mkdir(parents=True)
+    (installed / ".git" / "HEAD").write_text(COMMIT + "\n")
+    site = installed / ".venv" / "lib" / "python3.11" / "site-packages" / "mosys"
+    site.mkdir(parents=True)
+    assert checkout_commit(site) is None
+    unborn = tmp_path / "unborn"
+    (unborn / ".git").mkdir(parents=True)
+    (unborn / ".git" / "HEAD").write_text("ref: refs/heads/main\n")
+    assert checkout_commit(package_in(unborn)) is None
+    garbled = tmp_path / "garbled"
+    (garbled / ".git").mkdir(parents=True)
+    (garbled / ".git" / "HEAD").write_bytes(b"\xff\xfe not a ref")
+    assert checkout_commit(package_in(garbled)) is None
+
+
+# --- mosys info -------------------------------------------------------------------------------
+
+
+def info_of(path: Path, capsys) -> str:
+    assert main(["info", str(path)]) == 0
+    out, err = capsys.readouterr()
+    assert err == ""
+    return out
+
+
+def section(out: str, title: str) -> list[str]:
+    """The lines of a section of ``mosys info``: from its title to the blank line."""
+    lines = out.splitlines()
+    start = lines.index(title)
+    end = lines.index("", start) if "" in lines[start:] else len(lines)
+    return lines[start:end]
+
+
+def test_info_of_a_controller_table_shows_its_axes_and_controls_with_units(made, capsys):
+    out = info_of(made["controller table"], capsys)
+    assert out.startswith(
+        f"{made['controller table']}: controller table, format_version 1 "
+        "(docs/formats/controller_table.md)\n"
+    )
+    assert section(out, "axes (state_order):") == [
+        "axes (state_order):",
+        "  name   unit   min   max  count  step  wrap",
+        "  angle  deg    -180  170  36     10    yes (period 360)",
+        "  omega  deg/s  -500  500  21     50    no",
+    ]
+    assert section(out, "dimension scales (the /axes datasets):") == [
+        "dimension scales (the /axes datasets):",
+        "  dataset  dimensions",
+        "  /value   angle, omega",
+        "  /torque  angle, omega, control",
+    ]
+    assert section(out, "controls (control_names):") == [
+        "controls (control_names):",
+        "  name    unit  min  max  K    torque in table",
+        "  torque  N*m   -10  10   0.1  -10 … 10",
+    ]
+    datasets_section = section(out, "groups and datasets:")
+    assert datasets_section[0:2] == [
+        "groups and datasets:",
+        "  path         shape        dtype    unit   summary",
+    ]
+    assert "  /value       (36, 21)     float64  s      0 … " in "\n".join(datasets_section)
+    for key in PROVENANCE_KEYS:
+        assert f"\n  {key} " in out
+
+
+def test_info_of_each_other_kind(made, capsys):
+    out = info_of(made["trajectory"], capsys)
+    assert section(out, "control columns (control_names):")[1:] == [
+        "  name    unit  min  max",
+        "  torque  N*m   0    10",
+    ]
+    assert section(out, "samples:") == ["samples:", "  41 samples, t 0 … 0.4 s", "  controllers: B"]
+
+    out = info_of(made["start grid"], capsys)
+    assert section(out, "start columns (state_order):") == [
+        "start columns (state_order):",
+        "  name     unit  min  max",
+        "  x        m     -1   1.5",
+        "  y        m     0.6  2",
+        "  heading  deg   0    5",
+        "  steer    deg   0    0",
+        "  speed    m/s   0    0",
+    ]
+    assert section(out, "starts:") == [
+        "starts:",
+        "  3 starts, 1 parked; 2 counted (not excluded)",
+        "  success rate 50.0% of the counted starts",
+    ]
+    assert (
+        '  /excluded         (3,)    string   text                 2 distinct: "" ×2, '
+        '"start pose overlaps an obst…" ×1\n' in out
+    )
+    assert "  /parking_seconds  (3,)    float64  s                    7.5; 2 nan\n" in out
+
+    out = info_of(made["BSR search result"], capsys)
+    assert section(out, "search:")[1] == (
+        "  sense-based controller, 10 rules, joints: arm_a, arm_b, leg_a, leg_b"
+    )
+    assert "  /best/figure_motion: 151 samples, t 0 … 1.5 s, 2-D, 5 rods (torso, arm_a, " in out
+
+    out = info_of(made["composite result"], capsys)
+    refined = section(out, "phases, refined (phases):")
+    assert refined[1].split() == ["phase", "controller", "start", "(s)", "end", "(s)"]
+    assert [line.split()[0] for line in refined[2:]] == ["cartwheel", "jump", "shuffle"]
+    assert "  /before/figure_motion: " in out and "  /figure_motion: " in out
+
+
+def test_info_of_a_file_of_an_older_mosys(tmp_path, capsys):
+    """No units, no provenance, no scales: reported as such."""
+    path = tmp_path / "old.h5"
+    with h5py.File(path, "w") as h5:
+        h5["axes/angle"] = np.array([0.0, 10.0])
+        h5["axes/angle"].attrs.update({"unit": "deg", "wrap": False})
+        h5["torque"] = np.zeros((2, 1))
+        h5["value"] = np.array([0.0, np.inf])
+        h5.attrs.update({"state_order": ["angle"], "control_names": ["torque"]})
+    out = info_of(path, capsys)
+    assert "made by: no provenance recorded (an older mosys)\n" in out
+    assert "dimension scales (the /axes datasets):\n  none attached\n" in out
+    assert "  /value       (2,)    float64  -     0; 1 +inf\n" in out
+
+
+def test_summaries_read_block_by_block_agree_with_numpy(tmp_path, monkeypatch):
+    """Values read a few rows at a time: the same min, max and counts as the whole array."""
+    rng = np.random.default_rng(1)
+    values = rng.normal(size=(50, 4, 3))
+    values[rng.random(values.shape) < 0.1] = np.nan
+    values[3, 1, 2], values[40, 0, 0] = np.inf, -np.inf
+    with h5py.File(tmp_path / "v.h5", "w") as h5:
+        h5["v"] = values
+        monkeypatch.setattr(info, "BLOCK_ELEMENTS", 25)  # two rows (12 values each) a block
+        summary = info.summarise(h5["v"])
+    finite = np.where(np.isfinite(values), values, np.nan)
+    assert (summary.nan, summary.posinf, summary.neginf) == (int(np.isnan(values).sum()), 1, 1)
+    np.testing.assert_array_equal(summary.low, np.nanmin(finite, axis=(0, 1)))
+    np.testing.assert_array_equal(summary.high, np.nanmax(finite, axis=(0, 1)))
+
+
+def test_info_refuses_what_is_not_a_file_mosys_writes(tmp_path, capsys):
+    text = tmp_path / "notes.h5"
+    text.write_text("not HDF5\n")
+    foreign = tmp_path / "foreign.h5"
+    with h5py.File(foreign, "w") as h5:
+        h5["t"] = np.arange(3.0)
+    for path, message in (
+        (text, "not an HDF5 file (mosys info reads the .h5 files mosys writes)"),
+        (
+            foreign,
+            "an HDF5 file, but not one mosys writes: it has the groups and datasets of none of "
+            "its kinds (controller table, trajectory, BSR search result, composite result, "
+            "start grid; docs/formats/)",
+        ),
+        (tmp_path / "missing.h5", "no such file"),
+        (tmp_path, "not a file"),
+    ):
+        assert main(["info", str(path)]) == 2
+        assert capsys.readouterr() == ("", f"mosys: {path}: {message}\n")
+
+
+def test_info_on_a_file_that_is_not_hdf5_gives_no_traceback(tmp_path):
+    text = tmp_path / "notes.h5"
+    text.write_text("not HDF5\n")
+    done = subprocess.run(
+        [sys.executable, "-m", "mosys.cli", "info", str(text)], capture_output=True, text=True
+    )
+    assert (done.returncode, done.stdout) == (2, "")
+    assert done.stderr == (
+        f"mosys: {text}: not an HDF5 file (mosys info reads the .h5 files mosys writes)\n"
+    )
