@@ -206,21 +206,33 @@ def test_editing_the_figure_rebuilds_every_controller(workflow):
 
 @pytest.mark.slow
 def test_broken_spec_fails_with_its_location_and_leaves_no_output(workflow):
+    """The parser's message, while the DAG is built: no job starts, so C's table from the
+    earlier build is left as it was (and a fresh target is not made at all)."""
     spec = workflow / "specs/controllers/pendulum/C.ssc"
-    spec.write_text(
-        spec.read_text().replace(
-            "torq torque -10.0 10.0 11 0.1", "torq torque -10.0 10.0 eleven 0.1"
+    text = spec.read_text()
+    table = workflow / "results/controllers/pendulum/C.h5"
+    before = table.stat().st_mtime_ns
+    try:
+        spec.write_text(
+            text.replace("torq torque -10.0 10.0 11 0.1", "torq torque -10.0 10.0 eleven 0.1")
         )
-    )
-    done = run_snakemake(workflow, "results/controllers/pendulum/C.h5")
-    assert done.returncode != 0
-    line = next(n for n, text in enumerate(spec.read_text().splitlines(), 1) if "eleven" in text)
-    expected = (
-        f"specs/controllers/pendulum/C.ssc:{line}:24: expected a whole number for "
-        "samples, found 'eleven'"
-    )
-    assert expected in done.stdout + done.stderr
-    assert not (workflow / "results/controllers/pendulum/C.h5").exists()
+        done = run_snakemake(workflow, "results/controllers/pendulum/C.h5")
+        assert done.returncode != 0
+        line = next(n for n, row in enumerate(spec.read_text().splitlines(), 1) if "eleven" in row)
+        expected = (
+            f"specs/controllers/pendulum/C.ssc:{line}:24: expected a whole number for "
+            "samples, found 'eleven'"
+        )
+        assert expected in done.stdout + done.stderr
+        assert "rule dp_controller:" not in done.stdout + done.stderr  # no job was started
+        assert table.stat().st_mtime_ns == before
+        done = run_snakemake(workflow, "results/controllers/pendulum/Cx.h5")
+        assert "specs/controllers/pendulum/Cx.ssc:1:1: expected an existing spec file" in (
+            done.stdout + done.stderr
+        )
+        assert not (workflow / "results/controllers/pendulum/Cx.h5").exists()
+    finally:
+        spec.write_text(text)
 
 
 CAR_SCRIPTS = [f"park_{k}" for k in range(1, 7)]
