@@ -233,6 +233,7 @@ def test_the_shipped_swing_parses():
     assert [key.settings[0].value for key in program.keys] == [-90, -30, -150, -90, -90]
 
 
+# the keyframe grammar's errors: checked with the phase grammar's by test_motor_parser.py
 KEY_ERRORS = [
     (
         replace_line(6, "key 0.5 angle=-150"),
@@ -341,13 +342,6 @@ KEY_ERRORS = [
         "x.mot:1:1: expected a 'figure' line before the first 'key', found 'key'",
     ),
 ]
-
-
-@pytest.mark.parametrize(("text", "message"), KEY_ERRORS)
-def test_key_error_messages(text, message):
-    with pytest.raises(SpecError) as error:
-        parse_motor_program_text(text, "x.mot")
-    assert str(error.value) == message
 
 
 def test_keys_may_name_their_joints_in_any_order():

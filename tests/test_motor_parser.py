@@ -12,6 +12,7 @@ from conftest import SpecLines, parses_or_spec_error
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from spec_fuzz import token_mutations
+from test_keyframes import KEY_ERRORS
 
 from mosys.parsing.motor import (
     LIMP,
@@ -355,7 +356,7 @@ ERRORS = [
 ]
 
 
-@pytest.mark.parametrize(("text", "message"), ERRORS)
+@pytest.mark.parametrize(("text", "message"), ERRORS + KEY_ERRORS)
 def test_error_messages(text, message):
     with pytest.raises(SpecError) as error:
         parse_motor_program_text(text, "x.mot")
