@@ -475,7 +475,7 @@ def bsr_specs(draw) -> BsrSpec:
         generations=draw(WHOLE),
         reseed=draw(WHOLE),
         reinitialize=draw(st.just(0.5) | st.floats(0, 1)),
-        seeds=tuple(draw(st.lists(st.integers(0, 2**64), min_size=1, max_size=5, unique=True))),
+        seeds=tuple(draw(st.lists(st.integers(0, 2**63 - 1), min_size=1, max_size=5, unique=True))),
         start={} if chain else draw(st.dictionaries(IDENTIFIERS, NUMBERS, max_size=5)),
         perturbation=Perturbation(*(draw(st.just(0.0) | NON_NEGATIVE) for _ in range(4))),
         weights={term: draw(NUMBERS) for term in terms},

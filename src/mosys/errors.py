@@ -4,3 +4,20 @@
 class InputError(ValueError):
     """An input file that exists but cannot be used (wrong shape, missing group, ...). The CLI
     prints the message and exits 2."""
+
+
+class SimulationError(InputError):
+    """A simulation the inputs make impossible to go on with. The message comes complete, led by
+    the file and line it was asked for when there is one (``script.anim:3:1: ...``, as a
+    SpecError); the CLI prints it as it is and exits 2."""
+
+
+class NonFiniteStateError(SimulationError):
+    """The model's state became non-finite (NaN, inf, or beyond ``kernels.simulate.STATE_LIMIT``,
+    where the next step would overflow) at ``t`` seconds into a run; ``state`` (S,) SI is the
+    state there. The message names the source that was driving and the state."""
+
+    def __init__(self, message: str, t: float, state):
+        super().__init__(message)
+        self.t = t
+        self.state = state

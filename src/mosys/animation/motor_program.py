@@ -10,7 +10,9 @@ from types import ModuleType
 
 import numpy as np
 
+from mosys.errors import NonFiniteStateError
 from mosys.kernels.motor import run_motor_program
+from mosys.kernels.simulate import steps_before_blow_up
 from mosys.parsing.motor import (
     BoundProgram,
     MotorProgram,
@@ -184,7 +186,8 @@ class BoundMotorProgram:
         Each step's torque moves at most slew_rate dt from the step before; ``final_controls``
         of the result is the last step's, to pass as ``previous`` to what follows. A slew_rate
         or previous of the wrong shape, a negative or NaN slew_rate, or a non-finite previous
-        raises ValueError.
+        raises ValueError. A state that becomes non-finite (``kernels.motor``) raises
+        ``errors.NonFiniteStateError`` with the time from the run's start and that state.
         """
         actuators = len(self.coordinate)
         slew_step = np.full(actuators, np.inf)
@@ -203,7 +206,7 @@ class BoundMotorProgram:
         state = np.ascontiguousarray(figure_state, dtype=np.float64).copy()
         states = np.empty((steps + 1, len(state)))
         controls = np.empty((steps, actuators))
-        run_motor_program(
+        taken = run_motor_program(
             self.dynamics.derivative_into,
             rows.mode,
             rows.value,
@@ -220,6 +223,12 @@ class BoundMotorProgram:
             states[:-1],
             controls,
         )
+        if taken < 0:
+            from mosys.ssc.controller import non_finite_message
+
+            t = steps_before_blow_up(taken) * dt
+            driver = f"motor program {self.name}"
+            raise NonFiniteStateError(non_finite_message(self.dynamics, t, state, driver), t, state)
         states[-1] = state
         return MotorRun(states, controls, rows.phase, torque)
 

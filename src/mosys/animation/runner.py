@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from mosys.errors import NonFiniteStateError, SimulationError
 from mosys.parsing.script import (
     AnimationScript,
     Breakpoint,
@@ -36,7 +37,8 @@ from mosys.parsing.script import (
     SlewLimit,
     SwapController,
 )
-from mosys.ssc.controller import Controller
+from mosys.parsing.tokens import Token
+from mosys.ssc.controller import Controller, non_finite_message
 from mosys.ssc.grid import control_scale, figure_state_names, state_unit
 from mosys.ssc.regions import Bounds, regions
 
@@ -243,7 +245,7 @@ def run_script(script: AnimationScript, sources: ScriptSources, dt: float) -> Sc
             assert figure_state is not None  # the parser puts a 'state' first
             if isinstance(command, RunMotorProgram):
                 figure_state = _run_motor_program(
-                    command, sources, exchange, figure_state, dt, recorder
+                    script, command, sources, exchange, figure_state, dt, recorder
                 )
             else:
                 assert exchange.active is not None  # the parser puts a 'swapcon' first
@@ -302,7 +304,22 @@ def _set_slew(
         slew[name] = rate
 
 
+def _blown_up(
+    script: AnimationScript,
+    token: Token,
+    dynamics: ModuleType,
+    clock: float,
+    driver: str,
+    error: NonFiniteStateError,
+) -> SimulationError:
+    """The error for a run, started at ``clock`` s by the line of ``token``, whose state became
+    non-finite: led by the script's file, line and column, with the script's time."""
+    message = non_finite_message(dynamics, clock + error.t, error.state, driver)
+    return SimulationError(f"{script.path}:{token.line}:{token.column}: {message}")
+
+
 def _run_motor_program(
+    script: AnimationScript,
     command: RunMotorProgram,
     sources: ScriptSources,
     exchange: _Exchange,
@@ -310,7 +327,8 @@ def _run_motor_program(
     dt: float,
     recorder: _Recorder,
 ) -> np.ndarray:
-    """One ``motor`` line: the program to its end, slew-limited from the controls before it."""
+    """One ``motor`` line: the program to its end, slew-limited from the controls before it;
+    SimulationError at the line if the state becomes non-finite."""
     program = sources.programs[command.program]
     recorder.drive(command.program)
     scale = np.array(
@@ -319,12 +337,18 @@ def _run_motor_program(
             for c in program.coordinate
         ]
     )
-    run = program.run(
-        figure_state,
-        dt,
-        slew_rate=exchange.slew_rate[program.coordinate] * scale,
-        previous=recorder.held[program.coordinate],
-    )
+    try:
+        run = program.run(
+            figure_state,
+            dt,
+            slew_rate=exchange.slew_rate[program.coordinate] * scale,
+            previous=recorder.held[program.coordinate],
+        )
+    except NonFiniteStateError as error:
+        driver = f"motor program {program.name}"
+        raise _blown_up(
+            script, command.token, sources.dynamics, recorder.clock, driver, error
+        ) from None
     inputs = np.zeros((run.controls.shape[0], len(recorder.held)))
     inputs[:, program.coordinate] = run.controls
     recorder.add(run.states, inputs, np.zeros(len(inputs), dtype=bool), dt)
@@ -355,7 +379,8 @@ def _simulate(
     """One ``sim``: the active controller, or a breakpoint's where its box holds the state, in
     stretches that end where the state crosses a box border; stops early in the arrival box.
     A ``once`` breakpoint whose box holds the state makes its controller the active one and is
-    spent. Each change of controller is checked against the new one's domain."""
+    spent. Each change of controller is checked against the new one's domain. A state that
+    becomes non-finite raises SimulationError at the ``sim`` line."""
     remaining = int(round(command.seconds / dt))
     while remaining > 0:
         boxes = [box for box, _ in exchange.breakpoints]
@@ -392,6 +417,11 @@ def _simulate(
                 slew_rate=exchange.slew_rate[slots],
                 previous=recorder.held[slots] / driver.control_scale,
             )
+        except NonFiniteStateError as error:
+            driver_name = f"controller {driver.name}"
+            raise _blown_up(
+                script, command.token, sources.dynamics, recorder.clock, driver_name, error
+            ) from None
         except ValueError as error:  # a slew limit on a lookahead controller
             raise script.error(command.token, f"a run the controller can make ({error})") from None
         inputs = np.zeros((run.controls.shape[0], len(recorder.held)))

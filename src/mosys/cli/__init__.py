@@ -106,12 +106,12 @@ def main(argv: list[str] | None = None) -> int:
     problem = args.command.check(args)
     if problem:
         parser.error(problem)
-    from mosys.errors import InputError
+    from mosys.errors import InputError, SimulationError
     from mosys.parsing.tokens import SpecError
 
     try:
         args.command.handler(args)
-    except SpecError as error:
+    except (SpecError, SimulationError) as error:
         print(error, file=sys.stderr)  # file:line:column: first, as compilers do
         return 2
     except (OSError, InputError) as error:  # a missing, unreadable or corrupt input file

@@ -23,6 +23,21 @@ def _bsr_search_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-o", "--output", required=True)
 
 
+def _bsr_search_check(args: argparse.Namespace) -> str | None:
+    from mosys.parsing.bsr import MAX_SEED, MAX_WHOLE
+
+    if not 0 <= args.seed <= MAX_SEED:
+        return f"bsr-search: --seed must be a whole number from 0 to {MAX_SEED}, got {args.seed}"
+    if args.generations is not None and not 1 <= args.generations <= MAX_WHOLE:
+        return (
+            f"bsr-search: --generations must be a whole number from 1 to {MAX_WHOLE}, got "
+            f"{args.generations}"
+        )
+    if args.threads is not None and args.threads < 0:
+        return f"bsr-search: --threads must be at least 0 (0: numba's default), got {args.threads}"
+    return None
+
+
 def _bsr_search(args: argparse.Namespace) -> None:
     from mosys.bsr.result_file import search_to_file
 
@@ -50,6 +65,7 @@ FAMILY = Family(
             "BSR search spec (.bsr) -> result (.h5)",
             _bsr_search_arguments,
             _bsr_search,
+            _bsr_search_check,
         ),
     ),
 )

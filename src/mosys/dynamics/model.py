@@ -16,7 +16,12 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from mosys.parsing.figure import Figure
+from mosys.parsing.figure import (
+    ROD_INERTIA_RANGE,
+    ROD_LENGTH_RANGE,
+    ROD_MASS_RANGE,
+    Figure,
+)
 from mosys.parsing.tokens import SpecError
 
 
@@ -132,6 +137,7 @@ def build_model(figure: Figure) -> KinematicModel:
         raise SpecError.at(
             figure.path, ball.token, "a planar figure (ball joints are for 3-D BSR figures)"
         )
+    _check_rods(figure)
     n = len(figure.coordinates)
     q = tuple(sp.Symbol(f"q_{k}", real=True) for k in range(n))
     qd = tuple(sp.Symbol(f"qd_{k}", real=True) for k in range(n))
@@ -209,6 +215,24 @@ def build_model(figure: Figure) -> KinematicModel:
         com=com,
         contacts=tuple(contacts),
     )
+
+
+def _check_rods(figure: Figure) -> None:
+    """Every rod's length, mass and inertia within the parser's ranges (a Figure built in code
+    skips the parser): outside them the mass matrix over- or underflows and the kernels divide
+    by zero. SpecError at the rod's line."""
+    for rod in figure.rods:
+        for what, value, (low, high) in (
+            ("length (m)", rod.length, ROD_LENGTH_RANGE),
+            ("mass (kg)", rod.mass, ROD_MASS_RANGE),
+            ("inertia (kg·m²)", rod.inertia, ROD_INERTIA_RANGE),
+        ):
+            if not low <= value <= high:
+                raise SpecError.at(
+                    figure.path,
+                    rod.token,
+                    f"a rod whose {what} is from {low:g} to {high:g} (it is {value:g})",
+                )
 
 
 def _tree_order(figure: Figure) -> list[str]:

@@ -11,6 +11,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+# A wrap coordinate beyond this many grid steps from the first node (2**52: where a float64 holds
+# no fraction of a step) cannot be placed within its period: ``corner_weights`` gives NaN there.
+WRAP_LIMIT = 2.0**52
+
 
 @njit(cache=True)
 def grid_strides(axis_count, out):
@@ -24,11 +28,14 @@ def grid_strides(axis_count, out):
 @njit(cache=True)
 def clamp_to_domain(axis_min, axis_step, axis_count, wrap, state, out):
     """Copy ``state`` (d,) into ``out`` (d,), moving each non-wrap coordinate onto the nearest
-    point of its axis range. Returns True when nothing had to move."""
+    point of its axis range (±inf onto its ends). Returns True when nothing had to move; False
+    too when a coordinate is NaN (copied as is: ``corner_weights`` makes a NaN of it)."""
     unchanged = True
     for k in range(state.shape[0]):
         value = state[k]
-        if not wrap[k]:
+        if value != value:  # NaN lies nowhere: left NaN, and flagged
+            unchanged = False
+        elif not wrap[k]:
             top = axis_min[k] + axis_step[k] * (axis_count[k] - 1)
             if value < axis_min[k]:
                 value = axis_min[k]
@@ -73,17 +80,30 @@ def corner_weights(
     corner_index: (2**d,) int64 flat node indices out; corner_weight: (2**d,) float64 out.
     integer_scratch (3, d) int64 and fraction (d,) float64: work arrays
     (``interpolation_scratch``). Returns the number of corners written: 2**d, or 2**(d-1) when
-    ``on_node_axis`` >= 0. Weights are non-negative and sum to 1.
+    ``on_node_axis`` >= 0. Weights are non-negative and sum to 1. Whatever ``state`` holds, the
+    indices stay on the grid: a NaN coordinate, or an inf or beyond-WRAP_LIMIT one on a wrap
+    axis, gives NaN weights (at node 0 of that axis).
     """
     d = state.shape[0]
     low = integer_scratch[0]
     high = integer_scratch[1]
     free_axes = integer_scratch[2]
+    lost = False  # a coordinate with no place on the grid
     for k in range(d):
         n = axis_count[k]
         u = (state[k] - axis_min[k]) / axis_step[k]
+        if u != u or (wrap[k] and abs(u) > WRAP_LIMIT):
+            # NaN, or inf or so large a wrap coordinate that its place in the period is lost:
+            # node 0, every weight NaN (so is the result), never an index off the grid
+            low[k] = 0
+            high[k] = 0
+            fraction[k] = 0.0
+            lost = True
+            continue
         if wrap[k]:
             u = u - n * np.floor(u / n)
+            if not u >= 0.0:  # rounded to just below 0: node 0, never index -1
+                u = 0.0
             if k == on_node_axis:
                 i = np.int64(np.floor(u + 0.5)) % n
                 low[k] = i
@@ -129,7 +149,7 @@ def corner_weights(
                 index += low[k] * strides[k]
                 weight *= 1.0 - fraction[k]
         corner_index[corner] = index
-        corner_weight[corner] = weight
+        corner_weight[corner] = np.nan if lost else weight
     return count
 
 

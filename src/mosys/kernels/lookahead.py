@@ -39,9 +39,11 @@ from mosys.kernels.interpolate import (
     interpolation_scratch,
 )
 from mosys.kernels.simulate import (
+    blown_up,
     crossed_a_region_border,
     inside_region,
     region_membership,
+    state_is_sound,
 )
 
 OUTSIDE_PENALTY = 100.0  # s per grid step beyond the table's axes, added to the cost-to-go
@@ -506,7 +508,9 @@ def simulate_lookahead(
     region_period,
 ):
     """Simulate up to ``record_state.shape[0]`` RK4 steps of dt seconds by lookahead on the
-    cost-to-go (module docstring); return how many were taken.
+    cost-to-go (module docstring); return how many were taken, or ``simulate.blown_up(step)``
+    (< 0) when the state is not sound before step ``step`` or after the last, as
+    ``simulate.simulate_controlled``.
 
     Long because it threads the grid, table, obstacle and vehicle arrays through to ``_choose``
     one by one. Named tuples for those groups would shorten it, but measure first: passed to a
@@ -546,6 +550,8 @@ def simulate_lookahead(
     held_until = 0  # the step at which the held sample's segment ends
     arrived = False
     for step in range(record_state.shape[0]):
+        if not state_is_sound(state):
+            return blown_up(step)
         if crossed_a_region_border(
             state, region_lower, region_upper, region_period, start_membership, membership
         ):
@@ -600,4 +606,6 @@ def simulate_lookahead(
         for j in range(control_slot.shape[0]):
             record_control[step, j] = limited[control_slot[j]]
         rk4_step(derivative_into, state, limited, dt, scratch)
+    if not state_is_sound(state):
+        return blown_up(record_state.shape[0])
     return record_state.shape[0]

@@ -6,6 +6,7 @@ import numpy as np
 from numba import njit, types
 
 from mosys.kernels.integrate import DERIVATIVE_INTO, INDICES, VECTOR, rk4_scratch, rk4_step
+from mosys.kernels.simulate import blown_up, state_is_sound
 
 LIMP = 0  # the actuator applies no torque
 TORQUE = 1  # a constant torque, N m
@@ -13,7 +14,7 @@ SERVO = 2  # a servo towards a moving target: kp (target - angle) + kd (target r
 
 MATRIX = types.float64[:, ::1]
 
-MOTOR_SIGNATURE = types.void(
+MOTOR_SIGNATURE = types.int64(
     DERIVATIVE_INTO,  # derivative_into
     types.int64[:, ::1],  # mode
     MATRIX,  # value
@@ -64,12 +65,17 @@ def run_motor_program(
     float64, N m, the torques before the first step, left holding the last step's.
     state: (S,) the model's state q‖qd, advanced in place. Records, one row per step, taken at
     the step's start: record_state (steps, S), record_control (steps, A) N m.
+    Returns the steps taken, all of them, or ``simulate.blown_up(step)`` (< 0) when the state is
+    not sound (``simulate.state_is_sound``: NaN, inf, huge) before step ``step`` or after the
+    last: the records are filled for the steps before, ``state`` holds the unsound state.
     """
     size = state.shape[0]
     n = size // 2
     inputs = np.zeros(input_size)
     scratch = rk4_scratch(size)
     for step in range(mode.shape[0]):
+        if not state_is_sound(state):
+            return blown_up(step)
         for i in range(size):
             record_state[step, i] = state[i]
         for i in range(input_size):
@@ -89,3 +95,6 @@ def run_motor_program(
             record_control[step, a] = torque
             inputs[c] += torque
         rk4_step(derivative_into, state, inputs, dt, scratch)
+    if not state_is_sound(state):
+        return blown_up(mode.shape[0])
+    return mode.shape[0]

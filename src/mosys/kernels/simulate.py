@@ -23,6 +23,36 @@ from mosys.kernels.interpolate import (
     interpolation_scratch,
 )
 
+# The largest |entry| of a state the integrators step from: beyond it (or NaN), the state has
+# blown up, and the next step could overflow to inf and NaN.
+STATE_LIMIT = 1e150
+
+
+@njit(cache=True)
+def state_is_sound(state):
+    """True when every entry of ``state`` (S,) is finite and within ±STATE_LIMIT; the kernels
+    that integrate check it before every step and after the last, and return
+    ``blown_up(step)`` where it fails."""
+    for i in range(state.shape[0]):  # noqa: SIM110 (a loop numba compiles, no generator)
+        if not abs(state[i]) <= STATE_LIMIT:  # NaN fails too
+            return False
+    return True
+
+
+@njit(cache=True)
+def blown_up(step):
+    """The return code of a kernel that found the state unsound (``state_is_sound``) before
+    step ``step`` (0-based; the step count itself: after the last step), its records filled
+    for the steps before it: -(step + 1) < 0. ``steps_before_blow_up`` inverts it."""
+    return -(step + 1)
+
+
+def steps_before_blow_up(code: int) -> int:
+    """The steps a kernel took before the state became unsound, from its negative return code
+    (``blown_up``)."""
+    return -code - 1
+
+
 SIMULATE_SIGNATURE = types.int64(
     DERIVATIVE_INTO,  # derivative_into
     VECTOR,  # axis_min
@@ -106,7 +136,9 @@ def simulate_controlled(
     region_period,
 ):
     """Simulate up to ``record_state.shape[0]`` RK4 steps of dt seconds under a controller;
-    return how many were taken.
+    return how many were taken, or ``blown_up(step)`` (< 0) when the state is not sound
+    (``state_is_sound``: NaN, inf or beyond ±STATE_LIMIT) before step ``step`` or after the
+    last: the records are filled for the steps before, ``state`` holds the unsound state.
 
     Regions (state-space breakpoints and arrival boxes): boxes ``[region_lower[k],
     region_upper[k]]`` ((K, S) SI, ±inf for unbounded entries) over the model's full state,
@@ -141,6 +173,8 @@ def simulate_controlled(
     membership = np.empty(regions, np.bool_)
     region_membership(state, region_lower, region_upper, region_period, start_membership)
     for step in range(record_state.shape[0]):
+        if not state_is_sound(state):
+            return blown_up(step)
         if crossed_a_region_border(
             state, region_lower, region_upper, region_period, start_membership, membership
         ):
@@ -171,6 +205,8 @@ def simulate_controlled(
             record_control[step, j] = value
             inputs[control_slot[j]] += value
         rk4_step(derivative_into, state, inputs, dt, scratch)
+    if not state_is_sound(state):
+        return blown_up(record_state.shape[0])
     return record_state.shape[0]
 
 

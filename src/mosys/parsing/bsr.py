@@ -142,6 +142,9 @@ REQUIRED = ("figure", "controller", "simulate", "search", "seeds", "fitness")
 DEFAULT_REINITIALIZE = 0.5
 # rounding allowed in duration / dt being a whole number of steps, relative
 STEPS_TOLERANCE = 1e-9
+MAX_STEPS = 10_000_000  # simulator steps per evaluation (T / dt): the paper's runs take 1,000
+MAX_SEED = 2**63 - 1  # seeds are stored as int64 in the result file (and seed numpy's RNG)
+MAX_WHOLE = 2**31 - 1  # rules=, controllers=, generations=, reseed=: counts the kernels index
 
 # key -> (minimum, what) for whole numbers; (check, what) for numbers, check one of
 # '>0', '>=0', '0..1', None
@@ -297,7 +300,10 @@ class _Parser:
         or a number passing ``check``; errors point at the value."""
         part = value_token(token, key)
         if isinstance(check, int):
-            return parse_int(part, self.path, what, check)
+            whole = parse_int(part, self.path, what, check)
+            if whole > MAX_WHOLE:
+                raise self.error(part, f"a whole number from {check} to {MAX_WHOLE} for {what}")
+            return whole
         value = parse_number(part, self.path, what)
         bad = {
             ">0": value <= 0,
@@ -362,6 +368,12 @@ class _Parser:
                 f"a dt= (s) that divides duration={format_number(duration)} into whole steps "
                 f"({format_number(duration)} / {part.text} = {shown})",
             )
+        if steps > MAX_STEPS:
+            raise self.error(
+                part,
+                f"a dt= (s) of at least duration / {MAX_STEPS} = "
+                f"{format_number(duration / MAX_STEPS)} (at most {MAX_STEPS} steps per run)",
+            )
         if not 2 * dt < duration / 4:
             raise self.error(
                 part,
@@ -391,6 +403,8 @@ class _Parser:
         while True:
             token = reader.word(f"a whole number >= 0 for {what}")
             seed = parse_int(token, self.path, what, 0)
+            if seed > MAX_SEED:
+                raise self.error(token, f"a whole number from 0 to {MAX_SEED} (int64) for {what}")
             if seed in seeds:
                 raise self.error(
                     token, f"distinct seeds ({seed} is already at column {seeds[seed].column})"

@@ -80,6 +80,8 @@ DEFAULT_TOLERANCE = (
 DEFAULT_MAX_ITERATIONS = 1000
 DEFAULT_DT = 0.05  # s: the longest step of the DP's integrator (kernels.dp)
 MIN_DT = 1e-5  # s: below this a segment that stays in its cell (2 s) would take 200,000 steps
+MAX_NODES = 100_000_000  # state grid nodes (product of the ssd samples): 0.8 GB per table
+MAX_CONTROLS = 1_000_000  # control samples (product of the torq samples) tried at each node
 GRID_TOLERANCE = 1e-9  # a destination lies on a node if within GRID_TOLERANCE * step of it
 
 
@@ -400,8 +402,9 @@ class _Parser:
         self.finite_range(minimum, maximum, maximum_token)
         samples_token = reader.peek()
         samples = reader.integer("samples", minimum=2)
+        assert samples_token is not None
+        self.grid_size(samples, samples_token, self.state, MAX_NODES, "state grid nodes")
         if not (maximum - minimum) / (samples - 1) > 0:
-            assert samples_token is not None
             raise self.error(
                 samples_token,
                 "fewer samples (the step (max - min) / (samples - 1) is 0)",
@@ -429,8 +432,9 @@ class _Parser:
         self.finite_range(minimum, maximum, maximum_token)
         samples_token = reader.peek()
         samples = reader.integer("samples", minimum=1)
+        assert samples_token is not None
+        self.grid_size(samples, samples_token, self.controls, MAX_CONTROLS, "control samples")
         if samples == 1 and maximum != minimum:
-            assert samples_token is not None
             raise self.error(
                 samples_token,
                 f"samples >= 2 for a range from {_fmt(minimum)} to {_fmt(maximum)} "
@@ -442,6 +446,17 @@ class _Parser:
             raise self.error(weight_token, "a number >= 0 for K", weight_token.text)
         reader.end()
         self.controls.append(ControlDimension(name.text, minimum, maximum, samples, weight, name))
+
+    def grid_size(self, samples: int, token: Token, before: list, limit: int, what: str) -> None:
+        """Fail at ``token`` if ``samples`` times the samples of the lines ``before`` (ssd or
+        torq lines read so far) exceeds ``limit``."""
+        total = math.prod(dimension.samples for dimension in before) * samples
+        if total > limit:
+            raise self.error(
+                token,
+                f"fewer samples (at most {limit:,} {what} in all; these lines make {total:.3g})",
+                token.text,
+            )
 
     def line_dest(self, line: Line) -> None:
         if len(line.tokens) == 1:

@@ -54,7 +54,7 @@ from mosys.parsing.tokens import (
     unknown_keyword,
     value_token,
 )
-from mosys.parsing.vehicle import Vehicle, is_vehicle_spec, parse_vehicle
+from mosys.parsing.vehicle import Vehicle, is_vehicle_spec, parse_vehicle, render_vehicle_spec
 
 KEYWORDS = ("gravity", "rod", "pin", "free", "hinge", "limit", "contact", "terrain", "vehicle")
 KEYWORDS_3D = ("ball", "heading", "feet")  # only in a 3-D figure: one with a 'ball' line
@@ -65,6 +65,13 @@ DEFAULT_COM = 0.5  # fraction of the rod from its proximal end
 DEFAULT_SLIP = 0.01  # m/s: tangential speed at which contact friction reaches friction * normal
 TERRAIN_HALF_WIDTH = 1000.0  # m: 'floor' and 'steps' run from x = -1000 to x = +1000
 TERRAIN_KINDS = ("floor", "steps", "polyline")
+# Physical ranges (issue 27): beyond them the equations' products and inverses (m·l², 1/M, the
+# impulse solvers' determinants) overflow or underflow to 0 and the kernels divide by zero.
+ROD_LENGTH_RANGE = (1e-6, 1e6)  # m
+ROD_MASS_RANGE = (1e-6, 1e6)  # kg
+ROD_INERTIA_RANGE = (1e-20, 1e20)  # kg·m², about the com; m·l²/12 of any rod above lies in it
+MAX_GRAVITY = 1e6  # m/s²
+MAX_PIVOT = 1e6  # m: a pin's pivot lies within this of the origin in x and y, as terrain does
 
 _NO_TOKEN = Token("", 0, 0)
 # the options of a hinge or ball line
@@ -318,8 +325,11 @@ def parse_figure_text(
     return _Parser(path).parse(lines, spec_sha256)
 
 
-def render_figure_spec(figure: Figure) -> str:
-    """Spec text that parses back to ``figure`` (angles round-trip through degrees)."""
+def render_figure_spec(figure: Figure | Vehicle) -> str:
+    """Spec text that parses back to ``figure`` (angles round-trip through degrees), a vehicle
+    too (``parsing.vehicle.render_vehicle_spec``)."""
+    if isinstance(figure, Vehicle):
+        return render_vehicle_spec(figure)
     out = [f"gravity {format_number(figure.gravity)}"]
     for rod in figure.rods:
         out.append(
@@ -566,6 +576,8 @@ class _Parser:
         assert token is not None
         if value < 0:
             raise self.error(token, "a number >= 0 for gravity (m/s², pointing down)")
+        if value > MAX_GRAVITY:
+            raise self.error(token, f"a number <= {MAX_GRAVITY:g} for gravity (m/s²)")
         reader.end()
         self.gravity = value
 
@@ -586,19 +598,33 @@ class _Parser:
         )
         length_token = self.required(line, found, "length", "the rod's length in metres")
         mass_token = self.required(line, found, "mass", "the rod's mass in kg")
-        length = self.number(length_token, "length", "length (m)", ">0")
-        mass = self.number(mass_token, "mass", "mass (kg)", ">0")
+        length = self.ranged(length_token, "length", "length (m)", ROD_LENGTH_RANGE)
+        mass = self.ranged(mass_token, "mass", "mass (kg)", ROD_MASS_RANGE)
         com = DEFAULT_COM
         if "com" in found:
             com = self.number(found["com"], "com", "com (fraction of the length)", "0..1")
-        inertia = mass * length * length / 12.0
-        if not math.isfinite(inertia * length):  # the equations multiply these further
-            raise self.error(
-                value_token(length_token, "length"), "a smaller length or mass (they overflow)"
-            )
         if "inertia" in found:
-            inertia = self.number(found["inertia"], "inertia", "inertia (kg·m²)", ">0")
+            inertia = self.ranged(found["inertia"], "inertia", "inertia (kg·m²)", ROD_INERTIA_RANGE)
+        else:  # derived: the ranges above keep it in ROD_INERTIA_RANGE; checked all the same
+            inertia = mass * length * length / 12.0
+            low, high = ROD_INERTIA_RANGE
+            if not low <= inertia <= high:
+                raise self.error(
+                    value_token(length_token, "length"),
+                    f"a length and mass whose inertia m·l²/12 is from {low:g} to {high:g} kg·m² "
+                    f"(it is {inertia:g})",
+                )
         self.rods.append(Rod(name.text, length, mass, com, inertia, name))
+
+    def ranged(self, token: Token, key: str, what: str, bounds: tuple[float, float]) -> float:
+        """The number > 0 of a ``key=value`` token, within ``bounds`` (inclusive)."""
+        value = self.number(token, key, what, ">0")
+        low, high = bounds
+        if not low <= value <= high:
+            raise self.error(
+                value_token(token, key), f"a number from {low:g} to {high:g} for {what}"
+            )
+        return value
 
     def line_pin(self, line: Line) -> None:
         reader = line.reader()
@@ -612,7 +638,13 @@ class _Parser:
                 "actuator": _ACTUATOR_KEY,
             },
         )
-        pivot = self.point(found["at"], "at", "at") if "at" in found else (0.0, 0.0)
+        pivot = (0.0, 0.0)
+        if "at" in found:
+            pivot = self.point(found["at"], "at", "at")
+            if max(abs(pivot[0]), abs(pivot[1])) > MAX_PIVOT:
+                raise self.error(
+                    value_token(found["at"], "at"), f"a pivot within {MAX_PIVOT:g} m of the origin"
+                )
         offset = self.degrees(found, "offset")
         angle, names = self.angle_coordinate(found, rod)
         self.joints.append(

@@ -15,7 +15,14 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from mosys.parsing.tokens import Line, SpecError, Token, parse_number, value_token
+from mosys.parsing.tokens import (
+    Line,
+    SpecError,
+    Token,
+    format_number,
+    parse_number,
+    value_token,
+)
 
 STATE_NAMES = ("x", "y", "heading", "steer", "speed")
 STATE_UNITS = ("m", "m", "deg", "deg", "m/s")
@@ -30,6 +37,7 @@ _OPTIONS = {
     "wheel_radius": "the front wheels' radius in metres",
     "steer_limit": "the largest steering angle of the road wheels in degrees",
 }
+LENGTH_RANGE = (1e-6, 1e6)  # m: every length option (the car's equations divide by them)
 
 
 @dataclass(frozen=True)
@@ -84,6 +92,9 @@ def parse_vehicle(lines: list[Line], path: str, spec_sha256: str) -> Vehicle:
         value = parse_number(token, path, key)
         if not value > 0 or not math.isfinite(value):
             raise SpecError.at(path, token, f"a number > 0 for {key}")
+        low, high = LENGTH_RANGE
+        if key != "steer_limit" and not low <= value <= high:
+            raise SpecError.at(path, token, f"a number from {low:g} to {high:g} for {key}")
         values[key] = value
     if values["wheelbase"] + values["front_overhang"] > values["length"]:
         token = value_token(found["length"][0], "length")
@@ -109,3 +120,12 @@ def parse_vehicle(lines: list[Line], path: str, spec_sha256: str) -> Vehicle:
         spec_sha256=spec_sha256,
         token=line.keyword,
     )
+
+
+def render_vehicle_spec(vehicle: Vehicle) -> str:
+    """Spec text that parses back to ``vehicle`` (``steer_limit`` round-trips through degrees)."""
+    lengths = " ".join(
+        f"{key}={format_number(getattr(vehicle, key))}" for key in _OPTIONS if key != "steer_limit"
+    )
+    steer_limit = format_number(math.degrees(vehicle.steer_limit))
+    return f"vehicle {lengths} steer_limit={steer_limit}\n"

@@ -16,9 +16,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from mosys.errors import NonFiniteStateError
 from mosys.io.controller_table import ControllerTable, read_controller_table
 from mosys.kernels.interpolate import clamp_to_domain, interpolate_into
-from mosys.kernels.simulate import simulate_controlled
+from mosys.kernels.simulate import STATE_LIMIT, simulate_controlled, steps_before_blow_up
 from mosys.ssc.grid import FigureGrid, control_scale, figure_grid, figure_state_names, state_unit
 from mosys.ssc.regions import ARRIVAL_STEPS, REST_RATE, Bounds, Regions, state_periods
 
@@ -27,6 +28,27 @@ CLOSED_LOOP_DT = 0.001  # s: the simulator step of the closed-loop runs that jud
 
 if TYPE_CHECKING:  # the lookahead policy (a vehicle's) is imported when a table uses it
     from mosys.ssc.lookahead import Lookahead
+
+
+def non_finite_message(
+    dynamics: ModuleType, t: float, figure_state: np.ndarray, driver: str
+) -> str:
+    """What ``NonFiniteStateError`` says: the model state ``figure_state`` (S,) SI, NaN, inf or
+    beyond ±STATE_LIMIT, at ``t`` s under ``driver`` ('controller A', 'motor program swing'),
+    each variable in its spec unit."""
+    described = ", ".join(
+        f"{name}={value / state_unit(dynamics, name)[1]:.6g} {state_unit(dynamics, name)[0]}"
+        for name, value in zip(figure_state_names(dynamics), figure_state, strict=True)
+    )
+    what = (
+        f"lies beyond ±{STATE_LIMIT:g} (SI)"
+        if np.isfinite(figure_state).all()
+        else "became non-finite"
+    )
+    return (
+        f"the state {what} at t = {t:.6g} s under {driver} ({described}): the simulation "
+        "cannot go on (a huge state, gain or figure parameter?); nothing written"
+    )
 
 
 @dataclass(frozen=True)
@@ -271,7 +293,11 @@ class Controller:
         ``slew_rate`` (m,): the largest rate of change of each control, spec units per second
         (inf, or None for all: no limit), from ``previous`` (m,), the controls just before the
         run, spec units (None: 0). A ``policy lookahead`` table plans its own controls and
-        takes no slew limit (ValueError)."""
+        takes no slew limit (ValueError).
+
+        A state that becomes non-finite (NaN, inf, or beyond ±``kernels.simulate.STATE_LIMIT``
+        SI) at the start of a step or at the end raises ``errors.NonFiniteStateError`` with the time
+        from the run's start and that state."""
         steps = int(round(seconds / dt))
         m = len(self.table.control_names)
         slew_step = np.full(m, np.inf)
@@ -355,6 +381,11 @@ class Controller:
                 regions.lower,
                 regions.upper,
                 regions.period,
+            )
+        if taken < 0:
+            t = steps_before_blow_up(taken) * dt
+            raise NonFiniteStateError(
+                non_finite_message(self.dynamics, t, state, f"controller {self.name}"), t, state
             )
         states[taken] = state
         return ClosedLoopRun(

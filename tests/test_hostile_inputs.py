@@ -1,0 +1,297 @@
+"""Issue 27, "hostile input never crashes a verb": the reproducers end with exit 2 and a
+``file:line:column`` message (no traceback, no output file), and every accepted figure spec
+renders and parses back."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from conftest import SPECS
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from mosys.dynamics.model import build_model
+from mosys.parsing.bsr import MAX_SEED, parse_bsr_text
+from mosys.parsing.controller import parse_controller_text
+from mosys.parsing.figure import (
+    ROD_INERTIA_RANGE,
+    Figure,
+    parse_figure_spec,
+    parse_figure_text,
+    render_figure_spec,
+)
+from mosys.parsing.tokens import SpecError
+from mosys.parsing.vehicle import Vehicle
+
+FIGURES = SPECS / "figures"
+HUGE_SEED = "99999999999999999999999"
+
+
+def mosys_command(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "mosys.cli", *args], cwd=cwd, capture_output=True, text=True
+    )
+
+
+def edited(source: Path, old: str, new: str) -> str:
+    """``source``'s text with its one ``old`` replaced by ``new``."""
+    text = source.read_text()
+    assert text.count(old) == 1
+    return text.replace(old, new)
+
+
+def where(text: str, needle: str) -> str:
+    """``line:column`` (1-based) of the first ``needle`` in ``text``."""
+    for number, line in enumerate(text.split("\n"), start=1):
+        if needle in line:
+            return f"{number}:{line.index(needle) + 1}"
+    raise AssertionError(f"{needle!r} not in the text")
+
+
+def assert_refused(done: subprocess.CompletedProcess, message: str, directory: Path) -> None:
+    """Exit 2 with exactly ``message`` on stderr, and no .h5 or .py output left behind."""
+    assert "Traceback" not in done.stderr
+    assert done.returncode == 2
+    assert done.stderr == message + "\n"
+    assert not [path for path in directory.rglob("*") if path.suffix in (".h5", ".py")]
+    assert not [path for path in directory.rglob(".*.partial")]
+
+
+# --- 1. an underflowing length ---------------------------------------------------------------
+
+
+def test_compile_refuses_an_underflowing_length(tmp_path: Path) -> None:
+    text = edited(FIGURES / "link1.fig", "length=1 mass=1 ", "length=1e-300 mass=1 ")
+    spec = tmp_path / "link1.fig"
+    spec.write_text(text)
+    done = mosys_command("compile", str(spec), "-o", str(tmp_path / "link1.py"), cwd=tmp_path)
+    at = where(text, "1e-300")
+    assert_refused(
+        done,
+        f"{spec}:{at}: expected a number from 1e-06 to 1e+06 for length (m), found '1e-300'",
+        tmp_path,
+    )
+
+
+FIGURE_ERRORS = {
+    "rod a length=1 mass=1e300\npin a\n": "bad.fig:1:21: expected a number from 1e-06 to "
+    "1e+06 for mass (kg), found '1e300'",
+    "rod a length=1 mass=1 inertia=1e-300\npin a\n": "bad.fig:1:31: expected a number from "
+    "1e-20 to 1e+20 for inertia (kg·m²), found '1e-300'",
+    "rod a length=1 mass=1 inertia=0\npin a\n": "bad.fig:1:31: expected a number > 0 for "
+    "inertia (kg·m²), found '0'",
+    "gravity 1e300\nrod a length=1 mass=1\npin a\n": "bad.fig:1:9: expected a number <= "
+    "1e+06 for gravity (m/s²), found '1e300'",
+    "rod a length=1 mass=1\npin a at=1e300,0\n": "bad.fig:2:10: expected a pivot within "
+    "1e+06 m of the origin, found '1e300,0'",
+    "vehicle wheelbase=1e-300 length=4.0 width=1.7 front_overhang=0.8 wheel_radius=0.3 "
+    "steer_limit=35\n": "bad.fig:1:19: expected a number from 1e-06 to 1e+06 for wheelbase, "
+    "found '1e-300'",
+}
+
+
+@pytest.mark.parametrize("text", list(FIGURE_ERRORS))
+def test_figure_ranges(text: str) -> None:
+    with pytest.raises(SpecError) as error:
+        parse_figure_text(text, "bad.fig")
+    assert str(error.value) == FIGURE_ERRORS[text]
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.floats(1e-320, 1e308, allow_infinity=False),
+    st.floats(1e-320, 1e308, allow_infinity=False),
+)
+def test_any_accepted_rod_has_a_finite_positive_inertia(length: float, mass: float) -> None:
+    text = f"rod a length={length!r} mass={mass!r}\npin a\n"
+    try:
+        figure = parse_figure_text(text, "rod.fig")
+    except SpecError:
+        return
+    assert isinstance(figure, Figure)
+    inertia = figure.rods[0].inertia
+    assert ROD_INERTIA_RANGE[0] <= inertia <= ROD_INERTIA_RANGE[1]
+    assert 0 < mass * length * length < math.inf
+
+
+def test_model_refuses_a_zero_inertia_built_in_code() -> None:
+    figure = parse_figure_spec(FIGURES / "link1.fig")
+    assert isinstance(figure, Figure)
+    rod = dataclasses.replace(figure.rods[0], inertia=0.0)
+    with pytest.raises(SpecError) as error:
+        build_model(dataclasses.replace(figure, rods=(rod,)))
+    assert str(error.value) == (
+        f"{FIGURES / 'link1.fig'}:7:5: expected a rod whose inertia (kg·m²) is from 1e-20 to "
+        "1e+20 (it is 0), found 'link'"
+    )
+
+
+# --- 2. a tiny dt, a huge mass, a huge grid ---------------------------------------------------
+
+
+def test_dp_refuses_a_tiny_dt(tmp_path: Path) -> None:
+    spec = tmp_path / "A.ssc"
+    text = (SPECS / "controllers/pendulum/A.ssc").read_text() + "dt 1e-300\n"
+    spec.write_text(text)
+    done = mosys_command("dp", str(spec), "-o", str(tmp_path / "A.h5"), cwd=tmp_path)
+    at = where(text, "1e-300")
+    assert_refused(
+        done, f"{spec}:{at}: expected a dt of at least 1e-05 s, found '1e-300'", tmp_path
+    )
+
+
+def test_dp_refuses_a_grid_too_large(tmp_path: Path) -> None:
+    old = "ssd omega -500.0 500.0 21"
+    text = edited(SPECS / "controllers/pendulum/A.ssc", old, "ssd omega -500.0 500.0 " + "9" * 20)
+    spec = tmp_path / "A.ssc"
+    spec.write_text(text)
+    done = mosys_command("dp", str(spec), "-o", str(tmp_path / "A.h5"), cwd=tmp_path)
+    at = where(text, "9" * 20)
+    assert_refused(
+        done,
+        f"{spec}:{at}: expected fewer samples (at most 100,000,000 state grid nodes in all; "
+        f"these lines make 1e+20), found '{'9' * 20}'",
+        tmp_path,
+    )
+
+
+def test_controller_torq_samples_bounded() -> None:
+    text = "dyn link1\nssd angle -180 170 36 wrap\ntorq torque -10 10 2000000 0.1\n"
+    with pytest.raises(SpecError) as error:
+        parse_controller_text(text, "A.ssc")
+    assert str(error.value) == (
+        "A.ssc:3:20: expected fewer samples (at most 1,000,000 control samples in all; these "
+        "lines make 2e+06), found '2000000'"
+    )
+
+
+def test_bsr_search_refuses_a_huge_mass(tmp_path: Path) -> None:
+    figures = tmp_path / "figures"
+    figures.mkdir()
+    old = "rod arm_b length=0.6 mass=5"
+    text = edited(FIGURES / "starman.fig", old, "rod arm_b length=0.6 mass=1e300")
+    (figures / "starman.fig").write_text(text)
+    output = tmp_path / "seed1.h5"
+    done = mosys_command(
+        "bsr-search", str(SPECS / "bsr/starman_jump.bsr"), "--seed", "1", "--figures",
+        str(figures), "--generations", "1", "-o", str(output), cwd=tmp_path,
+    )  # fmt: skip
+    at = where(text, "1e300")
+    assert_refused(
+        done,
+        f"{figures / 'starman.fig'}:{at}: expected a number from 1e-06 to 1e+06 for mass (kg), "
+        "found '1e300'",
+        tmp_path,
+    )
+
+
+def test_bsr_search_refuses_a_tiny_dt(tmp_path: Path) -> None:
+    text = edited(SPECS / "bsr/starman_jump.bsr", "dt=0.01", "dt=1e-300")
+    spec = tmp_path / "jump.bsr"
+    spec.write_text(text)
+    done = mosys_command(
+        "bsr-search", str(spec), "--seed", "1", "--figures", str(FIGURES), "--generations", "1",
+        "-o", str(tmp_path / "seed1.h5"), cwd=tmp_path,
+    )  # fmt: skip
+    at = where(text, "1e-300")
+    assert_refused(
+        done,
+        f"{spec}:{at}: expected a dt= (s) of at least duration / 10000000 = 4e-07 (at most "
+        "10000000 steps per run), found '1e-300'",
+        tmp_path,
+    )
+
+
+# --- 3. a huge seed ---------------------------------------------------------------------------
+
+
+def test_bsr_search_refuses_a_huge_seed_in_the_spec(tmp_path: Path) -> None:
+    text = edited(SPECS / "bsr/starman_jump.bsr", "seeds 1 2 3 4 5", f"seeds 1 {HUGE_SEED}")
+    spec = tmp_path / "jump.bsr"
+    spec.write_text(text)
+    done = mosys_command(
+        "bsr-search", str(spec), "--seed", "1", "--figures", str(FIGURES), "--generations", "1",
+        "-o", str(tmp_path / "seed1.h5"), cwd=tmp_path,
+    )  # fmt: skip
+    at = where(text, HUGE_SEED)
+    assert_refused(
+        done,
+        f"{spec}:{at}: expected a whole number from 0 to {MAX_SEED} (int64) for a seed, found "
+        f"'{HUGE_SEED}'",
+        tmp_path,
+    )
+
+
+def test_bsr_search_refuses_a_huge_seed_argument(tmp_path: Path) -> None:
+    text = edited(SPECS / "bsr/starman_jump.bsr", "seeds 1 2 3 4 5", f"seeds {HUGE_SEED}")
+    spec = tmp_path / "jump.bsr"
+    spec.write_text(text)
+    done = mosys_command(
+        "bsr-search", str(spec), "--seed", HUGE_SEED, "--figures", str(FIGURES),
+        "--generations", "1", "-o", str(tmp_path / "seed.h5"), cwd=tmp_path,
+    )  # fmt: skip
+    assert "Traceback" not in done.stderr
+    assert done.returncode == 2
+    assert done.stderr.endswith(
+        f"mosys: error: bsr-search: --seed must be a whole number from 0 to {MAX_SEED}, got "
+        f"{HUGE_SEED}\n"
+    )
+    assert not list(tmp_path.glob("*.h5"))
+
+
+def test_bsr_whole_numbers_fit_the_kernels() -> None:
+    text = (
+        (SPECS / "bsr/starman_jump.bsr")
+        .read_text()
+        .replace("generations=4000", "generations=" + "9" * 20)
+    )
+    with pytest.raises(SpecError) as error:
+        parse_bsr_text(text, "jump.bsr")
+    assert str(error.value) == (
+        f"jump.bsr:{where(text, '9' * 20)}: expected a whole number from 1 to 2147483647 for "
+        f"generations=, found '{'9' * 20}'"
+    )
+
+
+# --- 4. render -> parse round-trips -----------------------------------------------------------
+
+
+def assert_same(a: object, b: object) -> None:
+    """Equal dataclasses, tuples and values, floats within 1e-12 (angles go through degrees);
+    ``path`` and ``spec_sha256`` are not compared."""
+    if dataclasses.is_dataclass(a):
+        assert type(a) is type(b)
+        for field in dataclasses.fields(a):
+            if field.name not in ("path", "spec_sha256", "token") and field.compare:
+                assert_same(getattr(a, field.name), getattr(b, field.name))
+    elif isinstance(a, tuple):
+        assert isinstance(b, tuple) and len(a) == len(b)
+        for x, y in zip(a, b, strict=True):
+            assert_same(x, y)
+    elif isinstance(a, float):
+        assert a == pytest.approx(b, rel=1e-12, abs=1e-12)
+    else:
+        assert a == b
+
+
+@pytest.mark.parametrize("path", sorted(FIGURES.glob("*.fig")), ids=lambda path: path.stem)
+def test_every_shipped_figure_renders_and_parses_back(path: Path) -> None:
+    figure = parse_figure_spec(path)
+    text = render_figure_spec(figure)
+    again = parse_figure_text(text, str(path))
+    assert_same(again, figure)
+    assert render_figure_spec(again) == text  # rendering is a fixed point after one trip
+
+
+def test_vehicle_renders_as_one_line() -> None:
+    vehicle = parse_figure_spec(FIGURES / "car.fig")
+    assert isinstance(vehicle, Vehicle)
+    assert render_figure_spec(vehicle) == (
+        "vehicle wheelbase=2.5 length=4 width=1.7 front_overhang=0.8 wheel_radius=0.3 "
+        "steer_limit=35\n"
+    )
