@@ -11,7 +11,8 @@ from types import ModuleType
 import numpy as np
 
 from mosys.errors import InputError
-from mosys.kernels.simulate import simulate_unpowered
+from mosys.kernels.motor import run_motor_program
+from mosys.kernels.simulate import steps_before_blow_up
 
 FREE_SWING_DT = 0.001  # s: the simulator step of the free swing
 ORBIT_SECONDS = 8.0  # s simulated per orbit: longer than one period of every drawn orbit
@@ -39,16 +40,34 @@ class FreeSwing:
 
 def free_motion(dynamics: ModuleType, angle: float, rate: float, seconds: float) -> np.ndarray:
     """(N, 2) (angle rad, rate rad/s) of a one-coordinate figure with its inputs at 0, from
-    (``angle``, ``rate``) for ``seconds``; InputError if the state becomes non-finite."""
+    (``angle``, ``rate``) for ``seconds``; InputError if the state becomes non-finite. Run by
+    the motor-program kernel with no actuator: every input stays 0."""
     _check_one_coordinate(dynamics)
     steps = int(round(seconds / FREE_SWING_DT))
     record = np.empty((steps + 1, 2))
     state = np.array([angle, rate], dtype=np.float64)
-    filled = simulate_unpowered(
-        dynamics.derivative_into, state, len(dynamics.INPUT_NAMES), FREE_SWING_DT, record
+    none = np.empty((steps, 0))  # per step and actuator: there is no actuator
+    taken = run_motor_program(
+        dynamics.derivative_into,
+        np.empty((steps, 0), dtype=np.int64),
+        none,
+        none,
+        none,
+        none,
+        np.empty(0),
+        np.empty(0),
+        np.empty(0),
+        np.empty(0, dtype=np.int64),
+        len(dynamics.INPUT_NAMES),
+        state,
+        FREE_SWING_DT,
+        record[:-1],
+        np.empty((steps, 0)),
     )
-    if filled < record.shape[0]:
-        raise InputError(f"the free swing became non-finite at t = {filled * FREE_SWING_DT} s")
+    if taken < 0:
+        at = steps_before_blow_up(taken) * FREE_SWING_DT
+        raise InputError(f"the free swing became non-finite at t = {at} s")
+    record[-1] = state
     return record
 
 

@@ -208,23 +208,3 @@ def simulate_controlled(
     if not state_is_sound(state):
         return blown_up(record_state.shape[0])
     return record_state.shape[0]
-
-
-@njit(cache=True)
-def simulate_unpowered(derivative_into, state, input_size, dt, record_state):
-    """Simulate ``record_state.shape[0] - 1`` RK4 steps of dt seconds with every input 0 (the
-    figure swinging freely). state: (S,) SI, advanced in place; record_state (steps+1, S): the
-    start, then the state after each step. Stops early, returning the rows filled, if the state
-    becomes non-finite."""
-    size = state.shape[0]
-    inputs = np.zeros(input_size)
-    scratch = rk4_scratch(size)
-    for i in range(size):
-        record_state[0, i] = state[i]
-    for step in range(1, record_state.shape[0]):
-        rk4_step(derivative_into, state, inputs, dt, scratch)
-        for i in range(size):
-            if not math.isfinite(state[i]):
-                return step
-            record_state[step, i] = state[i]
-    return record_state.shape[0]
