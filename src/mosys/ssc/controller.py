@@ -106,12 +106,22 @@ class Controller:
     def state_order(self) -> tuple[str, ...]:
         return self.table.state_order
 
-    def torque(self, state: np.ndarray) -> np.ndarray:
-        """Controls (m,) at a controller state (d,) in spec units (deg, deg/s, m, m/s)."""
+    def _clamped(self, state: np.ndarray) -> tuple[np.ndarray, bool]:
+        """A controller state (d,) in spec units as the table reads it: SI, each non-wrap
+        coordinate moved onto its axis range (``clamp_to_domain``); and whether nothing had to
+        move."""
         grid = self.grid
         si = np.asarray(state, dtype=np.float64) * grid.scale
         clamped = np.empty_like(si)
-        clamp_to_domain(grid.axis_min, grid.axis_step, grid.axis_count, grid.wrap, si, clamped)
+        inside = clamp_to_domain(
+            grid.axis_min, grid.axis_step, grid.axis_count, grid.wrap, si, clamped
+        )
+        return clamped, bool(inside)
+
+    def torque(self, state: np.ndarray) -> np.ndarray:
+        """Controls (m,) at a controller state (d,) in spec units (deg, deg/s, m, m/s)."""
+        grid = self.grid
+        clamped, _ = self._clamped(state)
         out = np.empty(len(self.table.control_names))
         interpolate_into(
             grid.axis_min,
@@ -132,9 +142,7 @@ class Controller:
         ``minimum_known_weight`` (0 when absent) of the weight; beyond the axes, at the nearest
         covered state."""
         grid = self.grid
-        si = np.asarray(state, dtype=np.float64) * grid.scale
-        clamped = np.empty_like(si)
-        clamp_to_domain(grid.axis_min, grid.axis_step, grid.axis_count, grid.wrap, si, clamped)
+        clamped, _ = self._clamped(state)
         known_values, known = self._known_values
         out = np.empty(1)
         known_weight = interpolate_into(
@@ -154,14 +162,8 @@ class Controller:
         """Why the model state ``figure_state`` (S,) SI lies outside this controller's domain
         (the 1990 paper's Figure 7: beyond a non-wrap axis of the table, or where its
         interpolated cost-to-go is inf), or None inside it."""
-        grid = self.grid
         state = self.controller_states(np.asarray(figure_state, dtype=np.float64)[None, :])[0]
-        si = state * grid.scale
-        clamped = np.empty_like(si)
-        inside = clamp_to_domain(
-            grid.axis_min, grid.axis_step, grid.axis_count, grid.wrap, si, clamped
-        )
-        if not inside:
+        if not self._clamped(state)[1]:
             return "beyond the table's axes"
         if not math.isfinite(self.cost_to_go(state)):
             return "where the table's cost-to-go is inf"
@@ -224,9 +226,7 @@ class Controller:
         if self.table.destination_index is None:
             return 0
         grid = self.grid
-        si = np.asarray(state, dtype=np.float64) * grid.scale
-        clamped = np.empty_like(si)
-        clamp_to_domain(grid.axis_min, grid.axis_step, grid.axis_count, grid.wrap, si, clamped)
+        clamped, _ = self._clamped(state)
         votes, known = self._destination_votes
         out = np.empty(votes.shape[1])
         weight = interpolate_into(
