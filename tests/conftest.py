@@ -144,6 +144,43 @@ def pendulum_tables(tmp_path_factory, link1):
     return directory
 
 
+@pytest.fixture(scope="session")
+def pendulum(tmp_path_factory, link1) -> Path:
+    """A directory with link1's dynamics (dynamics/link1.py), controller A (controllers/A.h5)
+    and, for motor programs, motor/link1/: what ``mosys run`` takes."""
+    from mosys.dynamics.compile import compile_figure
+    from mosys.parsing.controller import parse_controller_spec
+    from mosys.ssc.generate import generate_controller
+
+    root = tmp_path_factory.mktemp("pendulum_run")
+    (root / "dynamics").mkdir()
+    compile_figure(SPECS / "figures" / "link1.fig", root / "dynamics" / "link1.py")
+    (root / "controllers").mkdir()
+    spec = parse_controller_spec(SPECS / "controllers" / "pendulum" / "A.ssc")
+    generate_controller(spec, link1, root / "controllers" / "A.h5", quiet=True)
+    (root / "motor" / "link1").mkdir(parents=True)
+    return root
+
+
+@pytest.fixture(scope="session")
+def car_park(car, tmp_path_factory) -> Path:
+    """The car test's SMALL scene as a lookahead table, controllers/park.h5, and the car's
+    dynamics, dynamics/car.py."""
+    from test_car import SMALL
+
+    from mosys.dynamics.compile import compile_figure
+    from mosys.parsing.controller import parse_controller_text
+    from mosys.ssc.generate import generate_controller
+
+    root = tmp_path_factory.mktemp("car_park")
+    (root / "dynamics").mkdir()
+    compile_figure(SPECS / "figures" / "car.fig", root / "dynamics" / "car.py")
+    (root / "controllers").mkdir()
+    spec = parse_controller_text(SMALL + "policy lookahead x=0.1 y=0.1 heading=4\n", "park.ssc")
+    generate_controller(spec, car, root / "controllers" / "park.h5", quiet=True)
+    return root
+
+
 @dataclass(frozen=True)
 class CompositeWorkspace:
     """The three robust Star-Man searches built at a tiny budget (``bsr_results``/NAME/seedK.h5,

@@ -12,8 +12,16 @@ from mosys.bsr.figure3d import bsr_figure3d
 from mosys.bsr.search import SearchOutcome, SearchSetup, bind_search, run_search, searched_variables
 from mosys.bsr.search3d import bind_search3d, chain_start, standing_height
 from mosys.io.bsr_result import BsrResult, write_bsr_result
+from mosys.limits import check_job
 from mosys.parsing.bsr import BsrSpec, parse_bsr_spec
 from mosys.parsing.tokens import SpecError
+
+
+def motion_step_bytes(endpoints: int) -> int:
+    """About what one recorded step of a BSR run takes, bytes: each endpoint's position (3
+    float64, 3-D at most) in the kernel's record, the best run's copy and ``figure_motion``; the
+    state and senses beside them."""
+    return 8 * (3 * 3 * endpoints + 64)
 
 
 def search_to_file(
@@ -37,6 +45,13 @@ def search_to_file(
         )
     setup, extra = _bind(spec, figures_dir, generations, chain_results or [])
     figure = setup.figure
+    simulate = spec.tokens["simulate"]
+    check_job(
+        f"{spec.path}:{simulate.line}:{simulate.column}",
+        f"one evaluation of {spec.steps:,} steps",
+        spec.steps,
+        spec.steps * motion_step_bytes(len(figure.endpoint_names)),
+    )
     if threads:
         import numba
 

@@ -11,9 +11,11 @@ from pathlib import Path
 
 import numpy as np
 
+from mosys.bsr.result_file import motion_step_bytes
 from mosys.composite.session import CompositeSession, ScoredMotion, open_session
 from mosys.composite.transitions import TransitionSearch, search_transitions
 from mosys.io.composite_result import CompositeMotion, CompositeResult, write_composite_result
+from mosys.limits import check_job
 from mosys.parsing.composite import parse_composite_script
 from mosys.parsing.tokens import read_spec_text
 
@@ -44,6 +46,24 @@ def stored_motion(session: CompositeSession, scored: ScoredMotion) -> CompositeM
     )
 
 
+def check_size(session: CompositeSession) -> None:
+    """LimitError at the first phase's ``ticks=`` (or the ``figure`` line, without them) where
+    the guessed concatenation, counted from its start, needs more steps or memory than the
+    limits allow (``mosys.limits``)."""
+    script = session.script
+    step_bytes = motion_step_bytes(len(session.figure.endpoint_names))
+    ticks = 0.0
+    for phase, phase_ticks in zip(script.phases, session.guess, strict=True):
+        ticks += float(phase_ticks)
+        token = script.tokens.get(f"phase.{phase.name}.ticks", script.tokens["figure"])
+        check_job(
+            f"{script.path}:{token.line}:{token.column}",
+            f"the phases' {ticks:,.0f} ticks to the end of this one",
+            ticks,
+            ticks * step_bytes,
+        )
+
+
 def composite_to_file(
     script_path: str | Path,
     controller_files: Mapping[str, Sequence[str | Path]],
@@ -60,6 +80,7 @@ def composite_to_file(
     if search_sizes:
         script = replace(script, search=replace(script.search, **search_sizes))
     session = open_session(script, controller_files, figures_dir, bsr_specs_dir)
+    check_size(session)
     before = session.score(session.guess)  # also compiles the kernels before the clock starts
     settings = script.search
     began = time.perf_counter()

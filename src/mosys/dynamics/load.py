@@ -24,6 +24,12 @@ from pathlib import Path
 from types import ModuleType
 
 from mosys.errors import InputError
+from mosys.parsing.figure import (
+    MAX_GRAVITY,
+    ROD_INERTIA_RANGE,
+    ROD_LENGTH_RANGE,
+    ROD_MASS_RANGE,
+)
 from mosys.parsing.tokens import SpecError, Token
 
 # names every dynamics module defines (the controllers' first-order view), then those of each kind
@@ -99,7 +105,33 @@ def load_dynamics(path: str | Path) -> ModuleType:
             f"{path} is not a dynamics module of this mosys (it lacks {missing[0]}): compile its "
             "figure again (mosys compile, or snakemake, which does so when mosys changes)"
         )
+    if kind == "figure":
+        _check_parameters(path, module)
     return module
+
+
+def _check_parameters(path: Path, module: ModuleType) -> None:
+    """InputError if a figure module's rods or gravity lie outside the figure spec's bounds
+    (``parsing.figure``): a module compiled before the bounds, or edited by hand, whose numbers
+    would make the kernels divide by zero or overflow."""
+    ranges = (
+        ("ROD_LENGTH", "length", "m", ROD_LENGTH_RANGE),
+        ("ROD_MASS", "mass", "kg", ROD_MASS_RANGE),
+        ("ROD_INERTIA", "inertia", "kg·m²", ROD_INERTIA_RANGE),
+    )
+    for constant, quantity, unit, (low, high) in ranges:
+        for name, value in zip(getattr(module, "ROD_NAMES", ()), getattr(module, constant, ()), strict=False):
+            if not low <= value <= high:
+                raise InputError(
+                    f"{path}: rod {name}'s {quantity} is {value:g} {unit}, outside the figure "
+                    f"spec's {low:g}..{high:g}: fix the figure spec and compile it again"
+                )
+    gravity = getattr(module, "GRAVITY", 0.0)
+    if not 0 <= gravity <= MAX_GRAVITY:
+        raise InputError(
+            f"{path}: gravity is {gravity:g} m/s², outside the figure spec's 0..{MAX_GRAVITY:g}: "
+            "fix the figure spec and compile it again"
+        )
 
 
 def figure_dynamics(

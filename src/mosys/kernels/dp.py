@@ -26,6 +26,7 @@ from mosys.kernels.figure_state import load_state
 from mosys.kernels.geometry import pose_is_free
 from mosys.kernels.interpolate import corner_weights, grid_strides, interpolation_scratch
 from mosys.kernels.lookahead import stops_in_box
+from mosys.kernels.simulate import state_is_sound
 from mosys.kernels.specialise import model_derivative
 
 UNKNOWN = 1.0e9  # s: cost-to-go of a reachable node whose value is not known yet (the paper's
@@ -206,7 +207,8 @@ def exit_transitions_template(
     control_samples: (U, m) sampled controls; control_slot: (m,) int64 entry of the model's
     inputs (input_size of them) each control drives; effort_weight: (m,) K of the cost
     t + Σ K|u| t. max_step: the longest integration step, s. A segment still in its cell after
-    ``MAX_SEGMENT_SECONDS``, or whose state becomes non-finite, is discarded (cost inf).
+    ``MAX_SEGMENT_SECONDS`` is discarded (cost inf); one whose state becomes non-finite has
+    cost nan, for the caller to report.
     nodes: (P,) int64 flat node indices to process, each with a row (``row_of``: (N,) int64,
     the row of each node in the outputs, -1 for a removed node, which has none).
     pose_slot, outline, obstacle_vertices, obstacle_start, domain: the obstacles, as
@@ -221,7 +223,7 @@ def exit_transitions_template(
     Outputs, one row per node that is not removed: exit_index (R, U, 2**(d-1)) int32 and
     exit_weight (R, U, 2**(d-1)) float32, the nodes and weights interpolating the exit state on
     the face it crosses; segment_cost (R, U) float64, inf where the segment never leaves the
-    cell, leaves the domain or hits an obstacle.
+    cell, leaves the domain or hits an obstacle, nan where its state became non-finite.
     """
     d = axis_min.shape[0]
     size = base_state.shape[0]
@@ -304,8 +306,9 @@ def exit_transitions_template(
                         + E7 * k7[slot]
                     )
                     error = max(error, abs(estimate) / (STEP_TOLERANCE * axis_step[k]))
-                if not np.isfinite(error):
-                    break  # the model diverged: cost stays inf
+                if not (np.isfinite(error) and state_is_sound(after)):
+                    segment_cost[row, u] = np.nan  # the model diverged: the caller reports it
+                    break
                 if error > 1.0:
                     h *= max(0.2, 0.9 * error**-0.2)
                     if h < MIN_STEP:

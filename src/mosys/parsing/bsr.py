@@ -97,8 +97,9 @@ class BsrSpec:
     below which the figure counts as fallen; ``sense_filter`` s, the low-pass time constant of a
     sense-based controller's physical senses; ``chain`` the search whose final state this one
     starts from (``""``: none; then the spec has no ``start`` line). ``tokens`` keeps the token
-    of each setting (keyed like ``figure``, ``start.NAME``, ``fitness.TERM``) so that binding to
-    the figure can point at the offending word."""
+    of each setting (keyed like ``figure``, ``start.NAME``, ``fitness.TERM``; ``simulate``: that
+    line's keyword) so that binding to the figure, or a run that blows up, can point at the
+    offending word."""
 
     path: str
     figure: str
@@ -381,6 +382,7 @@ class _Parser:
                 "time-constant range [2 dt, T/4] is not empty",
             )
         self.duration, self.dt = duration, dt
+        self.tokens["simulate"] = line.keyword  # where a run whose state blows up points
         if "tau_min" in values:
             tau_min = float(values["tau_min"])
             if not 2 * dt <= tau_min < duration / 4:

@@ -18,6 +18,7 @@ from types import ModuleType
 import numpy as np
 
 from mosys import __version__
+from mosys.errors import SimulationError
 from mosys.io.controller_table import ControllerTable, write_controller_table
 from mosys.io.progress import Progress
 from mosys.kernels.dp import (
@@ -37,6 +38,7 @@ from mosys.kernels.dp import (
     sweep_order,
 )
 from mosys.kernels.specialise import specialise
+from mosys.limits import check_job
 from mosys.parsing.controller import ControllerSpec
 from mosys.ssc.grid import (
     FigureGrid,
@@ -372,6 +374,31 @@ def compute_transitions(
         progress.finish()
 
 
+def check_transitions_finite(problem: Problem, transitions: Transitions) -> None:
+    """SimulationError at the spec's ``dyn`` line if some segment's state became non-finite
+    (its cost nan, ``dp.exit_transitions_template``), naming the first such node and control."""
+    diverged = np.argwhere(np.isnan(transitions.segment_cost))
+    if not diverged.size:
+        return
+    row, u = diverged[0]
+    node = int(np.flatnonzero(transitions.row_of >= 0)[row])
+    grid, spec = problem.grid, problem.spec
+    where = np.unravel_index(node, grid.shape)
+    values = grid.axis_values()
+    start = ", ".join(f"{name}={values[k][where[k]]:g}" for k, name in enumerate(grid.names))
+    control = ", ".join(
+        f"{c.name}={value:g}"
+        for c, value in zip(spec.controls, problem.control_samples[u], strict=True)
+    )
+    token = spec.figure_token
+    raise SimulationError(
+        f"{spec.path}:{token.line}:{token.column}: the state became non-finite in the segment "
+        f"from node {start} under {control} ({len(diverged):,} of "
+        f"{transitions.segment_cost.size:,} segments): the figure's dynamics diverge there (a "
+        "huge figure parameter?); nothing written"
+    )
+
+
 def value_iteration(
     problem: Problem,
     transitions: Transitions,
@@ -435,6 +462,7 @@ def solve(
     kernel_load_seconds = load_kernels(exit_transitions, arguments, problem, transitions)
     started = time.perf_counter()
     compute_transitions(exit_transitions, arguments, problem, transitions, quiet)
+    check_transitions_finite(problem, transitions)
     transition_seconds = time.perf_counter() - started
     reachable = reachable_nodes(
         *transitions.arrays(), problem.is_destination, transitions.row_of, grid.axis_count
@@ -553,6 +581,16 @@ def figure_attributes(problem: Problem, dynamics: ModuleType) -> dict:
     return attrs
 
 
+def dp_memory_bytes(spec: ControllerSpec) -> float:
+    """About the memory the DP of ``spec`` takes, bytes: per node and control sample, the exit
+    (2^(d-1) corners of an int32 node and a float32 weight) and the segment's cost (float64);
+    per node, about a dozen float64/int64 arrays (values, policy, grid bookkeeping)."""
+    nodes = float(np.prod([float(d.samples) for d in spec.state]))
+    controls = float(np.prod([float(c.samples) for c in spec.controls]))
+    corners = 2.0 ** (len(spec.state) - 1)
+    return nodes * (controls * (8.0 * corners + 8.0) + 8.0 * (12 + len(spec.state)))
+
+
 def generate_controller(
     spec: ControllerSpec,
     dynamics: ModuleType,
@@ -565,6 +603,12 @@ def generate_controller(
     ``tolerance``/``max_iterations`` override the spec's. Raises SpecError where the spec does
     not fit the figure."""
     started = time.perf_counter()
+    last_torq = spec.controls[-1].token
+    check_job(
+        f"{spec.path}:{last_torq.line}:{last_torq.column}",
+        "the DP of this grid and these control samples",
+        memory_bytes=dp_memory_bytes(spec),
+    )
     problem = build_problem(spec, dynamics)
     solution = solve(
         problem,

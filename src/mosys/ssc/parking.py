@@ -16,6 +16,7 @@ from mosys.errors import InputError
 from mosys.io.car_scene import CarScene, car_scene_attributes, controller_table_scene
 from mosys.io.start_grid import NO_WAY, NOT_FREE, StartGrid
 from mosys.kernels.geometry import first_colliding_sample, pack_polygons
+from mosys.limits import check_job
 from mosys.ssc.controller import Controller
 
 TOLERANCE = {"position_m": 0.15, "heading_deg": 5.0, "speed_m_s": 0.05}
@@ -114,6 +115,14 @@ def evaluate_starts(
     from concurrent.futures import ThreadPoolExecutor
 
     starts = np.asarray(starts, dtype=np.float64)
+    steps = seconds / dt
+    state_size = len(controller.dynamics.STATE_NAMES) + len(controller.state_order)
+    check_job(
+        "mosys starts",
+        f"{seconds:g} s at dt {dt:g} s per start, {threads} at once",
+        steps,
+        threads * steps * 8.0 * (2 * state_size + 8),
+    )
     scene = controller_table_scene(controller.table)
     excluded, path_length = classify_starts(controller, starts)
 
