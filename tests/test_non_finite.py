@@ -78,10 +78,11 @@ def test_the_reproducer_exits_2_without_a_signal(tmp_path, pendulum):
     ids=["gravity 1e300", "mass 1e-300"],
 )
 def test_a_figure_that_blows_up_stops_the_sim_line(tmp_path, pendulum, edit, capsys):
-    """link1 with an absurd gravity (1e300 × 9.81 m/s² in its equations) or mass (1e-300 kg, its inertia with it),
-    under controller A: exit 2 at the ``sim`` line, after the first step (the start is
-    sound). The figure parser caps both now, so the generated module is edited: a dynamics
-    module can still carry anything."""
+    """link1 with an absurd gravity (1e300 × 9.81 m/s² in its equations) or mass (1e-300 kg, its
+    inertia with it), under controller A: exit 2 at the ``sim`` line, after the first step (the
+    start is sound). The figure parser caps both, and loading refuses a module whose constants
+    lie outside the caps, so the equations are edited: a dynamics module can still carry
+    anything."""
     dynamics = tmp_path / "dynamics"
     dynamics.mkdir()
     module = dynamics / "link1.py"

@@ -82,3 +82,16 @@ def test_a_controller_is_drawn_with_its_own_figures_dynamics(work):
     assert "mosys plot controller results/controllers/luxo/land.h5" in output
     assert "--dynamics results/dynamics/luxo_grounded.py" in output
     assert "results/dynamics/link1.py" not in output
+
+
+def test_the_configs_limits_reach_the_jobs(work):
+    """``limits: {memory_gib: ...}`` in a config file (README, "Limits") is what the DP job is
+    held to: it refuses, exit 2, its log says why, and nothing is left behind."""
+    config = work / "tiny_limits.yaml"
+    config.write_text("limits:\n  memory_gib: 0.000001\n", encoding="utf-8")
+    done = run_snakemake(work, "results/controllers/pendulum/A.h5", "--configfile", str(config))
+    assert done.returncode != 0
+    log = (work / "results/logs/dp/pendulum/A.log").read_text(encoding="utf-8")
+    assert "specs/controllers/pendulum/A.ssc:9:6: expected a job that fits in 0.00 GiB" in log
+    assert "raise MOSYS_MAX_MEMORY_GIB to allow it" in log
+    assert not (work / "results/controllers/pendulum/A.h5").exists()

@@ -16,6 +16,11 @@ from snakemake.utils import validate
 
 validate(config, "../schemas/config.schema.yaml")
 
+# The limits on one job's memory and steps (README, "Limits"), for every job this run starts.
+for _key, _variable in (("memory_gib", "MOSYS_MAX_MEMORY_GIB"), ("steps", "MOSYS_MAX_STEPS")):
+    if config["limits"].get(_key) is not None:
+        os.environ[_variable] = str(config["limits"][_key])
+
 # What the CLI's main imports for every verb (its error types).
 CLI_MODULES = ("mosys.errors", "mosys.parsing.tokens")
 # What every verb family's module builds its arguments with (shared options such as --budget).

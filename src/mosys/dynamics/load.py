@@ -120,7 +120,9 @@ def _check_parameters(path: Path, module: ModuleType) -> None:
         ("ROD_INERTIA", "inertia", "kg·m²", ROD_INERTIA_RANGE),
     )
     for constant, quantity, unit, (low, high) in ranges:
-        for name, value in zip(getattr(module, "ROD_NAMES", ()), getattr(module, constant, ()), strict=False):
+        for name, value in zip(
+            getattr(module, "ROD_NAMES", ()), getattr(module, constant, ()), strict=False
+        ):
             if not low <= value <= high:
                 raise InputError(
                     f"{path}: rod {name}'s {quantity} is {value:g} {unit}, outside the figure "

@@ -97,9 +97,9 @@ class BsrSpec:
     below which the figure counts as fallen; ``sense_filter`` s, the low-pass time constant of a
     sense-based controller's physical senses; ``chain`` the search whose final state this one
     starts from (``""``: none; then the spec has no ``start`` line). ``tokens`` keeps the token
-    of each setting (keyed like ``figure``, ``start.NAME``, ``fitness.TERM``; ``simulate``: that
-    line's keyword) so that binding to the figure, or a run that blows up, can point at the
-    offending word."""
+    of each setting (keyed like ``figure``, ``start.NAME``, ``fitness.TERM``) so that binding to
+    the figure can point at the offending word; ``simulate_token`` the ``simulate`` line's
+    keyword, where a run whose state blows up points (line 0 if the spec was not parsed)."""
 
     path: str
     figure: str
@@ -123,6 +123,7 @@ class BsrSpec:
     chain: str = ""
     spec_sha256: str = field(default="", compare=False)
     tokens: dict[str, Token] = field(default_factory=dict, compare=False, repr=False)
+    simulate_token: Token = field(default=_NO_TOKEN, compare=False, repr=False)
 
     @property
     def name(self) -> str:
@@ -143,9 +144,11 @@ REQUIRED = ("figure", "controller", "simulate", "search", "seeds", "fitness")
 DEFAULT_REINITIALIZE = 0.5
 # rounding allowed in duration / dt being a whole number of steps, relative
 STEPS_TOLERANCE = 1e-9
-MAX_STEPS = 10_000_000  # simulator steps per evaluation (T / dt): the paper's runs take 1,000
 MAX_SEED = 2**63 - 1  # seeds are stored as int64 in the result file (and seed numpy's RNG)
 MAX_WHOLE = 2**31 - 1  # rules=, controllers=, generations=, reseed=: counts the kernels index
+# simulator steps per evaluation (T / dt), a count the kernels index too (the paper's take 400);
+# how many one run may really take is the user's limit, checked before a search (mosys.limits)
+MAX_STEPS = MAX_WHOLE
 
 # key -> (minimum, what) for whole numbers; (check, what) for numbers, check one of
 # '>0', '>=0', '0..1', None
@@ -215,6 +218,7 @@ class _Parser:
         self.duration = 0.0
         self.dt = 0.0
         self.tau_min: float | None = None
+        self.simulate_token = _NO_TOKEN
         self.search: dict[str, int | float] = {}
         self.seeds: tuple[int, ...] = ()
         self.start: dict[str, float] = {}
@@ -277,6 +281,7 @@ class _Parser:
             chain=self.chain,
             spec_sha256=spec_sha256,
             tokens=self.tokens,
+            simulate_token=self.simulate_token,
         )
 
     # --- values ---------------------------------------------------------------------------
@@ -382,7 +387,7 @@ class _Parser:
                 "time-constant range [2 dt, T/4] is not empty",
             )
         self.duration, self.dt = duration, dt
-        self.tokens["simulate"] = line.keyword  # where a run whose state blows up points
+        self.simulate_token = line.keyword
         if "tau_min" in values:
             tau_min = float(values["tau_min"])
             if not 2 * dt <= tau_min < duration / 4:
