@@ -12,7 +12,7 @@ from typing import TypeVar
 
 import pytest
 
-from mosys.parsing.tokens import END_OF_FILE, SpecError
+from mosys.parsing.tokens import END_OF_FILE, SpecError, shortened_words, shown_text
 
 ROOT = Path(__file__).resolve().parents[1]
 SPECS = ROOT / "specs"
@@ -34,9 +34,10 @@ def parses_or_spec_error(
         parsed = parse(text, path)
     except SpecError as error:
         shown = {None: "end of line", END_OF_FILE: "end of file"}
-        found = shown.get(error.found, repr(error.found))
-        assert str(error) == (
-            f"{path}:{error.line}:{error.column}: expected {error.expected}, found {found}"
+        found = shown.get(error.found) or shown_text(error.found)
+        expected = shortened_words(error.expected)  # a word over 200 characters is cut
+        assert (
+            str(error) == f"{path}:{error.line}:{error.column}: expected {expected}, found {found}"
         )
         assert error.expected and error.line >= 1 and error.column >= 1
         lines = text.split("\n")  # lines end at '\n' only, as the tokenizer counts them

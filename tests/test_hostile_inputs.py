@@ -17,6 +17,7 @@ from hypothesis import strategies as st
 
 from mosys.dynamics.model import build_model
 from mosys.parsing.bsr import MAX_SEED, parse_bsr_text
+from mosys.parsing.composite import parse_composite_text
 from mosys.parsing.controller import parse_controller_text
 from mosys.parsing.figure import (
     ROD_INERTIA_RANGE,
@@ -25,6 +26,8 @@ from mosys.parsing.figure import (
     parse_figure_text,
     render_figure_spec,
 )
+from mosys.parsing.motor import parse_motor_program_text
+from mosys.parsing.script import parse_script_text
 from mosys.parsing.tokens import SpecError
 from mosys.parsing.vehicle import Vehicle
 
@@ -295,3 +298,41 @@ def test_vehicle_renders_as_one_line() -> None:
         "vehicle wheelbase=2.5 length=4 width=1.7 front_overhang=0.8 wheel_radius=0.3 "
         "steer_limit=35\n"
     )
+
+
+# --- 8. a 100 kB word is not echoed whole ------------------------------------------------------
+
+PARSERS = {
+    ".fig": parse_figure_text,
+    ".ssc": parse_controller_text,
+    ".anim": parse_script_text,
+    ".mot": parse_motor_program_text,
+    ".bsr": parse_bsr_text,
+    ".comp": parse_composite_text,
+}
+HUGE_WORD = 100_000
+
+
+@pytest.mark.parametrize("path", sorted(p for p in SPECS.rglob("*.*") if p.suffix in PARSERS))
+def test_an_error_quotes_at_most_the_start_of_a_huge_word(path: Path) -> None:
+    """Every word of every shipped spec, in turn, replaced by a 100,000-character one (a name, or a
+    name=value with a huge value): the error, wherever it arises, stays short — also where it
+    lists names the spec defined — and says how long the word was."""
+    parse = PARSERS[path.suffix]
+    lines = path.read_text().split("\n")
+    for number, line in enumerate(lines):
+        words = line.split("#")[0].split()
+        for k, word in enumerate(words):
+            name, equals, _ = word.partition("=")
+            for huge in (
+                "x" * HUGE_WORD,
+                f"{name}={'9' * HUGE_WORD}" if equals else "7" * HUGE_WORD,
+            ):
+                edited_line = " ".join([*words[:k], huge, *words[k + 1 :]])
+                text = "\n".join([*lines[:number], edited_line, *lines[number + 1 :]])
+                try:
+                    parse(text, str(path))
+                except SpecError as error:
+                    assert len(str(error)) < 2_000 + len(str(path))
+                    if len(error.found or "") >= HUGE_WORD:
+                        assert f"... ({len(error.found):,} characters)" in str(error)

@@ -18,6 +18,25 @@ NUMBER = re.compile(r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?")
 NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 ENDPOINT_ENDS = ("proximal", "distal")  # a rod's ends, as specs name them: ROD.END
 END_OF_FILE = "\x00end of file"  # the 'found' of an error about a line that never came
+SHOWN_CHARACTERS = 200  # of one word an error quotes: a longer word is cut, its length said
+
+
+def shown_text(found: str) -> str:
+    """``found`` as an error message quotes it: its repr, or, past ``SHOWN_CHARACTERS``, the repr
+    of its start and its length (a 100 kB word is not echoed whole)."""
+    if len(found) <= SHOWN_CHARACTERS:
+        return repr(found)
+    return f"{found[:SHOWN_CHARACTERS]!r}... ({len(found):,} characters)"
+
+
+def shortened_words(text: str) -> str:
+    """``text`` with every word longer than ``SHOWN_CHARACTERS`` cut to its start and its length
+    (a name a spec defined, quoted back in a list of what was expected)."""
+    return re.sub(
+        rf"\S{{{SHOWN_CHARACTERS + 1},}}",
+        lambda word: f"{word.group()[:SHOWN_CHARACTERS]}... ({len(word.group()):,} characters)",
+        text,
+    )
 
 
 class SpecError(Exception):
@@ -30,8 +49,10 @@ class SpecError(Exception):
         self.column = column
         self.expected = expected
         self.found = found
-        shown = {None: "end of line", END_OF_FILE: "end of file"}.get(found, repr(found))
-        super().__init__(f"{self.path}:{line}:{column}: expected {expected}, found {shown}")
+        shown = {None: "end of line", END_OF_FILE: "end of file"}.get(found) or shown_text(found)
+        super().__init__(
+            f"{self.path}:{line}:{column}: expected {shortened_words(expected)}, found {shown}"
+        )
 
     @classmethod
     def at(cls, path: str, token: Token, expected: str) -> SpecError:
