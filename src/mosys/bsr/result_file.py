@@ -45,7 +45,7 @@ def search_to_file(
         )
     setup, extra = _bind(spec, figures_dir, generations, chain_results or [])
     figure = setup.figure
-    simulate = spec.tokens["simulate"]
+    simulate = spec.simulate_token
     check_job(
         f"{spec.path}:{simulate.line}:{simulate.column}",
         f"one evaluation of {spec.steps:,} steps",
