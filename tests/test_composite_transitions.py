@@ -2,9 +2,14 @@
 
 from __future__ import annotations
 
+import json
+import math
+
 import numpy as np
+import pytest
 
 from mosys.composite.transitions import durations_of, search_transitions
+from mosys.io.composite_result import decode_scores, encode_scores
 
 
 def peaked(best: np.ndarray):
@@ -43,3 +48,29 @@ def test_a_seed_gives_the_same_search():
 
 def test_durations_of_switches():
     np.testing.assert_array_equal(durations_of(np.array([3, 3, 9]), 10), [3, 0, 6, 1])
+
+
+def test_a_nan_score_is_never_ranked_best():
+    """Issue 27: a script whose score divides 0 by 0 for some durations. The guess scores nan;
+    every numeric score beats it, nan never replaces a number, and the best is a number."""
+    best = np.array([30, 50, 20])
+    score = peaked(best)
+
+    def evaluate(durations: np.ndarray) -> float:
+        return math.nan if durations[0] % 3 == 0 else score(durations)  # the guess: 33 % 3 == 0
+
+    found = search_transitions(evaluate, [33, 33, 34], 3, q=8, g=10, h=4, seed=2)
+    assert math.isnan(found.guess_score)
+    assert math.isfinite(found.score)
+    assert np.isfinite(found.best_by_generation).all()
+    assert found.durations[0] % 3 != 0
+
+
+def test_non_finite_scores_are_strict_json_and_read_back():
+    scores = {"a": 1.5, "b": math.nan, "c": math.inf, "d": -math.inf}
+    text = encode_scores(scores)
+    assert text == '{"a": 1.5, "b": "nan", "c": "inf", "d": "-inf"}'
+    json.loads(text, parse_constant=lambda name: pytest.fail(f"non-strict JSON {name}"))
+    back = decode_scores(text)
+    assert back["a"] == 1.5 and math.isnan(back["b"]) and back["c"] == math.inf
+    assert back["d"] == -math.inf

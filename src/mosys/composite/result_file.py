@@ -14,7 +14,12 @@ import numpy as np
 from mosys.bsr.result_file import motion_step_bytes
 from mosys.composite.session import CompositeSession, ScoredMotion, open_session
 from mosys.composite.transitions import TransitionSearch, search_transitions
-from mosys.io.composite_result import CompositeMotion, CompositeResult, write_composite_result
+from mosys.io.composite_result import (
+    CompositeMotion,
+    CompositeResult,
+    encode_scores,
+    write_composite_result,
+)
 from mosys.limits import check_job
 from mosys.parsing.composite import parse_composite_script
 from mosys.parsing.tokens import read_spec_text
@@ -113,8 +118,8 @@ def composite_to_file(
             "dt": session.dt,
             "ticks_before": before.ticks,
             "ticks_after": after.ticks,
-            "scores_before": json.dumps(before.scores),
-            "scores_after": json.dumps(after.scores),
+            "scores_before": encode_scores(before.scores),
+            "scores_after": encode_scores(after.scores),
             "seeds": np.array(session.seeds, np.int64),
             "controller_files": list(session.controller_files),
             "search_q": settings.q,

@@ -6,7 +6,8 @@ guess (or, without one, equally spaced); each of G generations gives every array
 turn — one randomly chosen transition point redrawn uniformly a third of the time, else perturbed
 by a rounded N(0, PERTURB_FRACTION x length) step (at least one tick) — keeping a mutant that
 scores better; then the arrays are ranked and the worse half replaced by the better half. Q x G x
-H evaluations in all (the paper: 16 x 16 x 4 = 1,024). One seeded generator draws every random
+H evaluations in all (the paper: 16 x 16 x 4 = 1,024). A score of nan (a script's expression
+divided 0 by 0) ranks as -inf. One seeded generator draws every random
 number in a fixed order, so a seed gives the same result every time.
 """
 
@@ -46,6 +47,12 @@ def equal_split(length: int, phases: int) -> np.ndarray:
 def durations_of(switches: np.ndarray, length: int) -> np.ndarray:
     """Phase durations (P,) ticks from sorted switch ticks (P - 1,) in a motion of ``length``."""
     return np.diff(np.concatenate([[0], switches, [length]])).astype(np.int64)
+
+
+def ranked(score: float | np.ndarray) -> np.ndarray:
+    """A score as the search ranks it: nan (an expression's 0/0) as -inf, the worst, so that it
+    is never kept over a number nor chosen as the best; any other score as it is."""
+    return np.where(np.isnan(score), -np.inf, score)
 
 
 def search_transitions(
@@ -92,16 +99,16 @@ def search_transitions(
                     mutant.sort()
                 score = float(evaluate(durations_of(mutant, length)))
                 simulations += 1
-                if score > scores[k]:
+                if ranked(score) > ranked(scores[k]):
                     population[k], scores[k] = mutant, score
-        order = np.argsort(-scores, kind="stable")
+        order = np.argsort(-ranked(scores), kind="stable")
         half = q // 2
         population[order[q - half :]] = population[order[:half]]
         scores[order[q - half :]] = scores[order[:half]]
-        best_by_generation.append(float(scores.max()))
-        progress.update(generation + 1, f"best score {scores.max():.4g}")
-    progress.finish(f"best score {scores.max():.4g}")
-    best = int(np.argmax(scores))
+        best_by_generation.append(float(scores[order[0]]))
+        progress.update(generation + 1, f"best score {scores[order[0]]:.4g}")
+    progress.finish(f"best score {scores[order[0]]:.4g}")
+    best = int(np.argmax(ranked(scores)))
     return TransitionSearch(
         durations=durations_of(population[best], length),
         score=float(scores[best]),

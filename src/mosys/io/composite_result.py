@@ -6,10 +6,11 @@ Beside the contract's ``figure_motion``, ``before/figure_motion`` and root attri
 (N,) int64, the rule of that phase's controller active at each sample; ``search/best_score``
 (G,) float64, the best total after each generation. Root attrs ``name``, ``figure``, ``dt`` (s),
 ``ticks_before`` and ``ticks_after`` (P,) phase durations in simulator ticks, ``scores_before``
-and ``scores_after`` (JSON object: phase -> score), ``seeds`` (P,) the seed of each phase's
-controller, ``controller_files``, ``search_q``, ``search_g``, ``search_h``, ``search_seed``,
-``budget``, and ``script_text`` (the script as written). Each entry of ``phases`` also names the
-phase (``name``), its ``seed`` and its ``ticks``.
+and ``scores_after`` (JSON object: phase -> score; a score a division by zero made non-finite
+is the string ``"nan"``, ``"inf"`` or ``"-inf"``, which strict JSON readers take), ``seeds``
+(P,) the seed of each phase's controller, ``controller_files``, ``search_q``, ``search_g``,
+``search_h``, ``search_seed``, ``budget``, and ``script_text`` (the script as written). Each
+entry of ``phases`` also names the phase (``name``), its ``seed`` and its ``ticks``.
 
 Every dataset has a ``unit`` (``index`` for ``phase`` and ``active_rule``, ``1`` for
 ``search/best_score``) and the root the provenance attrs (``io.provenance``);
@@ -63,11 +64,28 @@ class CompositeResult:
 
     @property
     def scores_before(self) -> dict[str, float]:
-        return json.loads(self.attrs["scores_before"])
+        return decode_scores(self.attrs["scores_before"])
 
     @property
     def scores_after(self) -> dict[str, float]:
-        return json.loads(self.attrs["scores_after"])
+        return decode_scores(self.attrs["scores_after"])
+
+
+def encode_scores(scores: dict[str, float]) -> str:
+    """Phase -> score as strict JSON: a non-finite score as the string ``"nan"``, ``"inf"`` or
+    ``"-inf"`` (``float``'s own spelling), a finite one as a number."""
+    return json.dumps(
+        {
+            name: value if np.isfinite(value) else str(float(value))
+            for name, value in scores.items()
+        },
+        allow_nan=False,
+    )
+
+
+def decode_scores(text: str) -> dict[str, float]:
+    """``encode_scores``'s JSON back to phase -> score (float)."""
+    return {name: float(value) for name, value in json.loads(text).items()}
 
 
 def _write_motion(group: h5py.Group, stored: CompositeMotion) -> None:
