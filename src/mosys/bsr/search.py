@@ -21,6 +21,12 @@ evaluates a population and records a run (``PlanarSimulation`` here, the 3-D one
 the sense trajectory; 3-D (§4.2) contains a point of it (the point uniformly inside the box, at
 most 0.98 of the half-side from the centre), and the first population is enriched by three
 rounds of that mutation before the search begins.
+
+A run whose figure's state blows up (NaN, inf or beyond ±``kernels.simulate.STATE_LIMIT``: the
+kernels stop there) aborts the search with ``NonFiniteStateError`` at the spec's ``simulate``
+line, naming the time, seed, generation and state; no candidate is ever scored NaN. A fitness
+that is NaN all the same (weights so large that the terms overflow to inf - inf) ranks as -inf:
+never best.
 """
 
 from __future__ import annotations
@@ -28,13 +34,16 @@ from __future__ import annotations
 import json
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from typing import Protocol
 
 import numpy as np
 
 from mosys.bsr.figure import BsrFigure
 from mosys.bsr.start import perturbed_state, standing_state
+from mosys.errors import NonFiniteStateError
 from mosys.io.bsr_result import BsrController
 from mosys.io.progress import Progress
 from mosys.kernels.bsr_controller import (
@@ -47,8 +56,9 @@ from mosys.kernels.bsr_controller import (
     run_controller,
     run_population,
 )
+from mosys.kernels.simulate import STATE_LIMIT, steps_before_blow_up
 from mosys.parsing.bsr import FITNESS_TERMS, BsrSpec
-from mosys.parsing.tokens import SpecError
+from mosys.parsing.tokens import SpecError, Token
 
 CORNER_INSIDE = 0.98  # a re-initialised box's corner: this fraction of the half-side out
 RELEVANCE = ("corner", "contain")
@@ -64,10 +74,14 @@ CREEP_LOG_SEGMENT = 0.2
 class Simulation(Protocol):
     """How a search runs its figure: ``evaluate`` runs every controller of a population once
     and returns their fitness (C,), filling the population's senses; ``record`` runs one
-    controller from the nominal start, every step recorded. ``term_names``: the fitness terms
-    its runs measure, in their order."""
+    controller from the nominal start, every step recorded; both raise NonFiniteStateError
+    (``check_run``) where a run's state blows up. ``describe_state``: a state (S,) SI of the
+    figure in the spec's units. ``term_names``: the fitness terms its runs measure, in their
+    order."""
 
     term_names: tuple[str, ...]
+
+    def describe_state(self, figure, state: np.ndarray) -> str: ...
 
     def evaluate(
         self, setup: SearchSetup, population: _Population, rng: np.random.Generator
@@ -363,10 +377,94 @@ def population_arrays(setup: SearchSetup, population: _Population) -> Controller
     )
 
 
+def describe_values(values: list[tuple[str, float, str]]) -> str:
+    """``name=value unit, ...`` of (name, value, unit) triples, each value to 6 digits (unit
+    "": a pure number)."""
+    return ", ".join(f"{name}={value:.6g} {unit}".rstrip() for name, value, unit in values)
+
+
+def describe_planar_state(figure: BsrFigure, state: np.ndarray) -> str:
+    """A 2-D BSR state (S = 6 + 2J,) SI in the spec's units: the centre of mass (cm_x, cm_y m;
+    cm_vx, cm_vy m/s), the root rod's angle (deg), the angular momentum L (kg·m²/s), the joint
+    angles (deg) and their rates (NAME', deg/s)."""
+    joints = figure.joint_names
+    n = len(joints)
+    values = [
+        ("cm_x", state[0], "m"),
+        ("cm_y", state[1], "m"),
+        ("cm_vx", state[2], "m/s"),
+        ("cm_vy", state[3], "m/s"),
+        (figure.root_angle, math.degrees(state[4]), "deg"),
+        ("L", state[5], "kg·m²/s"),
+    ]
+    for j, name in enumerate(joints):
+        values.append((name, math.degrees(state[6 + j]), "deg"))
+    for j, name in enumerate(joints):
+        values.append((f"{name}'", math.degrees(state[6 + n + j]), "deg/s"))
+    return describe_values(values)
+
+
+def unsound_state_message(t: float, state: np.ndarray, described: str, when: str = "") -> str:
+    """What NonFiniteStateError says of a BSR run whose state (S,) SI, ``described`` in the
+    spec's units, was not sound (``kernels.simulate.state_is_sound``) at ``t`` s from the run's
+    start; ``when``: which run (seed, generation), if known. A state that blew up during the run
+    may want a smaller dt; one unsound at t = 0 was the start itself, which no dt mends."""
+    what = f"lies beyond ±{STATE_LIMIT:g} (SI)" if np.isfinite(state).all() else "became non-finite"
+    during = f" ({when})" if when else ""
+    hint = "a smaller dt= may help"
+    if t == 0:
+        hint = "the start is not sound (a huge start or perturb value?)"
+    return f"the figure's state {what} at t = {t:.6g} s{during}: {described}; {hint}"
+
+
+def check_run(
+    taken: int, dt: float, state: np.ndarray, describe: Callable[[np.ndarray], str]
+) -> None:
+    """Raise NonFiniteStateError if a run of dt s steps returned ``blown_up(n)`` (taken < 0):
+    its state ``state`` (S,) SI was not sound at t = n dt s (``describe`` puts it in the spec's
+    units). The message names no file: ``located`` adds the spec's."""
+    if taken >= 0:
+        return
+    t = steps_before_blow_up(taken) * dt
+    state = np.array(state, np.float64)
+    raise NonFiniteStateError(unsound_state_message(t, state, describe(state)), t, state)
+
+
+def check_population(
+    taken: np.ndarray, final: np.ndarray, dt: float, describe: Callable[[np.ndarray], str]
+) -> None:
+    """``check_run`` of the first (lowest-numbered) of C runs that stopped: taken (C,) what
+    each returned, final (C, S) SI their last states."""
+    stopped = np.flatnonzero(taken < 0)
+    if stopped.size:
+        check_run(int(taken[stopped[0]]), dt, final[stopped[0]], describe)
+
+
+def located(setup: SearchSetup, error: NonFiniteStateError, when: str) -> NonFiniteStateError:
+    """``error`` of one of the setup's runs, led by the spec's ``simulate`` line (its dt=) and
+    naming ``when`` (seed, generation)."""
+    spec = setup.spec
+    token = spec.simulate_token if spec.simulate_token.line else Token("simulate", 1, 1)
+    described = setup.simulation.describe_state(setup.figure, error.state)
+    message = unsound_state_message(error.t, error.state, described, when)
+    return NonFiniteStateError(
+        f"{spec.path}:{token.line}:{token.column}: {message}", error.t, error.state
+    )
+
+
+def ranked(fitness: np.ndarray) -> np.ndarray:
+    """The fitness (C,) as the search ranks it: NaN (terms times weights overflowing to
+    inf - inf) becomes -inf, never best."""
+    return np.where(np.isnan(fitness), -np.inf, fitness)
+
+
 class PlanarSimulation:
     """The 2-D simulator of ``mosys.kernels.bsr_simulate`` (Simulation)."""
 
     term_names = FITNESS_TERMS
+
+    def describe_state(self, figure: BsrFigure, state: np.ndarray) -> str:
+        return describe_planar_state(figure, state)
 
     def evaluate(
         self, setup: SearchSetup, population: _Population, rng: np.random.Generator
@@ -405,6 +503,8 @@ def _evaluate(setup: SearchSetup, population: _Population, rng: np.random.Genera
         starts = np.repeat(start[None, :], c, axis=0)
     rules = np.zeros((c, spec.steps + 1), np.int64)
     terms = np.zeros((c, len(FITNESS_TERMS)))
+    taken = np.zeros(c, np.int64)
+    final = np.empty_like(starts)
     run_population(
         figure.arrays,
         population_arrays(setup, population),
@@ -415,8 +515,22 @@ def _evaluate(setup: SearchSetup, population: _Population, rng: np.random.Genera
         population.senses,
         rules,
         terms,
+        taken,
+        final,
     )
+    check_population(taken, final, spec.dt, partial(describe_planar_state, figure))
     return terms @ setup.weights
+
+
+def _evaluated(
+    setup: SearchSetup, population: _Population, rng: np.random.Generator, when: str
+) -> np.ndarray:
+    """The population's fitness (C,) as the search ranks it (``ranked``); a run that blows up
+    raises NonFiniteStateError at the spec's ``simulate`` line, naming ``when``."""
+    try:
+        return ranked(setup.simulation.evaluate(setup, population, rng))
+    except NonFiniteStateError as error:
+        raise located(setup, error, when) from None
 
 
 def run_search(setup: SearchSetup, seed: int, label: str = "search") -> SearchOutcome:
@@ -427,12 +541,13 @@ def run_search(setup: SearchSetup, seed: int, label: str = "search") -> SearchOu
     rng = np.random.default_rng(seed)
     began = time.perf_counter()
     current = _Population(setup, rng)
-    current.fitness[:] = setup.simulation.evaluate(setup, current, rng)
+    first = f"seed {seed}, generation 0"
+    current.fitness[:] = _evaluated(setup, current, rng, first)
     for _ in range(setup.enrich_rounds):
         # §4.2: rounds of the relevance-heuristic mutation enrich the first population
         for k in range(c):
             current.draw_rule(k, int(rng.integers(spec.rules)), rng, current.senses[k])
-        current.fitness[:] = setup.simulation.evaluate(setup, current, rng)
+        current.fitness[:] = _evaluated(setup, current, rng, first)
     mutant = current.copy()
     best_k = int(np.argmax(current.fitness))
     best = current.controller(best_k)
@@ -448,7 +563,7 @@ def run_search(setup: SearchSetup, seed: int, label: str = "search") -> SearchOu
                 mutant.draw_rule(k, i, rng, current.senses[k] if spec.kind == "sense" else None)
             else:
                 mutant.creep_rule(k, i, rng)
-        fitness = setup.simulation.evaluate(setup, mutant, rng)
+        fitness = _evaluated(setup, mutant, rng, f"seed {seed}, generation {generation}")
         for k in range(c):
             if fitness[k] > current.fitness[k]:
                 current.copy_from(mutant, k, k)
@@ -467,13 +582,16 @@ def run_search(setup: SearchSetup, seed: int, label: str = "search") -> SearchOu
         progress.update(generation, f"best fitness {best_fitness:.3f}")
     progress.finish(f"best fitness {best_fitness:.3f}")
     wall = time.perf_counter() - began
-    run = setup.simulation.record(setup, best)
+    try:
+        run = setup.simulation.record(setup, best)
+    except NonFiniteStateError as error:
+        raise located(setup, error, f"seed {seed}, the best controller's recorded run") from None
     return SearchOutcome(
         evaluations=np.array(evaluations, np.int64),
         best_fitness=np.array(curve),
         controller=best,
         fitness=best_fitness,
-        nominal_fitness=float(run.terms @ setup.weights),
+        nominal_fitness=float(ranked(run.terms @ setup.weights)),
         terms=run.terms,
         active_rule=run.active_rule,
         rod_ends=run.rod_ends,
@@ -563,10 +681,11 @@ def record_run(
     """Run ``controller`` for ``steps`` steps of dt s from the state ``start`` (S,), recording
     every step. ``start_force`` (E,) N and ``carry_over``: a controller taking over from another
     keeps the senses (contact forces) where the last one left them and starts with the rule
-    they select."""
+    they select. A state that blows up raises NonFiniteStateError (``check_run``; t from the
+    run's start)."""
     n_ends = figure.endpoints.shape[0]
     run = RecordedRun.empty(len(FITNESS_TERMS), steps, figure, 2, start)
-    run_controller(
+    taken = run_controller(
         figure.arrays,
         controller_arrays(controller),
         np.asarray(start, np.float64),
@@ -577,4 +696,5 @@ def record_run(
         np.zeros(0, np.int64) if fall_endpoints is None else fall_endpoints,
         run.record(len(figure.sense_names)),
     )
+    check_run(taken, dt, run.final_state, partial(describe_planar_state, figure))
     return run

@@ -4,12 +4,15 @@
 A search that continues another (``chain NAME``) starts exactly where the best motion of that
 search's best seed (highest ``best_fitness``) ends: its final state and contact forces, in the
 same world frame.
+
+A run whose state blows up raises NonFiniteStateError, as in 2-D (``mosys.bsr.search``).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 import h5py
@@ -20,14 +23,17 @@ from mosys.bsr.search import (
     RecordedRun,
     SearchSetup,
     bind_names,
+    check_population,
+    check_run,
     controller_arrays,
+    describe_values,
     population_arrays,
 )
 from mosys.bsr.start3d import standing_state
 from mosys.errors import InputError
 from mosys.io.bsr_result import BsrController
 from mosys.kernels.bsr3d_controller import Task, run_controller, run_population
-from mosys.kernels.bsr3d_simulate import CY
+from mosys.kernels.bsr3d_simulate import CX, CY, JOINTS, LX, QW, VX
 from mosys.parsing.bsr import FITNESS_TERMS_3D, BsrSpec
 from mosys.parsing.tokens import SpecError
 
@@ -65,6 +71,22 @@ def chain_start(name: str, result_paths: list[str | Path]) -> ChainStart:
         return ChainStart(name, -best[1], h5["best/final_state"][()], h5["best/final_force"][()])
 
 
+def describe_spatial_state(figure: BsrFigure3D, state: np.ndarray) -> str:
+    """A 3-D BSR state (S = 13 + 2J,) SI in the spec's units: the centre of mass (cm_x, cm_y,
+    cm_z m; cm_vx, cm_vy, cm_vz m/s), the orientation quaternion (q_w, q_x, q_y, q_z), the
+    angular momentum (L_x, L_y, L_z kg·m²/s), the angles (deg) and their rates (NAME', deg/s)."""
+    values = [(f"cm_{axis}", state[CX + a], "m") for a, axis in enumerate("xyz")]
+    values += [(f"cm_v{axis}", state[VX + a], "m/s") for a, axis in enumerate("xyz")]
+    values += [(f"q_{axis}", state[QW + a], "") for a, axis in enumerate("wxyz")]
+    values += [(f"L_{axis}", state[LX + a], "kg·m²/s") for a, axis in enumerate("xyz")]
+    n = len(figure.joint_names)
+    for j, name in enumerate(figure.joint_names):
+        values.append((name, math.degrees(state[JOINTS + j]), "deg"))
+    for j, name in enumerate(figure.joint_names):
+        values.append((f"{name}'", math.degrees(state[JOINTS + n + j]), "deg/s"))
+    return describe_values(values)
+
+
 class SpatialSimulation:
     """The 3-D simulator (Simulation of ``mosys.bsr.search``): every controller from the same
     start (the nominal pose, or the chain's final state) measured as ``task`` says."""
@@ -76,6 +98,9 @@ class SpatialSimulation:
         self.start = start
         self.start_force = start_force
 
+    def describe_state(self, figure: BsrFigure3D, state: np.ndarray) -> str:
+        return describe_spatial_state(figure, state)
+
     def evaluate(self, setup: SearchSetup, population, rng: np.random.Generator) -> np.ndarray:
         spec = setup.spec
         c = spec.controllers
@@ -83,6 +108,8 @@ class SpatialSimulation:
         rules = np.zeros((c, spec.steps + 1), np.int64)
         terms = np.zeros((c, len(FITNESS_TERMS_3D)))
         senses = population.senses if spec.kind == "sense" else np.zeros((c, spec.steps + 1, 0))
+        taken = np.zeros(c, np.int64)
+        final = np.empty_like(starts)
         run_population(
             setup.figure.arrays,
             population_arrays(setup, population),
@@ -93,7 +120,10 @@ class SpatialSimulation:
             senses,
             rules,
             terms,
+            taken,
+            final,
         )
+        check_population(taken, final, spec.dt, partial(describe_spatial_state, setup.figure))
         return terms @ setup.weights
 
     def record(self, setup: SearchSetup, controller: BsrController) -> RecordedRun:
@@ -111,9 +141,10 @@ def record_run(
     spec: BsrSpec,
 ) -> RecordedRun:
     """Run ``controller`` for the spec's steps from the state ``start`` (S,) with the endpoint
-    forces ``start_force`` (E,) N, recording every step."""
+    forces ``start_force`` (E,) N, recording every step; a state that blows up raises
+    NonFiniteStateError (``check_run``)."""
     run = RecordedRun.empty(len(FITNESS_TERMS_3D), spec.steps, figure, 3, start)
-    run_controller(
+    taken = run_controller(
         figure.arrays,
         controller_arrays(controller),
         task,
@@ -124,6 +155,7 @@ def record_run(
         spec.dt,
         run.record(0 if controller.kind == "time" else len(figure.sense_names)),
     )
+    check_run(taken, spec.dt, run.final_state, partial(describe_spatial_state, figure))
     return run
 
 

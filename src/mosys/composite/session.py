@@ -6,6 +6,10 @@ Each phase names a BSR search (``results/bsr/SEARCH/seedK.h5``). Its controller 
 phase names, or else the seed whose best controller scores best from the search's own nominal
 start (the ``nominal_fitness`` attribute; the search's ``best_fitness`` of a perturbed search is
 one lucky draw). The motion starts from the first phase's search's nominal start pose, at rest.
+
+A motion whose figure's state blows up (NaN, inf or beyond ±``kernels.simulate.STATE_LIMIT``)
+raises NonFiniteStateError at the script's line of the phase that was running, with the
+motion's time and state: no score is ever NaN for it.
 """
 
 from __future__ import annotations
@@ -18,11 +22,12 @@ from pathlib import Path
 import numpy as np
 
 from mosys.bsr.figure import BsrFigure, load_bsr_figure
-from mosys.bsr.search import bind_search
+from mosys.bsr.search import bind_search, describe_planar_state, unsound_state_message
 from mosys.bsr.start import standing_state
 from mosys.composite.concatenation import ConcatenatedMotion, run_concatenation
 from mosys.composite.evaluate import PhaseMotion, score_script
 from mosys.composite.transitions import equal_split
+from mosys.errors import NonFiniteStateError
 from mosys.io.bsr_result import BsrController, read_bsr_result
 from mosys.parsing.bsr import parse_bsr_spec
 from mosys.parsing.composite_script import CompositeScript
@@ -66,8 +71,37 @@ class CompositeSession:
         return equal_split(self.default_length, len(self.controllers))
 
     def run(self, ticks: Sequence[int]) -> ConcatenatedMotion:
-        """The concatenated motion with these phase durations (P,) ticks."""
-        return run_concatenation(self.figure, self.controllers, ticks, self.start, self.dt)
+        """The concatenated motion with these phase durations (P,) ticks; a state that blows up
+        raises NonFiniteStateError at the script's line of the phase it blew up in."""
+        try:
+            return run_concatenation(self.figure, self.controllers, ticks, self.start, self.dt)
+        except NonFiniteStateError as error:
+            raise self._blown_up([int(count) for count in ticks], error) from None
+
+    def _blown_up(self, ticks: list[int], error: NonFiniteStateError) -> NonFiniteStateError:
+        """``error`` of ``run(ticks)`` (its t from the start of a phase) located: the phase is
+        the first whose motion up to its end blows up (the motion up to each phase is run
+        again, on this error path only), t becomes the motion's time."""
+        phase = len(ticks) - 1
+        for k in range(len(ticks) - 1):
+            if sum(max(count, 0) for count in ticks[: k + 1]) == 0:
+                continue  # no motion yet
+            try:
+                run_concatenation(
+                    self.figure, self.controllers[: k + 1], ticks[: k + 1], self.start, self.dt
+                )
+            except NonFiniteStateError:
+                phase = k
+                break
+        t = sum(max(count, 0) for count in ticks[:phase]) * self.dt + error.t
+        name = self.script.phases[phase].name
+        token = self.script.tokens[f"phase.{name}.controller"]
+        during = f"phase {name}, durations {', '.join(map(str, ticks))} ticks"
+        described = describe_planar_state(self.figure, error.state)
+        message = unsound_state_message(t, error.state, described, during)
+        return NonFiniteStateError(
+            f"{self.script.path}:{token.line}:{token.column}: {message}", t, error.state
+        )
 
     def score(self, ticks: Sequence[int]) -> ScoredMotion:
         """Run the phases for ``ticks`` (P,) and score the motion with the script."""

@@ -24,6 +24,9 @@ of the feet along the heading at t = 0, m; ``foot_steps`` the touch-downs (after
 least ``STEP_LIFT``) of a foot other than the one that touched down last; ``min_height`` the
 lowest com height, m; ``heading_sine`` the sine of the heading change (1: a quarter turn to the
 left, whatever the turns before it: a turn that a spin does not beat).
+
+A run stops where the state is not sound (``kernels.simulate.state_is_sound``), as the 2-D
+one does: checked before every step and after the last, it returns ``blown_up(step)`` (< 0).
 """
 
 from __future__ import annotations
@@ -56,8 +59,10 @@ from mosys.kernels.bsr_controller import (
     active_rule,
     rule_weights,
     segment_rule,
+    stop_unsound,
 )
 from mosys.kernels.bsr_simulate import CONTACT_TOLERANCE
+from mosys.kernels.simulate import state_is_sound
 
 # the columns of terms_out (``parsing.bsr.FITNESS_TERMS_3D`` names them in this order)
 (
@@ -144,7 +149,10 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
     steps of dt seconds from the state ``start`` (S,), measuring as ``task`` (a Task) says,
     filling ``record`` (a RunRecord). start_force (E,): the endpoints' normal forces at the
     start, N; carry_over: start with the rule the senses pick (a controller continuing another)
-    instead of rule 0. Long on purpose, as the 2-D run_controller."""
+    instead of rule 0. Long on purpose, as the 2-D run_controller.
+    Returns ``steps``, or ``blown_up(n)`` (< 0) if the state is not sound (``state_is_sound``)
+    before step n (n = steps: after the last), as the 2-D run_controller: the samples 0 to n
+    recorded, terms_out NaN, final_state the unsound state."""
     parent, hinge, rest, length, mass, com, inertia, joint, endpoints = figure[:9]
     joint_min, joint_max, gravity, floor, _ = figure[9:]
     time_based, target, tau, center, side, segment_end, period = controller
@@ -178,7 +186,7 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
     recording = ends_out.shape[0] == steps + 1
     weights = rule_weights(side)
     n_joints = joint_min.shape[0]
-    total_mass = body_frame(
+    body_frame(
         parent,
         hinge,
         rest,
@@ -261,6 +269,8 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
     last_foot = -1
     foot_lift = np.zeros(n_feet)  # each foot's highest point since it left the floor, m
     for n in range(steps):
+        if not state_is_sound(state):
+            return stop_unsound(n, state, end_force, terms_out, final_state, final_force)
         step(
             parent,
             hinge,
@@ -360,6 +370,8 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
             com_out[n + 1, 0] = state[CX]
             com_out[n + 1, 1] = state[CY]
             com_out[n + 1, 2] = state[CZ]
+    if not state_is_sound(state):
+        return stop_unsound(steps, state, end_force, terms_out, final_state, final_force)
     dx = state[CX] - start_x
     dz = state[CZ] - start_z
     terms_out[DISTANCE] = dx * forward_x + dz * forward_z
@@ -381,15 +393,29 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
     terms_out[HEADING_SINE] = math.sin(heading - heading_start)
     final_state[:] = state
     final_force[:] = end_force
-    return total_mass
+    return steps
 
 
 @njit(cache=True, parallel=True)
-def run_population(figure, controllers, task, starts, steps, dt, senses_out, rule_out, terms_out):
+def run_population(
+    figure,
+    controllers,
+    task,
+    starts,
+    steps,
+    dt,
+    senses_out,
+    rule_out,
+    terms_out,
+    taken_out,
+    final_out,
+):
     """``run_controller`` for C controllers at once, in parallel (each run is independent, so
     the results do not depend on the number of threads): controllers a ControllerArrays whose
     arrays have a leading axis C, starts (C, S); fills senses_out (C, steps + 1, V), rule_out
-    (C, steps + 1), terms_out (C, TERM_COUNT)."""
+    (C, steps + 1), terms_out (C, TERM_COUNT), taken_out (C,) int64 what each run returned
+    (steps, or ``blown_up(n)`` < 0: its terms are NaN) and final_out (C, S) each run's last
+    state (the unsound one where it stopped)."""
     n_rods = figure.parent.shape[0]
     n_ends = figure.endpoints.shape[0]
     for c in prange(starts.shape[0]):
@@ -408,9 +434,9 @@ def run_population(figure, controllers, task, starts, steps, dt, senses_out, rul
             terms_out[c],
             np.empty((0, n_rods, 2, 3)),
             np.empty((0, 3)),
-            np.empty(starts.shape[1]),
+            final_out[c],
             np.empty(n_ends),
         )
-        run_controller(
+        taken_out[c] = run_controller(
             figure, controller, task, starts[c], np.zeros(n_ends), False, steps, dt, record
         )

@@ -12,6 +12,10 @@ minus at the start, m; ``max_height`` the largest com y, m; ``contact_distance``
 distance travelled by endpoints while they touch the floor (within ``CONTACT_TOLERANCE``) at both
 ends of a step, m; ``rotations`` |net rotation of the root rod| / 360°; ``fall`` the fraction of
 steps that end with one of the ``fall`` endpoints touching the floor.
+
+A run stops where the state is not sound (``kernels.simulate.state_is_sound``: NaN, inf or beyond
+±STATE_LIMIT; checked before every step and after the last, which leaves the arithmetic of a
+sound run as it was) and returns ``blown_up(step)`` (< 0) instead of the steps it took.
 """
 
 from __future__ import annotations
@@ -34,6 +38,7 @@ from mosys.kernels.bsr_simulate import (
     place_in_world,
     step,
 )
+from mosys.kernels.simulate import blown_up, state_is_sound
 
 # Table 2 of the paper: a rule's hyper-rectangle side 2/lambda lies in [SIDE_MIN, SIDE_MAX], so
 # lambda_min = 2 / SIDE_MAX (the rule weights below); centres are drawn in [CENTER_MIN, CENTER_MAX].
@@ -135,9 +140,23 @@ class RunRecord(NamedTuple):
 
 
 @njit(cache=True)
+def stop_unsound(step, state, end_force, terms_out, final_state, final_force):
+    """End a run (2-D or 3-D) whose state (S,) is not sound before step ``step`` (the step count:
+    after the last): terms_out (T,) becomes NaN (no fitness), final_state and final_force take
+    the unsound state and the endpoints' forces (E,) N. Returns ``blown_up(step)``."""
+    terms_out[:] = np.nan
+    final_state[:] = state
+    final_force[:] = end_force
+    return blown_up(step)
+
+
+@njit(cache=True)
 def run_controller(figure, controller, start, start_force, carry_over, steps, dt, falls, record):
     """Run a controller (a ControllerArrays) of the figure (a FigureArrays) for ``steps`` steps
-    of dt seconds from the state ``start`` (S,), filling ``record`` (a RunRecord).
+    of dt seconds from the state ``start`` (S,), filling ``record`` (a RunRecord). Returns
+    ``steps``, or ``blown_up(n)`` (< 0) if the state is not sound (``state_is_sound``) before step
+    n (n = steps: after the last): then the samples 0 to n are recorded (sample n the unsound
+    state), terms_out is NaN and final_state the unsound state (``stop_unsound``).
 
     Long on purpose: the tuples are unpacked once, before the step loop, and the loop is one
     piece (the module docstring of ``mosys.kernels.bsr_simulate`` says why).
@@ -197,6 +216,8 @@ def run_controller(figure, controller, start, start_force, carry_over, steps, dt
     contact_distance = 0.0
     fallen_steps = 0
     for n in range(steps):
+        if not state_is_sound(state):
+            return stop_unsound(n, state, end_force, terms_out, final_state, final_force)
         step(
             parent,
             hinge,
@@ -252,6 +273,8 @@ def run_controller(figure, controller, start, start_force, carry_over, steps, dt
             ends_out[n + 1] = rod_ends
             com_out[n + 1, 0] = state[CX]
             com_out[n + 1, 1] = state[CY]
+    if not state_is_sound(state):
+        return stop_unsound(steps, state, end_force, terms_out, final_state, final_force)
     terms_out[DISTANCE] = state[CX] - start_x
     terms_out[MAX_HEIGHT] = max_height
     terms_out[CONTACT_DISTANCE] = contact_distance
@@ -259,14 +282,29 @@ def run_controller(figure, controller, start, start_force, carry_over, steps, dt
     terms_out[FALL] = fallen_steps / steps
     final_state[:] = state
     final_force[:] = end_force
+    return steps
 
 
 @njit(cache=True, parallel=True)
-def run_population(figure, controllers, starts, steps, dt, falls, senses_out, rule_out, terms_out):
+def run_population(
+    figure,
+    controllers,
+    starts,
+    steps,
+    dt,
+    falls,
+    senses_out,
+    rule_out,
+    terms_out,
+    taken_out,
+    final_out,
+):
     """``run_controller`` for C controllers at once, in parallel (each run is independent, so
     the results do not depend on the number of threads): controllers a ControllerArrays whose
     arrays have a leading axis C, starts (C, S); fills senses_out (C, steps + 1, V), rule_out
-    (C, steps + 1), terms_out (C, TERM_COUNT)."""
+    (C, steps + 1), terms_out (C, TERM_COUNT), taken_out (C,) int64 what each run returned
+    (steps, or ``blown_up(n)`` < 0: its terms are NaN) and final_out (C, S) each run's last
+    state (the unsound one where it stopped)."""
     n_rods = figure.parent.shape[0]
     n_ends = figure.endpoints.shape[0]
     for c in prange(starts.shape[0]):
@@ -285,9 +323,9 @@ def run_population(figure, controllers, starts, steps, dt, falls, senses_out, ru
             terms_out[c],
             np.empty((0, n_rods, 2, 2)),
             np.empty((0, 2)),
-            np.empty(starts.shape[1]),
+            final_out[c],
             np.empty(n_ends),
         )
-        run_controller(
+        taken_out[c] = run_controller(
             figure, controller, starts[c], np.zeros(n_ends), False, steps, dt, falls, record
         )
