@@ -145,8 +145,8 @@ def test_bsr_search_steps_are_limited(tmp_path, capsys, monkeypatch):
     argv = ["bsr-search", str(spec), "--seed", "1", "--generations", "1", "-o", str(out)]
     assert main(argv) == 2
     assert last_line(capsys) == (
-        f"{spec}:5:1: expected at most 100 integration steps per run, found 400 (one evaluation "
-        f"of 400 steps); {STEPS_HINT}"
+        f"{spec}:5:1: expected at most 100 integration steps per run, found 400 (10 controllers "
+        f"of 10 rules, 400 steps a run); {STEPS_HINT}"
     )
     assert_nothing_written(out)
 
@@ -198,3 +198,21 @@ def test_a_dp_segment_that_diverges_is_reported(link1):
         f"{spec.path}:6:5: the state became non-finite in the segment from node angle=-180, "
         "omega=-500 under torque=nan (756 of 8,316 segments): "
     )
+
+
+def test_a_huge_bsr_population_is_refused_before_it_is_drawn(tmp_path, capsys):
+    """``search controllers=2000000000`` parses (a count the kernels index) but its population
+    (the senses of each controller's last run) would take about 300 TB."""
+    text = (SPECS / "bsr" / "starman_jump.bsr").read_text()
+    spec = tmp_path / "jump.bsr"
+    spec.write_text(text.replace("controllers=10 ", "controllers=2000000000 "))
+    out = tmp_path / "seed1.h5"
+    argv = ["bsr-search", str(spec), "--seed", "1", "--generations", "1"]
+    assert main([*argv, "--figures", str(SPECS / "figures"), "-o", str(out)]) == 2
+    message = last_line(capsys)
+    assert message.startswith(f"{spec}:5:1: expected a job that fits in ")
+    assert (
+        "(2,000,000,000 controllers of 10 rules, 400 steps a run); raise MOSYS_MAX_MEMORY_GIB"
+        in message
+    )
+    assert_nothing_written(out)

@@ -9,7 +9,14 @@ from pathlib import Path
 
 from mosys.bsr.figure import bsr_figure, load_rod_figure
 from mosys.bsr.figure3d import bsr_figure3d
-from mosys.bsr.search import SearchOutcome, SearchSetup, bind_search, run_search, searched_variables
+from mosys.bsr.search import (
+    SearchOutcome,
+    SearchSetup,
+    bind_search,
+    run_search,
+    search_memory_bytes,
+    searched_variables,
+)
 from mosys.bsr.search3d import bind_search3d, chain_start, standing_height
 from mosys.io.bsr_result import BsrResult, write_bsr_result
 from mosys.limits import check_job
@@ -48,9 +55,9 @@ def search_to_file(
     simulate = spec.simulate_token
     check_job(
         f"{spec.path}:{simulate.line}:{simulate.column}",
-        f"one evaluation of {spec.steps:,} steps",
+        f"{spec.controllers:,} controllers of {spec.rules:,} rules, {spec.steps:,} steps a run",
         spec.steps,
-        spec.steps * motion_step_bytes(len(figure.endpoint_names)),
+        search_memory_bytes(setup, motion_step_bytes(len(figure.endpoint_names))),
     )
     if threads:
         import numba

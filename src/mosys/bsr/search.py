@@ -255,6 +255,17 @@ def searched_variables(setup: SearchSetup) -> int:
     return spec.rules * (free + 1) + spec.rules - 1
 
 
+def search_memory_bytes(setup: SearchSetup, record_step_bytes: int) -> float:
+    """About the memory a search takes, bytes: two populations (the controllers and their
+    mutants), each controller's rules (targets, tau, boxes) and the senses of its last run (steps
+    + 1, V) float64 (``_Population``), and one recorded run of ``record_step_bytes`` per step."""
+    spec, figure = setup.spec, setup.figure
+    senses = len(figure.sense_names)
+    rules = 8.0 * spec.rules * (len(figure.joint_names) + 3 + 2 * senses)
+    per_controller = rules + 8.0 * (spec.steps + 1) * senses
+    return 2.0 * spec.controllers * per_controller + float(spec.steps) * record_step_bytes
+
+
 class _Population:
     """C controllers as stacked arrays (what ``run_population`` takes), their fitness and the
     sense trajectory of each one's last run (for the relevance heuristic)."""
