@@ -5,16 +5,20 @@ renders and parses back."""
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 import subprocess
 import sys
 from pathlib import Path
 
+import h5py
+import numpy as np
 import pytest
 from conftest import SPECS
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from mosys.cli import main
 from mosys.dynamics.model import build_model
 from mosys.parsing.bsr import MAX_SEED, parse_bsr_text
 from mosys.parsing.composite import parse_composite_text
@@ -92,6 +96,8 @@ FIGURE_ERRORS = {
     "1e+06 for gravity (m/s²), found '1e300'",
     "rod a length=1 mass=1\npin a at=1e300,0\n": "bad.fig:2:10: expected a pivot within "
     "1e+06 m of the origin, found '1e300,0'",
+    "rod a length=1 mass=1\npin a\nterrain floor height=-1e300\n": "bad.fig:3:22: expected a "
+    "height within 1e+06 m of 0, as terrain vertices are, found '-1e300'",
     "vehicle wheelbase=1e-300 length=4.0 width=1.7 front_overhang=0.8 wheel_radius=0.3 "
     "steer_limit=35\n": "bad.fig:1:19: expected a number from 1e-06 to 1e+06 for wheelbase, "
     "found '1e-300'",
@@ -103,6 +109,32 @@ def test_figure_ranges(text: str) -> None:
     with pytest.raises(SpecError) as error:
         parse_figure_text(text, "bad.fig")
     assert str(error.value) == FIGURE_ERRORS[text]
+
+
+@pytest.mark.parametrize(
+    ("figure", "old", "new"),
+    [
+        ("link1.fig", "length=1 mass=1 ", "length=1 mass=1e-300 "),
+        ("link1.fig", "gravity 9.81 ", "gravity 1e300 "),
+        (
+            "luxo.fig",
+            "terrain polyline -1000,0 -1.25,0 -1.25,-0.15 -0.9,-0.15 -0.9,-0.3 -0.65,-0.3 "
+            "-0.65,0 1000,0",
+            "terrain floor height=1e300",
+        ),
+    ],
+    ids=["mass 1e-300", "gravity 1e300", "Luxo's floor at 1e300"],
+)
+def test_compile_refuses_the_segfaulting_figures(tmp_path: Path, figure, old, new) -> None:
+    """Reproducer 1's figures, which compiled and then crashed the simulator with a segfault:
+    refused at the word, exit 2, no module written."""
+    text = edited(FIGURES / figure, old, new)
+    spec = tmp_path / figure
+    spec.write_text(text)
+    done = mosys_command("compile", str(spec), "-o", str(tmp_path / "out.py"), cwd=tmp_path)
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert done.stderr.startswith(f"{spec}:{where(text, '1e')}: expected ")
+    assert not list(tmp_path.glob("out.py*"))
 
 
 @settings(max_examples=200, deadline=None)
@@ -336,3 +368,48 @@ def test_an_error_quotes_at_most_the_start_of_a_huge_word(path: Path) -> None:
                     assert len(str(error)) < 2_000 + len(str(path))
                     if len(error.found or "") >= HUGE_WORD:
                         assert f"... ({len(error.found):,} characters)" in str(error)
+
+
+# --- 6. a step longer than a sim line -----------------------------------------------------------
+
+
+def test_run_with_a_step_longer_than_its_sim_line(tmp_path: Path, pendulum: Path) -> None:
+    """``mosys run --dt 2`` (reproducer 6, once an AssertionError): a 0.4 s ``sim`` rounds to no
+    step, a 4 s one to two steps of 2 s; the run ends with a finite trajectory."""
+    script = tmp_path / "long_steps.anim"
+    script.write_text("state link -135,350\nswapcon link conA.ctab\nsim 0.4\nsim 4\n")
+    out = tmp_path / "long_steps.h5"
+    argv = ["run", str(script), "--controllers", str(pendulum / "controllers")]
+    argv += ["--dynamics-dir", str(pendulum / "dynamics"), "--dt", "2", "-o", str(out)]
+    assert main(argv) == 0
+    with h5py.File(out) as file:
+        assert np.isfinite(file["state"][...]).all() and np.isfinite(file["t"][...]).all()
+        assert file["t"][-1] == 4.0
+
+
+# --- 8. a composite score that divides by zero ------------------------------------------------
+
+
+@pytest.mark.parametrize(("expression", "shown"), [("0 / 0", "nan"), ("1 / 0", "inf")])
+def test_a_composite_score_dividing_by_zero_is_written_plainly(
+    tmp_path: Path, composite_workspace, capsys, expression: str, shown: str
+) -> None:
+    """IEEE arithmetic in a script's scores (README, "The composite script"): the result file
+    says "nan"/"inf" in strict JSON, ``mosys info`` shows it, and the search's best is never
+    nan."""
+    script = tmp_path / "show.comp"
+    text = composite_workspace.script.read_text()
+    old = "score jump      = max_t(min_i(y_i(t))) * (dtime ?= 100)"
+    script.write_text(text.replace(old, f"score jump      = {expression}"))
+    out = tmp_path / "show.h5"
+    argv = ["composite", str(script), "--bsr-results", str(composite_workspace.bsr_results)]
+    assert main([*argv, "--q", "4", "--g", "2", "--h", "2", "-o", str(out)]) == 0
+    with h5py.File(out) as file:
+        scores = json.loads(file.attrs["scores_after"])  # strict JSON: no NaN/Infinity tokens
+        assert scores["jump"] == shown
+        assert not np.isnan(file["search/best_score"][...]).any() or shown == "nan"
+    capsys.readouterr()
+    assert main(["info", str(out)]) == 0
+    listing = capsys.readouterr().out
+    assert f'"jump": "{shown}"' in listing
+    assert f"score_after       {shown}" in listing

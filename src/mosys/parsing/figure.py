@@ -71,7 +71,7 @@ ROD_LENGTH_RANGE = (1e-6, 1e6)  # m
 ROD_MASS_RANGE = (1e-6, 1e6)  # kg
 ROD_INERTIA_RANGE = (1e-20, 1e20)  # kg·m², about the com; m·l²/12 of any rod above lies in it
 MAX_GRAVITY = 1e6  # m/s²
-MAX_PIVOT = 1e6  # m: a pin's pivot lies within this of the origin in x and y, as terrain does
+MAX_PIVOT = 1e6  # m: a pin's pivot, a terrain vertex or height lies within this of the origin
 
 _NO_TOKEN = Token("", 0, 0)
 # the options of a hinge or ball line
@@ -897,6 +897,11 @@ class _Parser:
             found = self.options(reader, {"height": "the ground height in metres"})
             if "height" in found:
                 height = self.number(found["height"], "height", "height (m)")
+                if abs(height) > MAX_PIVOT:
+                    raise self.error(
+                        value_token(found["height"], "height"),
+                        f"a height within {MAX_PIVOT:g} m of 0, as terrain vertices are",
+                    )
         reader.end()
         if kind == "polyline":
             self.check_polyline(line, points, point_tokens)
