@@ -60,7 +60,9 @@ def write_composite_table(
         "alone, one thread, kernels compiled. speed-up: the paper's minute scaled to our "
         "simulations over our wall time (a lower bound: the paper says under a minute). budget: "
         "the config the pipeline ran with (the robustness table gives each controller's budget "
-        "and generations). Scores are the script's; ticks are 0.01 s.\n\n"
+        "and generations). Scores are the script's; ticks are 0.01 s. A score of nan or inf is a "
+        "division by zero in the script's expressions (IEEE arithmetic); the search ranks nan "
+        "as -inf, never as the best.\n\n"
     )
     write_text_atomically(md_path, caption + frame.to_markdown(index=False) + "\n")
     return frame
