@@ -463,9 +463,9 @@ def located(setup: SearchSetup, error: NonFiniteStateError, when: str) -> NonFin
     )
 
 
-def ranked(fitness: np.ndarray) -> np.ndarray:
-    """The fitness (C,) as the search ranks it: NaN (terms times weights overflowing to
-    inf - inf) becomes -inf, never best."""
+def ranked(fitness: float | np.ndarray) -> np.ndarray:
+    """A fitness (C,) or a score as a search ranks it: NaN (terms times weights overflowing to
+    inf - inf; a composite script's 0/0) becomes -inf, never best."""
     return np.where(np.isnan(fitness), -np.inf, fitness)
 
 

@@ -7,8 +7,9 @@ turn — one randomly chosen transition point redrawn uniformly a third of the t
 by a rounded N(0, PERTURB_FRACTION x length) step (at least one tick) — keeping a mutant that
 scores better; then the arrays are ranked and the worse half replaced by the better half. Q x G x
 H evaluations in all (the paper: 16 x 16 x 4 = 1,024). A score of nan (a script's expression
-divided 0 by 0) ranks as -inf. One seeded generator draws every random
-number in a fixed order, so a seed gives the same result every time.
+divided 0 by 0) ranks as -inf (``bsr.search.ranked``, as a search's fitness): never best.
+One seeded generator draws every random number in a fixed order, so a seed gives the same
+result every time.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mosys.bsr.search import ranked
 from mosys.io.progress import Progress
 
 PERTURB_FRACTION = 0.05
@@ -47,12 +49,6 @@ def equal_split(length: int, phases: int) -> np.ndarray:
 def durations_of(switches: np.ndarray, length: int) -> np.ndarray:
     """Phase durations (P,) ticks from sorted switch ticks (P - 1,) in a motion of ``length``."""
     return np.diff(np.concatenate([[0], switches, [length]])).astype(np.int64)
-
-
-def ranked(score: float | np.ndarray) -> np.ndarray:
-    """A score as the search ranks it: nan (an expression's 0/0) as -inf, the worst, so that it
-    is never kept over a number nor chosen as the best; any other score as it is."""
-    return np.where(np.isnan(score), -np.inf, score)
 
 
 def search_transitions(
