@@ -184,7 +184,7 @@ def usage_error(message: str) -> str:
                 (
                     ("0", "1", "2"),
                     ("--threads", "0"),
-                    "starts: --threads must be at least 1, got 0",
+                    "starts: --threads must be a whole number from 1 to 2147483647, got 0",
                 ),
                 (("0", "1", "2"), ("--dt", "0"), "starts: --dt must be a number > 0, got 0.0"),
                 (
@@ -204,6 +204,47 @@ def usage_error(message: str) -> str:
                     "starts: at most 1,000,000 starts, asked for 2,000,000",
                 ),
             )
+        ),
+        # issue 27's verb fuzz: numeric options nothing checked (tracebacks and hangs)
+        *(
+            (argv, usage_error(message))
+            for argv, message in (
+                (["run", "S.anim", "--controllers", "c", "--dt", dt, "-o", "T.h5"], message)
+                for dt, message in (
+                    ("0", "run: --dt must be a number > 0, got 0.0"),
+                    ("-1", "run: --dt must be a number > 0, got -1.0"),
+                    ("inf", "run: --dt must be a number > 0, got inf"),
+                    ("nan", "run: --dt must be a number > 0, got nan"),
+                )
+            )
+        ),
+        *(
+            (
+                ["composite", "S.comp", f"--{key}", value, "-o", "C.h5"],
+                usage_error(
+                    f"composite: --{key} must be a whole number from 1 to {2**31 - 1}, got {value}"
+                ),
+            )  # fmt: skip
+            for key, value in (("q", "-1"), ("g", "0"), ("h", "2147483648"))
+        ),
+        (
+            ["dp", "S.ssc", "--tol", "-0.001", "-o", "T.h5"],
+            usage_error("dp: --tol must be a number > 0, got -0.001"),
+        ),
+        (
+            ["dp", "S.ssc", "--max-iterations", "9223372036854775808", "-o", "T.h5"],
+            usage_error(
+                "dp: --max-iterations must be a whole number from 1 to 2147483647, got "
+                "9223372036854775808"
+            ),
+        ),
+        (
+            ["bsr-search", "S.bsr", "--seed", "1", "--threads", "99999999999999999999999"]
+            + ["-o", "R.h5"],
+            usage_error(
+                "bsr-search: --threads must be a whole number from 0 to 2147483647, got "
+                "99999999999999999999999"
+            ),
         ),
         ([], usage_error("the following arguments are required: verb")),
         (

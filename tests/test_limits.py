@@ -216,3 +216,14 @@ def test_a_huge_bsr_population_is_refused_before_it_is_drawn(tmp_path, capsys):
         in message
     )
     assert_nothing_written(out)
+
+
+def test_a_composite_search_of_too_many_arrays_is_refused(composite_workspace, capsys, tmp_path):
+    out = tmp_path / "show.h5"
+    argv = ["composite", str(composite_workspace.script), "--bsr-results"]
+    argv += [str(composite_workspace.bsr_results), "--q", "2147483647", "-o", str(out)]
+    assert main(argv) == 2  # 2^31 - 1 arrays of 3 phases: about 192 GiB
+    message = last_line(capsys)
+    assert message.startswith(f"{composite_workspace.script}:4:8: expected a job that fits in ")
+    assert "found about 192.00 GiB (a transition search of 2,147,483,647 arrays)" in message
+    assert_nothing_written(out)

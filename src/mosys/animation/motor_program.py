@@ -125,7 +125,9 @@ def step_rows(bound: BoundProgram, dt: float) -> StepRows:
     interval = np.clip(np.searchsorted(times, t, side="right") - 1, 0, len(times) - 2)
 
     def held(array: np.ndarray) -> np.ndarray:
-        return np.ascontiguousarray(np.broadcast_to(array[0], (steps, array.shape[1])))
+        """Row 0 of ``array`` for every step, (steps, A), writable: a copy (for 0 or 1 steps,
+        ``ascontiguousarray`` would hand back the read-only broadcast view itself)."""
+        return np.broadcast_to(array[0], (steps, array.shape[1])).copy()
 
     return StepRows(
         mode=held(bound.mode),

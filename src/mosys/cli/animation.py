@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from mosys.cli.verb import Family, Verb
+from mosys.cli.verb import Family, Verb, positive_number_problem
 
 
 def _run_arguments(parser: argparse.ArgumentParser) -> None:
@@ -16,6 +16,10 @@ def _run_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--dt", type=float, default=0.001, help="simulator step, s")
     parser.add_argument("-o", "--output", required=True)
+
+
+def _run_check(args: argparse.Namespace) -> str | None:
+    return positive_number_problem("run", "dt", args.dt)
 
 
 def _run(args: argparse.Namespace) -> None:
@@ -34,6 +38,7 @@ FAMILY = Family(
             "animation script (.anim) -> trajectory (.h5)",
             _run_arguments,
             _run,
+            _run_check,
         ),
     ),
 )

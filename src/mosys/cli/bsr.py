@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from mosys.cli.verb import Family, Verb, add_budget
+from mosys.cli.verb import Family, Verb, add_budget, first_problem, whole_number_problem
 
 
 def _bsr_search_arguments(parser: argparse.ArgumentParser) -> None:
@@ -24,18 +24,14 @@ def _bsr_search_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _bsr_search_check(args: argparse.Namespace) -> str | None:
-    from mosys.parsing.bsr import MAX_SEED, MAX_WHOLE
+    from mosys.parsing.bsr import MAX_SEED
 
-    if not 0 <= args.seed <= MAX_SEED:
-        return f"bsr-search: --seed must be a whole number from 0 to {MAX_SEED}, got {args.seed}"
-    if args.generations is not None and not 1 <= args.generations <= MAX_WHOLE:
-        return (
-            f"bsr-search: --generations must be a whole number from 1 to {MAX_WHOLE}, got "
-            f"{args.generations}"
-        )
-    if args.threads is not None and args.threads < 0:
-        return f"bsr-search: --threads must be at least 0 (0: numba's default), got {args.threads}"
-    return None
+    return first_problem(
+        whole_number_problem("bsr-search", "seed", args.seed, 0, MAX_SEED),
+        whole_number_problem("bsr-search", "generations", args.generations, 1),
+        # 0: numba's default
+        whole_number_problem("bsr-search", "threads", args.threads, 0),
+    )
 
 
 def _bsr_search(args: argparse.Namespace) -> None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from mosys.cli.verb import Family, Verb, add_budget
+from mosys.cli.verb import Family, Verb, add_budget, first_problem, whole_number_problem
 
 
 def _composite_arguments(parser: argparse.ArgumentParser) -> None:
@@ -26,6 +26,12 @@ def _composite_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-o", "--output", required=True)
 
 
+def _composite_check(args: argparse.Namespace) -> str | None:
+    return first_problem(
+        *(whole_number_problem("composite", key, getattr(args, key), 1) for key in ("q", "g", "h"))
+    )
+
+
 def _composite_controller_files(args: argparse.Namespace, script) -> dict:
     """The BSR result files the script may use: the ``--controllers`` given (grouped by their
     directory, the search's name), else every seed file under ``--bsr-results``."""
@@ -41,7 +47,7 @@ def _composite(args: argparse.Namespace) -> None:
     from mosys.parsing.composite import parse_composite_script
 
     script = parse_composite_script(args.script)
-    sizes = {key: getattr(args, key) for key in ("q", "g", "h") if getattr(args, key)}
+    sizes = {key: getattr(args, key) for key in ("q", "g", "h") if getattr(args, key) is not None}
     found = composite_to_file(
         args.script,
         _composite_controller_files(args, script),
@@ -79,6 +85,7 @@ FAMILY = Family(
             "composite script (.comp) -> refined transition points (.h5)",
             _composite_arguments,
             _composite,
+            _composite_check,
         ),
         Verb(
             "edit",

@@ -6,7 +6,13 @@ from __future__ import annotations
 import argparse
 import math
 
-from mosys.cli.verb import Family, Verb
+from mosys.cli.verb import (
+    Family,
+    Verb,
+    first_problem,
+    positive_number_problem,
+    whole_number_problem,
+)
 
 
 def _dp_arguments(parser: argparse.ArgumentParser) -> None:
@@ -16,6 +22,13 @@ def _dp_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--tol", type=float, default=None, help="override the spec's tolerance, s")
     parser.add_argument("--max-iterations", type=int, default=None)
     parser.add_argument("--quiet", action="store_true")
+
+
+def _dp_check(args: argparse.Namespace) -> str | None:
+    return first_problem(
+        positive_number_problem("dp", "tol", args.tol),
+        whole_number_problem("dp", "max-iterations", args.max_iterations, 1),
+    )
 
 
 def _dp(args: argparse.Namespace) -> None:
@@ -64,12 +77,13 @@ MAX_STARTS = 1_000_000  # a start runs for seconds; a million take days on two c
 
 
 def _starts_check(args: argparse.Namespace) -> str | None:
-    if args.threads < 1:
-        return f"starts: --threads must be at least 1, got {args.threads}"
-    for name in ("seconds", "dt"):
-        value = getattr(args, name)
-        if not 0 < value < float("inf"):
-            return f"starts: --{name} must be a number > 0, got {value}"
+    problem = first_problem(
+        whole_number_problem("starts", "threads", args.threads, 1),
+        positive_number_problem("starts", "seconds", args.seconds),
+        positive_number_problem("starts", "dt", args.dt),
+    )
+    if problem:
+        return problem
     for name in ("x", "y", "heading", "steer"):
         values = getattr(args, name)
         if not all(math.isfinite(value) for value in values):
@@ -117,6 +131,7 @@ FAMILY = Family(
             "controller spec (.ssc) -> controller table (.h5)",
             _dp_arguments,
             _dp,
+            _dp_check,
         ),
         Verb(
             "starts",

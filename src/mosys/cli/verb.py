@@ -7,9 +7,32 @@ import argparse
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from mosys.parsing.tokens import MAX_WHOLE
+
 
 def no_check(args: argparse.Namespace) -> str | None:
     return None
+
+
+def whole_number_problem(
+    verb: str, option: str, value: int | None, low: int, high: int = MAX_WHOLE
+) -> str | None:
+    """The usage error of ``--option`` outside ``low..high`` (None: not given, fine)."""
+    if value is None or low <= value <= high:
+        return None
+    return f"{verb}: --{option} must be a whole number from {low} to {high}, got {value}"
+
+
+def positive_number_problem(verb: str, option: str, value: float | None) -> str | None:
+    """The usage error of ``--option`` that is not a finite number > 0 (None: not given)."""
+    if value is None or 0 < value < float("inf"):
+        return None
+    return f"{verb}: --{option} must be a number > 0, got {value}"
+
+
+def first_problem(*problems: str | None) -> str | None:
+    """The first usage error of several checks, or None."""
+    return next((problem for problem in problems if problem), None)
 
 
 def add_budget(parser: argparse.ArgumentParser) -> None:

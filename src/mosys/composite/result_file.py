@@ -54,7 +54,7 @@ def stored_motion(session: CompositeSession, scored: ScoredMotion) -> CompositeM
 def check_size(session: CompositeSession) -> None:
     """LimitError at the first phase's ``ticks=`` (or the ``figure`` line, without them) where
     the guessed concatenation, counted from its start, needs more steps or memory than the
-    limits allow (``mosys.limits``)."""
+    limits allow, or at the ``figure`` line when the search's Q arrays do (``mosys.limits``)."""
     script = session.script
     step_bytes = motion_step_bytes(len(session.figure.endpoint_names))
     ticks = 0.0
@@ -67,6 +67,12 @@ def check_size(session: CompositeSession) -> None:
             ticks,
             ticks * step_bytes,
         )
+    arrays, figure = script.search.q, script.tokens["figure"]
+    check_job(  # the search's population: Q arrays of switch ticks and their scores, copied
+        f"{script.path}:{figure.line}:{figure.column}",
+        f"a transition search of {arrays:,} arrays",
+        memory_bytes=4.0 * 8.0 * arrays * len(script.phases),
+    )
 
 
 def composite_to_file(

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from mosys.parsing.tokens import (
+    MAX_WHOLE,
     NAME,
     Line,
     LineReader,
@@ -145,7 +146,6 @@ DEFAULT_REINITIALIZE = 0.5
 # rounding allowed in duration / dt being a whole number of steps, relative
 STEPS_TOLERANCE = 1e-9
 MAX_SEED = 2**63 - 1  # seeds are stored as int64 in the result file (and seed numpy's RNG)
-MAX_WHOLE = 2**31 - 1  # rules=, controllers=, generations=, reseed=: counts the kernels index
 # simulator steps per evaluation (T / dt), a count the kernels index too (the paper's take 400);
 # how many one run may really take is the user's limit, checked before a search (mosys.limits)
 MAX_STEPS = MAX_WHOLE

@@ -452,9 +452,10 @@ class _Parser:
         torq lines read so far) exceeds ``limit``."""
         total = math.prod(dimension.samples for dimension in before) * samples
         if total > limit:
+            made = f"{total:.3g}" if total < 1e300 else "more than 1e+300"  # ints past floats
             raise self.error(
                 token,
-                f"fewer samples (at most {limit:,} {what} in all; these lines make {total:.3g})",
+                f"fewer samples (at most {limit:,} {what} in all; these lines make {made})",
                 token.text,
             )
 

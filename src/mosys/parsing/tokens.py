@@ -18,6 +18,7 @@ NUMBER = re.compile(r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?")
 NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 ENDPOINT_ENDS = ("proximal", "distal")  # a rod's ends, as specs name them: ROD.END
 END_OF_FILE = "\x00end of file"  # the 'found' of an error about a line that never came
+MAX_WHOLE = 2**31 - 1  # the largest count (generations, controllers, sweeps...) kernels index
 SHOWN_CHARACTERS = 200  # of one word an error quotes: a longer word is cut, its length said
 
 
