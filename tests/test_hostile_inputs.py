@@ -413,3 +413,18 @@ def test_a_composite_score_dividing_by_zero_is_written_plainly(
     listing = capsys.readouterr().out
     assert f'"jump": "{shown}"' in listing
     assert f"score_after       {shown}" in listing
+
+
+def test_a_joint_range_written_minus_zero_is_zero(tmp_path: Path) -> None:
+    """The verb fuzz's ``swing_upper=-0`` on a fixed angle (range 0..0): numpy's uniform took
+    -0 below 0 and refused the range with a traceback; the search runs."""
+    figures = tmp_path / "figures"
+    figures.mkdir()
+    text = (FIGURES / "rex.fig").read_text()
+    (figures / "rex.fig").write_text(
+        text.replace("swing_lower=0 swing_upper=0\n", "swing_lower=0 swing_upper=-0\n")
+    )
+    out = tmp_path / "seed1.h5"
+    argv = ["bsr-search", str(SPECS / "bsr/rex_walk.bsr"), "--figures", str(figures)]
+    assert main([*argv, "--seed", "1", "--generations", "1", "-o", str(out)]) == 0
+    assert out.exists()

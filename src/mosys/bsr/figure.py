@@ -139,8 +139,8 @@ def bsr_figure(figure: Figure) -> BsrFigure:
         inertia=np.array([rod.inertia for rod in figure.rods]),
         joint=joint,
         joint_names=tuple(joint_names),
-        joint_min=np.array(joint_min),
-        joint_max=np.array(joint_max),
+        joint_min=np.array(joint_min) + 0.0,  # + 0.0: a limit written -0 is 0 (numpy's uniform
+        joint_max=np.array(joint_max) + 0.0,  # takes max -0 below min 0 and refuses the range)
         endpoints=endpoints,
         endpoint_names=tuple(f"{names[rod]}.{ENDPOINT_ENDS[end]}" for rod, end in endpoints),
         floor=terrain.height if terrain.kind == "floor" else math.nan,

@@ -164,7 +164,8 @@ def bsr_figure3d(figure: Figure) -> BsrFigure3D:
         ranges += _ranges(figure.path, spec, limits.get(rod.name))
     length = np.array([rod.length for rod in figure.rods])
     endpoints = distinct_endpoints(parent, hinge, length)
-    bounds = np.array(ranges).reshape(-1, 2)
+    bounds = np.array(ranges).reshape(-1, 2) + 0.0  # a limit written -0 is 0 (numpy's uniform
+    # takes max -0 below min 0 and refuses the range)
     return BsrFigure3D(
         figure=figure,
         parent=parent,
