@@ -238,3 +238,28 @@ def test_a_lost_wrap_coordinate_interpolates_to_nan(value):
         out,
     )
     assert np.isnan(out[0])
+
+
+def test_luxos_contacts_blow_up_at_a_coarse_step(tmp_path, capsys):
+    """Luxo's stiff ground contacts (penalty springs in its equations) under a 50 ms step: the
+    hop's state blows up in the air-to-ground contact; exit 2 at the motor line, nothing
+    written. (At the shipped 0.5 ms step the same script runs; the kernel family of Luxo's
+    contacts is the motor program's and the controller's, covered above for link1.)"""
+    dynamics = tmp_path / "dynamics"
+    dynamics.mkdir()
+    compile_figure(SPECS / "figures" / "luxo.fig", dynamics / "luxo.py")
+    script = tmp_path / "hop.anim"
+    script.write_text(
+        "object luxo figure=luxo\nstate luxo x=-0.085 hip=0 elbow=120\nmotor luxo hop\n"
+    )
+    out = tmp_path / "hop.h5"
+    argv = ["run", str(script), "--controllers", str(tmp_path), "--dynamics-dir", str(dynamics)]
+    argv += ["--motor-dir", str(SPECS / "motor"), "-o", str(out)]
+    assert main([*argv, "--dt", "0.05"]) == 2
+    message = capsys.readouterr().err.strip().splitlines()[-1]
+    assert message.startswith(
+        f"{script}:3:1: the state became non-finite at t = 0.15 s under motor program hop (x="
+    )
+    assert "vx=nan m/s" in message
+    assert_nothing_written(out)
+    assert main([*argv, "--dt", "0.0005"]) == 0
