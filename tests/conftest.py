@@ -261,3 +261,26 @@ def assert_png(
     assert len(colors) > 20, f"{path} looks blank: {len(colors)} colours"
     assert not list(path.parent.glob(".*.partial"))  # written atomically
     return width, height
+
+
+# --- summaries a test leaves for the end of the run ---------------------------------------------
+
+SUMMARY_PROPERTY = "summary"  # a test's record_property(SUMMARY_PROPERTY, text): printed at the end
+_summaries: list[tuple[str, str]] = []
+
+
+def pytest_runtest_logreport(report) -> None:
+    """Keep the summaries of passed and failed tests (xdist sends each report, with its
+    properties, back from the worker that ran it)."""
+    if report.when == "call":
+        _summaries.extend(
+            (report.nodeid, str(value)) for key, value in report.user_properties
+            if key == SUMMARY_PROPERTY
+        )  # fmt: skip
+
+
+def pytest_terminal_summary(terminalreporter) -> None:
+    """The summaries (the verb fuzz's table of outcome classes), after the test results."""
+    for nodeid, text in _summaries:
+        terminalreporter.section(nodeid)
+        terminalreporter.write_line(text)

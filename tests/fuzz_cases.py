@@ -43,6 +43,7 @@ from pathlib import Path
 
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
+from test_car import SMALL
 
 ROOT = Path(__file__).resolve().parents[1]
 SPECS = ROOT / "specs"
@@ -97,22 +98,7 @@ KINDS = ("fig", "ssc", "anim", "mot", "bsr", "comp", "cli")
 
 # A smaller grid of specs/controllers/car/park.ssc (its 366,240 nodes take minutes): the car test's
 # SMALL scene with the lookahead policy, so that `run` and `starts` drive the lookahead runtime.
-CAR_SMALL_SSC = b"""dyn car
-ssd x -2 2 9
-ssd y 1 2 5
-ssd heading -20 20 3
-ssd steer -30 30 3
-ssd speed -1 1 3
-torq steer_rate -30 30 3 0
-torq wheel_accel -200 200 3 0
-dest x=0 y=1 heading=0 speed=0
-tol 0.001
-dt 0.02
-obstacle curb -20,-1 20,-1 20,0 -20,0
-obstacle front 3.0,0.15 7,0.15 7,1.85 3.0,1.85
-domain -3,0.5 3,0.5 3,2.5 -3,2.5
-policy lookahead x=0.1 y=0.1 heading=4
-"""
+CAR_SMALL_SSC = (SMALL + "policy lookahead x=0.1 y=0.1 heading=4\n").encode()
 CAR_SMALL_NAME = "specs/controllers/car/park.ssc (small grid)"
 
 PENDULUM_TABLES = "ABCDEFG"
@@ -440,6 +426,17 @@ def _pendulum_run(script: str, dynamics: str = "{shared}/dynamics", **kw) -> Ste
     )  # fmt: skip
 
 
+def _compile_then_run() -> tuple[Step, Step]:
+    """``compile`` the case's link1.fig, then ``run`` the pendulum script on what it made."""
+    compile_step = Step(
+        ("compile", "{case}/link1.fig", "-o", "{case}/dynamics/link1.py"),
+        ("dynamics/link1.py",),
+        "dynamics",
+    )
+    run_step = _pendulum_run("{specs}/scripts/pendulum.anim", "{case}/dynamics", scratch_cache=True)
+    return compile_step, run_step
+
+
 def _car_run(script: str, options: tuple[str, ...] = ("--dt", "0.01")) -> Step:
     return Step(
         (
@@ -483,17 +480,7 @@ def fig_cases(draw) -> Case:
         )
         return _spec_case(draw, "fig", f"specs/figures/{figure}.fig", f"{figure}.fig", (step,))
     if how == "compile_run":
-        compile_step = Step(
-            ("compile", "{case}/link1.fig", "-o", "{case}/dynamics/link1.py"),
-            ("dynamics/link1.py",),
-            "dynamics",
-        )
-        run_step = _pendulum_run(
-            "{specs}/scripts/pendulum.anim", "{case}/dynamics", scratch_cache=True
-        )
-        return _spec_case(
-            draw, "fig", "specs/figures/link1.fig", "link1.fig", (compile_step, run_step)
-        )
+        return _spec_case(draw, "fig", "specs/figures/link1.fig", "link1.fig", _compile_then_run())
     figure = draw(st.sampled_from(sorted(BSR_FIGURES)))
     step = _bsr_step(f"{{specs}}/bsr/{BSR_FIGURES[figure]}.bsr", "{case}/figures")
     return _spec_case(draw, "fig", f"specs/figures/{figure}.fig", f"figures/{figure}.fig", (step,))
@@ -771,14 +758,7 @@ def baseline_cases() -> list[Case]:
     """The shipped specs unmutated, one per verb and family: each worker runs them first (numba
     loads its caches, a stale cache is compiled) and they must exit 0 with sound outputs."""
     link1 = spec_text("specs/figures/link1.fig")
-    compile_step = Step(
-        ("compile", "{case}/link1.fig", "-o", "{case}/dynamics/link1.py"),
-        ("dynamics/link1.py",),
-        "dynamics",
-    )
-    run_on_it = _pendulum_run(
-        "{specs}/scripts/pendulum.anim", "{case}/dynamics", scratch_cache=True
-    )
+    compile_step, run_on_it = _compile_then_run()
     starts = Step(
         (
             "starts", "{shared}/controllers/car/park.h5", "--dynamics", "{shared}/dynamics/car.py",

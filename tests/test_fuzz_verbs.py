@@ -16,7 +16,7 @@ lines in-process in a fresh directory, under low limits (``MOSYS_MAX_MEMORY_GIB=
 
 The table of counts (kind x class) is printed whatever the result; the test fails on any case
 of a failing class and lists one reproducer per distinct finding. Two profiles: a fast one in
-every run (about 90 cases, 10 s), and the large one (``slow``: about 1,750 cases, every hostile
+every run (about 90 cases, 10 s), and the large one (``slow``: about 1,100 cases, every hostile
 value of every numeric option among them, 2 to 4 minutes) that CI runs. The cases are the same
 on every run (hypothesis derandomized). A worker that hangs or dies is replaced, so one finding
 does not hide the next.
@@ -35,10 +35,11 @@ from pathlib import Path
 
 import fuzz_cases as fc
 import pytest
+from conftest import SUMMARY_PROPERTY
 
 # cases per kind (after duplicates are dropped, a few fewer)
 FAST = {"fig": 14, "ssc": 14, "anim": 14, "mot": 10, "bsr": 16, "comp": 12, "cli": 20}
-LARGE = {"fig": 240, "ssc": 260, "anim": 250, "mot": 180, "bsr": 300, "comp": 200, "cli": 200}
+LARGE = {"fig": 130, "ssc": 140, "anim": 140, "mot": 100, "bsr": 160, "comp": 110, "cli": 110}
 # Seconds a step may take before it counts as a hang: the slowest sound case takes 5 to 12 s (a
 # BSR generation of 10,000 controllers; the longer on a busy machine), most under 0.1 s.
 FAST_TIMEOUT = 20.0
@@ -54,7 +55,7 @@ def shared(tmp_path_factory) -> Path:
 
 
 def run_profile(name: str, sizes: dict[str, int], timeout: float, root: Path, shared: Path,
-                capsys, grid: bool = False) -> list[fc.Outcome]:  # fmt: skip
+                record_property, grid: bool = False) -> list[fc.Outcome]:  # fmt: skip
     """Draw the profile's cases (and with ``grid``, add ``fc.cli_grid``), run them, judge them,
     print the table; the outcomes."""
     cases = [
@@ -87,11 +88,14 @@ def run_profile(name: str, sizes: dict[str, int], timeout: float, root: Path, sh
     if report:
         Path(report).write_text(fc.findings_markdown(outcomes, f"verb fuzz, {name} profile"))
     slowest = sorted(outcomes, key=lambda outcome: -outcome.seconds)[:5]
-    with capsys.disabled():
-        print(f"\n\nverb fuzz, {name} profile: {len(outcomes)} cases in {wall:.1f} s on "
-              f"{WORKERS} workers (step timeout {timeout:g} s)")  # fmt: skip
-        print(fc.counts_table(outcomes))
-        print("slowest: " + ", ".join(f"{o.case_id} {o.seconds:.1f} s" for o in slowest))
+    summary = "\n".join([
+        f"verb fuzz, {name} profile: {len(outcomes)} cases in {wall:.1f} s on {WORKERS} "
+        f"workers (step timeout {timeout:g} s)",
+        fc.counts_table(outcomes),
+        "slowest: " + ", ".join(f"{o.case_id} {o.seconds:.1f} s" for o in slowest),
+    ])  # fmt: skip
+    # conftest's pytest_terminal_summary prints it at the end of the run (from xdist's workers too)
+    record_property(SUMMARY_PROPERTY, summary)
     assert all(outcome.klass == "ok" for outcome in baseline), [
         (outcome.case_id, outcome.case.verbs, outcome.problems)
         for outcome in baseline
@@ -145,18 +149,20 @@ def test_the_runner_sorts_misbehaviour_into_its_classes(tmp_path):
     assert "SIGSEGV" in crash.problems[0] and "Fatal Python error" in crash.traceback
 
 
-def test_fuzz_fast_profile(tmp_path, shared, capsys):
+def test_fuzz_fast_profile(tmp_path, shared, record_property):
     """About 90 cases across every kind, in the default run."""
-    outcomes = run_profile("fast", FAST, FAST_TIMEOUT, tmp_path, shared, capsys)
+    outcomes = run_profile("fast", FAST, FAST_TIMEOUT, tmp_path, shared, record_property)
     assert {outcome.case.kind for outcome in outcomes} == set(fc.KINDS)
     assert_no_findings(outcomes)
 
 
 @pytest.mark.slow
-def test_fuzz_large_profile(tmp_path, shared, capsys):
-    """About 1,750 cases across every kind (CI), every hostile value of every numeric option
+def test_fuzz_large_profile(tmp_path, shared, record_property):
+    """About 1,100 cases across every kind (CI), every hostile value of every numeric option
     among them."""
-    outcomes = run_profile("large", LARGE, LARGE_TIMEOUT, tmp_path, shared, capsys, grid=True)
+    outcomes = run_profile(
+        "large", LARGE, LARGE_TIMEOUT, tmp_path, shared, record_property, grid=True
+    )
     assert len(outcomes) >= 1000
     assert {outcome.case.kind for outcome in outcomes} == set(fc.KINDS)
     assert_no_findings(outcomes)

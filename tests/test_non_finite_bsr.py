@@ -241,16 +241,21 @@ def test_a_spatial_search_continuing_a_nan_state_stops_at_its_simulate_line():
     assert message.endswith("; the start is not sound (a huge start or perturb value?)")
 
 
+def one_generation(spec: Path, tmp_path: Path):
+    """``mosys bsr-search`` of ``spec``, seed 1, one generation, in a subprocess."""
+    return mosys_command(
+        "bsr-search", str(spec), "--seed", "1", "--figures", str(SPECS / "figures"),
+        "--generations", "1", "-o", str(tmp_path / "seed1.h5"), cwd=tmp_path,
+    )  # fmt: skip
+
+
 def test_bsr_search_exits_2_when_the_figure_blows_up(tmp_path: Path) -> None:
     text = edited(
         SPECS / "bsr/starman_jump.bsr", "simulate duration=4 dt=0.01 tau_min=0.2", HUGE_DT
     )
     spec = tmp_path / "jump.bsr"
     spec.write_text(text)
-    done = mosys_command(
-        "bsr-search", str(spec), "--seed", "1", "--figures", str(SPECS / "figures"),
-        "--generations", "1", "-o", str(tmp_path / "seed1.h5"), cwd=tmp_path,
-    )  # fmt: skip
+    done = one_generation(spec, tmp_path)
     assert_refused(
         done,
         f"{spec}:{where(text, 'simulate')}: the figure's state became non-finite at t = 1e+298 s "
@@ -267,10 +272,7 @@ def test_bsr_search_exits_2_when_a_3d_figure_blows_up(tmp_path: Path) -> None:
     text = SPATIAL_SPEC.replace("simulate duration=0.5 dt=0.01 tau_min=0.03", HUGE_DT)
     spec = tmp_path / "walk.bsr"
     spec.write_text(text)
-    done = mosys_command(
-        "bsr-search", str(spec), "--seed", "1", "--figures", str(SPECS / "figures"),
-        "--generations", "1", "-o", str(tmp_path / "seed1.h5"), cwd=tmp_path,
-    )  # fmt: skip
+    done = one_generation(spec, tmp_path)
     assert_refused(
         done,
         f"{spec}:3:1: the figure's state became non-finite at t = 1e+298 s (seed 1, generation "
