@@ -207,8 +207,9 @@ def exit_transitions_template(
     control_samples: (U, m) sampled controls; control_slot: (m,) int64 entry of the model's
     inputs (input_size of them) each control drives; effort_weight: (m,) K of the cost
     t + Σ K|u| t. max_step: the longest integration step, s. A segment still in its cell after
-    ``MAX_SEGMENT_SECONDS`` is discarded (cost inf); one whose state becomes non-finite has
-    cost nan, for the caller to report.
+    ``MAX_SEGMENT_SECONDS``, or whose step error is not finite (too stiff to follow), is
+    discarded (cost inf); one whose accepted step's state is not sound (``simulate.state_is_sound``:
+    NaN, inf or beyond 1e150) has cost nan, for the caller to report.
     nodes: (P,) int64 flat node indices to process, each with a row (``row_of``: (N,) int64,
     the row of each node in the outputs, -1 for a removed node, which has none).
     pose_slot, outline, obstacle_vertices, obstacle_start, domain: the obstacles, as
@@ -306,14 +307,16 @@ def exit_transitions_template(
                         + E7 * k7[slot]
                     )
                     error = max(error, abs(estimate) / (STEP_TOLERANCE * axis_step[k]))
-                if not (np.isfinite(error) and state_is_sound(after)):
-                    segment_cost[row, u] = np.nan  # the model diverged: the caller reports it
-                    break
+                if not np.isfinite(error):
+                    break  # too stiff to follow at this step: cost stays inf
                 if error > 1.0:
                     h *= max(0.2, 0.9 * error**-0.2)
                     if h < MIN_STEP:
                         break  # too stiff to follow: cost stays inf
                     continue
+                if not state_is_sound(after):  # an accepted step (a nan input passes the error
+                    segment_cost[row, u] = np.nan  # test): the caller reports it
+                    break
                 if not pose_is_free(
                     after, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
                 ):
