@@ -121,6 +121,8 @@ def time_population(
         senses = np.zeros((c, spec.steps + 1, v))
         rules = np.zeros((c, spec.steps + 1), np.int64)
         terms = np.zeros((c, TERM_COUNT))
+        taken = np.zeros(c, np.int64)  # each run's steps (< 0: where its state blew up)
+        final = np.empty_like(starts)
         started = time.perf_counter()
         run_population(
             setup.figure.arrays,
@@ -132,8 +134,11 @@ def time_population(
             senses,
             rules,
             terms,
+            taken,
+            final,
         )
         seconds.append(time.perf_counter() - started)
+        assert (taken == spec.steps).all(), "a benchmark run blew up"
     return seconds[1:], terms, rules
 
 
