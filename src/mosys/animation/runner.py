@@ -38,7 +38,7 @@ from mosys.parsing.script import (
     SlewLimit,
     SwapController,
 )
-from mosys.parsing.tokens import Token
+from mosys.parsing.tokens import Token, location
 from mosys.ssc.controller import Controller, non_finite_message
 from mosys.ssc.grid import control_scale, figure_state_names, state_unit
 from mosys.ssc.regions import Bounds, regions
@@ -311,7 +311,7 @@ def _check_size(script: AnimationScript, sources: ScriptSources, dt: float) -> N
             steps += sources.programs[command.program].duration() / dt
         else:
             continue
-        where = f"{script.path}:{command.token.line}:{command.token.column}"
+        where = location(script.path, command.token)
         job = f"the run to the end of this line at dt {dt:g} s"
         check_job(where, job, steps, steps * row_bytes)
 
@@ -345,7 +345,7 @@ def _blown_up(
     """The error for a run, started at ``clock`` s by the line of ``token``, whose state became
     non-finite: led by the script's file, line and column, with the script's time."""
     message = non_finite_message(dynamics, clock + error.t, error.state, driver)
-    return SimulationError(f"{script.path}:{token.line}:{token.column}: {message}")
+    return SimulationError(f"{location(script.path, token)}: {message}")
 
 
 def _run_motor_program(

@@ -21,7 +21,7 @@ from mosys.bsr.search3d import bind_search3d, chain_start, standing_height
 from mosys.io.bsr_result import BsrResult, write_bsr_result
 from mosys.limits import check_job
 from mosys.parsing.bsr import BsrSpec, parse_bsr_spec
-from mosys.parsing.tokens import SpecError
+from mosys.parsing.tokens import SpecError, location
 
 
 def motion_step_bytes(endpoints: int) -> int:
@@ -54,7 +54,7 @@ def search_to_file(
     figure = setup.figure
     simulate = spec.simulate_token
     check_job(
-        f"{spec.path}:{simulate.line}:{simulate.column}",
+        location(spec.path, simulate),
         f"{spec.controllers:,} controllers of {spec.rules:,} rules, {spec.steps:,} steps a run",
         spec.steps,
         search_memory_bytes(setup, motion_step_bytes(len(figure.endpoint_names))),

@@ -56,9 +56,9 @@ from mosys.kernels.bsr_controller import (
     run_controller,
     run_population,
 )
-from mosys.kernels.simulate import STATE_LIMIT, steps_before_blow_up
+from mosys.kernels.simulate import steps_before_blow_up, unsoundness
 from mosys.parsing.bsr import FITNESS_TERMS, BsrSpec
-from mosys.parsing.tokens import SpecError, Token
+from mosys.parsing.tokens import SpecError, Token, location
 
 CORNER_INSIDE = 0.98  # a re-initialised box's corner: this fraction of the half-side out
 RELEVANCE = ("corner", "contain")
@@ -420,12 +420,11 @@ def unsound_state_message(t: float, state: np.ndarray, described: str, when: str
     spec's units, was not sound (``kernels.simulate.state_is_sound``) at ``t`` s from the run's
     start; ``when``: which run (seed, generation), if known. A state that blew up during the run
     may want a smaller dt; one unsound at t = 0 was the start itself, which no dt mends."""
-    what = f"lies beyond ±{STATE_LIMIT:g} (SI)" if np.isfinite(state).all() else "became non-finite"
     during = f" ({when})" if when else ""
     hint = "a smaller dt= may help"
     if t == 0:
         hint = "the start is not sound (a huge start or perturb value?)"
-    return f"the figure's state {what} at t = {t:.6g} s{during}: {described}; {hint}"
+    return f"the figure's state {unsoundness(state)} at t = {t:.6g} s{during}: {described}; {hint}"
 
 
 def check_run(
@@ -458,9 +457,7 @@ def located(setup: SearchSetup, error: NonFiniteStateError, when: str) -> NonFin
     token = spec.simulate_token if spec.simulate_token.line else Token("simulate", 1, 1)
     described = setup.simulation.describe_state(setup.figure, error.state)
     message = unsound_state_message(error.t, error.state, described, when)
-    return NonFiniteStateError(
-        f"{spec.path}:{token.line}:{token.column}: {message}", error.t, error.state
-    )
+    return NonFiniteStateError(f"{location(spec.path, token)}: {message}", error.t, error.state)
 
 
 def ranked(fitness: float | np.ndarray) -> np.ndarray:

@@ -22,7 +22,7 @@ from mosys.io.composite_result import (
 )
 from mosys.limits import check_job
 from mosys.parsing.composite import parse_composite_script
-from mosys.parsing.tokens import read_spec_text
+from mosys.parsing.tokens import location, read_spec_text
 
 
 def phase_table(session: CompositeSession, ticks: np.ndarray) -> list[dict]:
@@ -62,14 +62,14 @@ def check_size(session: CompositeSession) -> None:
         ticks += float(phase_ticks)
         token = script.tokens.get(f"phase.{phase.name}.ticks", script.tokens["figure"])
         check_job(
-            f"{script.path}:{token.line}:{token.column}",
+            location(script.path, token),
             f"the phases' {ticks:,.0f} ticks to the end of this one",
             ticks,
             ticks * step_bytes,
         )
     arrays, figure = script.search.q, script.tokens["figure"]
     check_job(  # the search's population: Q arrays of switch ticks and their scores, copied
-        f"{script.path}:{figure.line}:{figure.column}",
+        location(script.path, figure),
         f"a transition search of {arrays:,} arrays",
         memory_bytes=4.0 * 8.0 * arrays * len(script.phases),
     )

@@ -31,7 +31,7 @@ from mosys.errors import NonFiniteStateError
 from mosys.io.bsr_result import BsrController, read_bsr_result
 from mosys.parsing.bsr import parse_bsr_spec
 from mosys.parsing.composite_script import CompositeScript
-from mosys.parsing.tokens import SpecError
+from mosys.parsing.tokens import SpecError, location
 
 _SEED_FILE = re.compile(r"seed(\d+)\.h5$")
 
@@ -100,7 +100,7 @@ class CompositeSession:
         described = describe_planar_state(self.figure, error.state)
         message = unsound_state_message(t, error.state, described, during)
         return NonFiniteStateError(
-            f"{self.script.path}:{token.line}:{token.column}: {message}", t, error.state
+            f"{location(self.script.path, token)}: {message}", t, error.state
         )
 
     def score(self, ticks: Sequence[int]) -> ScoredMotion:

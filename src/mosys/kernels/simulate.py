@@ -53,6 +53,13 @@ def steps_before_blow_up(code: int) -> int:
     return -code - 1
 
 
+def unsoundness(state: np.ndarray) -> str:
+    """How a state (S,) SI that is not sound (``state_is_sound``) fails, as its error message
+    says it: ``lies beyond ±1e+150 (SI)`` when every entry is finite, else ``became
+    non-finite``."""
+    return f"lies beyond ±{STATE_LIMIT:g} (SI)" if np.isfinite(state).all() else "became non-finite"
+
+
 SIMULATE_SIGNATURE = types.int64(
     DERIVATIVE_INTO,  # derivative_into
     VECTOR,  # axis_min

@@ -70,6 +70,12 @@ class Token:
     column: int
 
 
+def location(path: str, token: Token) -> str:
+    """``path:line:column`` of ``token`` in the spec ``path``: how a message about that word
+    begins (as a SpecError's does)."""
+    return f"{path}:{token.line}:{token.column}"
+
+
 @dataclass(frozen=True)
 class Line:
     """One non-blank spec line with its comment removed; ``tokens[0]`` is the keyword."""

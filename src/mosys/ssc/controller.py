@@ -19,7 +19,11 @@ import numpy as np
 from mosys.errors import NonFiniteStateError
 from mosys.io.controller_table import ControllerTable, read_controller_table
 from mosys.kernels.interpolate import clamp_to_domain, interpolate_into
-from mosys.kernels.simulate import STATE_LIMIT, simulate_controlled, steps_before_blow_up
+from mosys.kernels.simulate import (
+    simulate_controlled,
+    steps_before_blow_up,
+    unsoundness,
+)
 from mosys.ssc.grid import FigureGrid, control_scale, figure_grid, figure_state_names, state_unit
 from mosys.ssc.regions import ARRIVAL_STEPS, REST_RATE, Bounds, Regions, state_periods
 
@@ -40,14 +44,9 @@ def non_finite_message(
         f"{name}={value / state_unit(dynamics, name)[1]:.6g} {state_unit(dynamics, name)[0]}"
         for name, value in zip(figure_state_names(dynamics), figure_state, strict=True)
     )
-    what = (
-        f"lies beyond ±{STATE_LIMIT:g} (SI)"
-        if np.isfinite(figure_state).all()
-        else "became non-finite"
-    )
     return (
-        f"the state {what} at t = {t:.6g} s under {driver} ({described}): the simulation "
-        "cannot go on (a huge state, gain or figure parameter?); nothing written"
+        f"the state {unsoundness(figure_state)} at t = {t:.6g} s under {driver} ({described}): "
+        "the simulation cannot go on (a huge state, gain or figure parameter?); nothing written"
     )
 
 

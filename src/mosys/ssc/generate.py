@@ -40,6 +40,7 @@ from mosys.kernels.dp import (
 from mosys.kernels.specialise import specialise
 from mosys.limits import check_job
 from mosys.parsing.controller import ControllerSpec
+from mosys.parsing.tokens import location
 from mosys.ssc.grid import (
     FigureGrid,
     control_scale,
@@ -392,7 +393,7 @@ def check_transitions_finite(problem: Problem, transitions: Transitions) -> None
     )
     token = spec.figure_token
     raise SimulationError(
-        f"{spec.path}:{token.line}:{token.column}: the state became non-finite in the segment "
+        f"{location(spec.path, token)}: the state became non-finite in the segment "
         f"from node {start} under {control} ({len(diverged):,} of "
         f"{transitions.segment_cost.size:,} segments): the figure's dynamics diverge there (a "
         "huge figure parameter?); nothing written"
@@ -605,7 +606,7 @@ def generate_controller(
     started = time.perf_counter()
     last_torq = spec.controls[-1].token
     check_job(
-        f"{spec.path}:{last_torq.line}:{last_torq.column}",
+        location(spec.path, last_torq),
         "the DP of this grid and these control samples",
         memory_bytes=dp_memory_bytes(spec),
     )
