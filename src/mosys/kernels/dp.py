@@ -26,6 +26,7 @@ from mosys.kernels.figure_state import load_state
 from mosys.kernels.geometry import pose_is_free
 from mosys.kernels.interpolate import corner_weights, grid_strides, interpolation_scratch
 from mosys.kernels.lookahead import stops_in_box
+from mosys.kernels.prefetch import prefetch
 from mosys.kernels.simulate import state_is_sound
 from mosys.kernels.specialise import model_derivative
 
@@ -34,6 +35,17 @@ UNKNOWN = 1.0e9  # s: cost-to-go of a reachable node whose value is not known ye
 DEAD_END_BOUND = 1.0e4  # s: that bound for a spec with known_weight, whose dead ends keep it (far
 # above any path's seconds, and low enough that values resting partly on it settle in fewer sweeps)
 DEAD_END_SECONDS = 1.0e3  # s: a cost-to-go this long rests on a dead end
+PREFETCH_AHEAD = 2  # nodes: a sweep asks the cache for the exits of the node this far ahead in
+# its order, for the segment costs of the one twice as far, and for the cost-to-go at the next
+# node's corners (``kernels.prefetch``)
+CACHE_LINE = 64  # bytes
+PREFETCH_ABOVE_BYTES = 64 * 2**20  # exit tables larger than this are swept with cache hints: on
+# smaller ones (in or near the processor's caches) the hints cost more than they save
+
+
+def prefetch_pays(exit_index: np.ndarray, exit_weight: np.ndarray) -> bool:
+    """Whether sweeps over these exit tables should ask the cache ahead (PREFETCH_ABOVE_BYTES)."""
+    return exit_index.nbytes + exit_weight.nbytes > PREFETCH_ABOVE_BYTES
 
 
 @njit(cache=True)
@@ -521,9 +533,47 @@ def _bellman(exit_index, exit_weight, segment_cost, value, row):
     return best, choice
 
 
+@njit(cache=True, inline="always")
+def _prefetch_exits(exit_index, exit_weight, segment_cost, row_of, value, order, p):
+    """Ask the cache for what the sweep at position p of ``order`` reads soon, each a step
+    before the next needs it: the segment costs of the node 2·PREFETCH_AHEAD places ahead, the
+    exits (corners and weights) of the finite-cost controls of the node PREFETCH_AHEAD ahead,
+    and the cost-to-go of the next node's corners."""
+    n = order.shape[0]
+    if p + 2 * PREFETCH_AHEAD < n:
+        far = row_of[order[p + 2 * PREFETCH_AHEAD]]
+        if far >= 0:
+            for u in range(0, segment_cost.shape[1], CACHE_LINE // segment_cost.itemsize):
+                prefetch(segment_cost, (far, u))
+    if p + PREFETCH_AHEAD < n:
+        ahead = row_of[order[p + PREFETCH_AHEAD]]
+        if ahead >= 0:
+            per_line = CACHE_LINE // exit_index.itemsize
+            for u in range(segment_cost.shape[1]):
+                if segment_cost[ahead, u] != np.inf:
+                    for i in range(0, exit_index.shape[2], per_line):
+                        prefetch(exit_index, (ahead, u, i))
+                        prefetch(exit_weight, (ahead, u, i))
+    if p + 1 < n:
+        following = row_of[order[p + 1]]
+        if following >= 0:
+            for u in range(segment_cost.shape[1]):
+                if segment_cost[following, u] != np.inf:
+                    for i in range(exit_index.shape[2]):
+                        prefetch(value, (exit_index[following, u, i],))
+
+
 @njit(cache=True)
 def gauss_seidel_sweep(
-    exit_index, exit_weight, segment_cost, row_of, is_destination, value, order, settled_above
+    exit_index,
+    exit_weight,
+    segment_cost,
+    row_of,
+    is_destination,
+    value,
+    order,
+    settled_above,
+    prefetching,
 ):
     """One Gauss–Seidel sweep of value iteration over the nodes in ``order`` (``sweep_order``):
     each node's cost-to-go becomes ``min(old, update)`` at once, so the nodes after it in the
@@ -537,10 +587,15 @@ def gauss_seidel_sweep(
     is_destination: (N,) bool, held at 0. A decrease to a value still at or above
     ``settled_above`` (s; inf: none) does not count in the largest decrease: such a node is a
     dead end (``known_weight``), whatever its exact bound. One thread, in a fixed order: the
-    same result on any machine whatever the thread count.
+    same result on any machine whatever the thread count. ``prefetching``: ask the cache for
+    the rows a few nodes ahead (``_prefetch_exits``; ``prefetch_pays``): half the orders run
+    backwards through memory, where the processor's own prefetch falls behind on tables larger
+    than its caches. The hint changes no value.
     """
     largest = 0.0
     for p in range(order.shape[0]):
+        if prefetching:
+            _prefetch_exits(exit_index, exit_weight, segment_cost, row_of, value, order, p)
         node = order[p]
         row = row_of[node]
         if row < 0 or is_destination[node]:
@@ -568,6 +623,7 @@ def gauss_seidel_sweeps(
     tolerance,
     order,
     settled_above,
+    prefetching,
 ):
     """Sweeps number ``first``, ``first + 1``, ... (``gauss_seidel_sweep`` in the orders of
     ``sweep_order``), at most ``count`` of them, stopping after the first whose largest decrease
@@ -585,6 +641,7 @@ def gauss_seidel_sweeps(
             value,
             order,
             settled_above,
+            prefetching,
         )
         if largest < tolerance:
             return k + 1, largest

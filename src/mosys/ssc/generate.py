@@ -34,6 +34,7 @@ from mosys.kernels.dp import (
     gauss_seidel_sweeps,
     interpolate_known_values_only,
     node_coordinates,
+    prefetch_pays,
     reach_sweep,
     sweep_order,
 )
@@ -328,7 +329,17 @@ def load_kernels(
     reach_sweep(*empty.arrays(), none, flags, none)
     interpolate_known_values_only(*empty.arrays(), flags, 1.0)
     gauss_seidel_sweeps(
-        *empty.arrays(), none, flags, np.empty(0), problem.grid.axis_count, 0, 0, 1.0, none, 1.0
+        *empty.arrays(),
+        none,
+        flags,
+        np.empty(0),
+        problem.grid.axis_count,
+        0,
+        0,
+        1.0,
+        none,
+        1.0,
+        prefetch_pays(*empty.arrays()[:2]),
     )
     best_controls(*empty.arrays(), none, np.empty(0), none)
     sweep_order(problem.grid.axis_count, 0, none)
@@ -415,6 +426,7 @@ def value_iteration(
     bound = DEAD_END_BOUND if problem.spec.known_weight else UNKNOWN
     value = np.where(problem.is_destination, 0.0, np.where(reachable, bound, np.inf))
     order = np.empty(grid.node_count, dtype=np.int64)
+    prefetching = prefetch_pays(transitions.exit_index, transitions.exit_weight)
     progress = Progress("value iteration", max_iterations, "sweeps")
     residual = np.inf
     iterations = 0
@@ -430,6 +442,7 @@ def value_iteration(
             tolerance,
             order,
             DEAD_END_SECONDS if problem.spec.known_weight else np.inf,
+            prefetching,
         )
         iterations += swept
         if not quiet:

@@ -1,0 +1,102 @@
+"""The DP sweep's cache hints (``kernels.prefetch``) change no value: a Gauss–Seidel sweep gives,
+bit for bit, what the same sweep computes written out plainly, with the hints and without, on
+random exit tables with removed nodes, destinations, discarded (inf) segments and zero weights,
+in every sweep order; and only tables larger than the caches get them."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from numba import njit
+
+from mosys.kernels.dp import gauss_seidel_sweep, sweep_order
+from mosys.kernels.prefetch import prefetch
+
+
+def plain_sweep(exit_index, exit_weight, segment_cost, row_of, is_destination, value, order):
+    """The sweep as ``gauss_seidel_sweep``'s docstring states it, in Python, without hints."""
+    largest = 0.0
+    for node in order:
+        row = row_of[node]
+        if row < 0 or is_destination[node]:
+            continue
+        best = np.inf
+        for u in range(segment_cost.shape[1]):
+            if segment_cost[row, u] == np.inf:
+                continue
+            total = 0.0
+            for i in range(exit_index.shape[2]):
+                if exit_weight[row, u, i] != 0.0:
+                    total += exit_weight[row, u, i] * value[exit_index[row, u, i]]
+            best = min(best, segment_cost[row, u] + total)
+        if best < value[node]:
+            largest = max(largest, value[node] - best)
+            value[node] = best
+    return largest
+
+
+def random_tables(rng: np.random.Generator, axis_count: np.ndarray, controls: int):
+    """Exit tables (R, U, 2**(d-1)) of a grid with axis_count nodes per axis: about a fifth of
+    the nodes removed, a third of the segments discarded, a quarter of the weights zero."""
+    nodes = int(np.prod(axis_count))
+    corners = 2 ** (len(axis_count) - 1)
+    kept = rng.random(nodes) > 0.2
+    row_of = np.full(nodes, -1, dtype=np.int64)
+    row_of[kept] = np.arange(kept.sum())
+    rows = int(kept.sum())
+    exit_index = rng.integers(0, nodes, (rows, controls, corners)).astype(np.int32)
+    weight = rng.random((rows, controls, corners)) * (rng.random((rows, controls, corners)) > 0.25)
+    weight /= np.maximum(weight.sum(axis=2, keepdims=True), 1e-12)
+    cost = rng.uniform(0.05, 1.0, (rows, controls))
+    cost[rng.random((rows, controls)) < 0.33] = np.inf
+    is_destination = np.zeros(nodes, dtype=np.bool_)
+    is_destination[rng.choice(np.flatnonzero(kept), 3, replace=False)] = True
+    return exit_index, weight.astype(np.float32), cost, row_of, is_destination
+
+
+@pytest.mark.parametrize("prefetching", [True, False])
+@pytest.mark.parametrize("axis_count", [(7, 5), (4, 3, 5, 2, 3), (3, 2, 2, 3, 2, 2)])
+def test_the_sweep_gives_the_plain_sweeps_values_bit_for_bit(axis_count, prefetching):
+    rng = np.random.default_rng(len(axis_count))
+    counts = np.array(axis_count, dtype=np.int64)
+    exit_index, exit_weight, cost, row_of, is_destination = random_tables(rng, counts, 5)
+    value = np.where(is_destination, 0.0, np.where(row_of >= 0, 1e4, np.inf))
+    expected = value.copy()
+    order = np.empty(value.size, dtype=np.int64)
+    for sweep in range(2**counts.size + 3):
+        sweep_order(counts, sweep, order)
+        largest = gauss_seidel_sweep(
+            exit_index, exit_weight, cost, row_of, is_destination, value, order, np.inf, prefetching
+        )
+        expected_largest = plain_sweep(
+            exit_index, exit_weight, cost, row_of, is_destination, expected, order
+        )
+        assert np.array_equal(value, expected)
+        assert largest == expected_largest
+    assert np.isfinite(value).sum() > is_destination.sum()  # values really moved
+
+
+@njit
+def hint_then_sum(array, row):
+    prefetch(array, (row,))
+    prefetch(array, (row, 1))
+    return array[row].sum()
+
+
+def test_a_hint_reads_and_writes_nothing():
+    array = np.arange(24.0).reshape(4, 3, 2)
+    before = array.copy()
+    assert hint_then_sum(array, 2) == before[2].sum()
+    assert np.array_equal(array, before)
+
+
+def test_only_tables_larger_than_the_caches_are_swept_with_hints():
+    from mosys.kernels.dp import PREFETCH_ABOVE_BYTES, prefetch_pays
+
+    small = np.empty((10, 4, 8), dtype=np.int32)
+    assert not prefetch_pays(small, small.astype(np.float32))
+    rows = PREFETCH_ABOVE_BYTES // (2 * 4 * 8 * 4) + 1
+    # broadcast: the shapes' bytes, without the memory
+    large_index = np.broadcast_to(np.int32(0), (rows, 4, 8))
+    large_weight = np.broadcast_to(np.float32(0), (rows, 4, 8))
+    assert prefetch_pays(large_index, large_weight)
