@@ -48,6 +48,13 @@ def test_first_crossing_finds_an_excursion_between_two_inside_ends():
     assert hermite(0.0, 0.0, 4.0, -4.0, s) == pytest.approx(0.5, abs=1e-9)
 
 
+def test_first_crossing_looks_past_control_points_that_reach_a_bound():
+    """The Bézier control points (0, 1, 1, 0) pass the bound 0.9, but the cubic only reaches
+    0.75: the shortcut for control points clear of both bounds must not be the only check."""
+    assert first_crossing(0.0, 0.0, 3.0, -3.0, -1.0, 0.9) == 2.0
+    assert first_crossing(0.0, 0.0, 3.0, -3.0, -1.0, 0.7) < 0.5
+
+
 @pytest.mark.parametrize("counts", [(5,), (3, 4), (2, 3, 4)])
 def test_each_sweep_order_visits_every_node_once_in_its_directions(counts):
     """Sweep k runs the grid in C order with the axes of bit set in k mod 2**d reversed."""
