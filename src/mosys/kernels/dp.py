@@ -638,8 +638,8 @@ def gauss_seidel_sweeps(
 ):
     """Sweeps number ``first``, ``first + 1``, ... (``gauss_seidel_sweep`` in the orders of
     ``sweep_order``), at most ``count`` of them, stopping after the first whose largest decrease
-    is below ``tolerance`` (s). order: (N,) int64 work space. Returns (sweeps run, the last
-    one's largest decrease)."""
+    is below ``tolerance`` (s). order: (N,) int64 work space; settled_above, prefetching: as
+    ``gauss_seidel_sweep``. Returns (sweeps run, the last one's largest decrease)."""
     largest = np.inf
     for k in range(count):
         sweep_order(axis_count, first + k, order)

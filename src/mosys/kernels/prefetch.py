@@ -2,11 +2,12 @@
 
 The DP's value-iteration sweeps visit the rows of its exit tables in the 2**d orders of
 ``dp.sweep_order``, half of them with the grid's last axis backwards, where the processor's own
-prefetcher falls behind: on the car's table (366,240 rows, 1.2 GB) a sweep took 220–290 ms in
-those orders against 120–160 ms in memory order. Asking for the rows a few nodes ahead of their
-use took every order to 100–140 ms. A hint changes no value (LLVM's ``llvm.prefetch``: a read,
-kept in every cache level); an address outside the array is never touched, only hinted, and the
-callers only hint at elements that exist.
+prefetcher falls behind: on the car's table (366,240 rows, 1.2 GB), replaying sweeps on its
+near-converged cost-to-go, a sweep took 220–290 ms in those orders against 120–160 ms in memory
+order, and asking for the rows a few nodes ahead took every order to 100–140 ms. Over a whole
+value iteration, where most rows change in every sweep, the car's 222 sweeps were about 10 %
+faster. A hint changes no value (LLVM's ``llvm.prefetch``: a read, kept in every cache level);
+the callers only hint at elements that exist.
 """
 
 from __future__ import annotations
