@@ -339,7 +339,7 @@ def load_kernels(
         1.0,
         none,
         1.0,
-        prefetch_pays(*empty.arrays()[:2]),
+        False,  # prefetching: a flag, whose type is all that compiling needs
     )
     best_controls(*empty.arrays(), none, np.empty(0), none)
     sweep_order(problem.grid.axis_count, 0, none)
