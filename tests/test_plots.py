@@ -4,6 +4,7 @@ phase portraits and the CLI from controllers generated here by the DP from the r
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -318,6 +319,28 @@ def test_script_figure_without_tables_draws_no_destinations(trajectory):
     assert "dX: destination of controller X" not in legend_labels(figure)
     assert ax.get_ylim() == pytest.approx((-520.0, 520.0))  # the pendulum's rates, deg/s
     assert not [line for line in ax.lines if line.get_marker() == "x"]
+
+
+def test_a_breakpoint_box_open_in_omega_is_shaded_across_the_plot_only(
+    trajectory, drawn_tables, tmp_path
+):
+    """A ``when`` box bounding the angle alone spans the plot's rates, clipped to its limits
+    (an edge reaching to ±1e9 deg/s took Agg 16 s to dash)."""
+    source = read_trajectory(trajectory)
+    attrs = dict(
+        source.attrs,
+        breakpoints='[{"box": {"angle": [75.0, 105.0]}, '
+        '"controller": "D", "once": true, "line": 3}]',
+    )
+    path = tmp_path / "breakpoint.h5"
+    write_trajectory(path, dataclasses.replace(source, attrs=attrs))
+    figure = script_path_figure(path, [drawn_tables["A"], drawn_tables["D"]])
+    (ax,) = figure.axes
+    (box,) = [patch for patch in ax.patches if patch.get_alpha() == pytest.approx(0.18)]
+    (x0, y0), (x1, y1) = box.get_bbox().get_points()
+    assert (x0, x1) == (75.0, 105.0)
+    assert (y0, y1) == pytest.approx(ax.get_ylim())
+    assert "breakpoint: 75 < angle < 105 → D (once)" in legend_labels(figure)
 
 
 def test_script_writes_a_png(trajectory, drawn_tables, tmp_path):

@@ -661,6 +661,7 @@ def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | 
             obstacles.append((x, y, 7.0))
         if used:
             legend.append((destination_handle(), "dX: destination of controller X"))
+        format_state_axes(ax, axes, state)
         legend += _shade_breakpoints(ax, trajectory, axes, colors)
         ax.plot(state[-1, 0], state[-1, 1], marker="o", markersize=5, color="black", zorder=6)
         obstacles.append((state[-1, 0], state[-1, 1], 3.0))
@@ -670,7 +671,6 @@ def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | 
                 f"end, t = {trajectory.t[-1]:.2f} s",
             )
         )
-        format_state_axes(ax, axes, state)
         script = str(trajectory.attrs.get("script", Path(trajectory_path).name))
         ax.set_title(
             f"State-space path of the animation script {Path(script).name}\n"
@@ -686,21 +686,20 @@ def _shade_breakpoints(
     ax: Axes, trajectory: Trajectory, axes: Sequence[StateAxis], colors: dict
 ) -> list[tuple[object, str]]:
     """Shade each state-space breakpoint's box (the trajectory's root attr ``breakpoints``) in
-    its controller's colour; bounds on variables other than the plot's two span the plot.
-    Returns the legend entries."""
+    its controller's colour, clipped to the plot's limits (set before this is called): bounds
+    on variables other than the plot's two, and open bounds, span the plot. Returns the legend
+    entries."""
     entries = []
+    # Clipped here, not by Agg: a dashed edge is dashed along its whole length before clipping,
+    # and an edge a million plot-widths long took 16 s to draw.
+    view = (ax.get_xlim(), ax.get_ylim())
     for breakpoint_ in json.loads(str(trajectory.attrs.get("breakpoints", "[]"))):
         box = breakpoint_["box"]
         color = colors.get(breakpoint_["controller"], "0.5")
         limits = []
-        for axis in axes:
+        for axis, (view_low, view_high) in zip(axes, view, strict=True):
             low, high = box.get(axis.name, (-math.inf, math.inf))
-            limits.append(
-                (
-                    max(low, axis.low - 1e9 if not axis.period else axis.low),
-                    min(high, axis.high + 1e9 if not axis.period else axis.high),
-                )
-            )
+            limits.append((max(low, view_low), min(high, view_high)))
         (x0, x1), (y0, y1) = limits
         patch = Rectangle(
             (x0, y0),
