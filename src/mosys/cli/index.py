@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from mosys.cli import job_server
 from mosys.cli.verb import Family, Verb
 
 
@@ -31,5 +32,6 @@ FAMILY = Family(
             _index_arguments,
             _index,
         ),
+        job_server.VERB,
     ),
 )

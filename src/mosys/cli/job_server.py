@@ -1,0 +1,296 @@
+"""``mosys job-server SOCKET``: one process that imports mosys's libraries once and runs each
+``mosys`` command handed to it (``mosys.cli.job_client``) in a fork of itself.
+
+A pipeline job's own work is often a few tens of milliseconds (a pendulum DP, a script run);
+starting Python with numpy, h5py, numba, matplotlib and pandas and loading numba's cached
+kernels took 0.7-1.4 s of every job. Snakemake starts this server when a run begins
+(``workflow/rules/common.smk``, ``onstart``), puts its socket in ``MOSYS_JOB_SERVER`` for the
+jobs, and stops it when the run ends; a user can do the same by hand.
+
+A job runs in a fork exactly as it would in its own process: its arguments, working directory,
+environment and standard streams are the client's, and its exit code is sent back. The server
+declines (and the client runs the command itself) when the client's interpreter, mosys package
+or any ``NUMBA_*`` variable that numba reads at import differs from the server's, or when
+``NUMBA_NUM_THREADS`` asks for more threads than the server's numba allows. The server itself
+never runs a kernel: a numba thread pool started before a fork would not survive it.
+
+It stops on SIGTERM or SIGINT, when the process that started it exits, or after
+``--idle`` seconds without a job; a job whose client goes away is sent SIGTERM.
+"""
+
+from __future__ import annotations
+
+import argparse
+import atexit
+import contextlib
+import importlib
+import json
+import os
+import random
+import selectors
+import signal
+import socket
+import struct
+import sys
+import time
+import traceback
+
+from mosys.cli.job_client import FORWARDED_SIGNALS, forward, package_directory
+from mosys.cli.verb import Verb, positive_number_problem
+
+# What jobs import, loaded once here. The pendulum's verbs' modules pull in numpy, h5py, numba
+# (and mosys's kernels, their cached code loaded lazily by each job), matplotlib and pandas.
+PRELOADED = (
+    "numpy",
+    "h5py",
+    "numba",
+    "matplotlib",
+    "pandas",
+    "PIL.Image",
+    "mosys.ssc.generate",
+    "mosys.ssc.quality",
+    "mosys.animation.runner",
+    "mosys.plots.pendulum",
+    "mosys.plots.free_swing",
+    "mosys.paper_tables.pendulum",
+)
+# Variables numba reads once, at import: a job must see the server's values.
+NUMBA_PREFIX = "NUMBA_"
+PER_JOB_VARIABLES = ("NUMBA_NUM_THREADS",)  # set per job (numba.set_num_threads in the fork)
+POLL_S = 1.0  # how often the server looks for its parent and its idle time
+REQUEST_TIMEOUT_S = 10.0
+
+
+def serve(path: str, idle_seconds: float) -> None:
+    """Listen on the Unix socket ``path`` (replacing a stale one), import ``PRELOADED``, and run
+    each request in a fork until told to stop. The socket is listening before the imports, so
+    clients that connect early wait for them rather than running without the server."""
+    os.close(os.pidfd_open(os.getpid()))  # Linux 5.3 or later: else fail now, not per job
+    listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    if os.path.exists(path):
+        os.unlink(path)
+    listener.bind(path)
+    listener.listen(64)
+    parent = os.getppid()
+    wakeup, woken = socket.socketpair()  # a stop signal wakes the selector at once
+    wakeup.setblocking(False)
+    signal.set_wakeup_fd(wakeup.fileno(), warn_on_full_buffer=False)
+    stopping: list[int] = []
+    for number in (signal.SIGTERM, signal.SIGINT, signal.SIGHUP):
+        signal.signal(number, lambda received, frame: stopping.append(received))
+    try:
+        for name in PRELOADED:
+            importlib.import_module(name)
+        main = importlib.import_module("mosys.cli").main
+        _check_no_thread_pool()
+        selector = selectors.DefaultSelector()
+        selector.register(listener, selectors.EVENT_READ, ("listener", 0))
+        selector.register(woken, selectors.EVENT_READ, ("signal", 0))
+        _serve_requests(selector, listener, main, parent, idle_seconds, stopping)
+    finally:
+        listener.close()
+        if os.path.exists(path):
+            os.unlink(path)
+
+
+def _check_no_thread_pool() -> None:
+    """Refuse to serve if importing started numba's thread pool (a fork would inherit it
+    broken)."""
+    from numba.np.ufunc import parallel
+
+    if parallel._is_initialized:
+        raise RuntimeError("numba's thread pool started while importing: cannot fork jobs")
+
+
+def _serve_requests(selector, listener, main, parent: int, idle_seconds: float, stopping) -> None:
+    """The server's loop: accept requests and fork their jobs, report each job's exit code to
+    its client, SIGTERM a job whose client went away; until a stop signal, the parent's exit or
+    ``idle_seconds`` without a job."""
+    jobs: dict[int, tuple[socket.socket, int]] = {}  # pid -> (its client's connection, pidfd)
+    last_activity = time.monotonic()
+    while not stopping and os.getppid() == parent:
+        if not jobs and time.monotonic() - last_activity > idle_seconds:
+            break
+        for key, _ in selector.select(POLL_S):
+            kind, pid = key.data
+            if kind == "listener":
+                connection, _ = listener.accept()
+                started = _start_job(connection, main, selector)
+                if started is None:
+                    connection.close()
+                    continue
+                pid, pidfd = started
+                jobs[pid] = (connection, pidfd)
+                selector.register(pidfd, selectors.EVENT_READ, ("ended", pid))
+                selector.register(connection, selectors.EVENT_READ, ("client", pid))
+            elif kind == "ended":
+                connection, pidfd = jobs.pop(pid)
+                _, status = os.waitpid(pid, 0)
+                code = os.waitstatus_to_exitcode(status)  # -N: killed by signal N
+                _send_line(connection, f"exit {code if code >= 0 else 128 - code}")
+                selector.unregister(pidfd)
+                os.close(pidfd)
+                if connection in (k.fileobj for k in selector.get_map().values()):
+                    selector.unregister(connection)
+                connection.close()
+            elif kind == "signal":
+                key.fileobj.recv(256)  # drained; the loop's test sees the stop
+            elif kind == "client":  # readable: the client hung up (it sends nothing more)
+                selector.unregister(key.fileobj)
+                forward(pid, signal.SIGTERM)
+            last_activity = time.monotonic()
+    for pid in jobs:
+        forward(pid, signal.SIGTERM)
+
+
+def _send_line(connection: socket.socket, line: str) -> None:
+    with contextlib.suppress(OSError):  # the client went away: its job ended or was told to
+        connection.sendall(f"{line}\n".encode())
+
+
+def _receive_request(connection: socket.socket) -> tuple[dict, list[int]]:
+    """The client's request and the descriptors of its standard streams."""
+    connection.settimeout(REQUEST_TIMEOUT_S)
+    data, fds, _, _ = socket.recv_fds(connection, 1 << 16, 3)
+    if len(data) < 4:
+        raise OSError("short request")
+    (length,) = struct.unpack(">I", data[:4])
+    body = data[4:]
+    while len(body) < length:
+        chunk = connection.recv(length - len(body))
+        if not chunk:
+            raise OSError("truncated request")
+        body += chunk
+    connection.settimeout(None)
+    return json.loads(body), fds
+
+
+def decline_reason(request: dict) -> str | None:
+    """Why this server cannot run the request as its own process would (None: it can)."""
+    if request["python"] != sys.executable:
+        return f"interpreter {request['python']}, not {sys.executable}"
+    if request["package"] != package_directory():
+        return f"mosys at {request['package']}, not {package_directory()}"
+    env = request["env"]
+    for name in sorted(set(env) | set(os.environ)):
+        imported = name.startswith(NUMBA_PREFIX) and name not in PER_JOB_VARIABLES
+        if imported and env.get(name) != os.environ.get(name):
+            return f"{name}={env.get(name)!r}, not {os.environ.get(name)!r}"
+    threads = env.get("NUMBA_NUM_THREADS", "").strip()
+    if threads:
+        import numba
+
+        most = numba.config.NUMBA_NUM_THREADS
+        if not threads.isdigit() or not 1 <= int(threads) <= most:
+            return f"NUMBA_NUM_THREADS={threads} (this server allows 1 to {most})"
+    return None
+
+
+def _start_job(connection, main, selector) -> tuple[int, int] | None:
+    """Fork a job for the request on ``connection``: its pid and a pidfd that becomes readable
+    when it ends; None if the request is unreadable or declined, or the fork failed (the client
+    then runs it)."""
+    try:
+        request, fds = _receive_request(connection)
+    except (OSError, ValueError, KeyError):
+        return None
+    try:
+        reason = decline_reason(request)
+        if reason is not None:
+            _send_line(connection, f"declined {reason}")
+            return None
+        try:
+            pid = os.fork()
+        except OSError:
+            return None
+        if pid == 0:  # the job: it keeps none of the server's sockets
+            for key in list(selector.get_map().values()):
+                os.close(key.fd)
+            os.close(signal.set_wakeup_fd(-1))
+            os._exit(_run_job(main, request, fds))
+        pidfd = os.pidfd_open(pid)
+        _send_line(connection, f"started {pid}")
+        return pid, pidfd
+    finally:
+        for fd in fds:
+            os.close(fd)
+
+
+def _run_job(main, request: dict, fds: list[int]) -> int:
+    """In the fork: become the client's process (streams, directory, environment, signals) and
+    run ``main(argv)``; its exit code as Python's own exit would give it."""
+    code = 1
+    try:
+        for number in FORWARDED_SIGNALS:
+            signal.signal(number, signal.SIG_DFL)
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        null = os.open(os.devnull, os.O_RDWR)
+        for fd in (0, 1, 2):
+            os.dup2(fds[request["streams"].index(fd)] if fd in request["streams"] else null, fd)
+        os.chdir(request["cwd"])
+        os.environ.clear()
+        os.environ.update(request["env"])
+        sys.stdin = open(0, closefd=False)  # noqa: SIM115 (the job's own streams, never closed)
+        sys.stdout = open(1, "w", buffering=1 if os.isatty(1) else -1, closefd=False)  # noqa: SIM115
+        sys.stderr = open(2, "w", buffering=1, errors="backslashreplace", closefd=False)  # noqa: SIM115
+        sys.argv = ["mosys", *request["argv"]]
+        random.seed()  # as a new process would be
+        threads = request["env"].get("NUMBA_NUM_THREADS", "").strip()
+        if threads:
+            import numba
+
+            numba.set_num_threads(int(threads))
+        code = _exit_code(main, request["argv"])
+    finally:
+        try:
+            atexit._run_exitfuncs()
+            sys.stdout.flush()
+            sys.stderr.flush()
+        except BaseException:
+            pass
+    return code
+
+
+def _exit_code(main, argv: list[str]) -> int:
+    """``main(argv)``'s exit code as ``sys.exit(main())`` would make it."""
+    try:
+        result = main(argv)
+    except SystemExit as exit_:
+        result = exit_.code
+    except KeyboardInterrupt:
+        return 130
+    except BaseException:
+        traceback.print_exc()
+        return 1
+    if result is None or isinstance(result, int):
+        return result or 0
+    print(result, file=sys.stderr)
+    return 1
+
+
+def _arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("socket", help="path of the Unix socket to listen on")
+    parser.add_argument(
+        "--idle",
+        type=float,
+        default=3600.0,
+        help="stop after this many seconds without a job (default 3600)",
+    )
+
+
+def _check(args: argparse.Namespace) -> str | None:
+    return positive_number_problem("job-server", "idle", args.idle)
+
+
+def _job_server(args: argparse.Namespace) -> None:
+    serve(args.socket, args.idle)
+
+
+VERB = Verb(
+    "job-server",
+    "run the mosys commands of jobs that name this socket in MOSYS_JOB_SERVER, "
+    "in forks of one process (Snakemake starts it)",
+    _arguments,
+    _job_server,
+    _check,
+)
