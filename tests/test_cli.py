@@ -319,6 +319,7 @@ TOP_LEVEL_HELP = (
     "  robustness-table   robust BSR searches against their plain twins\n"
     "pipeline:\n"
     "  index              write an aggregate target: the list of its files\n"
+    "  job-server         fork each job's mosys command from one warm process\n"
     "looking inside results:\n"
     "  info               a result file (.h5): its kind, axes, units and datasets\n"
     "\n"
@@ -372,6 +373,7 @@ VERBS = [
     "composite-table",
     "robustness-table",
     "index",
+    "job-server",
     "info",
 ]
 

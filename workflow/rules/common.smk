@@ -67,11 +67,7 @@ def stop_job_server():
     if process is None:
         return
     del os.environ["MOSYS_JOB_SERVER"]
-    process.terminate()
-    try:
-        process.wait(timeout=10.0)
-    except subprocess.TimeoutExpired:
-        process.kill()
+    process.terminate()  # not waited for: it stops at once, its interpreter's exit takes 0.5 s
     shutil.rmtree(JOB_SERVER.pop("directory"), ignore_errors=True)
 
 

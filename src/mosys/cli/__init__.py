@@ -101,15 +101,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the verb ``argv`` names (None: this command line's, which a job server named by
-    ``MOSYS_JOB_SERVER`` runs instead when there is one: ``mosys.cli.job_client``); its exit
-    code."""
-    if argv is None:
-        from mosys.cli.job_client import delegate
-
-        code = delegate(sys.argv[1:])
-        if code is not None:
-            return code
+    """Run the verb ``argv`` names (None: this command line's); its exit code."""
     parser = build_parser()
     args = parser.parse_args(argv)
     problem = args.command.check(args)

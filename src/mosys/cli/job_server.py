@@ -1,5 +1,5 @@
 """``mosys job-server SOCKET``: one process that imports mosys's libraries once and runs each
-``mosys`` command handed to it (``mosys.cli.job_client``) in a fork of itself.
+``mosys`` command handed to it (``mosys.job_client``) in a fork of itself.
 
 A pipeline job's own work is often a few tens of milliseconds (a pendulum DP, a script run);
 starting Python with numpy, h5py, numba, matplotlib and pandas and loading numba's cached
@@ -8,11 +8,12 @@ kernels took 0.7-1.4 s of every job. Snakemake starts this server when a run beg
 jobs, and stops it when the run ends; a user can do the same by hand.
 
 A job runs in a fork exactly as it would in its own process: its arguments, working directory,
-environment and standard streams are the client's, and its exit code is sent back. The server
-declines (and the client runs the command itself) when the client's interpreter, mosys package
-or any ``NUMBA_*`` variable that numba reads at import differs from the server's, or when
-``NUMBA_NUM_THREADS`` asks for more threads than the server's numba allows. The server itself
-never runs a kernel: a numba thread pool started before a fork would not survive it.
+environment and standard streams are the client's, and its exit code is sent back. numba read
+its ``NUMBA_*`` variables when the server imported it: the fork re-reads them (so each job has
+its own ``NUMBA_NUM_THREADS``), and the server declines (the client then runs the command
+itself) when any other of them, the interpreter or the mosys package differs from the server's,
+since the kernels' caches were set up at import. The server never runs a kernel itself: a numba
+thread pool started before a fork would not survive it.
 
 It stops on SIGTERM or SIGINT, when the process that started it exits, or after
 ``--idle`` seconds without a job; a job whose client goes away is sent SIGTERM.
@@ -28,6 +29,7 @@ import json
 import os
 import random
 import selectors
+import shlex
 import signal
 import socket
 import struct
@@ -35,87 +37,83 @@ import sys
 import time
 import traceback
 
-from mosys.cli.job_client import FORWARDED_SIGNALS, forward, package_directory
 from mosys.cli.verb import Verb, positive_number_problem
+from mosys.job_client import FORWARDED_SIGNALS, forward, package_directory
 
-# What jobs import, loaded once here. The pendulum's verbs' modules pull in numpy, h5py, numba
-# (and mosys's kernels, their cached code loaded lazily by each job), matplotlib and pandas.
+# What jobs import, loaded here one at a time while the server is idle, in this order (the
+# first jobs of a run need the first ones): the command line, numpy, h5py, numba and mosys's
+# kernels (their cached code is loaded by each job), then what plots and tables use.
 PRELOADED = (
+    "mosys.cli",
     "numpy",
     "h5py",
     "numba",
-    "matplotlib",
-    "pandas",
-    "PIL.Image",
     "mosys.ssc.generate",
-    "mosys.ssc.quality",
     "mosys.animation.runner",
+    "matplotlib",
+    "PIL.Image",
     "mosys.plots.pendulum",
     "mosys.plots.free_swing",
+    "pandas",
+    "mosys.ssc.quality",
     "mosys.paper_tables.pendulum",
 )
 # Variables numba reads once, at import: a job must see the server's values.
 NUMBA_PREFIX = "NUMBA_"
-PER_JOB_VARIABLES = ("NUMBA_NUM_THREADS",)  # set per job (numba.set_num_threads in the fork)
+PER_JOB_VARIABLES = ("NUMBA_NUM_THREADS",)  # each job's own: numba's config re-read in the fork
 POLL_S = 1.0  # how often the server looks for its parent and its idle time
 REQUEST_TIMEOUT_S = 10.0
 
 
 def serve(path: str, idle_seconds: float) -> None:
-    """Listen on the Unix socket ``path`` (replacing a stale one), import ``PRELOADED``, and run
-    each request in a fork until told to stop. The socket is listening before the imports, so
-    clients that connect early wait for them rather than running without the server."""
+    """Listen on the Unix socket ``path`` (replacing a stale one) and run each request in a
+    fork until told to stop, importing ``PRELOADED`` one module at a time while no request
+    waits: a job that comes early starts at once and imports what is not loaded yet itself."""
     os.close(os.pidfd_open(os.getpid()))  # Linux 5.3 or later: else fail now, not per job
     listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
-    if os.path.exists(path):
+    with contextlib.suppress(FileNotFoundError):
         os.unlink(path)
     listener.bind(path)
     listener.listen(64)
-    parent = os.getppid()
     wakeup, woken = socket.socketpair()  # a stop signal wakes the selector at once
     wakeup.setblocking(False)
     signal.set_wakeup_fd(wakeup.fileno(), warn_on_full_buffer=False)
     stopping: list[int] = []
-    for number in (signal.SIGTERM, signal.SIGINT, signal.SIGHUP):
+    for number in FORWARDED_SIGNALS:
         signal.signal(number, lambda received, frame: stopping.append(received))
+    _log(f"listening on {path}")
+    selector = selectors.DefaultSelector()
+    selector.register(listener, selectors.EVENT_READ, ("listener", 0))
+    selector.register(woken, selectors.EVENT_READ, ("signal", 0))
     try:
-        for name in PRELOADED:
-            importlib.import_module(name)
-        main = importlib.import_module("mosys.cli").main
-        _check_no_thread_pool()
-        selector = selectors.DefaultSelector()
-        selector.register(listener, selectors.EVENT_READ, ("listener", 0))
-        selector.register(woken, selectors.EVENT_READ, ("signal", 0))
-        _serve_requests(selector, listener, main, parent, idle_seconds, stopping)
+        _serve_requests(selector, listener, os.getppid(), idle_seconds, stopping)
     finally:
         listener.close()
-        if os.path.exists(path):
+        with contextlib.suppress(FileNotFoundError):
             os.unlink(path)
 
 
-def _check_no_thread_pool() -> None:
-    """Refuse to serve if importing started numba's thread pool (a fork would inherit it
-    broken)."""
-    from numba.np.ufunc import parallel
-
-    if parallel._is_initialized:
-        raise RuntimeError("numba's thread pool started while importing: cannot fork jobs")
-
-
-def _serve_requests(selector, listener, main, parent: int, idle_seconds: float, stopping) -> None:
+def _serve_requests(selector, listener, parent: int, idle_seconds: float, stopping) -> None:
     """The server's loop: accept requests and fork their jobs, report each job's exit code to
-    its client, SIGTERM a job whose client went away; until a stop signal, the parent's exit or
-    ``idle_seconds`` without a job."""
+    its client, SIGTERM a job whose client went away, preload while idle; until a stop signal,
+    the parent's exit or ``idle_seconds`` without a job."""
     jobs: dict[int, tuple[socket.socket, int]] = {}  # pid -> (its client's connection, pidfd)
+    to_import = list(PRELOADED)
     last_activity = time.monotonic()
     while not stopping and os.getppid() == parent:
         if not jobs and time.monotonic() - last_activity > idle_seconds:
             break
-        for key, _ in selector.select(POLL_S):
+        events = selector.select(0.0 if to_import else POLL_S)
+        if not events and to_import:
+            importlib.import_module(to_import.pop(0))
+            if not to_import:
+                _log(f"imported {', '.join(PRELOADED)}")
+            continue
+        for key, _ in events:
             kind, pid = key.data
             if kind == "listener":
                 connection, _ = listener.accept()
-                started = _start_job(connection, main, selector)
+                started = _start_job(connection, selector)
                 if started is None:
                     connection.close()
                     continue
@@ -127,10 +125,12 @@ def _serve_requests(selector, listener, main, parent: int, idle_seconds: float, 
                 connection, pidfd = jobs.pop(pid)
                 _, status = os.waitpid(pid, 0)
                 code = os.waitstatus_to_exitcode(status)  # -N: killed by signal N
-                _send_line(connection, f"exit {code if code >= 0 else 128 - code}")
+                code = code if code >= 0 else 128 - code
+                _send_line(connection, f"exit {code}")
+                _log(f"job {pid} ended: exit {code}")
                 selector.unregister(pidfd)
                 os.close(pidfd)
-                if connection in (k.fileobj for k in selector.get_map().values()):
+                with contextlib.suppress(KeyError):  # unless its client hung up before
                     selector.unregister(connection)
                 connection.close()
             elif kind == "signal":
@@ -141,6 +141,13 @@ def _serve_requests(selector, listener, main, parent: int, idle_seconds: float, 
             last_activity = time.monotonic()
     for pid in jobs:
         forward(pid, signal.SIGTERM)
+
+
+def _log(line: str) -> None:
+    """A line of the server's log (its standard output), stamped with the wall-clock time."""
+    now = time.time()
+    stamp = time.strftime("%H:%M:%S", time.localtime(now)) + f".{int(now % 1 * 1000):03d}"
+    print(f"{stamp} {line}", flush=True)
 
 
 def _send_line(connection: socket.socket, line: str) -> None:
@@ -176,17 +183,13 @@ def decline_reason(request: dict) -> str | None:
         imported = name.startswith(NUMBA_PREFIX) and name not in PER_JOB_VARIABLES
         if imported and env.get(name) != os.environ.get(name):
             return f"{name}={env.get(name)!r}, not {os.environ.get(name)!r}"
-    threads = env.get("NUMBA_NUM_THREADS", "").strip()
-    if threads:
-        import numba
-
-        most = numba.config.NUMBA_NUM_THREADS
-        if not threads.isdigit() or not 1 <= int(threads) <= most:
-            return f"NUMBA_NUM_THREADS={threads} (this server allows 1 to {most})"
+    parallel = sys.modules.get("numba.np.ufunc.parallel")
+    if parallel is not None and parallel._is_initialized:
+        return "numba's thread pool started in the server: a fork would inherit it broken"
     return None
 
 
-def _start_job(connection, main, selector) -> tuple[int, int] | None:
+def _start_job(connection, selector) -> tuple[int, int] | None:
     """Fork a job for the request on ``connection``: its pid and a pidfd that becomes readable
     when it ends; None if the request is unreadable or declined, or the fork failed (the client
     then runs it)."""
@@ -207,16 +210,17 @@ def _start_job(connection, main, selector) -> tuple[int, int] | None:
             for key in list(selector.get_map().values()):
                 os.close(key.fd)
             os.close(signal.set_wakeup_fd(-1))
-            os._exit(_run_job(main, request, fds))
+            os._exit(_run_job(request, fds))
         pidfd = os.pidfd_open(pid)
         _send_line(connection, f"started {pid}")
+        _log(f"job {pid} started: mosys {shlex.join(request['argv'])}")
         return pid, pidfd
     finally:
         for fd in fds:
             os.close(fd)
 
 
-def _run_job(main, request: dict, fds: list[int]) -> int:
+def _run_job(request: dict, fds: list[int]) -> int:
     """In the fork: become the client's process (streams, directory, environment, signals) and
     run ``main(argv)``; its exit code as Python's own exit would give it."""
     code = 1
@@ -235,12 +239,11 @@ def _run_job(main, request: dict, fds: list[int]) -> int:
         sys.stderr = open(2, "w", buffering=1, errors="backslashreplace", closefd=False)  # noqa: SIM115
         sys.argv = ["mosys", *request["argv"]]
         random.seed()  # as a new process would be
-        threads = request["env"].get("NUMBA_NUM_THREADS", "").strip()
-        if threads:
-            import numba
+        if "numba" in sys.modules:  # numba read NUMBA_NUM_THREADS at import: read the job's
+            from numba.core import config
 
-            numba.set_num_threads(int(threads))
-        code = _exit_code(main, request["argv"])
+            config.reload_config()  # allowed: no thread pool has started in this process
+        code = _exit_code(importlib.import_module("mosys.cli").main, request["argv"])
     finally:
         try:
             atexit._run_exitfuncs()
@@ -288,8 +291,7 @@ def _job_server(args: argparse.Namespace) -> None:
 
 VERB = Verb(
     "job-server",
-    "run the mosys commands of jobs that name this socket in MOSYS_JOB_SERVER, "
-    "in forks of one process (Snakemake starts it)",
+    "fork each job's mosys command from one warm process",
     _arguments,
     _job_server,
     _check,

@@ -31,9 +31,7 @@ CONNECT_TIMEOUT_S = 120.0  # the server imports its libraries before it answers 
 
 def package_directory() -> str:
     """The directory of the mosys package this process imports (server and client must agree)."""
-    import mosys
-
-    return os.path.dirname(os.path.abspath(mosys.__file__))
+    return os.path.dirname(os.path.abspath(__file__))
 
 
 def open_streams() -> list[int]:

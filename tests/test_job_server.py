@@ -1,0 +1,208 @@
+"""The job server (``mosys job-server``, README "The job server"): a command handed to it runs
+as it would in its own process (arguments, working directory, environment, streams, exit code,
+files written bit for bit the same); signals reach the job; a job whose client dies is stopped;
+a request the server cannot serve as its own process would runs in the client instead; and the
+server stops cleanly. Every command here is a real ``mosys`` process started the way Snakemake
+starts one, and the server's log says which of them it ran."""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SPEC = ROOT / "specs" / "controllers" / "pendulum" / "A.ssc"
+
+
+class Server:
+    def __init__(self, socket: Path, log: Path, process: subprocess.Popen):
+        self.socket, self.log, self.process = socket, log, process
+
+    def jobs(self) -> list[tuple[str, str]]:
+        """(pid, "started: mosys ..." or "ended: exit N") for each job line of the log."""
+        return re.findall(r"job (\d+) (started: .*|ended: .*)$", self.log.read_text(), re.M)
+
+    def wait_for_end(self, pid: str, timeout: float = 20.0) -> str:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            ended = [line for job, line in self.jobs() if job == pid and line.startswith("ended")]
+            if ended:
+                return ended[0]
+            time.sleep(0.02)
+        raise AssertionError(f"job {pid} did not end: {self.log.read_text()}")
+
+
+def environment(**extra: str) -> dict[str, str]:
+    bin_dir = str(Path(sys.executable).parent)
+    env = dict(os.environ, PATH=bin_dir + os.pathsep + os.environ.get("PATH", ""), **extra)
+    env.pop("MOSYS_JOB_SERVER", None)
+    return env
+
+
+def start_server(directory: Path, **env: str) -> Server:
+    socket, log = directory / "server.sock", directory / "server.log"
+    with open(log, "w") as stream:
+        process = subprocess.Popen(
+            [sys.executable, "-m", "mosys.cli", "job-server", str(socket), "--idle", "600"],
+            stdout=stream,
+            stderr=subprocess.STDOUT,
+            env=environment(**env),
+        )
+    deadline = time.monotonic() + 20.0
+    while not socket.exists() and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert socket.exists(), log.read_text()
+    return Server(socket, log, process)
+
+
+@pytest.fixture
+def server(tmp_path) -> Iterator[Server]:
+    server = start_server(tmp_path)
+    yield server
+    server.process.terminate()
+    server.process.wait(timeout=20)
+
+
+def mosys(server: Server | None, *argv: str, cwd: Path, **env: str) -> subprocess.CompletedProcess:
+    """``mosys argv`` as its own process (the command line a job runs), handed to ``server``."""
+    extra = {"MOSYS_JOB_SERVER": str(server.socket)} if server else {}
+    return subprocess.run(
+        [sys.executable, "-m", "mosys.command", *argv],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        env={**environment(**env), **extra},
+        timeout=120,
+    )
+
+
+def test_a_served_job_runs_in_the_clients_directory_with_its_streams_and_exit_code(
+    server, tmp_path
+):
+    (tmp_path / "a.txt").write_text("a")
+    done = mosys(server, "index", "a.txt", "-o", "listed.txt", cwd=tmp_path)
+    assert (done.returncode, done.stdout, done.stderr) == (0, "", "")
+    assert (tmp_path / "listed.txt").read_text() == "a.txt\n"  # relative to the client's cwd
+    failed = mosys(server, "index", "missing.txt", "-o", "none.txt", cwd=tmp_path)
+    assert failed.returncode == 2
+    assert failed.stderr == "mosys: cannot index missing files: missing.txt\n"
+    assert not (tmp_path / "none.txt").exists()
+    version = mosys(server, "--version", cwd=tmp_path)
+    assert (version.returncode, version.stdout) == (0, "mosys 0.1.0\n")
+    usage = mosys(server, "dp", cwd=tmp_path)  # argparse's own exit 2 on stderr
+    assert usage.returncode == 2 and "the following arguments are required" in usage.stderr
+    started = [line for _, line in server.jobs() if line.startswith("started")]
+    assert started == [
+        "started: mosys index a.txt -o listed.txt",
+        "started: mosys index missing.txt -o none.txt",
+        "started: mosys --version",
+        "started: mosys dp",
+    ]
+    assert [line for _, line in server.jobs() if line.startswith("ended")] == [
+        "ended: exit 0",
+        "ended: exit 2",
+        "ended: exit 0",
+        "ended: exit 2",
+    ]
+
+
+def test_a_served_dp_writes_the_same_table_and_sees_the_clients_environment(
+    server, tmp_path, pendulum
+):
+    args = ("dp", str(SPEC), "--dynamics-dir", str(pendulum / "dynamics"), "--quiet")
+    alone = mosys(None, *args, "-o", "alone.h5", cwd=tmp_path)
+    served = mosys(server, *args, "-o", "served.h5", cwd=tmp_path, NUMBA_NUM_THREADS="1")
+    assert alone.returncode == served.returncode == 0, served.stderr
+    with h5py.File(tmp_path / "alone.h5") as a, h5py.File(tmp_path / "served.h5") as b:
+        for name in ("value", "torque"):
+            np.testing.assert_array_equal(a[name][()], b[name][()])
+    refused = mosys(server, *args, "-o", "big.h5", cwd=tmp_path, MOSYS_MAX_MEMORY_GIB="1e-9")
+    assert refused.returncode == 2 and "raise MOSYS_MAX_MEMORY_GIB" in refused.stderr
+    assert not (tmp_path / "big.h5").exists()
+    assert sum(line.startswith("started: mosys dp") for _, line in server.jobs()) == 2
+
+
+@pytest.mark.slow
+def test_a_served_job_compiles_on_a_cold_cache_with_its_own_thread_count(tmp_path, pendulum):
+    """A compilation re-reads numba's config from the environment: the fork's must be the job's
+    (NUMBA_NUM_THREADS=1 here, unset in the server) before any thread starts."""
+    cache = str(tmp_path / "numba_cache")
+    server = start_server(tmp_path, NUMBA_CACHE_DIR=cache)
+    try:
+        args = ("dp", str(SPEC), "--dynamics-dir", str(pendulum / "dynamics"), "--quiet")
+        done = mosys(
+            server,
+            *args,
+            "-o",
+            "cold.h5",
+            cwd=tmp_path,
+            NUMBA_CACHE_DIR=cache,
+            NUMBA_NUM_THREADS="1",
+        )
+    finally:
+        server.process.terminate()
+        server.process.wait(timeout=20)
+    assert done.returncode == 0, done.stderr
+    assert [line for _, line in server.jobs()] == [
+        f"started: mosys {' '.join(args)} -o cold.h5",
+        "ended: exit 0",
+    ]
+    assert any(Path(cache).rglob("*.nbi"))  # it compiled, into the job's cache
+
+
+def test_signals_reach_the_job_and_a_job_whose_client_dies_is_stopped(server, tmp_path):
+    """A dp whose spec is a FIFO nobody writes blocks in open(): a job that runs until told."""
+    fifo = tmp_path / "blocked.ssc"
+    os.mkfifo(fifo)
+    for kill_client in (signal.SIGTERM, signal.SIGKILL):
+        known = {pid for pid, _ in server.jobs()}
+        client = subprocess.Popen(
+            [sys.executable, "-m", "mosys.command", "dp", str(fifo), "-o", "x.h5"],
+            cwd=tmp_path,
+            env={**environment(), "MOSYS_JOB_SERVER": str(server.socket)},
+            stderr=subprocess.PIPE,
+        )
+        deadline = time.monotonic() + 20.0
+        while not (new := {pid for pid, _ in server.jobs()} - known):
+            assert time.monotonic() < deadline, server.log.read_text()
+            time.sleep(0.02)
+        (job,) = new
+        time.sleep(0.3)  # the job is blocked opening the FIFO
+        client.send_signal(kill_client)
+        client.wait(timeout=20)
+        assert server.wait_for_end(job) == "ended: exit 143"  # SIGTERM, forwarded or sent
+        if kill_client == signal.SIGTERM:
+            assert client.returncode == 143  # the job's status became the client's
+    assert not (tmp_path / "x.h5").exists()
+
+
+def test_a_request_the_server_cannot_serve_runs_in_the_client(server, tmp_path):
+    """numba set up its kernels' caches (NUMBA_CACHE_DIR) and their optimisation (NUMBA_OPT)
+    when the server imported it: a job asking for others runs itself; so does a job whose
+    server is not there."""
+    (tmp_path / "a.txt").write_text("a")
+    other = mosys(
+        server, "index", "a.txt", "-o", "1.txt", cwd=tmp_path, NUMBA_CACHE_DIR=str(tmp_path)
+    )
+    unoptimised = mosys(server, "index", "a.txt", "-o", "2.txt", cwd=tmp_path, NUMBA_OPT="0")
+    absent = mosys(None, "index", "a.txt", "-o", "3.txt", cwd=tmp_path, MOSYS_JOB_SERVER="/nowhere")
+    for done, out in ((other, "1.txt"), (unoptimised, "2.txt"), (absent, "3.txt")):
+        assert done.returncode == 0, done.stderr
+        assert (tmp_path / out).read_text() == "a.txt\n"
+    assert server.jobs() == []
+
+
+def test_the_server_stops_on_sigterm_and_removes_its_socket(server):
+    server.process.send_signal(signal.SIGTERM)
+    assert server.process.wait(timeout=20) == 0
+    assert not server.socket.exists()
