@@ -9,6 +9,7 @@ import re
 import shutil
 import subprocess
 import tempfile
+import threading
 import time
 from importlib.machinery import PathFinder
 from pathlib import Path
@@ -67,8 +68,22 @@ def stop_job_server():
     if process is None:
         return
     del os.environ["MOSYS_JOB_SERVER"]
-    process.terminate()  # not waited for: it stops at once, its interpreter's exit takes 0.5 s
+    process.terminate()
+    try:
+        process.wait(timeout=10.0)
+    except subprocess.TimeoutExpired:
+        process.kill()
     shutil.rmtree(JOB_SERVER.pop("directory"), ignore_errors=True)
+
+
+def cancel_rescheduling_timers():
+    """Snakemake's job rate limiter (--max-jobs-per-timespan, 100/1s by default) leaves a
+    threading.Timer that wakes its scheduler a second after each scheduling round; Python waits
+    for the last one before it exits, up to 1 s after the last job. Once the run is over there
+    is nothing left to wake."""
+    for thread in threading.enumerate():
+        if isinstance(thread, threading.Timer):
+            thread.cancel()
 
 
 onstart:
@@ -77,10 +92,12 @@ onstart:
 
 onsuccess:
     stop_job_server()
+    cancel_rescheduling_timers()
 
 
 onerror:
     stop_job_server()
+    cancel_rescheduling_timers()
 
 
 # What the CLI's main imports for every verb (its error types).
