@@ -47,3 +47,48 @@ def test_two_cold_processes_compile_a_kernel_once(tmp_path):
     # hit); without the lock both would compile (no hit)
     assert [hits for _, hits in outcomes] == [0, 1] or [hits for _, hits in outcomes] == [1, 0]
     assert (tmp_path / "cache" / "mosys-compile-cold_kernel.lock").exists()
+
+
+EAGER_KERNEL = """
+from numba import njit
+
+
+@njit("float64(int64)", cache=True)  # a signature: compiled (or loaded) at import
+def kernel(x):
+    total = 0.0
+    for i in range(x):
+        total += i ** 0.5
+    return total
+"""
+
+IMPORT_CACHE_ONLY = """
+import sys
+from mosys.kernels.compile_lock import ColdCompilationError, cache_only
+sys.path.insert(0, sys.argv[1])
+with cache_only():
+    try:
+        import eager_kernel
+    except ColdCompilationError as cold:
+        print("cold", cold, "eager_kernel" in sys.modules)
+    else:
+        print("loaded", eager_kernel.kernel(4))
+"""
+
+
+def test_within_cache_only_a_kernel_not_in_the_cache_is_refused_not_compiled(tmp_path):
+    """What the job server preloads: a module whose kernel needs compiling fails to import
+    (and is not left half-imported); once compiled, it loads."""
+    (tmp_path / "eager_kernel.py").write_text(EAGER_KERNEL)
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+
+    def run(code: str) -> str:
+        done = subprocess.run(
+            [sys.executable, "-c", code, str(tmp_path)], env=env, capture_output=True, text=True
+        )
+        assert done.returncode == 0, done.stderr
+        return done.stdout.strip()
+
+    assert run(IMPORT_CACHE_ONLY) == "cold eager_kernel.kernel False"
+    assert not list((tmp_path / "cache").rglob("*.nbc"))  # nothing was compiled
+    run(f"import sys; sys.path.insert(0, {str(tmp_path)!r}); import mosys.kernels, eager_kernel")
+    assert run(IMPORT_CACHE_ONLY) == f"loaded {sum(i**0.5 for i in range(4))!r}"

@@ -10,7 +10,7 @@ import shutil
 import subprocess
 import sys
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 
 import h5py
@@ -113,6 +113,22 @@ def test_pendulum_all_lists_every_output(workflow):
         assert path in index
     for path in index:
         assert (workflow / path).stat().st_size > 0
+
+
+@pytest.mark.slow
+def test_the_build_ran_its_jobs_in_the_job_server_and_stopped_it(workflow):
+    """Every job of the build was a served fork that exited 0, and the server is gone."""
+    log = (workflow / ".snakemake/log/mosys_job_server.log").read_text()
+    started = re.findall(r"job (\d+) started: mosys (\S+)", log)
+    ended = dict(re.findall(r"job (\d+) ended: exit (\d+)", log))
+    verbs = sorted(verb for _, verb in started)
+    assert verbs.count("dp") == len(PENDULUM_CONTROLLERS) and "compile" in verbs, log
+    assert all(ended[pid] == "0" for pid, _ in started), log
+    (socket,) = re.findall(r"listening on (\S+)", log)
+    assert not Path(socket).exists() and not Path(socket).parent.exists()
+    for cmdline in Path("/proc").glob("[0-9]*/cmdline"):
+        with suppress(OSError):
+            assert socket.encode() not in cmdline.read_bytes(), "the server is still running"
 
 
 @pytest.mark.slow

@@ -61,6 +61,7 @@ PRELOADED = (
 # Variables numba reads once, at import: a job must see the server's values.
 NUMBA_PREFIX = "NUMBA_"
 PER_JOB_VARIABLES = ("NUMBA_NUM_THREADS",)  # each job's own: numba's config re-read in the fork
+PRELOAD_TRIES = 3  # tries of a module that needed compiling, one after each job's end
 POLL_S = 1.0  # how often the server looks for its parent and its idle time
 REQUEST_TIMEOUT_S = 10.0
 
@@ -98,16 +99,17 @@ def _serve_requests(selector, listener, parent: int, idle_seconds: float, stoppi
     its client, SIGTERM a job whose client went away, preload while idle; until a stop signal,
     the parent's exit or ``idle_seconds`` without a job."""
     jobs: dict[int, tuple[socket.socket, int]] = {}  # pid -> (its client's connection, pidfd)
-    to_import = list(PRELOADED)
+    preloads = Preloads(PRELOADED)
     last_activity = time.monotonic()
     while not stopping and os.getppid() == parent:
         if not jobs and time.monotonic() - last_activity > idle_seconds:
             break
-        events = selector.select(0.0 if to_import else POLL_S)
-        if not events and to_import:
-            importlib.import_module(to_import.pop(0))
-            if not to_import:
-                _log(f"imported {', '.join(PRELOADED)}")
+        events = selector.select(0.0 if preloads.pending else POLL_S)
+        if not events and preloads.pending:
+            if not preloads.import_next() and not preloads.warming_up:
+                pid, pidfd = _fork_warm_up(selector)
+                preloads.warming_up = True
+                selector.register(pidfd, selectors.EVENT_READ, ("warmed up", pid))
             continue
         for key, _ in events:
             kind, pid = key.data
@@ -133,6 +135,13 @@ def _serve_requests(selector, listener, parent: int, idle_seconds: float, stoppi
                 with contextlib.suppress(KeyError):  # unless its client hung up before
                     selector.unregister(connection)
                 connection.close()
+                preloads.job_ended()
+            elif kind == "warmed up":
+                _, status = os.waitpid(pid, 0)
+                _log(f"warm-up {pid} ended: exit {os.waitstatus_to_exitcode(status)}")
+                selector.unregister(key.fileobj)
+                os.close(key.fd)
+                preloads.job_ended()
             elif kind == "signal":
                 key.fileobj.recv(256)  # drained; the loop's test sees the stop
             elif kind == "client":  # readable: the client hung up (it sends nothing more)
@@ -141,6 +150,69 @@ def _serve_requests(selector, listener, parent: int, idle_seconds: float, stoppi
             last_activity = time.monotonic()
     for pid in jobs:
         forward(pid, signal.SIGTERM)
+
+
+class Preloads:
+    """Modules imported one at a time while the server is idle. The server never compiles: a
+    module whose import would compile a kernel (not in numba's cache yet) is left out, and tried
+    again after a job or the warm-up (``_fork_warm_up``) ends, ``PRELOAD_TRIES`` times at
+    most."""
+
+    def __init__(self, names: tuple[str, ...]):
+        self.pending = list(names)
+        self.failures: dict[str, int] = {}
+        self.waiting: list[str] = []  # to try again after the next job ends
+        self.warming_up = False  # whether the warm-up has been forked
+
+    def import_next(self) -> bool:
+        """Import the next pending module; False if it needs compiling first."""
+        from mosys.kernels.compile_lock import ColdCompilationError, cache_only
+
+        name = self.pending.pop(0)
+        with cache_only():
+            try:
+                importlib.import_module(name)
+            except ColdCompilationError as cold:
+                _log(f"not preloaded yet: {name} ({cold} is not in numba's cache)")
+                self.failures[name] = self.failures.get(name, 0) + 1
+                if self.failures[name] < PRELOAD_TRIES:
+                    self.waiting.append(name)
+                return False
+        if not self.pending:
+            _log(f"preloaded {', '.join(n for n in PRELOADED if n in sys.modules)}")
+        return True
+
+    def job_ended(self) -> None:
+        self.pending += self.waiting  # the job may have compiled what they need
+        self.waiting.clear()
+
+
+def _fork_warm_up(selector) -> tuple[int, int]:
+    """Fork a process that imports ``PRELOADED``, compiling into numba's cache the kernels
+    their imports compile, beside the jobs (a job that needs one meanwhile waits for it under
+    the compile lock, then loads it); its pid and a pidfd readable when it ends."""
+    pid = os.fork()
+    if pid == 0:
+        _leave_server(selector)
+        code = 0
+        try:
+            for name in PRELOADED:
+                importlib.import_module(name)
+        except BaseException:
+            traceback.print_exc()
+            code = 1
+        sys.stdout.flush()
+        os._exit(code)
+    _log(f"warm-up {pid} started: compiling what the preloads need")
+    return pid, os.pidfd_open(pid)
+
+
+def _leave_server(selector) -> None:
+    """In a fork: close the server's sockets and descriptors (its listener, clients, pidfds and
+    signal wake-up), which are not the fork's to use."""
+    for key in list(selector.get_map().values()):
+        os.close(key.fd)
+    os.close(signal.set_wakeup_fd(-1))
 
 
 def _log(line: str) -> None:
@@ -207,9 +279,7 @@ def _start_job(connection, selector) -> tuple[int, int] | None:
         except OSError:
             return None
         if pid == 0:  # the job: it keeps none of the server's sockets
-            for key in list(selector.get_map().values()):
-                os.close(key.fd)
-            os.close(signal.set_wakeup_fd(-1))
+            _leave_server(selector)
             os._exit(_run_job(request, fds))
         pidfd = os.pidfd_open(pid)
         _send_line(connection, f"started {pid}")

@@ -14,6 +14,10 @@ without a cache.
 The lock of module M is ``mosys-compile-M.lock`` in ``$NUMBA_CACHE_DIR`` if set (the cache it
 guards), else in ``$XDG_CACHE_HOME/mosys`` (``~/.cache/mosys``); without ``fcntl`` (Windows), or
 if the file cannot be opened or locked, compilation goes unguarded, as numba alone does it.
+
+Within ``cache_only()`` a top-level compilation that misses the cache raises
+``ColdCompilationError`` instead (the job server imports kernel modules ahead of its jobs, and
+must not spend seconds compiling one while its jobs wait to be reported).
 """
 
 from __future__ import annotations
@@ -24,6 +28,24 @@ from collections.abc import Iterator
 from pathlib import Path
 
 _installed = False
+_cache_only = False
+
+
+class ColdCompilationError(Exception):
+    """A compilation that missed numba's cache within ``cache_only()``."""
+
+
+@contextlib.contextmanager
+def cache_only() -> Iterator[None]:
+    """Within: a cached function that is not in numba's cache raises ``ColdCompilationError`` where
+    it would be compiled (at its first call, or at import given a signature)."""
+    global _cache_only
+    serialize_cold_compilation()
+    before, _cache_only = _cache_only, True
+    try:
+        yield
+    finally:
+        _cache_only = before
 
 
 def lock_path(module: str) -> Path:
@@ -103,7 +125,9 @@ def serialize_cold_compilation() -> None:
             try:
                 return compile_signature(self, sig)  # in memory or on disk: no lock
             except CacheMissError:
-                pass
+                if _cache_only:
+                    name = f"{self.py_func.__module__}.{self.__name__}"
+                    raise ColdCompilationError(name) from None
             finally:
                 probe.armed = armed
             with machine_lock(self.py_func.__module__ or ""):
