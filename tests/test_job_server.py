@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 import re
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -25,8 +26,8 @@ SPEC = ROOT / "specs" / "controllers" / "pendulum" / "A.ssc"
 
 
 class Server:
-    def __init__(self, socket: Path, log: Path, process: subprocess.Popen):
-        self.socket, self.log, self.process = socket, log, process
+    def __init__(self, socket_path: Path, log: Path, process: subprocess.Popen):
+        self.socket, self.log, self.process = socket_path, log, process
 
     def jobs(self) -> list[tuple[str, str]]:
         """(pid, "started: mosys ..." or "ended: exit N") for each job line of the log."""
@@ -50,19 +51,19 @@ def environment(**extra: str) -> dict[str, str]:
 
 
 def start_server(directory: Path, **env: str) -> Server:
-    socket, log = directory / "server.sock", directory / "server.log"
+    socket_path, log = directory / "server.sock", directory / "server.log"
     with open(log, "w") as stream:
         process = subprocess.Popen(
-            [sys.executable, "-m", "mosys.cli", "job-server", str(socket), "--idle", "600"],
+            [sys.executable, "-m", "mosys.cli", "job-server", str(socket_path), "--idle", "600"],
             stdout=stream,
             stderr=subprocess.STDOUT,
             env=environment(**env),
         )
     deadline = time.monotonic() + 20.0
-    while not socket.exists() and time.monotonic() < deadline:
+    while not socket_path.exists() and time.monotonic() < deadline:
         time.sleep(0.01)
-    assert socket.exists(), log.read_text()
-    return Server(socket, log, process)
+    assert socket_path.exists(), log.read_text()
+    return Server(socket_path, log, process)
 
 
 @pytest.fixture
@@ -202,6 +203,29 @@ def test_a_request_the_server_cannot_serve_runs_in_the_client(server, tmp_path):
         assert done.returncode == 0, done.stderr
         assert (tmp_path / out).read_text() == "a.txt\n"
     assert server.jobs() == []
+
+
+@pytest.mark.parametrize(
+    "request_bytes",
+    [
+        b"",
+        b"\x00\x00\x00\x05hello",
+        b"\x00\x00\x00\x02{}",
+        b"\x00\x00\x00\x0f" + b'{"argv": [1,2]}',
+        b"\xff\xff\xff\xff",
+    ],
+)
+def test_a_malformed_request_is_refused_and_the_server_serves_on(server, tmp_path, request_bytes):
+    with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as connection:
+        connection.settimeout(30)
+        connection.connect(str(server.socket))
+        connection.sendall(request_bytes)
+        connection.shutdown(socket.SHUT_WR)
+        assert connection.recv(256) == b""  # closed without an answer
+    (tmp_path / "a.txt").write_text("a")
+    done = mosys(server, "index", "a.txt", "-o", "listed.txt", cwd=tmp_path)
+    assert done.returncode == 0 and server.process.poll() is None
+    assert [line for _, line in server.jobs()][0] == "started: mosys index a.txt -o listed.txt"
 
 
 def test_the_server_stops_on_sigterm_and_removes_its_socket(server):

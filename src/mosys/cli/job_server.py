@@ -107,9 +107,10 @@ def _serve_requests(selector, listener, parent: int, idle_seconds: float, stoppi
         events = selector.select(0.0 if preloads.pending else POLL_S)
         if not events and preloads.pending:
             if not preloads.import_next() and not preloads.warming_up:
-                pid, pidfd = _fork_warm_up(selector)
                 preloads.warming_up = True
-                selector.register(pidfd, selectors.EVENT_READ, ("warmed up", pid))
+                with contextlib.suppress(OSError):  # no fork: the jobs compile it all
+                    pid, pidfd = _fork_warm_up(selector)
+                    selector.register(pidfd, selectors.EVENT_READ, ("warmed up", pid))
             continue
         for key, _ in events:
             kind, pid = key.data
@@ -192,17 +193,18 @@ def _fork_warm_up(selector) -> tuple[int, int]:
     their imports compile, beside the jobs (a job that needs one meanwhile waits for it under
     the compile lock, then loads it); its pid and a pidfd readable when it ends."""
     pid = os.fork()
-    if pid == 0:
-        _leave_server(selector)
-        code = 0
+    if pid == 0:  # never returns
+        code = 1
         try:
+            _leave_server(selector)
             for name in PRELOADED:
                 importlib.import_module(name)
+            code = 0
         except BaseException:
             traceback.print_exc()
-            code = 1
-        sys.stdout.flush()
-        os._exit(code)
+        finally:
+            sys.stdout.flush()
+            os._exit(code)
     _log(f"warm-up {pid} started: compiling what the preloads need")
     return pid, os.pidfd_open(pid)
 
@@ -241,7 +243,29 @@ def _receive_request(connection: socket.socket) -> tuple[dict, list[int]]:
             raise OSError("truncated request")
         body += chunk
     connection.settimeout(None)
-    return json.loads(body), fds
+    request = json.loads(body)
+    if not _well_formed(request, fds):
+        for fd in fds:
+            os.close(fd)
+        raise ValueError("malformed request")
+    return request, fds
+
+
+def _well_formed(request, fds: list[int]) -> bool:
+    """Whether ``request`` has the fields ``mosys.job_client.request_bytes`` sends, of their
+    types, and one descriptor per stream it names."""
+    return (
+        isinstance(request, dict)
+        and isinstance(request.get("argv"), list)
+        and all(isinstance(arg, str) for arg in request["argv"])
+        and all(isinstance(request.get(key), str) for key in ("cwd", "python", "package"))
+        and isinstance(request.get("env"), dict)
+        and all(isinstance(k, str) and isinstance(v, str) for k, v in request["env"].items())
+        and isinstance(request.get("streams"), list)
+        and sorted(request["streams"]) == request["streams"]
+        and set(request["streams"]) <= {0, 1, 2}
+        and len(request["streams"]) == len(fds)
+    )
 
 
 def decline_reason(request: dict) -> str | None:
@@ -278,9 +302,13 @@ def _start_job(connection, selector) -> tuple[int, int] | None:
             pid = os.fork()
         except OSError:
             return None
-        if pid == 0:  # the job: it keeps none of the server's sockets
-            _leave_server(selector)
-            os._exit(_run_job(request, fds))
+        if pid == 0:  # the job: it keeps none of the server's sockets, and never returns
+            code = 1
+            try:
+                _leave_server(selector)
+                code = _run_job(request, fds)
+            finally:
+                os._exit(code)
         pidfd = os.pidfd_open(pid)
         _send_line(connection, f"started {pid}")
         _log(f"job {pid} started: mosys {shlex.join(request['argv'])}")
@@ -291,37 +319,45 @@ def _start_job(connection, selector) -> tuple[int, int] | None:
 
 
 def _run_job(request: dict, fds: list[int]) -> int:
-    """In the fork: become the client's process (streams, directory, environment, signals) and
-    run ``main(argv)``; its exit code as Python's own exit would give it."""
-    code = 1
+    """In the fork: become the client's process and run ``main(argv)``; its exit code as
+    Python's own exit would give it."""
     try:
-        for number in FORWARDED_SIGNALS:
-            signal.signal(number, signal.SIG_DFL)
-        signal.signal(signal.SIGINT, signal.default_int_handler)
-        null = os.open(os.devnull, os.O_RDWR)
-        for fd in (0, 1, 2):
-            os.dup2(fds[request["streams"].index(fd)] if fd in request["streams"] else null, fd)
-        os.chdir(request["cwd"])
-        os.environ.clear()
-        os.environ.update(request["env"])
-        sys.stdin = open(0, closefd=False)  # noqa: SIM115 (the job's own streams, never closed)
-        sys.stdout = open(1, "w", buffering=1 if os.isatty(1) else -1, closefd=False)  # noqa: SIM115
-        sys.stderr = open(2, "w", buffering=1, errors="backslashreplace", closefd=False)  # noqa: SIM115
-        sys.argv = ["mosys", *request["argv"]]
-        random.seed()  # as a new process would be
-        if "numba" in sys.modules:  # numba read NUMBA_NUM_THREADS at import: read the job's
-            from numba.core import config
-
-            config.reload_config()  # allowed: no thread pool has started in this process
-        code = _exit_code(importlib.import_module("mosys.cli").main, request["argv"])
-    finally:
-        try:
-            atexit._run_exitfuncs()
-            sys.stdout.flush()
-            sys.stderr.flush()
-        except BaseException:
-            pass
+        _become_client(request, fds)
+    except BaseException:
+        traceback.print_exc()
+        return 1
+    code = _exit_code(importlib.import_module("mosys.cli").main, request["argv"])
+    with contextlib.suppress(BaseException):
+        atexit._run_exitfuncs()
+        sys.stdout.flush()
+        sys.stderr.flush()
     return code
+
+
+def _become_client(request: dict, fds: list[int]) -> None:
+    """Take the client's standard streams (``fds``, /dev/null for those it has not), working
+    directory, environment (numba's settings re-read from it) and arguments, and the default
+    signal handlers."""
+    for number in FORWARDED_SIGNALS:
+        signal.signal(number, signal.SIG_DFL)
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    null = os.open(os.devnull, os.O_RDWR)
+    for fd in (0, 1, 2):
+        os.dup2(fds[request["streams"].index(fd)] if fd in request["streams"] else null, fd)
+    for fd in (null, *fds):
+        os.close(fd)
+    os.chdir(request["cwd"])
+    os.environ.clear()
+    os.environ.update(request["env"])
+    sys.stdin = open(0, closefd=False)  # noqa: SIM115 (the job's own streams, never closed)
+    sys.stdout = open(1, "w", buffering=1 if os.isatty(1) else -1, closefd=False)  # noqa: SIM115
+    sys.stderr = open(2, "w", buffering=1, errors="backslashreplace", closefd=False)  # noqa: SIM115
+    sys.argv = ["mosys", *request["argv"]]
+    random.seed()  # as a new process would be
+    if "numba" in sys.modules:  # numba read NUMBA_NUM_THREADS at import: read the job's
+        from numba.core import config
+
+        config.reload_config()  # allowed: no thread pool has started in this process
 
 
 def _exit_code(main, argv: list[str]) -> int:
