@@ -49,17 +49,8 @@ def test_two_cold_processes_compile_a_kernel_once(tmp_path):
     assert (tmp_path / "cache" / "mosys-compile-cold_kernel.lock").exists()
 
 
-EAGER_KERNEL = """
-from numba import njit
-
-
-@njit("float64(int64)", cache=True)  # a signature: compiled (or loaded) at import
-def kernel(x):
-    total = 0.0
-    for i in range(x):
-        total += i ** 0.5
-    return total
-"""
+# with a signature: compiled (or loaded from the cache) at import, not at its first call
+EAGER_KERNEL = KERNEL.replace("@njit(cache=True)", '@njit("float64(int64)", cache=True)')
 
 IMPORT_CACHE_ONLY = """
 import sys
