@@ -36,6 +36,8 @@ JOB_SERVER_LOG = Path(".snakemake/log/mosys_job_server.log")
 def start_job_server():
     if not config["job_server"] or os.environ.get("MOSYS_JOB_SERVER"):
         return  # off, or a run inside another's: the outer run's server serves it
+    if workflow.non_local_exec or workflow.remote_exec:
+        return  # SLURM: the jobs run on the cluster's nodes, each in its own process
     directory = Path(tempfile.mkdtemp(prefix="mosys-jobs-"))
     socket_path = directory / "socket"
     JOB_SERVER_LOG.parent.mkdir(parents=True, exist_ok=True)
