@@ -145,7 +145,7 @@ def _serve_requests(selector, listener, parent: int, idle_seconds: float, stoppi
                 preloads.job_ended()
             elif kind == "signal":
                 key.fileobj.recv(256)  # drained; the loop's test sees the stop
-            elif kind == "client":  # readable: the client hung up (it sends nothing more)
+            elif kind == "client" and pid in jobs:  # readable: the client hung up
                 selector.unregister(key.fileobj)
                 forward(pid, signal.SIGTERM)
             last_activity = time.monotonic()
