@@ -80,10 +80,22 @@ def forward(job: int, number: int) -> None:
 
 def delegate(argv: list[str]) -> int | None:
     """Run ``mosys argv`` in the job server named by ``MOSYS_JOB_SERVER``: its exit code, or
-    None if there is no server to take it (run it here)."""
+    None if there is no server to take it (run it here). A signal that comes before the job has
+    started waits for it (then it is passed on), or, if the server does not take the command,
+    is delivered to this process again before it runs the command itself."""
     path = os.environ.get(SERVER_VARIABLE)
     if not path:
         return None
+    pending: list[int] = []
+    job = 0  # the job's pid once the server has started it
+
+    def on_signal(number: int, frame: object) -> None:
+        if job:
+            forward(job, number)
+        else:
+            pending.append(number)
+
+    previous = {number: signal.signal(number, on_signal) for number in FORWARDED_SIGNALS}
     connection = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
     connection.settimeout(CONNECT_TIMEOUT_S)
     try:
@@ -92,14 +104,17 @@ def delegate(argv: list[str]) -> int | None:
         socket.send_fds(connection, [request_bytes(argv, streams)], streams)
         answer = read_line(connection)
     except OSError:
-        connection.close()
-        return None
+        answer = None
     if answer is None or not answer.startswith("started "):
-        connection.close()
-        return None  # declined (a different environment or interpreter) or gone: run it here
+        connection.close()  # declined (another environment or interpreter) or gone: run here
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+        for number in pending:
+            os.kill(os.getpid(), number)
+        return None
     job = int(answer.split()[1])
-    for number in FORWARDED_SIGNALS:
-        signal.signal(number, lambda received, frame: forward(job, received))
+    for number in pending:
+        forward(job, number)
     connection.settimeout(None)  # a job may take hours
     try:
         answer = read_line(connection)

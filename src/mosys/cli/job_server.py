@@ -71,17 +71,17 @@ def serve(path: str, idle_seconds: float) -> None:
     fork until told to stop, importing ``PRELOADED`` one module at a time while no request
     waits: a job that comes early starts at once and imports what is not loaded yet itself."""
     os.close(os.pidfd_open(os.getpid()))  # Linux 5.3 or later: else fail now, not per job
+    wakeup, woken = socket.socketpair()  # a stop signal wakes the selector at once
+    wakeup.setblocking(False)
+    signal.set_wakeup_fd(wakeup.fileno(), warn_on_full_buffer=False)
+    stopping: list[int] = []
+    for number in FORWARDED_SIGNALS:  # before the socket exists: a stop is never missed
+        signal.signal(number, lambda received, frame: stopping.append(received))
     listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
     with contextlib.suppress(FileNotFoundError):
         os.unlink(path)
     listener.bind(path)
     listener.listen(64)
-    wakeup, woken = socket.socketpair()  # a stop signal wakes the selector at once
-    wakeup.setblocking(False)
-    signal.set_wakeup_fd(wakeup.fileno(), warn_on_full_buffer=False)
-    stopping: list[int] = []
-    for number in FORWARDED_SIGNALS:
-        signal.signal(number, lambda received, frame: stopping.append(received))
     _log(f"listening on {path}")
     selector = selectors.DefaultSelector()
     selector.register(listener, selectors.EVENT_READ, ("listener", 0))
