@@ -934,6 +934,9 @@ class Run:
     seconds: float = 0.0
 
 
+WORKER_START_S = 60.0  # how long a new worker may take to start before its first step
+
+
 class Worker:
     """One worker process, the warm-up cases it still has to run, and the run it is busy with."""
 
@@ -955,7 +958,8 @@ class Worker:
     def begin(self, run: Run, steps: list, timeout: float, warming: bool = False) -> None:
         self.run, self.warming, self.timeout = run, warming, timeout
         self.started = time.monotonic()
-        self.deadline = self.started + timeout
+        # a new worker first imports mosys (seconds on a busy machine): not the step's time
+        self.deadline = self.started + timeout + (WORKER_START_S if self.cases == 0 else 0.0)
         self.cases += 1
         self.connection.send((str(run.directory), str(run.logs), steps))
 
