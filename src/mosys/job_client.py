@@ -5,8 +5,9 @@ status, instead of importing numpy, numba, h5py, matplotlib and pandas in this p
 Standard library only, so that a delegated command starts in a few tens of milliseconds.
 Whatever goes wrong before the server has started the job (no socket, no server behind it, a
 request it declines) returns ``None``: the caller then runs the command in its own process as it
-always did, so the server can only ever save time. Once the job has started, SIGINT, SIGTERM and
-SIGHUP sent to this process are passed on to it, and its exit status becomes this one's.
+always did, so the server can only ever save time. SIGINT, SIGTERM and SIGHUP sent to this
+process are passed on to the job (held until it has started), and its exit status becomes this
+one's.
 
 The exchange, on a Unix stream socket: the client sends a 4-byte big-endian length and that many
 bytes of JSON ``{"argv", "cwd", "env", "python", "package", "streams"}`` with its standard
@@ -26,7 +27,7 @@ import sys
 
 SERVER_VARIABLE = "MOSYS_JOB_SERVER"
 FORWARDED_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
-CONNECT_TIMEOUT_S = 120.0  # the server imports its libraries before it answers (about 1 s)
+CONNECT_TIMEOUT_S = 120.0  # to connect and be answered (the server answers between imports)
 
 
 def package_directory() -> str:
