@@ -81,6 +81,7 @@ def main() -> None:
                     "table_states": warm["table_states"],
                     "paper_states": PAPER_STATES,
                     "iterations": warm["iterations"],
+                    "policy_sweeps": warm["policy_sweeps"],
                     "dp_s_warm": round(warm["dp_seconds"], 2),
                     "process_s_warm": round(warm["process_seconds"], 2),
                     "peak_rss_MiB": round(warm["peak_rss_bytes"] / 2**20, 1),

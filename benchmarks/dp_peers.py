@@ -44,8 +44,9 @@ The machine may be shared: each time is the best (minimum) of the repeats, besid
 Columns: ``grid`` angle x omega nodes; ``nodes`` mosys's table nodes (Drake's mesh has one more
 angle column); ``mosys_dp_s``/``mosys_dp_s_median`` transitions + value iteration, best and median;
 ``drake_s``/``drake_s_median`` the FittedValueIteration call; ``drake_over_mosys`` Drake's best
-over mosys's best; ``mosys_sweeps`` the table's ``iterations`` (mosys's default tolerance),
-``drake_sweeps`` Drake's (its default, 1e-4 s); ``mosys_value_hanging_s``/
+over mosys's best; ``mosys_sweeps`` the table's ``iterations``, its Bellman sweeps (mosys's
+default tolerance), and ``mosys_policy_sweeps`` its ``policy_sweeps`` (each under one control
+per node); ``drake_sweeps`` Drake's (its default, 1e-4 s); ``mosys_value_hanging_s``/
 ``drake_value_hanging_s`` the cost-to-go, s, at angle -90 deg, omega 0 (a node of every grid).
 """
 
@@ -141,6 +142,7 @@ def time_mosys(factor: int, repeats: int, dynamics: Path, work: Path, cache: Pat
         "mosys_dp_s": min(seconds),
         "mosys_dp_s_median": statistics.median(seconds),
         "mosys_sweeps": runs[-1]["iterations"],
+        "mosys_policy_sweeps": runs[-1]["policy_sweeps"],
         "mosys_value_hanging_s": table_value_at(table, *HANGING),
     }
 
@@ -250,6 +252,7 @@ def grid_row(mosys: dict, drake: dict | None, factor: int) -> dict:
         "drake_s_median": rounded(drake["drake_s_median"], 4),
         "drake_over_mosys": rounded(ratio, 2),
         "mosys_sweeps": mosys["mosys_sweeps"],
+        "mosys_policy_sweeps": mosys["mosys_policy_sweeps"],
         "drake_sweeps": drake["drake_sweeps"],
         "mosys_value_hanging_s": round(mosys["mosys_value_hanging_s"], 4),
         "drake_value_hanging_s": rounded(drake["drake_value_hanging_s"], 4),

@@ -30,6 +30,7 @@ print(json.dumps({"dp_seconds": dp_seconds,
                   "kernel_load_seconds": table.attrs["kernel_load_seconds"],
                   "process_seconds": time.perf_counter() - started,
                   "iterations": int(table.attrs["iterations"]),
+                  "policy_sweeps": int(table.attrs["policy_sweeps"]),
                   "nodes": int(table.value.size),
                   "table_states": int(table.attrs["table_states"]),
                   "peak_rss_bytes": int(table.attrs["peak_rss_bytes"])}))

@@ -98,6 +98,7 @@ def main() -> None:
                 "case": "landing controller (land.ssc)",
                 "nodes": warm["nodes"],
                 "iterations": warm["iterations"],
+                "policy_sweeps": warm["policy_sweeps"],
                 "generation_s_warm": round(warm["dp_seconds"], 2),
                 "process_s_warm": round(warm["process_seconds"], 2),
                 "process_s_cold": round(cold["process_seconds"], 1) if cold else None,

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from exit_tables import random_tables
 from numba import njit
 
 from mosys.kernels.dp import gauss_seidel_sweep, sweep_order
@@ -35,25 +36,6 @@ def plain_sweep(exit_index, exit_weight, segment_cost, row_of, is_destination, v
     return largest
 
 
-def random_tables(rng: np.random.Generator, axis_count: np.ndarray, controls: int):
-    """Exit tables (R, U, 2**(d-1)) of a grid with axis_count nodes per axis: about a fifth of
-    the nodes removed, a third of the segments discarded, a quarter of the weights zero."""
-    nodes = int(np.prod(axis_count))
-    corners = 2 ** (len(axis_count) - 1)
-    kept = rng.random(nodes) > 0.2
-    row_of = np.full(nodes, -1, dtype=np.int64)
-    row_of[kept] = np.arange(kept.sum())
-    rows = int(kept.sum())
-    exit_index = rng.integers(0, nodes, (rows, controls, corners)).astype(np.int32)
-    weight = rng.random((rows, controls, corners)) * (rng.random((rows, controls, corners)) > 0.25)
-    weight /= np.maximum(weight.sum(axis=2, keepdims=True), 1e-12)
-    cost = rng.uniform(0.05, 1.0, (rows, controls))
-    cost[rng.random((rows, controls)) < 0.33] = np.inf
-    is_destination = np.zeros(nodes, dtype=np.bool_)
-    is_destination[rng.choice(np.flatnonzero(kept), 3, replace=False)] = True
-    return exit_index, weight.astype(np.float32), cost, row_of, is_destination
-
-
 @pytest.mark.parametrize("prefetching", [True, False])
 @pytest.mark.parametrize("axis_count", [(7, 5), (4, 3, 5, 2, 3), (3, 2, 2, 3, 2, 2)])
 def test_the_sweep_gives_the_plain_sweeps_values_bit_for_bit(axis_count, prefetching):
@@ -63,10 +45,20 @@ def test_the_sweep_gives_the_plain_sweeps_values_bit_for_bit(axis_count, prefetc
     value = np.where(is_destination, 0.0, np.where(row_of >= 0, 1e4, np.inf))
     expected = value.copy()
     order = np.empty(value.size, dtype=np.int64)
+    control = np.zeros(value.size, dtype=np.int64)
     for sweep in range(2**counts.size + 3):
         sweep_order(counts, sweep, order)
         largest = gauss_seidel_sweep(
-            exit_index, exit_weight, cost, row_of, is_destination, value, order, np.inf, prefetching
+            exit_index,
+            exit_weight,
+            cost,
+            row_of,
+            is_destination,
+            value,
+            order,
+            np.inf,
+            prefetching,
+            control,
         )
         expected_largest = plain_sweep(
             exit_index, exit_weight, cost, row_of, is_destination, expected, order

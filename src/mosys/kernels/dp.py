@@ -10,7 +10,9 @@ V(corner)]`` until the largest change is below a tolerance (``gauss_seidel_sweep
 is difficult to sequence local optimizations such that each local optimization always uses accurate
 information. It is simpler to approximate this order and repeat this for several iterations" —
 the sweeps run through the grid in the 2**d orders of the fast sweeping method in turn
-(``sweep_order``), each node using the values the sweep has just updated. For a spec with
+(``sweep_order``), each node using the values the sweep has just updated; between them, sweeps
+of the policy the last one left, each node under its own control only (modified policy
+iteration: ``policy_sweep``), run down the slow tail at a fraction of the cost. For a spec with
 several destinations (the paper's "conditional" goals), ``destination_indices`` then finds
 which destination each node's optimal path ends at, by the same sweeps over the exits.
 
@@ -585,10 +587,13 @@ def gauss_seidel_sweep(
     order,
     settled_above,
     prefetching,
+    control,
 ):
     """One Gauss–Seidel sweep of value iteration over the nodes in ``order`` (``sweep_order``):
     each node's cost-to-go becomes ``min(old, update)`` at once, so the nodes after it in the
-    sweep use it. Returns the largest decrease, s.
+    sweep use it. Returns the largest decrease, s. control: (N,) int64, in place: where a
+    node's value decreases, the control sample that gave the new value (the policy that
+    ``policy_sweep`` follows).
 
     value: (N,) float64 cost-to-go, s, in place. Value iteration starts from an upper bound (0
     at the destination nodes, a large finite ``UNKNOWN`` at the other reachable nodes: the
@@ -612,11 +617,60 @@ def gauss_seidel_sweep(
         if row < 0 or is_destination[node]:
             continue
         old = value[node]
-        best = _bellman(exit_index, exit_weight, segment_cost, value, row)[0]
+        best, choice = _bellman(exit_index, exit_weight, segment_cost, value, row)
         if best < old:
             value[node] = best
+            control[node] = choice
             if old - best > largest and best < settled_above:
                 largest = old - best
+    return largest
+
+
+@njit(cache=True)
+def gather_policy(
+    exit_index, exit_weight, segment_cost, row_of, control, policy_index, policy_weight, policy_cost
+):
+    """Copy each row's exit under its node's control (control: (N,) int64) into the compact
+    tables policy_index (R, 1, 2**(d-1)) int32, policy_weight (same shape) float32 and
+    policy_cost (R, 1) s, which ``policy_sweep`` reads in order instead of picking one control's
+    exit out of every row of the full tables."""
+    for node in range(row_of.shape[0]):
+        row = row_of[node]
+        if row < 0:
+            continue
+        u = control[node]
+        policy_cost[row, 0] = segment_cost[row, u]
+        for i in range(exit_index.shape[2]):
+            policy_index[row, 0, i] = exit_index[row, u, i]
+            policy_weight[row, 0, i] = exit_weight[row, u, i]
+
+
+@njit(cache=True)
+def policy_sweep(
+    policy_index, policy_weight, policy_cost, row_of, is_destination, value, order, settled_above
+):
+    """One Gauss–Seidel sweep in ``order`` of the Bellman update restricted to each node's
+    control in the compact tables of ``gather_policy``: ``min(old, cost + Σ w·V(corner))``
+    under that one control. Each update is the cost of a real control from the node, onto
+    values that are themselves upper bounds, so values stay upper bounds of the cost-to-go and
+    still only decrease; a sweep reads one control's exit per node instead of all of them.
+    Returns the largest decrease, s (decreases to values at or above ``settled_above`` not
+    counted, as in ``gauss_seidel_sweep``)."""
+    largest = 0.0
+    for p in range(order.shape[0]):
+        node = order[p]
+        row = row_of[node]
+        if row < 0 or is_destination[node]:
+            continue
+        cost = policy_cost[row, 0]
+        if cost == np.inf:
+            continue
+        candidate = cost + _expected_value(policy_index, policy_weight, row, 0, value)
+        old = value[node]
+        if candidate < old:
+            value[node] = candidate
+            if old - candidate > largest and candidate < settled_above:
+                largest = old - candidate
     return largest
 
 
@@ -635,14 +689,32 @@ def gauss_seidel_sweeps(
     order,
     settled_above,
     prefetching,
+    control,
+    policy_index,
+    policy_weight,
+    policy_cost,
+    policy_sweeps,
 ):
-    """Sweeps number ``first``, ``first + 1``, ... (``gauss_seidel_sweep`` in the orders of
-    ``sweep_order``), at most ``count`` of them, stopping after the first whose largest decrease
-    is below ``tolerance`` (s). order: (N,) int64 work space; settled_above, prefetching: as
-    ``gauss_seidel_sweep``. Returns (sweeps run, the last one's largest decrease)."""
+    """Value iteration by modified policy iteration: Bellman sweeps (``gauss_seidel_sweep``),
+    at most ``count`` of them, stopping after the first whose largest decrease is below
+    ``tolerance`` (s); after each other one, up to ``policy_sweeps`` sweeps of the policy it
+    left (``gather_policy``, ``policy_sweep``), stopping early once one of them changes less
+    than ``tolerance``. Where Bellman sweeps shrink the largest change by only a few per cent a
+    sweep (the policy's chain keeps returning to a few cells before it escapes: 130 of Luxo's
+    191 sweeps, most of the car's 222), the policy has long stopped changing; the policy sweeps
+    run that slow mode down reading one control's exit per node from a compact table instead
+    of all of them (about a tenth of a Bellman sweep's time). Every sweep takes the next of
+    the orders of ``sweep_order``, counting from sweep number ``first``. order: (N,) int64
+    and control (N,) int64 work space (control: zeros before the first call, kept between
+    calls); policy_*: ``gather_policy``'s tables; settled_above, prefetching: as
+    ``gauss_seidel_sweep``. Returns (Bellman sweeps run, policy sweeps run, the last Bellman
+    sweep's largest decrease)."""
     largest = np.inf
+    sweep = first
+    policy = 0
     for k in range(count):
-        sweep_order(axis_count, first + k, order)
+        sweep_order(axis_count, sweep, order)
+        sweep += 1
         largest = gauss_seidel_sweep(
             exit_index,
             exit_weight,
@@ -653,10 +725,38 @@ def gauss_seidel_sweeps(
             order,
             settled_above,
             prefetching,
+            control,
         )
         if largest < tolerance:
-            return k + 1, largest
-    return count, largest
+            return k + 1, policy, largest
+        if policy_sweeps > 0:
+            gather_policy(
+                exit_index,
+                exit_weight,
+                segment_cost,
+                row_of,
+                control,
+                policy_index,
+                policy_weight,
+                policy_cost,
+            )
+        for _ in range(policy_sweeps):
+            sweep_order(axis_count, sweep, order)
+            sweep += 1
+            policy += 1
+            change = policy_sweep(
+                policy_index,
+                policy_weight,
+                policy_cost,
+                row_of,
+                is_destination,
+                value,
+                order,
+                settled_above,
+            )
+            if change < tolerance:
+                break
+    return count, policy, largest
 
 
 @njit(cache=True)

@@ -54,7 +54,8 @@ from mosys.ssc.obstacles import Obstacles, blocked_reason, spec_obstacles
 
 PROGRESS_CHUNKS = 20  # at most; fewer for small grids (each chunk wakes numba's threads)
 SIMULATIONS_PER_CHUNK = 20_000  # at least, but for the last chunk
-SWEEPS_PER_CALL = 8  # value-iteration sweeps between progress updates
+SWEEPS_PER_CALL = 8  # value-iteration (Bellman) sweeps between progress updates
+POLICY_SWEEPS = 16  # at most, after each Bellman sweep (``dp.gauss_seidel_sweeps``)
 
 
 @dataclass(frozen=True)
@@ -224,6 +225,7 @@ class Solution:
     best_control: np.ndarray
     dead_end: np.ndarray
     iterations: int
+    policy_sweeps: int
     residual: float
     transition_seconds: float
     iteration_seconds: float
@@ -340,6 +342,9 @@ def load_kernels(
         none,
         1.0,
         False,  # prefetching: a flag, whose type is all that compiling needs
+        none,
+        *empty.arrays(),
+        0,
     )
     best_controls(*empty.arrays(), none, np.empty(0), none)
     sweep_order(problem.grid.axis_count, 0, none)
@@ -418,38 +423,47 @@ def value_iteration(
     tolerance: float,
     max_iterations: int,
     quiet: bool,
-) -> tuple[np.ndarray, int, float]:
-    """Gauss–Seidel sweeps (``dp.gauss_seidel_sweeps``) in the orders of ``dp.sweep_order`` until
-    the largest decrease < tolerance (s) or ``max_iterations`` sweeps, from the paper's upper
-    bound; returns the cost-to-go (N,) s, the sweeps and the last sweep's largest decrease."""
+) -> tuple[np.ndarray, int, int, float]:
+    """Bellman sweeps, each followed by up to POLICY_SWEEPS sweeps of its policy
+    (``dp.gauss_seidel_sweeps``), in the orders of ``dp.sweep_order`` until a Bellman sweep's
+    largest decrease < tolerance (s) or ``max_iterations`` Bellman sweeps, from the paper's upper
+    bound; returns the cost-to-go (N,) s, the Bellman sweeps, the policy sweeps and the last
+    Bellman sweep's largest decrease."""
     grid = problem.grid
     bound = DEAD_END_BOUND if problem.spec.known_weight else UNKNOWN
     value = np.where(problem.is_destination, 0.0, np.where(reachable, bound, np.inf))
     order = np.empty(grid.node_count, dtype=np.int64)
+    control = np.zeros(grid.node_count, dtype=np.int64)
+    policy = Transitions.empty(transitions.row_of >= 0, 1, len(grid.names))
     prefetching = prefetch_pays(transitions.exit_index, transitions.exit_weight)
     progress = Progress("value iteration", max_iterations, "sweeps")
     residual = np.inf
     iterations = 0
+    policy_sweeps = 0
     while iterations < max_iterations and not residual < tolerance:
-        swept, residual = gauss_seidel_sweeps(
+        swept, followed, residual = gauss_seidel_sweeps(
             *transitions.arrays(),
             transitions.row_of,
             problem.is_destination,
             value,
             grid.axis_count,
-            iterations,
+            iterations + policy_sweeps,
             min(SWEEPS_PER_CALL, max_iterations - iterations),
             tolerance,
             order,
             DEAD_END_SECONDS if problem.spec.known_weight else np.inf,
             prefetching,
+            control,
+            *policy.arrays(),
+            POLICY_SWEEPS,
         )
         iterations += swept
+        policy_sweeps += followed
         if not quiet:
             progress.update(iterations, f"largest change {residual:.3g} s")
     if not quiet:
         progress.finish(f"largest change {residual:.3g} s")
-    return value, iterations, float(residual)
+    return value, iterations, policy_sweeps, float(residual)
 
 
 def solve(
@@ -482,7 +496,7 @@ def solve(
         *transitions.arrays(), problem.is_destination, transitions.row_of, grid.axis_count
     )
     interpolate_known_values_only(*transitions.arrays(), reachable, problem.spec.known_weight)
-    value, iterations, residual = value_iteration(
+    value, iterations, policy_sweeps, residual = value_iteration(
         problem, transitions, reachable, tolerance, max_iterations, quiet
     )
     best_control = np.empty(grid.node_count, dtype=np.int64)
@@ -512,6 +526,7 @@ def solve(
         best_control,
         dead_end,
         iterations,
+        policy_sweeps,
         residual,
         transition_seconds,
         iteration_seconds,
@@ -596,13 +611,14 @@ def figure_attributes(problem: Problem, dynamics: ModuleType) -> dict:
 
 
 def dp_memory_bytes(spec: ControllerSpec) -> float:
-    """About the memory the DP of ``spec`` takes, bytes: per node and control sample, the exit
-    (2^(d-1) corners of an int32 node and a float32 weight) and the segment's cost (float64);
-    per node, about a dozen float64/int64 arrays (values, policy, grid bookkeeping)."""
+    """About the memory the DP of ``spec`` takes, bytes: per node and control sample, and once
+    more for the policy's compact copy (``dp.gather_policy``), the exit (2^(d-1) corners of an
+    int32 node and a float32 weight) and the segment's cost (float64); per node, about a dozen
+    float64/int64 arrays (values, policy, grid bookkeeping)."""
     nodes = float(np.prod([float(d.samples) for d in spec.state]))
     controls = float(np.prod([float(c.samples) for c in spec.controls]))
     corners = 2.0 ** (len(spec.state) - 1)
-    return nodes * (controls * (8.0 * corners + 8.0) + 8.0 * (12 + len(spec.state)))
+    return nodes * ((controls + 1.0) * (8.0 * corners + 8.0) + 8.0 * (12 + len(spec.state)))
 
 
 def generate_controller(
@@ -669,6 +685,7 @@ def generate_controller(
             "iteration_seconds": solution.iteration_seconds,
             "kernel_load_seconds": solution.kernel_load_seconds,
             "iterations": solution.iterations,
+            "policy_sweeps": solution.policy_sweeps,
             "residual": solution.residual,
             "converged": bool(
                 solution.residual < (spec.tolerance if tolerance is None else tolerance)
