@@ -701,7 +701,7 @@ def gauss_seidel_sweeps(
     left (``gather_policy``, ``policy_sweep``), stopping early once one of them changes less
     than ``tolerance``. Where Bellman sweeps shrink the largest change by only a few per cent a
     sweep (the policy's chain keeps returning to a few cells before it escapes: 130 of Luxo's
-    191 sweeps, most of the car's 222), the policy has long stopped changing; the policy sweeps
+    191 sweeps, most of the car's 222), the policy has nearly settled; the policy sweeps
     run that slow mode down reading one control's exit per node from a compact table instead
     of all of them (about a tenth of a Bellman sweep's time). Every sweep takes the next of
     the orders of ``sweep_order``, counting from sweep number ``first``. order: (N,) int64
