@@ -1,5 +1,5 @@
 """A state that blows up (issue 27): the integrating kernels stop at a NaN, inf or huge state
-(``kernels.simulate.state_is_sound``), and ``mosys run`` exits 2 with the script's file and line,
+(``kernels.soundness.state_is_sound``), and ``mosys run`` exits 2 with the script's file and line,
 the time and the state, writing nothing; never a signal or a traceback. And the interpolation
 keeps its indices on the grid whatever the coordinates (NaN, inf, huge)."""
 
@@ -20,7 +20,7 @@ from mosys.cli import main
 from mosys.dynamics.compile import compile_figure
 from mosys.errors import NonFiniteStateError
 from mosys.kernels.interpolate import clamp_to_domain, interpolate_into
-from mosys.kernels.simulate import STATE_LIMIT, state_is_sound
+from mosys.kernels.soundness import STATE_LIMIT, state_is_sound
 from mosys.parsing.motor import parse_motor_program_text
 from mosys.ssc.controller import Controller
 

@@ -1,5 +1,5 @@
 """Issue 27 for the BSR simulators, 2-D and 3-D: a run stops where the figure's state is not
-sound (NaN, inf or beyond ±STATE_LIMIT: ``kernels.simulate.state_is_sound``) and returns
+sound (NaN, inf or beyond ±STATE_LIMIT: ``kernels.soundness.state_is_sound``) and returns
 ``blown_up(step)``; a search then aborts with NonFiniteStateError at the spec's ``simulate``
 line (``mosys bsr-search``: exit 2, one line, no traceback, no output file), and a composite
 motion at the line of the phase that was running."""
@@ -32,7 +32,7 @@ from mosys.errors import NonFiniteStateError
 from mosys.kernels import bsr3d_controller, bsr_controller
 from mosys.kernels.bsr3d_simulate import VY as VY_3D
 from mosys.kernels.bsr_simulate import VY
-from mosys.kernels.simulate import STATE_LIMIT, blown_up, state_is_sound, steps_before_blow_up
+from mosys.kernels.soundness import STATE_LIMIT, blown_up, state_is_sound, steps_before_blow_up
 from mosys.parsing.bsr import FITNESS_TERMS, FITNESS_TERMS_3D, parse_bsr_text
 from mosys.parsing.composite import parse_composite_text
 from mosys.parsing.figure import parse_figure_spec

@@ -13,7 +13,7 @@ class SimulationError(InputError):
 
 
 class NonFiniteStateError(SimulationError):
-    """The model's state became non-finite (NaN, inf, or beyond ``kernels.simulate.STATE_LIMIT``,
+    """The model's state became non-finite (NaN, inf, or beyond ``kernels.soundness.STATE_LIMIT``,
     where the next step would overflow) at ``t`` seconds into a run; ``state`` (S,) SI is the
     state there. The message names the source that was driving and the state."""
 

@@ -12,7 +12,7 @@ import numpy as np
 
 from mosys.errors import NonFiniteStateError
 from mosys.kernels.motor import run_motor_program
-from mosys.kernels.simulate import steps_before_blow_up
+from mosys.kernels.soundness import steps_before_blow_up
 from mosys.parsing.motor import (
     BoundProgram,
     MotorProgram,

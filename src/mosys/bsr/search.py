@@ -22,7 +22,7 @@ the sense trajectory; 3-D (§4.2) contains a point of it (the point uniformly in
 most 0.98 of the half-side from the centre), and the first population is enriched by three
 rounds of that mutation before the search begins.
 
-A run whose figure's state blows up (NaN, inf or beyond ±``kernels.simulate.STATE_LIMIT``: the
+A run whose figure's state blows up (NaN, inf or beyond ±``kernels.soundness.STATE_LIMIT``: the
 kernels stop there) aborts the search with ``NonFiniteStateError`` at the spec's ``simulate``
 line, naming the time, seed, generation and state; no candidate is ever scored NaN. A fitness
 that is NaN all the same (weights so large that the terms overflow to inf - inf) ranks as -inf:
@@ -56,7 +56,7 @@ from mosys.kernels.bsr_controller import (
     run_controller,
     run_population,
 )
-from mosys.kernels.simulate import steps_before_blow_up, unsoundness
+from mosys.kernels.soundness import steps_before_blow_up, unsoundness
 from mosys.parsing.bsr import FITNESS_TERMS, BsrSpec
 from mosys.parsing.tokens import SpecError, Token, location
 
@@ -417,7 +417,7 @@ def describe_planar_state(figure: BsrFigure, state: np.ndarray) -> str:
 
 def unsound_state_message(t: float, state: np.ndarray, described: str, when: str = "") -> str:
     """What NonFiniteStateError says of a BSR run whose state (S,) SI, ``described`` in the
-    spec's units, was not sound (``kernels.simulate.state_is_sound``) at ``t`` s from the run's
+    spec's units, was not sound (``kernels.soundness.state_is_sound``) at ``t`` s from the run's
     start; ``when``: which run (seed, generation), if known. A state that blew up during the run
     may want a smaller dt; one unsound at t = 0 was the start itself, which no dt mends."""
     during = f" ({when})" if when else ""

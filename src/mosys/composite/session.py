@@ -7,7 +7,7 @@ phase names, or else the seed whose best controller scores best from the search'
 start (the ``nominal_fitness`` attribute; the search's ``best_fitness`` of a perturbed search is
 one lucky draw). The motion starts from the first phase's search's nominal start pose, at rest.
 
-A motion whose figure's state blows up (NaN, inf or beyond ±``kernels.simulate.STATE_LIMIT``)
+A motion whose figure's state blows up (NaN, inf or beyond ±``kernels.soundness.STATE_LIMIT``)
 raises NonFiniteStateError at the script's line of the phase that was running, with the
 motion's time and state: no score is ever NaN for it.
 """

@@ -12,7 +12,7 @@ import numpy as np
 
 from mosys.errors import InputError
 from mosys.kernels.motor import run_motor_program
-from mosys.kernels.simulate import steps_before_blow_up
+from mosys.kernels.soundness import steps_before_blow_up
 
 FREE_SWING_DT = 0.001  # s: the simulator step of the free swing
 ORBIT_SECONDS = 8.0  # s simulated per orbit: longer than one period of every drawn orbit

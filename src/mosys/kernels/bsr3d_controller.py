@@ -25,7 +25,7 @@ least ``STEP_LIFT``) of a foot other than the one that touched down last; ``min_
 lowest com height, m; ``heading_sine`` the sine of the heading change (1: a quarter turn to the
 left, whatever the turns before it: a turn that a spin does not beat).
 
-A run stops where the state is not sound (``kernels.simulate.state_is_sound``), as the 2-D
+A run stops where the state is not sound (``kernels.soundness.state_is_sound``), as the 2-D
 one does: checked before every step and after the last, it returns ``blown_up(step)`` (< 0).
 """
 
@@ -62,7 +62,7 @@ from mosys.kernels.bsr_controller import (
     stop_unsound,
 )
 from mosys.kernels.bsr_simulate import CONTACT_TOLERANCE
-from mosys.kernels.simulate import state_is_sound
+from mosys.kernels.soundness import state_is_sound
 
 # the columns of terms_out (``parsing.bsr.FITNESS_TERMS_3D`` names them in this order)
 (

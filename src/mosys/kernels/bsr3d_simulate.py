@@ -722,7 +722,7 @@ def step(
     left them), frames (N, 3, 3), scratch (N, 7, 3) (``new_scratch``), matrices (5, 3, 3),
     vectors (3, 4), contact (3, M, 3), responses (M, M, 3, 3), system (M + 3, M + 4), work
     (3, M), chosen (M,) int64, entry (E, 3), end_share (E,) (zeros at the start); M =
-    MAX_CONTACTS. The state must be sound (``kernels.simulate.state_is_sound``): the runs of
+    MAX_CONTACTS. The state must be sound (``kernels.soundness.state_is_sound``): the runs of
     ``kernels.bsr3d_controller`` check it before every step and stop where it is not.
 
     One piece on purpose, its arrays one by one, as the 2-D step (that module's docstring says

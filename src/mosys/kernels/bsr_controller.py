@@ -13,7 +13,7 @@ distance travelled by endpoints while they touch the floor (within ``CONTACT_TOL
 ends of a step, m; ``rotations`` |net rotation of the root rod| / 360°; ``fall`` the fraction of
 steps that end with one of the ``fall`` endpoints touching the floor.
 
-A run stops where the state is not sound (``kernels.simulate.state_is_sound``: NaN, inf or beyond
+A run stops where the state is not sound (``kernels.soundness.state_is_sound``: NaN, inf or beyond
 ±STATE_LIMIT; checked before every step and after the last, which leaves the arithmetic of a
 sound run as it was) and returns ``blown_up(step)`` (< 0) instead of the steps it took.
 """
@@ -38,7 +38,7 @@ from mosys.kernels.bsr_simulate import (
     place_in_world,
     step,
 )
-from mosys.kernels.simulate import blown_up, state_is_sound
+from mosys.kernels.soundness import blown_up, state_is_sound
 
 # Table 2 of the paper: a rule's hyper-rectangle side 2/lambda lies in [SIDE_MIN, SIDE_MAX], so
 # lambda_min = 2 / SIDE_MAX (the rule weights below); centres are drawn in [CENTER_MIN, CENTER_MAX].

@@ -383,7 +383,7 @@ def step(
     end_force (E,) the ground's normal force on each endpoint over the step, N. gravity m/s²,
     floor: the floor's height, m (nan: no floor). scratch (N, 8), contact (3, 2, 2), entry
     (E, 2): work space; end_offset must hold the figure's endpoints as the previous step (or the
-    start) left them. The state must be sound (``kernels.simulate.state_is_sound``): the runs of
+    start) left them. The state must be sound (``kernels.soundness.state_is_sound``): the runs of
     ``kernels.bsr_controller`` check it before every step and stop where it is not.
 
     One piece on purpose, and its arrays one by one (the module docstring says why): it runs

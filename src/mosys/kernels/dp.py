@@ -24,12 +24,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from mosys.kernels.arrival import stops_in_box
 from mosys.kernels.figure_state import load_state
 from mosys.kernels.geometry import pose_is_free
 from mosys.kernels.interpolate import corner_weights, grid_strides, interpolation_scratch
-from mosys.kernels.lookahead import stops_in_box
 from mosys.kernels.prefetch import prefetch
-from mosys.kernels.simulate import state_is_sound
+from mosys.kernels.soundness import state_is_sound
 from mosys.kernels.specialise import model_derivative
 
 UNKNOWN = 1.0e9  # s: cost-to-go of a reachable node whose value is not known yet (the paper's
@@ -233,8 +233,9 @@ def exit_transitions_template(
     inputs (input_size of them) each control drives; effort_weight: (m,) K of the cost
     t + Σ K|u| t. max_step: the longest integration step, s. A segment still in its cell after
     ``MAX_SEGMENT_SECONDS``, or whose step error is not finite (too stiff to follow), is
-    discarded (cost inf); one whose accepted step's state is not sound (``simulate.state_is_sound``:
-    NaN, inf or beyond 1e150) has cost nan, for the caller to report.
+    discarded (cost inf); one whose accepted step's state is not sound
+    (``soundness.state_is_sound``: NaN, inf or beyond 1e150) has cost nan, for the caller to
+    report.
     nodes: (P,) int64 flat node indices to process, each with a row (``row_of``: (N,) int64,
     the row of each node in the outputs, -1 for a removed node, which has none).
     pose_slot, outline, obstacle_vertices, obstacle_start, domain: the obstacles, as
@@ -242,7 +243,7 @@ def exit_transitions_template(
     free at the end of any integration step is discarded.
     arrives: whether the table runs by lookahead (a vehicle), whose runtime brakes to rest as
     soon as the point where full braking would stop it lies in ``arrival_box`` (3, d)
-    (``lookahead.stops_in_box``, with vehicle_slot (7,), wheelbase and wheel_radius m, brake
+    (``arrival.stops_in_box``, with vehicle_slot (7,), wheelbase and wheel_radius m, brake
     rad/s²): then a segment that gets there before leaving its cell ends there, its cost the
     seconds so far plus the braking time, its exit the destination node ``terminal_node``
     (weight 1, value 0), so that the DP's cost-to-go is what that runtime takes.

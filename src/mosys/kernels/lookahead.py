@@ -22,6 +22,7 @@ import math
 import numpy as np
 from numba import njit, types
 
+from mosys.kernels.arrival import stops_in_box
 from mosys.kernels.figure_state import read_state
 from mosys.kernels.geometry import pose_is_free
 from mosys.kernels.integrate import (
@@ -38,13 +39,8 @@ from mosys.kernels.interpolate import (
     interpolate_with,
     interpolation_scratch,
 )
-from mosys.kernels.simulate import (
-    blown_up,
-    crossed_a_region_border,
-    inside_region,
-    region_membership,
-    state_is_sound,
-)
+from mosys.kernels.regions import crossed_a_region_border, region_membership
+from mosys.kernels.soundness import blown_up, state_is_sound
 
 OUTSIDE_PENALTY = 100.0  # s per grid step beyond the table's axes, added to the cost-to-go
 SWEEP_STEP = 0.005  # m: the collision tests along a lookahead step are this far apart
@@ -149,32 +145,6 @@ def _limit_inputs(state, vehicle_slot, limits, wheel_radius, dt, inputs, out):
         slot = vehicle_slot[5 + k]
         out[slot] = min(out[slot], max(0.0, (limits[k, 1] - value) / (gain * dt)))
         out[slot] = max(out[slot], min(0.0, (limits[k, 0] - value) / (gain * dt)))
-
-
-@njit(cache=True)
-def stops_in_box(state, vehicle_slot, wheelbase, wheel_radius, brake, state_slot, box, stop):
-    """True when the state where full braking from ``state`` ends lies in the arrival box
-    (``box`` (3, d): lower, upper and period over the controller's axes, as ``inside_region``
-    takes them). Braking, steering held, the front wheels roll s = v|v| / 2a: the heading turns
-    by s sin(steer) / wheelbase and the reference point moves s along the mean of the start and
-    end heading, plus steer. stop: (d,) work array, the controller state where it stops."""
-    speed = state[vehicle_slot[4]]
-    steer = state[vehicle_slot[3]]
-    distance = speed * abs(speed) / (2.0 * wheel_radius * brake)
-    turn = distance * math.sin(steer) / wheelbase
-    direction = state[vehicle_slot[2]] + 0.5 * turn + steer
-    for k in range(state_slot.shape[0]):
-        slot = state_slot[k]
-        stop[k] = state[slot]
-        if slot == vehicle_slot[0]:
-            stop[k] += distance * math.cos(direction)
-        elif slot == vehicle_slot[1]:
-            stop[k] += distance * math.sin(direction)
-        elif slot == vehicle_slot[2]:
-            stop[k] += turn
-        elif slot == vehicle_slot[4]:
-            stop[k] = 0.0
-    return inside_region(stop, box[0], box[1], box[2])
 
 
 @njit(cache=True)
@@ -508,7 +478,7 @@ def simulate_lookahead(
     region_period,
 ):
     """Simulate up to ``record_state.shape[0]`` RK4 steps of dt seconds by lookahead on the
-    cost-to-go (module docstring); return how many were taken, or ``simulate.blown_up(step)``
+    cost-to-go (module docstring); return how many were taken, or ``soundness.blown_up(step)``
     (< 0) when the state is not sound before step ``step`` or after the last, as
     ``simulate.simulate_controlled``.
 

@@ -6,7 +6,7 @@ import numpy as np
 from numba import njit, types
 
 from mosys.kernels.integrate import DERIVATIVE_INTO, INDICES, VECTOR, rk4_scratch, rk4_step
-from mosys.kernels.simulate import blown_up, state_is_sound
+from mosys.kernels.soundness import blown_up, state_is_sound
 
 LIMP = 0  # the actuator applies no torque
 TORQUE = 1  # a constant torque, N m
@@ -65,8 +65,8 @@ def run_motor_program(
     float64, N m, the torques before the first step, left holding the last step's.
     state: (S,) the model's state q‖qd, advanced in place. Records, one row per step, taken at
     the step's start: record_state (steps, S), record_control (steps, A) N m.
-    Returns the steps taken, all of them, or ``simulate.blown_up(step)`` (< 0) when the state is
-    not sound (``simulate.state_is_sound``: NaN, inf, huge) before step ``step`` or after the
+    Returns the steps taken, all of them, or ``soundness.blown_up(step)`` (< 0) when the state is
+    not sound (``soundness.state_is_sound``: NaN, inf, huge) before step ``step`` or after the
     last: the records are filled for the steps before, ``state`` holds the unsound state.
     """
     size = state.shape[0]

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit, types
 
@@ -22,43 +20,8 @@ from mosys.kernels.interpolate import (
     interpolate_with,
     interpolation_scratch,
 )
-
-# The largest |entry| of a state the integrators step from: beyond it (or NaN), the state has
-# blown up, and the next step could overflow to inf and NaN.
-STATE_LIMIT = 1e150
-
-
-@njit(cache=True)
-def state_is_sound(state):
-    """True when every entry of ``state`` (S,) is finite and within ±STATE_LIMIT; the kernels
-    that integrate check it before every step and after the last, and return
-    ``blown_up(step)`` where it fails."""
-    for i in range(state.shape[0]):  # noqa: SIM110 (a loop numba compiles, no generator)
-        if not abs(state[i]) <= STATE_LIMIT:  # NaN fails too
-            return False
-    return True
-
-
-@njit(cache=True)
-def blown_up(step):
-    """The return code of a kernel that found the state unsound (``state_is_sound``) before
-    step ``step`` (0-based; the step count itself: after the last step), its records filled
-    for the steps before it: -(step + 1) < 0. ``steps_before_blow_up`` inverts it."""
-    return -(step + 1)
-
-
-def steps_before_blow_up(code: int) -> int:
-    """The steps a kernel took before the state became unsound, from its negative return code
-    (``blown_up``)."""
-    return -code - 1
-
-
-def unsoundness(state: np.ndarray) -> str:
-    """How a state (S,) SI that is not sound (``state_is_sound``) fails, as its error message
-    says it: ``lies beyond ±1e+150 (SI)`` when every entry is finite, else ``became
-    non-finite``."""
-    return f"lies beyond ±{STATE_LIMIT:g} (SI)" if np.isfinite(state).all() else "became non-finite"
-
+from mosys.kernels.regions import crossed_a_region_border, region_membership
+from mosys.kernels.soundness import blown_up, state_is_sound
 
 SIMULATE_SIGNATURE = types.int64(
     DERIVATIVE_INTO,  # derivative_into
@@ -84,37 +47,6 @@ SIMULATE_SIGNATURE = types.int64(
     types.float64[:, ::1],  # region_upper
     VECTOR,  # region_period
 )
-
-
-@njit(cache=True)
-def inside_region(state, lower, upper, period):
-    """True when every entry of ``state`` (S,) lies in [lower, upper] ((S,) each). An entry with
-    a period (> 0: an angle, 2π) and finite bounds is compared modulo its period."""
-    for i in range(state.shape[0]):
-        value = state[i]
-        if period[i] > 0.0 and math.isfinite(lower[i]) and math.isfinite(upper[i]):
-            value = lower[i] + (value - lower[i]) % period[i]
-        if not lower[i] <= value <= upper[i]:
-            return False
-    return True
-
-
-@njit(cache=True)
-def region_membership(state, region_lower, region_upper, period, out):
-    """out (K,) bool: whether ``state`` (S,) lies in each of the K boxes (K, S)."""
-    for k in range(region_lower.shape[0]):
-        out[k] = inside_region(state, region_lower[k], region_upper[k], period)
-
-
-@njit(cache=True)
-def crossed_a_region_border(state, region_lower, region_upper, period, start_membership, work):
-    """True when ``state`` (S,) lies in a different set of the K boxes than
-    ``start_membership`` (K,) bool, the run's first state's; work: (K,) bool."""
-    region_membership(state, region_lower, region_upper, period, work)
-    crossed = False
-    for k in range(region_lower.shape[0]):
-        crossed |= work[k] != start_membership[k]
-    return crossed
 
 
 @njit(SIMULATE_SIGNATURE, cache=True)

@@ -19,11 +19,8 @@ import numpy as np
 from mosys.errors import NonFiniteStateError
 from mosys.io.controller_table import ControllerTable, read_controller_table
 from mosys.kernels.interpolate import clamp_to_domain, interpolate_into
-from mosys.kernels.simulate import (
-    simulate_controlled,
-    steps_before_blow_up,
-    unsoundness,
-)
+from mosys.kernels.simulate import simulate_controlled
+from mosys.kernels.soundness import steps_before_blow_up, unsoundness
 from mosys.ssc.grid import FigureGrid, control_scale, figure_grid, figure_state_names, state_unit
 from mosys.ssc.regions import ARRIVAL_STEPS, REST_RATE, Bounds, Regions, state_periods
 
@@ -294,7 +291,7 @@ class Controller:
         run, spec units (None: 0). A ``policy lookahead`` table plans its own controls and
         takes no slew limit (ValueError).
 
-        A state that becomes non-finite (NaN, inf, or beyond ±``kernels.simulate.STATE_LIMIT``
+        A state that becomes non-finite (NaN, inf, or beyond ±``kernels.soundness.STATE_LIMIT``
         SI) at the start of a step or at the end raises ``errors.NonFiniteStateError`` with the time
         from the run's start and that state."""
         steps = int(round(seconds / dt))

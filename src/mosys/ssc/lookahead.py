@@ -59,7 +59,7 @@ class Arrival:
     (±inf where free) and period (> 0: an angle) over the controller's axes; vehicle_slot (7,)
     the state slots of x, y, heading, steer and speed, the input slots of steer_rate and
     wheel_accel; wheelbase and wheel_radius, m; brake: the largest wheel deceleration, rad/s²
-    (``kernels.lookahead.stops_in_box``)."""
+    (``kernels.arrival.stops_in_box``)."""
 
     box: np.ndarray
     vehicle_slot: np.ndarray

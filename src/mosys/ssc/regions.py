@@ -10,7 +10,7 @@ from types import ModuleType
 
 import numpy as np
 
-from mosys.kernels.simulate import region_membership
+from mosys.kernels.regions import region_membership
 from mosys.ssc.grid import figure_state_names, state_unit
 
 # a figure at rest: every rate of the figure below this, SI (m/s, rad/s)
