@@ -88,12 +88,10 @@ def test_a_policy_sweep_is_a_bellman_sweep_over_each_nodes_own_control(axis_coun
         gather_policy(
             exit_index, exit_weight, cost, row_of, control, policy_index, policy_weight, policy_cost
         )
-        kept = np.flatnonzero(row_of >= 0)
-        picked = control[kept]
         cut = (
-            exit_index[row_of[kept], picked][:, None, :].copy(),
-            exit_weight[row_of[kept], picked][:, None, :].copy(),
-            cost[row_of[kept], picked][:, None].copy(),
+            exit_index[held, chosen][:, None, :].copy(),
+            exit_weight[held, chosen][:, None, :].copy(),
+            cost[held, chosen][:, None].copy(),
         )
         assert np.array_equal(policy_index, cut[0])
         assert np.array_equal(policy_weight, cut[1])
