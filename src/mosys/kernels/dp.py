@@ -343,9 +343,7 @@ def exit_transitions_template(
                 if not state_is_sound(after):  # an accepted step (a nan input passes the error
                     segment_cost[row, u] = np.nan  # test): the caller reports it
                     break
-                # (a model without obstacles makes no call: its seven array arguments' reference
-                # counts cost about a tenth of Luxo's transitions)
-                if pose_slot[0] >= 0 and not pose_is_free(
+                if not pose_is_free(
                     after, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
                 ):
                     break  # hits an obstacle or leaves the domain polygon: cost stays inf

@@ -110,7 +110,8 @@ def first_collision(outline, x, y, heading, obstacle_vertices, obstacle_start, b
     return -1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")  # its callers' hot loops: no call (and no reference
+# counts of its seven arrays) where there are no obstacles
 def pose_is_free(state, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body):
     """True when a model state (S,) is allowed: its reference point (state[pose_slot[0]],
     state[pose_slot[1]]) lies inside ``domain`` (P, 2; P = 0: no domain polygon) and its body,
