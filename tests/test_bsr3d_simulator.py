@@ -75,25 +75,9 @@ class Stepper:
     def __init__(self, figure: sim.FigureArrays3D, state: np.ndarray):
         self.figure = figure
         self.state = np.asarray(state, float).copy()
-        n, e, m = figure.parent.shape[0], figure.endpoints.shape[0], sim.MAX_CONTACTS
-        self.rod_ends = np.empty((n, 2, 3))
-        self.end_offset = np.empty((e, 3))
-        self.end_velocity = np.empty((e, 3))
-        self.end_force = np.zeros(e)
-        self.frames = np.empty((n, 3, 3))
-        self.scratch = sim.new_scratch(n)
-        self.matrices = np.empty((5, 3, 3))
-        self.vectors = np.zeros((3, 4))
-        self.contact = np.empty((3, m, 3))
-        self.responses = np.empty((m, m, 3, 3))
-        self.system = np.empty((m + 3, m + 4))
-        self.work = np.empty((3, m))
-        self.end_share = np.zeros(e)
-        self.chosen = np.empty(m, np.int64)
-        self.entry = np.empty((e, 3))
-        self.previous = np.zeros(3)
+        self.work = sim.new_step_work(figure.parent.shape[0], figure.endpoints.shape[0])
         tensor = self.body()
-        self.previous[:] = self.rotation() @ np.linalg.solve(tensor, self.vectors[0, :3])
+        self.work.previous[:] = self.rotation() @ np.linalg.solve(tensor, self.work.vectors[0, :3])
 
     @property
     def angles(self) -> np.ndarray:
@@ -103,19 +87,20 @@ class Stepper:
     def body(self) -> np.ndarray:
         """Refresh the body-frame quantities of the current pose; its inertia tensor (3, 3)."""
         j = self.figure.joint_min.shape[0]
+        w = self.work
         sim.body_frame(
             *self.figure[:9],
             self.state[sim.JOINTS : sim.JOINTS + j],
             self.state[sim.JOINTS + j :],
-            self.rod_ends,
-            self.end_offset,
-            self.end_velocity,
-            self.frames,
-            self.scratch,
-            self.matrices[1],
-            self.vectors[0, :3],
+            w.rod_ends,
+            w.end_offset,
+            w.end_velocity,
+            w.frames,
+            w.scratch,
+            w.matrices[1],
+            w.vectors[0, :3],
         )
-        return self.matrices[1].copy()
+        return self.work.matrices[1].copy()
 
     def rotation(self) -> np.ndarray:
         out = np.empty((3, 3))
@@ -123,36 +108,11 @@ class Stepper:
         return out
 
     def step(self, target: np.ndarray, tau: float, dt: float) -> None:
-        f = self.figure
-        sim.step(
-            *f[:11],
-            f.gravity,
-            f.floor,
-            self.state,
-            target,
-            tau,
-            dt,
-            self.previous,
-            self.rod_ends,
-            self.end_offset,
-            self.end_velocity,
-            self.end_force,
-            self.frames,
-            self.scratch,
-            self.matrices,
-            self.vectors,
-            self.contact,
-            self.responses,
-            self.system,
-            self.work,
-            self.chosen,
-            self.entry,
-            self.end_share,
-        )
+        sim.step(self.figure, self.state, target, tau, dt, self.work, True)
 
     def world_ends(self) -> np.ndarray:
         """(N, 2, 3) every rod's ends in the world now, m."""
-        return self.rod_ends.copy()
+        return self.work.rod_ends.copy()
 
 
 def state_of(
@@ -408,6 +368,7 @@ def contact_case(u, r, inverse_mass=1 / 42.1, spin_inertia=(3.0, 4.0, 2.5)):
         impulse,
         responses,
         np.zeros((m + 3, m + 4)),
+        np.zeros((3, m, m)),
         np.zeros((3, m)),
         np.arange(m),
         np.zeros(m),

@@ -43,13 +43,13 @@ from mosys.kernels.bsr3d_simulate import (
     CZ,
     JOINTS,
     LX,
-    MAX_CONTACTS,
     QW,
     VX,
     apply,
     body_frame,
     conjugate,
     invert_symmetric,
+    new_step_work,
     rotation_of,
     step,
 )
@@ -160,23 +160,10 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
     state = start.copy()
     n_rods = parent.shape[0]
     n_ends = endpoints.shape[0]
-    m = MAX_CONTACTS
-    rod_ends = np.empty((n_rods, 2, 3))
-    end_offset = np.empty((n_ends, 3))
-    end_velocity = np.empty((n_ends, 3))
-    end_force = start_force.copy()
-    frames = np.empty((n_rods, 3, 3))
-    scratch = np.full((n_rods, 7, 3), np.nan)  # as new_scratch
-    matrices = np.empty((5, 3, 3))
-    vectors = np.zeros((3, 4))
-    contact = np.empty((3, m, 3))
-    responses = np.empty((m, m, 3, 3))
-    system = np.empty((m + 3, m + 4))
-    work = np.empty((3, m))
-    end_share = np.zeros(n_ends)
-    chosen = np.empty(m, np.int64)
-    entry = np.empty((n_ends, 3))
-    previous = np.zeros(3)
+    work = new_step_work(n_rods, n_ends)
+    rod_ends, end_offset, end_velocity, end_force, frames, scratch = work[1:7]
+    matrices, vectors = work[7:9]
+    end_force[:] = start_force
     rotation = np.empty((3, 3))
     world_inverse = np.empty((3, 3))
     sensing = senses_out.shape[1] > 0
@@ -210,7 +197,7 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
     rotation_of(state[QW : QW + 4], rotation)
     conjugate(rotation, matrices[2], world_inverse)
     sx, sy, sz = apply(matrices[2], vectors[0, 0], vectors[0, 1], vectors[0, 2])
-    previous[0], previous[1], previous[2] = apply(rotation, sx, sy, sz)
+    work.previous[0], work.previous[1], work.previous[2] = apply(rotation, sx, sy, sz)
     # the start
     n_feet = task.feet.shape[0]
     foot_start = np.empty((n_feet, 3))
@@ -271,41 +258,7 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
     for n in range(steps):
         if not state_is_sound(state):
             return stop_unsound(n, state, end_force, terms_out, final_state, final_force)
-        step(
-            parent,
-            hinge,
-            rest,
-            length,
-            mass,
-            com,
-            inertia,
-            joint,
-            endpoints,
-            joint_min,
-            joint_max,
-            gravity,
-            floor,
-            state,
-            target[rule],
-            tau[rule],
-            dt,
-            previous,
-            rod_ends,
-            end_offset,
-            end_velocity,
-            end_force,
-            frames,
-            scratch,
-            matrices,
-            vectors,
-            contact,
-            responses,
-            system,
-            work,
-            chosen,
-            entry,
-            end_share,
-        )
+        step(figure, state, target[rule], tau[rule], dt, work, recording)
         rotation = matrices[0]
         fallen = state[CY] < task.fall_height
         for e in range(n_ends):

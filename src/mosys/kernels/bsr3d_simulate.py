@@ -72,7 +72,8 @@ class FigureArrays3D(NamedTuple):
     reach: float  # m: the sum of the rods' lengths
 
 
-def new_scratch(n_rods: int) -> np.ndarray:
+@njit(cache=True)
+def new_scratch(n_rods):
     """The (N, 7, 3) scratch of ``body_frame``, its angle memory empty (NaN: never seen)."""
     return np.full((n_rods, 7, 3), np.nan)
 
@@ -82,7 +83,7 @@ def _cross(ax, ay, az, bx, by, bz):
     return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def body_frame(
     parent,
     hinge,
@@ -374,58 +375,93 @@ def endpoint_motion(state, rotation, body_rate, end_offset, end_velocity, e):
     return rx, ry, rz, state[VX] + wx + dx, state[VY] + wy + dy, state[VZ] + wz + dz
 
 
-@njit(cache=True, error_model="numpy")
-def response(ri, rj, inverse_mass, world_inverse, out):
-    """out (3, 3): the velocity change at a point with offset ri (3,) from the centre of mass
-    per unit impulse at a point with offset rj (3,), for a rigid body of inverse mass
-    inverse_mass and inverse inertia world_inverse (3, 3): E/M - [ri]x I⁻¹ [rj]x."""
+@njit(cache=True, inline="always", error_model="numpy")
+def response(r, i, j, inverse_mass, world_inverse, responses):
+    """responses[i, j] (3, 3): the velocity change at a point with offset r[i] (3,) from the
+    centre of mass per unit impulse at a point with offset r[j], for a rigid body of inverse
+    mass inverse_mass and inverse inertia world_inverse (3, 3): E/M - [r_i]x I⁻¹ [r_j]x."""
     for b in range(3):
-        # column b: impulse along axis b at rj -> angular impulse rj x e_b
+        # column b: impulse along axis b at r_j -> angular impulse r_j x e_b
         ex = 1.0 if b == 0 else 0.0
         ey = 1.0 if b == 1 else 0.0
         ez = 1.0 if b == 2 else 0.0
-        tx, ty, tz = _cross(rj[0], rj[1], rj[2], ex, ey, ez)
+        tx, ty, tz = _cross(r[j, 0], r[j, 1], r[j, 2], ex, ey, ez)
         wx, wy, wz = apply(world_inverse, tx, ty, tz)
-        vx, vy, vz = _cross(wx, wy, wz, ri[0], ri[1], ri[2])
-        out[0, b] = vx + inverse_mass * ex
-        out[1, b] = vy + inverse_mass * ey
-        out[2, b] = vz + inverse_mass * ez
+        vx, vy, vz = _cross(wx, wy, wz, r[i, 0], r[i, 1], r[i, 2])
+        responses[i, j, 0, b] = vx + inverse_mass * ex
+        responses[i, j, 1, b] = vy + inverse_mass * ey
+        responses[i, j, 2, b] = vz + inverse_mass * ez
 
 
-@njit(cache=True, error_model="numpy")
-def _solve(system, size):
-    """Solve the linear system in system[:size, :size + 1] (augmented) in place by Gaussian
-    elimination with partial pivoting; the solution ends in column ``size``. False if singular."""
-    scale = 0.0
-    for i in range(size):
-        for j in range(size):
-            scale = max(scale, abs(system[i, j]))
-    if scale == 0.0:
-        return False
-    for col in range(size):
-        pivot = col
-        for row in range(col + 1, size):
-            if abs(system[row, col]) > abs(system[pivot, col]):
-                pivot = row
-        if abs(system[pivot, col]) <= 1e-12 * scale:
-            return False
-        if pivot != col:
-            for j in range(col, size + 1):
-                system[col, j], system[pivot, j] = system[pivot, j], system[col, j]
-        for row in range(size):
-            if row != col:
-                factor = system[row, col] / system[col, col]
-                if factor != 0.0:
-                    for j in range(col, size + 1):
-                        system[row, j] -= factor * system[col, j]
-    for row in range(size):
-        system[row, size] /= system[row, row]
-    return True
+@njit(cache=True, inline="always", error_model="numpy")
+def _mix_shares(weight, active, count, mixing, stored):
+    """Anderson mixing of the shared-friction shares: weight (count,) holds the plain update g
+    of the active points' shares; mixing[0, :stored] and mixing[1, :stored] the last changes of
+    g and of its residual f = g - w, mixing[:2, MAX_CONTACTS - 1] the last g and f. The shares
+    become g - ΔG γ with γ the least-squares fit of f by ΔF (for a nearly affine map in n - 1
+    free shares, as this one is, that converges in about n iterations where the plain update
+    shrinks the residual only 5 to 10 times an iteration). Kept plain when the fit is
+    degenerate or a share would not stay positive. mixing[2]: work space."""
+    if stored == 0:
+        return
+    last = MAX_CONTACTS - 1
+    for a in range(stored):
+        for b in range(a + 1):
+            total = 0.0
+            for i in range(count):
+                if active[i]:
+                    total += mixing[1, a, i] * mixing[1, b, i]
+            mixing[2, a, b] = total
+        total = 0.0
+        for i in range(count):
+            if active[i]:
+                total += mixing[1, a, i] * mixing[1, last, i]
+        mixing[2, a, last] = total
+    largest = 0.0
+    for a in range(stored):
+        largest = max(largest, mixing[2, a, a])
+    # Cholesky of the normal equations in place, then γ in mixing[2, :stored, last]
+    for a in range(stored):
+        for b in range(a):
+            total = mixing[2, a, b]
+            for c in range(b):
+                total -= mixing[2, a, c] * mixing[2, b, c]
+            mixing[2, a, b] = total / mixing[2, b, b]
+        total = mixing[2, a, a]
+        for c in range(a):
+            total -= mixing[2, a, c] * mixing[2, a, c]
+        if not total > 1e-12 * largest:
+            return
+        mixing[2, a, a] = math.sqrt(total)
+        total = mixing[2, a, last]
+        for c in range(a):
+            total -= mixing[2, a, c] * mixing[2, c, last]
+        mixing[2, a, last] = total / mixing[2, a, a]
+    for a in range(stored - 1, -1, -1):
+        total = mixing[2, a, last]
+        for c in range(a + 1, stored):
+            total -= mixing[2, c, a] * mixing[2, c, last]
+        mixing[2, a, last] = total / mixing[2, a, a]
+    for i in range(count):
+        if active[i]:
+            mixed = weight[i]
+            for a in range(stored):
+                mixed -= mixing[0, a, i] * mixing[2, a, last]
+            if not mixed > 0.0:
+                return
+    total = 0.0
+    for i in range(count):
+        if active[i]:
+            for a in range(stored):
+                weight[i] -= mixing[0, a, i] * mixing[2, a, last]
+            total += weight[i]
+    for i in range(count):
+        weight[i] /= total
 
 
 @njit(cache=True, error_model="numpy")
 def _shared_friction(
-    u, r, active, count, responses, impulse, system, weight, compliance, share, twisting
+    u, r, active, count, responses, impulse, system, mixing, weight, compliance, share, twisting
 ):
     """Impulses at the active contacts (at least two), the paper's friction carried to 3-D: no
     active point sinks; each point's horizontal impulse is its share (its normal impulse over
@@ -442,7 +478,16 @@ def _shared_friction(
     iterate, as the 2-D rule does). ``share`` (count,): the shares the points had the step
     before (0: not in contact then), where the iteration starts if every active point had one
     and there are three or more (which the 2-D rule never has: two start at even shares, as in
-    2-D, since where the iteration starts can decide whether a normal impulse pulls)."""
+    2-D, since where the iteration starts can decide whether a normal impulse pulls).
+
+    How it is solved: the system in the n normal impulses and the m = 3 (2 without the twist)
+    tangential unknowns is symmetric positive semi-definite, [[A, B], [Bᵀ, D]] (the body's
+    response restricted to those impulses, plus the compliance on A's diagonal). A does not
+    depend on the shares, so its Cholesky factor L is made once a call; each share iteration
+    factors only the Schur complement S = D - Wᵀ W, W = L⁻¹ B (m × m). A pivot at most 1e-12 of
+    the system's largest entry is singular. system (M + 3, M + 4) holds, M = MAX_CONTACTS: L
+    and W in rows :n (columns :n and M:M + m), S in rows M:M + m, the right-hand sides and
+    solutions in column M + 3, and the normal impulses in row M + 2, columns :n."""
     n = 0
     known = 0.0
     for i in range(count):
@@ -456,65 +501,142 @@ def _shared_friction(
             weight[i] = share[i] / known
         else:
             weight[i] = 1.0 / n
-    size = n + 3 if twisting else n + 2
+    m = 3 if twisting else 2
+    t = MAX_CONTACTS  # the tangential block's first row and column
+    rhs = MAX_CONTACTS + 3  # the right-hand sides' and solutions' column
+    normal = MAX_CONTACTS + 2  # the row that keeps the normal impulses
+    # A and -u_y; then L in place of A, and h = L⁻¹ (-u_y) in place of -u_y
+    scale_a = 0.0
+    row = 0
+    for i in range(count):
+        if not active[i]:
+            continue
+        column = 0
+        for j in range(count):
+            if active[j]:
+                value = responses[i, j, 1, 1] + (compliance if i == j else 0.0)
+                system[row, column] = value
+                scale_a = max(scale_a, abs(value))
+                column += 1
+        system[row, rhs] = -u[i, 1]
+        row += 1
+    for k in range(n):
+        for c in range(k):
+            total = system[k, c]
+            for p in range(c):
+                total -= system[k, p] * system[c, p]
+            system[k, c] = total / system[c, c]
+        total = system[k, k]
+        for p in range(k):
+            total -= system[k, p] * system[k, p]
+        if not total > 1e-12 * scale_a:
+            return -2
+        system[k, k] = math.sqrt(total)
+        total = system[k, rhs]
+        for p in range(k):
+            total -= system[k, p] * system[p, rhs]
+        system[k, rhs] = total / system[k, k]
     converged = False
-    for _ in range(FIXED_POINT_ITERATIONS):
-        system[:size, : size + 1] = 0.0
+    last = MAX_CONTACTS - 1  # mixing's row of the last update and residual
+    for iteration in range(FIXED_POINT_ITERATIONS):
+        # B, D and the tangential right-hand side at the present shares
+        for p in range(m):
+            for q in range(m):
+                system[t + p, t + q] = 0.0
+            system[t + p, rhs] = 0.0
+        scale = scale_a
         row = 0
         for i in range(count):
             if not active[i]:
                 continue
-            for a in range(3):
-                # the velocity u'_ia after the impulses: u_ia + sum over the unknowns
-                if a == 1:
-                    target = row  # this point's normal row: u'_iy = 0
-                    scale_x = 1.0
-                else:
-                    target = -1
-                    scale_x = weight[i]
-                column = 0
-                slide_x = 0.0
-                slide_z = 0.0
-                twist = 0.0
-                for j in range(count):
-                    if not active[j]:
-                        continue
-                    k = responses[i, j]
-                    normal = k[a, 1] + (compliance if (i == j and a == 1) else 0.0)
-                    slide_x += weight[j] * k[a, 0]
-                    slide_z += weight[j] * k[a, 2]
-                    twist += weight[j] * (k[a, 0] * r[j, 2] - k[a, 2] * r[j, 0])
-                    if a == 1:
-                        system[target, column] += normal
-                    else:
-                        system[n, column] += scale_x * normal if a == 0 else 0.0
-                        system[n + 1, column] += scale_x * normal if a == 2 else 0.0
-                        lever = r[i, 2] if a == 0 else -r[i, 0]
-                        if twisting:
-                            system[n + 2, column] += weight[i] * lever * normal
-                    column += 1
-                if a == 1:
-                    system[target, n] += slide_x
-                    system[target, n + 1] += slide_z
-                    if twisting:
-                        system[target, n + 2] += twist
-                    system[target, size] = -u[i, 1]
-                else:
-                    axis_row = n if a == 0 else n + 1
-                    lever = r[i, 2] if a == 0 else -r[i, 0]
-                    system[axis_row, n] += weight[i] * slide_x
-                    system[axis_row, n + 1] += weight[i] * slide_z
-                    system[axis_row, size] -= weight[i] * u[i, a]
-                    if not twisting:
-                        continue
-                    system[axis_row, n + 2] += weight[i] * twist
-                    system[n + 2, n] += weight[i] * lever * slide_x
-                    system[n + 2, n + 1] += weight[i] * lever * slide_z
-                    system[n + 2, n + 2] += weight[i] * lever * twist
-                    system[n + 2, size] -= weight[i] * lever * u[i, a]
+            # the velocity change at point i along x, y, z per unit slide x (sx), slide z (sz)
+            # and twist (tw), each point taking its share
+            sx0 = sx1 = sx2 = sz0 = sz1 = sz2 = tw0 = tw1 = tw2 = 0.0
+            for j in range(count):
+                if not active[j]:
+                    continue
+                wj = weight[j]
+                lever_x = wj * r[j, 2]
+                lever_z = -wj * r[j, 0]
+                k00 = responses[i, j, 0, 0]
+                k10 = responses[i, j, 1, 0]
+                k20 = responses[i, j, 2, 0]
+                k02 = responses[i, j, 0, 2]
+                k12 = responses[i, j, 1, 2]
+                k22 = responses[i, j, 2, 2]
+                sx0 += wj * k00
+                sx1 += wj * k10
+                sx2 += wj * k20
+                sz0 += wj * k02
+                sz1 += wj * k12
+                sz2 += wj * k22
+                tw0 += lever_x * k00 + lever_z * k02
+                tw1 += lever_x * k10 + lever_z * k12
+                tw2 += lever_x * k20 + lever_z * k22
+            wi = weight[i]
+            system[row, t] = sx1
+            system[row, t + 1] = sz1
+            system[t, t] += wi * sx0
+            system[t + 1, t] += wi * sx2
+            system[t + 1, t + 1] += wi * sz2
+            system[t, rhs] -= wi * u[i, 0]
+            system[t + 1, rhs] -= wi * u[i, 2]
+            if twisting:
+                lever_x = wi * r[i, 2]
+                lever_z = -wi * r[i, 0]
+                system[row, t + 2] = tw1
+                system[t + 2, t] += lever_x * sx0 + lever_z * sx2
+                system[t + 2, t + 1] += lever_x * sz0 + lever_z * sz2
+                system[t + 2, t + 2] += lever_x * tw0 + lever_z * tw2
+                system[t + 2, rhs] -= lever_x * u[i, 0] + lever_z * u[i, 2]
+            for q in range(m):
+                scale = max(scale, abs(system[row, t + q]))
             row += 1
-        if not _solve(system, size):
-            return -2
+        for p in range(m):
+            for q in range(p + 1):
+                scale = max(scale, abs(system[t + p, t + q]))
+        # W = L⁻¹ B in place of B; S = D - Wᵀ W and b - Wᵀ h (lower triangle)
+        for q in range(m):
+            for k in range(n):
+                total = system[k, t + q]
+                for p in range(k):
+                    total -= system[k, p] * system[p, t + q]
+                system[k, t + q] = total / system[k, k]
+        for p in range(m):
+            for k in range(n):
+                system[t + p, rhs] -= system[k, t + p] * system[k, rhs]
+                for q in range(p + 1):
+                    system[t + p, t + q] -= system[k, t + p] * system[k, t + q]
+        # S's Cholesky factor in place and its forward solve, then the back solves: the
+        # tangential unknowns, then the normal impulses L⁻ᵀ (h - W x)
+        for p in range(m):
+            for q in range(p):
+                total = system[t + p, t + q]
+                for s in range(q):
+                    total -= system[t + p, t + s] * system[t + q, t + s]
+                system[t + p, t + q] = total / system[t + q, t + q]
+            total = system[t + p, t + p]
+            for s in range(p):
+                total -= system[t + p, t + s] * system[t + p, t + s]
+            if not total > 1e-12 * scale:
+                return -2
+            system[t + p, t + p] = math.sqrt(total)
+            total = system[t + p, rhs]
+            for s in range(p):
+                total -= system[t + p, t + s] * system[t + s, rhs]
+            system[t + p, rhs] = total / system[t + p, t + p]
+        for p in range(m - 1, -1, -1):
+            total = system[t + p, rhs]
+            for s in range(p + 1, m):
+                total -= system[t + s, t + p] * system[t + s, rhs]
+            system[t + p, rhs] = total / system[t + p, t + p]
+        for k in range(n - 1, -1, -1):
+            total = system[k, rhs]
+            for q in range(m):
+                total -= system[k, t + q] * system[t + q, rhs]
+            for p in range(k + 1, n):
+                total -= system[p, k] * system[normal, p]
+            system[normal, k] = total / system[k, k]
         total = 0.0
         worst = -1
         worst_value = 0.0
@@ -522,55 +644,74 @@ def _shared_friction(
         for i in range(count):
             if not active[i]:
                 continue
-            normal = system[row, size]
-            if normal <= worst_value:
-                worst_value = normal
+            value = system[normal, row]
+            if value <= worst_value:
+                worst_value = value
                 worst = i
-            total += normal
+            total += value
             row += 1
         if worst >= 0:
             return worst
+        # the plain update g (each point's share of the normal impulses) and its residual
+        # g - w, remembered as changes since the last iteration
+        depth = n - 1
+        slot = (iteration - 1) % depth
         change = 0.0
         row = 0
         for i in range(count):
             if not active[i]:
                 continue
-            updated = system[row, size] / total
-            change = max(change, abs(updated - weight[i]))
+            updated = system[normal, row] / total
+            residual = updated - weight[i]
+            change = max(change, abs(residual))
+            if iteration > 0:
+                mixing[0, slot, i] = updated - mixing[0, last, i]
+                mixing[1, slot, i] = residual - mixing[1, last, i]
+            mixing[0, last, i] = updated
+            mixing[1, last, i] = residual
             weight[i] = updated
             row += 1
         if change <= 1e-12:
             converged = True
             break
+        if n >= 3:  # two iterate plainly, as the 2-D rule does
+            _mix_shares(weight, active, count, mixing, min(iteration, depth))
     if twisting and not converged:
         return -3
-    slide_x = system[n, size]
-    slide_z = system[n + 1, size]
-    twist = system[n + 2, size] if twisting else 0.0
+    slide_x = system[t, rhs]
+    slide_z = system[t + 1, rhs]
+    twist = system[t + 2, rhs] if twisting else 0.0
     row = 0
     for i in range(count):
         if active[i]:
             impulse[i, 0] = weight[i] * (slide_x + twist * r[i, 2])
-            impulse[i, 1] = system[row, size]
+            impulse[i, 1] = system[normal, row]
             impulse[i, 2] = weight[i] * (slide_z - twist * r[i, 0])
             row += 1
     return -1
 
 
-@njit(cache=True, error_model="numpy")
-def stop_dead(u, responses, i, system):
+@njit(cache=True, inline="always", error_model="numpy")
+def stop_dead(u, responses, i):
     """The impulse (x, y, z) that stops contact i (velocity u[i] (3,)) dead, from its own
-    response responses[i, i] (3, 3); its y is <= 0 if that would pull the point down."""
-    for a in range(3):
-        for b in range(3):
-            system[a, b] = responses[i, i, a, b]
-        system[a, 3] = -u[i, a]
-    if not _solve(system, 3):
-        return 0.0, 0.0, 0.0
-    return system[0, 3], system[1, 3], system[2, 3]
+    response responses[i, i] (3, 3) (symmetric positive definite: solved by its Cholesky
+    factor); its y is <= 0 if that would pull the point down."""
+    l00 = math.sqrt(responses[i, i, 0, 0])
+    l10 = responses[i, i, 1, 0] / l00
+    l20 = responses[i, i, 2, 0] / l00
+    l11 = math.sqrt(responses[i, i, 1, 1] - l10 * l10)
+    l21 = (responses[i, i, 2, 1] - l20 * l10) / l11
+    l22 = math.sqrt(responses[i, i, 2, 2] - l20 * l20 - l21 * l21)
+    y0 = -u[i, 0] / l00
+    y1 = (-u[i, 1] - l10 * y0) / l11
+    y2 = (-u[i, 2] - l20 * y0 - l21 * y1) / l22
+    z = y2 / l22
+    y = (y1 - l21 * z) / l11
+    x = (y0 - l10 * y - l20 * z) / l00
+    return x, y, z
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def _others_hold(u, count, responses, impulse, members):
     """True if no touching point outside ``members`` ((count,) 1.0 for a member) sinks after
     the impulses (count, 3)."""
@@ -586,7 +727,7 @@ def _others_hold(u, count, responses, impulse, members):
     return True
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def _twist_too_strong(impulse, active, count):
     """True if some active contact's horizontal impulse exceeds TWIST_RATIO times its normal."""
     for i in range(count):
@@ -597,9 +738,20 @@ def _twist_too_strong(impulse, active, count):
     return False
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def contact_impulses(
-    u, r, count, inverse_mass, world_inverse, impulse, responses, system, work, chosen, end_share
+    u,
+    r,
+    count,
+    inverse_mass,
+    world_inverse,
+    impulse,
+    responses,
+    system,
+    mixing,
+    shares,
+    chosen,
+    end_share,
 ):
     """The ground's impulses (count, 3) N s on ``count`` touching endpoints: u (count, 3) their
     velocities m/s, r (count, 3) their offsets from the centre of mass m. First the sinking ones
@@ -607,13 +759,14 @@ def contact_impulses(
     trying again while two or more are left; then each sinking one alone, the fastest first,
     stopped dead. The first set whose normal impulses push and after which no other touching
     point sinks is kept; none, no impulse (the 2-D rule for two, carried to any number).
-    responses (M, M, 3, 3), system (M + 3, M + 4), work (3, M): work space. chosen (count,):
-    the points' endpoint numbers; end_share (E,): each endpoint's share of the horizontal impulse
-    the step before, updated (the shared-friction iteration starts from it)."""
+    responses (M, M, 3, 3), system (M + 3, M + 4), mixing (3, M, M), shares (3, M): work space.
+    chosen (count,): the points' endpoint numbers; end_share (E,): each endpoint's share of the
+    horizontal impulse the step before, updated (the shared-friction iteration starts from
+    it)."""
     impulse[:count, :] = 0.0
-    active = work[0]
-    weight = work[1]
-    share = work[2]
+    active = shares[0]
+    weight = shares[1]
+    share = shares[2]
     for i in range(count):
         share[i] = end_share[chosen[i]]
     end_share[:] = 0.0
@@ -625,17 +778,28 @@ def contact_impulses(
         return
     for i in range(count):
         for j in range(count):
-            response(r[i], r[j], inverse_mass, world_inverse, responses[i, j])
+            response(r, i, j, inverse_mass, world_inverse, responses)
     # three or more points: a rigid body often leaves their split undecided
     compliance = 0.0 if n < 3 else COMPLIANCE * (responses[0, 0, 0, 0] + responses[0, 0, 1, 1])
     while n >= 2:
         worst = _shared_friction(
-            u, r, active, count, responses, impulse, system, weight, compliance, share, True
+            u, r, active, count, responses, impulse, system, mixing, weight, compliance, share, True
         )
         if worst == -1 and _twist_too_strong(impulse, active, count) or worst == -3:
             # slide only: the paper's rule as it is
             worst = _shared_friction(
-                u, r, active, count, responses, impulse, system, weight, compliance, share, False
+                u,
+                r,
+                active,
+                count,
+                responses,
+                impulse,
+                system,
+                mixing,
+                weight,
+                compliance,
+                share,
+                False,
             )
         if worst == -2 and compliance == 0.0:
             # the rigid body leaves the split undecided: a little compliance decides it
@@ -654,7 +818,7 @@ def contact_impulses(
         active[worst] = 0.0
         n -= 1
         impulse[:count, :] = 0.0
-    tried = work[1]
+    tried = shares[1]
     tried[:count] = 0.0
     for _ in range(count):
         first = -1
@@ -664,7 +828,7 @@ def contact_impulses(
         if first < 0:
             return
         tried[first] = 1.0
-        px, py, pz = stop_dead(u, responses, first, system)
+        px, py, pz = stop_dead(u, responses, first)
         if py <= 0.0:
             continue
         impulse[first, 0] = px
@@ -677,57 +841,79 @@ def contact_impulses(
         impulse[first, :] = 0.0
 
 
-@njit(cache=True, error_model="numpy")
-def step(
-    parent,
-    hinge,
-    rest,
-    length,
-    mass,
-    com,
-    inertia,
-    joint,
-    endpoints,
-    joint_min,
-    joint_max,
-    gravity,
-    floor,
-    state,
-    target,
-    tau,
-    dt,
-    previous,
-    rod_ends,
-    end_offset,
-    end_velocity,
-    end_force,
-    frames,
-    scratch,
-    matrices,
-    vectors,
-    contact,
-    responses,
-    system,
-    work,
-    chosen,
-    entry,
-    end_share,
-):
-    """Advance the state (S,) of a figure (its arrays as in FigureArrays3D) by dt seconds toward
-    the target pose (J,) rad with time constant tau s. ``previous`` (3,): the deformation's own
-    spin I⁻¹ h in the world before the step (rad/s), updated to the one after it. Fills rod_ends
-    (N, 2, 3) with world positions of every rod's ends after the step (m), end_force (E,) the
-    ground's normal force on each endpoint over the step, N. Work space: end_offset and
-    end_velocity (E, 3) (end_offset must hold the endpoints as the previous step or the start
-    left them), frames (N, 3, 3), scratch (N, 7, 3) (``new_scratch``), matrices (5, 3, 3),
-    vectors (3, 4), contact (3, M, 3), responses (M, M, 3, 3), system (M + 3, M + 4), work
-    (3, M), chosen (M,) int64, entry (E, 3), end_share (E,) (zeros at the start); M =
-    MAX_CONTACTS. The state must be sound (``kernels.soundness.state_is_sound``): the runs of
+class StepWork(NamedTuple):
+    """What ``step`` keeps between steps and works in, for a figure of N rods and E endpoints
+    (``new_step_work`` makes it); M = MAX_CONTACTS. ``previous``, ``end_offset``,
+    ``end_share`` and the last two rows of ``scratch`` carry from one step to the next;
+    ``rod_ends`` and ``end_force`` are the step's outputs; the rest is scratch."""
+
+    previous: np.ndarray  # (3,) the deformation's own spin I⁻¹ h in the world, rad/s
+    rod_ends: np.ndarray  # (N, 2, 3) every rod's ends in the world after the step, m
+    end_offset: np.ndarray  # (E, 3) each endpoint from the centre of mass, body frame, m
+    end_velocity: np.ndarray  # (E, 3) each endpoint's velocity from the deformation, m/s
+    end_force: np.ndarray  # (E,) the ground's normal force on each endpoint over the step, N
+    frames: np.ndarray  # (N, 3, 3) each rod's frame in the body frame
+    scratch: np.ndarray  # (N, 7, 3) ``body_frame``'s (``new_scratch``)
+    matrices: np.ndarray  # (5, 3, 3) rotation, tensor, its inverse, world inverse, half turn
+    vectors: np.ndarray  # (3, 4) spin, body rate, half-step quaternion
+    contact: np.ndarray  # (3, M, 3) the contacts' velocities, offsets and impulses
+    responses: np.ndarray  # (M, M, 3, 3) the contacts' responses
+    system: np.ndarray  # (M + 3, M + 4) the shared-friction system
+    mixing: np.ndarray  # (3, M, M) the shared-friction shares' memory (Anderson mixing)
+    shares: np.ndarray  # (3, M) active flags, weights and last shares of the contacts
+    chosen: np.ndarray  # (M,) int64 the contacts' endpoints
+    entry: np.ndarray  # (E, 3) each endpoint in the world before the step, m
+    end_share: np.ndarray  # (E,) each endpoint's share of the horizontal impulse last step
+
+
+@njit(cache=True)
+def new_step_work(n_rods, n_ends):
+    """A StepWork for N = n_rods rods and E = n_ends endpoints, at rest: no spin, no contact
+    before, no force; its ``end_offset`` must then be filled (``body_frame``) before a step."""
+    m = MAX_CONTACTS
+    return StepWork(
+        np.zeros(3),
+        np.empty((n_rods, 2, 3)),
+        np.empty((n_ends, 3)),
+        np.empty((n_ends, 3)),
+        np.zeros(n_ends),
+        np.empty((n_rods, 3, 3)),
+        new_scratch(n_rods),
+        np.empty((5, 3, 3)),
+        np.zeros((3, 4)),
+        np.empty((3, m, 3)),
+        np.empty((m, m, 3, 3)),
+        np.empty((m + 3, m + 4)),
+        np.empty((3, m, m)),
+        np.empty((3, m)),
+        np.empty(m, np.int64),
+        np.empty((n_ends, 3)),
+        np.zeros(n_ends),
+    )
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def step(figure, state, target, tau, dt, work, place_rods):
+    """Advance the state (S,) of a figure (a FigureArrays3D) by dt seconds toward the target pose
+    (J,) rad with time constant tau s, in the StepWork ``work`` (``work.previous``: the
+    deformation's own spin before the step, updated to the one after it; ``work.end_offset``
+    must hold the endpoints as the previous step or the start left them). Fills
+    ``work.end_force`` with the ground's normal force on each endpoint over the step and, if
+    place_rods, ``work.rod_ends`` with the world positions of every rod's ends after the step
+    (else it keeps them in the body frame, from the centre of mass: a run that records no
+    motion skips placing them). The state
+    must be sound (``kernels.soundness.state_is_sound``): the runs of
     ``kernels.bsr3d_controller`` check it before every step and stop where it is not.
 
-    One piece on purpose, its arrays one by one, as the 2-D step (that module's docstring says
-    why).
+    One piece on purpose, as the 2-D step (that module's docstring says why); inlined where it
+    is called, so that no array crosses a call each step.
     """
+    parent, hinge, rest, length, mass, com, inertia, joint, endpoints = figure[:9]
+    joint_min, joint_max, gravity, floor, _ = figure[9:]
+    previous, rod_ends, end_offset, end_velocity, end_force, frames, scratch = work[:7]
+    matrices, vectors, contact, responses, system, mixing, shares, chosen, entry, end_share = work[
+        7:
+    ]
     rotation = matrices[0]
     tensor = matrices[1]
     tensor_inverse = matrices[2]
@@ -791,7 +977,7 @@ def step(
     if not math.isnan(floor):
         # the endpoints (at most M, the lowest) that would end the step within the contact
         # tolerance of the floor (speculative contacts, as in 2-D)
-        lowest = work[1]
+        lowest = shares[1]
         count = 0
         for e in range(n_ends):
             _, ry, _, _, uy, _ = endpoint_motion(
@@ -833,7 +1019,8 @@ def step(
             impulse,
             responses,
             system,
-            work,
+            mixing,
+            shares,
             chosen,
             end_share,
         )
@@ -909,8 +1096,8 @@ def step(
             u[0, 1] = uy
             u[0, 2] = uz
             inverse_mass = 1.0 / total_mass
-            response(r[0], r[0], inverse_mass, world_inverse, responses[0, 0])
-            px, py, pz = stop_dead(u, responses, 0, system)
+            response(r, 0, 0, inverse_mass, world_inverse, responses)
+            px, py, pz = stop_dead(u, responses, 0)
             if py <= 0.0:
                 # horizontal only: solve the x-z block for zero horizontal velocity
                 k = responses[0, 0]
@@ -929,6 +1116,8 @@ def step(
             if entry[bottom, 1] - floor <= CONTACT_TOLERANCE:
                 state[CX] = entry[bottom, 0] - rx
                 state[CZ] = entry[bottom, 2] - rz
+    if not place_rods:
+        return
     for k in range(rod_ends.shape[0]):
         for end in range(2):
             x, y, z = apply(rotation, rod_ends[k, end, 0], rod_ends[k, end, 1], rod_ends[k, end, 2])
