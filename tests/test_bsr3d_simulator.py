@@ -76,8 +76,7 @@ class Stepper:
         self.figure = figure
         self.state = np.asarray(state, float).copy()
         self.work = sim.new_step_work(figure.parent.shape[0], figure.endpoints.shape[0])
-        tensor = self.body()
-        self.work.previous[:] = self.rotation() @ np.linalg.solve(tensor, self.work.vectors[0, :3])
+        sim.start_step_work(figure, self.state, self.work)
 
     @property
     def angles(self) -> np.ndarray:

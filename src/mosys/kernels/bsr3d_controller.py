@@ -43,14 +43,11 @@ from mosys.kernels.bsr3d_simulate import (
     CZ,
     JOINTS,
     LX,
-    QW,
     VX,
     apply,
-    body_frame,
     conjugate,
-    invert_symmetric,
     new_step_work,
-    rotation_of,
+    start_step_work,
     step,
 )
 from mosys.kernels.bsr_controller import (
@@ -161,10 +158,9 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
     n_rods = parent.shape[0]
     n_ends = endpoints.shape[0]
     work = new_step_work(n_rods, n_ends)
-    rod_ends, end_offset, end_velocity, end_force, frames, scratch = work[1:7]
+    rod_ends, end_offset, _, end_force, frames = work[1:6]
     matrices, vectors = work[7:9]
     end_force[:] = start_force
-    rotation = np.empty((3, 3))
     world_inverse = np.empty((3, 3))
     sensing = senses_out.shape[1] > 0
     raw = np.empty(senses_out.shape[1])
@@ -172,32 +168,9 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
     weight = mass.sum() * gravity
     recording = ends_out.shape[0] == steps + 1
     weights = rule_weights(side)
-    n_joints = joint_min.shape[0]
-    body_frame(
-        parent,
-        hinge,
-        rest,
-        length,
-        mass,
-        com,
-        inertia,
-        joint,
-        endpoints,
-        state[JOINTS : JOINTS + n_joints],
-        state[JOINTS + n_joints : JOINTS + 2 * n_joints],
-        rod_ends,
-        end_offset,
-        end_velocity,
-        frames,
-        scratch,
-        matrices[1],
-        vectors[0, :3],
-    )
-    invert_symmetric(matrices[1], matrices[2])
-    rotation_of(state[QW : QW + 4], rotation)
+    start_step_work(figure, state, work)
+    rotation = matrices[0]
     conjugate(rotation, matrices[2], world_inverse)
-    sx, sy, sz = apply(matrices[2], vectors[0, 0], vectors[0, 1], vectors[0, 2])
-    work.previous[0], work.previous[1], work.previous[2] = apply(rotation, sx, sy, sz)
     # the start
     n_feet = task.feet.shape[0]
     foot_start = np.empty((n_feet, 3))

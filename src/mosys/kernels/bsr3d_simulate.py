@@ -20,7 +20,9 @@ and ground contact act on the rigid figure: impulses at every rod endpoint that 
 step on the floor (up to ``MAX_CONTACTS``, the lowest first), with the paper's friction carried
 to 3-D: a lone contact does not slide; several take horizontal impulses in the ratio of their
 normal impulses, sized so that their normal-impulse-weighted horizontal velocity is zero (a
-fixed point over the weights). Contacts whose normal impulse would pull are dropped one at a
+fixed point over the weights: each iteration a symmetric positive definite solve, its normal
+block factored once; Anderson mixing of the weights for three or more contacts, where the plain
+iteration would take twice as many). Contacts whose normal impulse would pull are dropped one at a
 time. An endpoint that still ends the step below the floor lifts the figure out of it, and an
 endpoint alone on the floor is stopped and held where it stood, as in 2-D.
 
@@ -78,7 +80,7 @@ def new_scratch(n_rods):
     return np.full((n_rods, 7, 3), np.nan)
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _cross(ax, ay, az, bx, by, bz):
     return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
 
@@ -267,7 +269,7 @@ def body_frame(
     return total_mass
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def rotation_of(quaternion, out):
     """The rotation matrix (3, 3) of a unit quaternion (w, x, y, z), into out."""
     w = quaternion[0]
@@ -285,7 +287,7 @@ def rotation_of(quaternion, out):
     out[2, 2] = 1.0 - 2.0 * (x * x + y * y)
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def turn(quaternion, ax, ay, az):
     """Turn the unit quaternion (4,) in place by the world rotation vector (ax, ay, az), rad,
     and renormalise it (the drift correction)."""
@@ -311,7 +313,7 @@ def turn(quaternion, ax, ay, az):
         quaternion[a] /= norm
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def invert_symmetric(matrix, out):
     """The inverse (3, 3) of a symmetric positive definite matrix, into out."""
     a = matrix[0, 0]
@@ -332,7 +334,7 @@ def invert_symmetric(matrix, out):
     out[2, 2] = (a * d - b * b) / det
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def conjugate(rotation, matrix, out):
     """out = rotation @ matrix @ rotation.T, all (3, 3)."""
     for a in range(3):
@@ -346,7 +348,7 @@ def conjugate(rotation, matrix, out):
             out[a, b] = total
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def apply(matrix, x, y, z):
     """matrix (3, 3) @ (x, y, z)."""
     return (
@@ -356,7 +358,7 @@ def apply(matrix, x, y, z):
     )
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def endpoint_position(state, rotation, end_offset, e):
     """World (x, y, z) of endpoint e, m, from its offset from the centre of mass in the body
     frame (end_offset (E, 3)) and the body's orientation (rotation (3, 3))."""
@@ -364,7 +366,7 @@ def endpoint_position(state, rotation, end_offset, e):
     return state[CX] + x, state[CY] + y, state[CZ] + z
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def endpoint_motion(state, rotation, body_rate, end_offset, end_velocity, e):
     """Endpoint e's offset (rx, ry, rz) from the centre of mass in the world, m, and its
     velocity (ux, uy, uz), m/s: the body's motion (velocity of the centre of mass, rotation at
@@ -890,6 +892,44 @@ def new_step_work(n_rods, n_ends):
         np.empty((n_ends, 3)),
         np.zeros(n_ends),
     )
+
+
+@njit(cache=True, error_model="numpy")
+def start_step_work(figure, state, work):
+    """Make the StepWork ``work`` ready for a first step from the state (S,): the body-frame
+    quantities of its pose (``body_frame``: the endpoints, rods and frames, the inertia tensor in
+    work.matrices[1] and its inverse in work.matrices[2], the deformation's spin in
+    work.vectors[0, :3]), the body's rotation in work.matrices[0], and the deformation's own
+    spin I⁻¹ h in the world in work.previous. Kept out of ``step``'s callers' code (a call, not
+    inlined): one copy of ``body_frame`` inlined there is enough to compile."""
+    parent, hinge, rest, length, mass, com, inertia, joint, endpoints = figure[:9]
+    n_joints = figure.joint_min.shape[0]
+    matrices = work.matrices
+    vectors = work.vectors
+    body_frame(
+        parent,
+        hinge,
+        rest,
+        length,
+        mass,
+        com,
+        inertia,
+        joint,
+        endpoints,
+        state[JOINTS : JOINTS + n_joints],
+        state[JOINTS + n_joints : JOINTS + 2 * n_joints],
+        work.rod_ends,
+        work.end_offset,
+        work.end_velocity,
+        work.frames,
+        work.scratch,
+        matrices[1],
+        vectors[0, :3],
+    )
+    invert_symmetric(matrices[1], matrices[2])
+    rotation_of(state[QW : QW + 4], matrices[0])
+    sx, sy, sz = apply(matrices[2], vectors[0, 0], vectors[0, 1], vectors[0, 2])
+    work.previous[0], work.previous[1], work.previous[2] = apply(matrices[0], sx, sy, sz)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
