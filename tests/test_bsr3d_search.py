@@ -115,3 +115,21 @@ def test_continuing_a_result_without_a_final_state_is_a_clear_error(tmp_path):
         chain_start("cujo_bound", [old])
     with pytest.raises(InputError, match="no result files of search 'cujo_bound'"):
         chain_start("cujo_bound", [])
+
+
+def test_final_spin_is_the_bodys_rate_at_the_end():
+    """``final_spin`` is the rigid body's angular speed I⁻¹ (L - h) at the final state, computed
+    here from the state alone (its pose's inertia tensor and the deformation's own spin)."""
+    from mosys.kernels import bsr3d_simulate as sim
+    from mosys.parsing.bsr import FITNESS_TERMS_3D
+
+    outcome = run_search(setup(), 1)
+    state = outcome.final_state
+    work = sim.new_step_work(CUJO.arrays.parent.shape[0], CUJO.arrays.endpoints.shape[0])
+    sim.start_step_work(CUJO.arrays, state, work)
+    rotation, tensor_inverse = work.matrices[0], work.matrices[2]
+    momentum = state[sim.LX : sim.LX + 3] - rotation @ work.vectors[0, :3]
+    rate = rotation @ tensor_inverse @ rotation.T @ momentum
+    measured = outcome.terms[FITNESS_TERMS_3D.index("final_spin")]
+    assert measured == pytest.approx(np.degrees(np.linalg.norm(rate)), rel=1e-9)
+    assert measured > 1.0  # a run of a random controller ends moving

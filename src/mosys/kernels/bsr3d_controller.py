@@ -23,7 +23,9 @@ below ``fall_height`` or a ``fall`` endpoint on the floor); ``heading_deviation`
 of the feet along the heading at t = 0, m; ``foot_steps`` the touch-downs (after a lift of at
 least ``STEP_LIFT``) of a foot other than the one that touched down last; ``min_height`` the
 lowest com height, m; ``heading_sine`` the sine of the heading change (1: a quarter turn to the
-left, whatever the turns before it: a turn that a spin does not beat).
+left, whatever the turns before it: a turn that a spin does not beat); ``final_spin`` the body's
+angular speed at the end, deg/s (a run that ends toppling or spinning pays for it: the next
+search of a chain starts there).
 
 A run stops where the state is not sound (``kernels.soundness.state_is_sound``), as the 2-D
 one does: checked before every step and after the last, it returns ``blown_up(step)`` (< 0).
@@ -73,8 +75,9 @@ from mosys.kernels.soundness import state_is_sound
     FOOT_STEPS,
     MIN_HEIGHT,
     HEADING_SINE,
-) = range(10)
-TERM_COUNT = 10
+    FINAL_SPIN,
+) = range(11)
+TERM_COUNT = 11
 PHYSICAL_SENSES = 10  # height, velocity (3), angular velocity (3), up (3)
 STEP_LIFT = 0.01  # m: a foot that comes down counts as a step if it rose this high since it left
 
@@ -317,6 +320,11 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
     terms_out[FOOT_STEPS] = foot_steps
     terms_out[MIN_HEIGHT] = min_height
     terms_out[HEADING_SINE] = math.sin(heading - heading_start)
+    # the body's rate at the end: I⁻¹ (L - h) in the world (the deformation's own spin h)
+    conjugate(rotation, matrices[2], world_inverse)
+    hx, hy, hz = apply(rotation, vectors[0, 0], vectors[0, 1], vectors[0, 2])
+    wx, wy, wz = apply(world_inverse, state[LX] - hx, state[LX + 1] - hy, state[LX + 2] - hz)
+    terms_out[FINAL_SPIN] = math.degrees(math.sqrt(wx * wx + wy * wy + wz * wz))
     final_state[:] = state
     final_force[:] = end_force
     return steps

@@ -112,6 +112,7 @@ TERMS_3D = {
     "foot_steps": ("foot steps", "", ".0f"),
     "min_height": ("min height", "m", ".2f"),
     "heading_sine": ("sin(heading change)", "", "+.2f"),
+    "final_spin": ("final spin", "deg/s", ".0f"),
     **TERMS,
 }
 LEGEND_WIDTH = 130  # characters of a filmstrip legend's line of terms
