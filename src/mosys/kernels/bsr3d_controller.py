@@ -44,11 +44,11 @@ from mosys.kernels.bsr3d_simulate import (
     CY,
     CZ,
     JOINTS,
-    LX,
     VX,
     apply,
     conjugate,
     new_step_work,
+    rigid_rate,
     start_step_work,
     step,
 )
@@ -128,8 +128,7 @@ def measure_senses(
             + rotation[2, a] * state[VX + 2]
         )
         out[1 + a] = min(max(0.5 + value / (2.0 * v0), 0.0), 1.0)
-    hx, hy, hz = apply(rotation, spin[0], spin[1], spin[2])
-    wx, wy, wz = apply(world_inverse, state[LX] - hx, state[LX + 1] - hy, state[LX + 2] - hz)
+    wx, wy, wz = rigid_rate(state, rotation, world_inverse, spin)
     for a in range(3):
         value = rotation[0, a] * wx + rotation[1, a] * wy + rotation[2, a] * wz
         out[4 + a] = min(max(0.5 + value / (2.0 * w0), 0.0), 1.0)
@@ -322,8 +321,7 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
     terms_out[HEADING_SINE] = math.sin(heading - heading_start)
     # the body's rate at the end: I⁻¹ (L - h) in the world (the deformation's own spin h)
     conjugate(rotation, matrices[2], world_inverse)
-    hx, hy, hz = apply(rotation, vectors[0, 0], vectors[0, 1], vectors[0, 2])
-    wx, wy, wz = apply(world_inverse, state[LX] - hx, state[LX + 1] - hy, state[LX + 2] - hz)
+    wx, wy, wz = rigid_rate(state, rotation, world_inverse, vectors[0, :3])
     terms_out[FINAL_SPIN] = math.degrees(math.sqrt(wx * wx + wy * wy + wz * wz))
     final_state[:] = state
     final_force[:] = end_force

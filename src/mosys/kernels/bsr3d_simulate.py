@@ -358,6 +358,15 @@ def apply(matrix, x, y, z):
     )
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def rigid_rate(state, rotation, world_inverse, spin):
+    """The body's angular velocity (x, y, z), rad/s, world: I⁻¹ (L - h), L the state's (S,)
+    angular momentum and h the deformation's own (spin (3,), body frame, turned to the world by
+    rotation (3, 3)); world_inverse (3, 3): the inverse inertia tensor in the world."""
+    hx, hy, hz = apply(rotation, spin[0], spin[1], spin[2])
+    return apply(world_inverse, state[LX] - hx, state[LX + 1] - hy, state[LX + 2] - hz)
+
+
 @njit(cache=True, error_model="numpy")
 def endpoint_position(state, rotation, end_offset, e):
     """World (x, y, z) of endpoint e, m, from its offset from the centre of mass in the body
@@ -1007,10 +1016,7 @@ def step(figure, state, target, tau, dt, work, place_rods):
     rotation_of(quaternion, rotation)
     conjugate(rotation, tensor_inverse, world_inverse)
     state[VY] -= gravity * dt
-    hx, hy, hz = apply(rotation, spin[0], spin[1], spin[2])
-    body_rate[0], body_rate[1], body_rate[2] = apply(
-        world_inverse, state[LX] - hx, state[LX + 1] - hy, state[LX + 2] - hz
-    )
+    body_rate[0], body_rate[1], body_rate[2] = rigid_rate(state, rotation, world_inverse, spin)
     end_force[:] = 0.0
     pushing = 0
     pinned = -1
@@ -1120,9 +1126,8 @@ def step(figure, state, target, tau, dt, work, place_rods):
             # one endpoint down does not slide, however it came to be alone on the floor (as in
             # 2-D): stopped dead if that pushes, else horizontally, and held where it stood
             conjugate(rotation, tensor_inverse, world_inverse)
-            hx, hy, hz = apply(rotation, spin[0], spin[1], spin[2])
-            body_rate[0], body_rate[1], body_rate[2] = apply(
-                world_inverse, state[LX] - hx, state[LX + 1] - hy, state[LX + 2] - hz
+            body_rate[0], body_rate[1], body_rate[2] = rigid_rate(
+                state, rotation, world_inverse, spin
             )
             u = contact[0]
             r = contact[1]
