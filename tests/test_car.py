@@ -428,3 +428,46 @@ def test_a_run_that_touches_an_obstacle_is_a_failure_even_if_it_ends_parked():
     assert not outcome.parked
     assert outcome.collided_with == "curb"
     assert 0 < outcome.collision_index < 50
+
+
+def transitions_of(problem, car, classes):
+    """The exit transitions of ``problem``, its classes replayed or (None) every node
+    integrated."""
+    from mosys.ssc import generate
+
+    transitions = generate.Transitions.empty(
+        problem.node_valid, problem.control_samples.shape[0], len(problem.grid.names)
+    )
+    kernel = generate.specialise(generate.exit_transitions_template, car, parallel=True)
+    arguments = generate.exit_transition_arguments(
+        problem, car, problem.spec.dt, transitions.row_of
+    )
+    generate.compute_transitions(kernel, arguments, problem, transitions, classes, quiet=True)
+    return transitions
+
+
+@pytest.mark.parametrize("policy", ["", "policy lookahead x=0.3 y=0.2 heading=10\n"])
+def test_replaying_each_class_gives_the_transitions_of_integrating_every_node(car, policy):
+    """The car's equations read neither x nor y, so each (heading, steer, speed) class is
+    integrated once and replayed at its nodes, with the obstacles, the domain and the arrival
+    box tested at each node: the same exits as integrating from every node, to rounding."""
+    from mosys.ssc.generate import MotionClasses
+
+    problem = build_problem(parse_controller_text(SMALL + policy, "small.ssc"), car)
+    classes = MotionClasses.of(problem, car)
+    assert classes is not None and classes.representative.size == 3 * 3 * 3
+    replayed = transitions_of(problem, car, classes)
+    integrated = transitions_of(problem, car, None)
+    cost = integrated.segment_cost
+    finite = np.isfinite(cost)
+    assert 0 < finite.sum() < cost.size  # obstacles and the domain discard some segments
+    np.testing.assert_array_equal(np.isfinite(replayed.segment_cost), finite)
+    np.testing.assert_allclose(replayed.segment_cost[finite], cost[finite], rtol=1e-12)
+    weight = integrated.exit_weight
+    np.testing.assert_allclose(replayed.exit_weight, weight, atol=1e-6)
+    used = weight > 0
+    np.testing.assert_array_equal(replayed.exit_index[used], integrated.exit_index[used])
+    if policy:  # some segments end braking into the arrival box, at the destination node
+        terminal = np.flatnonzero(problem.is_destination)[0]
+        arrivals = (integrated.exit_index[..., 0] == terminal) & (weight[..., 0] == 1.0)
+        assert arrivals.sum() > 0

@@ -53,6 +53,8 @@ SPEC_SHA256 = {json.dumps(vehicle.spec_sha256)}
 STATE_NAMES = {STATE_NAMES!r}
 STATE_UNITS = {STATE_UNITS!r}  # spec units
 COORDINATE_COUNT = 4  # x, y, heading, steer are positions; speed is a rate
+# the equations read neither x nor y: a motion from any x, y is the same motion, moved
+IGNORABLE_STATES = ('x', 'y')
 INPUT_NAMES = {INPUT_NAMES!r}
 INPUT_UNITS = {INPUT_UNITS!r}  # spec units of the controls
 

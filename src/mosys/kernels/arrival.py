@@ -12,12 +12,11 @@ from mosys.kernels.regions import inside_region
 
 
 @njit(cache=True)
-def stops_in_box(state, vehicle_slot, wheelbase, wheel_radius, brake, state_slot, box, stop):
-    """True when the state where full braking from ``state`` ends lies in the arrival box
-    (``box`` (3, d): lower, upper and period over the controller's axes, as ``inside_region``
-    takes them). Braking, steering held, the front wheels roll s = v|v| / 2a: the heading turns
-    by s sin(steer) / wheelbase and the reference point moves s along the mean of the start and
-    end heading, plus steer. stop: (d,) work array, the controller state where it stops."""
+def braking_stop(state, vehicle_slot, wheelbase, wheel_radius, brake, state_slot, stop):
+    """Into stop (d,): the controller state where full braking from model state ``state`` ends.
+    Braking, steering held, the front wheels roll s = v|v| / 2a: the heading turns by
+    s sin(steer) / wheelbase and the reference point moves s along the mean of the start and end
+    heading, plus steer; the speed ends at 0."""
     speed = state[vehicle_slot[4]]
     steer = state[vehicle_slot[3]]
     distance = speed * abs(speed) / (2.0 * wheel_radius * brake)
@@ -34,4 +33,12 @@ def stops_in_box(state, vehicle_slot, wheelbase, wheel_radius, brake, state_slot
             stop[k] += turn
         elif slot == vehicle_slot[4]:
             stop[k] = 0.0
+
+
+@njit(cache=True)
+def stops_in_box(state, vehicle_slot, wheelbase, wheel_radius, brake, state_slot, box, stop):
+    """True when the state where full braking from ``state`` ends (``braking_stop``) lies in the
+    arrival box (``box`` (3, d): lower, upper and period over the controller's axes, as
+    ``inside_region`` takes them). stop: (d,) work array, the controller state where it stops."""
+    braking_stop(state, vehicle_slot, wheelbase, wheel_radius, brake, state_slot, stop)
     return inside_region(stop, box[0], box[1], box[2])

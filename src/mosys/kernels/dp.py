@@ -24,9 +24,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from mosys.kernels.arrival import stops_in_box
+from mosys.kernels.arrival import braking_stop, stops_in_box
 from mosys.kernels.figure_state import load_state
-from mosys.kernels.geometry import pose_is_free
+from mosys.kernels.geometry import box_is_clear, place_outline, pose_is_free
 from mosys.kernels.interpolate import corner_weights, grid_strides, interpolation_scratch
 from mosys.kernels.prefetch import prefetch
 from mosys.kernels.soundness import state_is_sound
@@ -57,6 +57,19 @@ def node_coordinates(axis_min, axis_step, axis_count, node, out):
     for k in range(axis_count.shape[0] - 1, -1, -1):
         out[k] = axis_min[k] + axis_step[k] * (rest % axis_count[k])
         rest //= axis_count[k]
+
+
+PLAIN, RECORD, REPLAY = 0, 1, 2  # the exit kernel's record modes (``exit_transitions_template``)
+
+
+@njit(cache=True)
+def axis_of_slot(state_slot, slot):
+    """The controller axis whose model-state slot is ``slot`` (state_slot (d,) int64), 0 if
+    none is."""
+    for k in range(state_slot.shape[0]):
+        if state_slot[k] == slot:
+            return k
+    return 0
 
 
 WEIGHT_EPSILON = 1e-9  # interpolation weights below this are rounding noise
@@ -216,6 +229,13 @@ def exit_transitions_template(
     exit_index,
     exit_weight,
     segment_cost,
+    record_mode,
+    class_of,
+    record_start,
+    record_count,
+    record,
+    relative_slot,
+    segment_box,
 ):
     """Simulate every (node, control sample) pair until it leaves the node's cell; a template
     (``specialise.specialise``, with the model's ``derivative_into`` as ``model_derivative``).
@@ -251,12 +271,30 @@ def exit_transitions_template(
     exit_weight (R, U, 2**(d-1)) float32, the nodes and weights interpolating the exit state on
     the face it crosses; segment_cost (R, U) float64, inf where the segment never leaves the
     cell, leaves the domain or hits an obstacle, nan where its state became non-finite.
+
+    Models whose equations do not read some controller coordinates (``IGNORABLE_STATES``: the
+    car's x and y) move the same way from every node of a *class* (the nodes that differ only
+    in those coordinates), so the integration is done once per class and control and replayed
+    at each node, where only the obstacles, the arrival box and the domain differ.
+    record_mode ``RECORD`` integrates from ``nodes`` (one per class, ``row_of`` giving its
+    class; no obstacles, no arrival) and writes each segment's steps to ``record`` (T, 2S + 1)
+    from row record_start[class, u] (C, U) int64 on: row 0 holds the rate at the start (columns
+    S..2S-1), then a row per accepted step: its end state (the slots where relative_slot (S,)
+    bool is True relative to the start), the rate there and the step, s; record_count (C, U)
+    int64 gets the rows (with an empty ``record``, only they are counted). ``REPLAY`` takes
+    each node's steps from its class's rows (class_of (N,) int64) instead of integrating, and
+    tests a step for obstacles only where the box the class's body sweeps (segment_box (C, U,
+    8), ``segment_boxes``), moved to the node, meets one, and for arrival only where the box of
+    its braking points meets the arrival box. ``PLAIN`` (empty record arrays) integrates every
+    pair.
     """
     d = axis_min.shape[0]
     size = base_state.shape[0]
     n_controls = control_samples.shape[0]
     strides = np.empty(d, np.int64)
     grid_strides(axis_count, strides)
+    x_axis = axis_of_slot(state_slot, vehicle_slot[0])  # the vehicle's reference point
+    y_axis = axis_of_slot(state_slot, vehicle_slot[1])
     for p in prange(nodes.shape[0]):
         node = nodes[p]
         row = row_of[node]
@@ -274,8 +312,14 @@ def exit_transitions_template(
         after = np.empty(size)
         inputs = np.zeros(input_size)
         body = np.empty_like(outline)
+        shift = np.empty(size)  # a replayed step's offset: the start state on relative slots
         integer_scratch, fraction, corner_index, corner_weight = interpolation_scratch(d)
         node_coordinates(axis_min, axis_step, axis_count, node, center)
+        load_state(center, state_slot, base_state, shift)
+        for i in range(size):
+            if not relative_slot[i]:
+                shift[i] = 0.0
+        segment_class = class_of[node] if record_mode == REPLAY else row
         for u in range(n_controls):
             load_state(center, state_slot, base_state, state)
             for i in range(input_size):
@@ -288,69 +332,126 @@ def exit_transitions_template(
             for i in range(exit_index.shape[2]):
                 exit_index[row, u, i] = node
                 exit_weight[row, u, i] = 0.0
-            model_derivative(state, inputs, k1)
+            first_row = record_start[segment_class, u] if record_mode != PLAIN else 0
+            if record_mode == REPLAY:
+                for i in range(size):
+                    k1[i] = record[first_row, size + i]
+            else:
+                model_derivative(state, inputs, k1)
+            if record_mode == RECORD:
+                record_count[segment_class, u] = 1
+                if record.shape[0] > 0:
+                    for i in range(size):
+                        record[first_row, i] = state[i] - shift[i]
+                        record[first_row, size + i] = k1[i]
+                    record[first_row, 2 * size] = 0.0
             elapsed = 0.0
             h = max_step
+            replayed = 0
+            obstacles = obstacle_start
+            arriving = arrives
+            if record_mode == REPLAY:
+                box = segment_box[segment_class, u]
+                if pose_slot[0] >= 0:
+                    x = shift[pose_slot[0]]
+                    y = shift[pose_slot[1]]
+                    if box_is_clear(
+                        box[0] + x, box[1] + x, box[2] + y, box[3] + y, obstacle_vertices, obstacles
+                    ):
+                        obstacles = obstacle_start[:1]  # none
+                if arrives:
+                    x = shift[vehicle_slot[0]]
+                    y = shift[vehicle_slot[1]]
+                    arriving = (
+                        box[4] + x <= arrival_box[1, x_axis]
+                        and box[5] + x >= arrival_box[0, x_axis]
+                        and box[6] + y <= arrival_box[1, y_axis]
+                        and box[7] + y >= arrival_box[0, y_axis]
+                    )
             while elapsed < MAX_SEGMENT_SECONDS:
-                for k in range(d):
-                    speed = abs(k1[state_slot[k]])
-                    if speed * h > CELL_FRACTION * axis_step[k]:
-                        h = CELL_FRACTION * axis_step[k] / speed
-                for i in range(size):
-                    after[i] = state[i] + h * (A21 * k1[i])
-                model_derivative(after, inputs, k2)
-                for i in range(size):
-                    after[i] = state[i] + h * (A31 * k1[i] + A32 * k2[i])
-                model_derivative(after, inputs, k3)
-                for i in range(size):
-                    after[i] = state[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
-                model_derivative(after, inputs, k4)
-                for i in range(size):
-                    after[i] = state[i] + h * (
-                        A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i]
-                    )
-                model_derivative(after, inputs, k5)
-                for i in range(size):
-                    after[i] = state[i] + h * (
-                        A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]
-                    )
-                model_derivative(after, inputs, k6)
-                for i in range(size):
-                    after[i] = state[i] + h * (
-                        B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i]
-                    )
-                model_derivative(after, inputs, k7)
-                # the error of the step, in units of the tolerance on each controller axis
-                error = 0.0
-                for k in range(d):
-                    slot = state_slot[k]
-                    estimate = h * (
-                        E1 * k1[slot]
-                        + E3 * k3[slot]
-                        + E4 * k4[slot]
-                        + E5 * k5[slot]
-                        + E6 * k6[slot]
-                        + E7 * k7[slot]
-                    )
-                    error = max(error, abs(estimate) / (STEP_TOLERANCE * axis_step[k]))
-                if not np.isfinite(error):
-                    break  # too stiff to follow at this step: cost stays inf
-                if error > 1.0:
-                    h *= max(0.2, 0.9 * error**-0.2)
-                    if h < MIN_STEP:
-                        break  # too stiff to follow: cost stays inf
-                    continue
+                if record_mode == REPLAY:
+                    replayed += 1
+                    if replayed == record_count[segment_class, u]:
+                        break  # where the class's integration ended: cost stays inf
+                    r = first_row + replayed
+                    for i in range(size):
+                        after[i] = record[r, i] + shift[i]
+                    h = record[r, 2 * size]
+                    last = replayed == record_count[segment_class, u] - 1
+                    if last:  # the only step that can cross: the class's last
+                        for i in range(size):
+                            state[i] = record[r - 1, i] + shift[i]
+                            k1[i] = record[r - 1, size + i]
+                            k7[i] = record[r, size + i]
+                else:
+                    last = True
+                    for k in range(d):
+                        speed = abs(k1[state_slot[k]])
+                        if speed * h > CELL_FRACTION * axis_step[k]:
+                            h = CELL_FRACTION * axis_step[k] / speed
+                    for i in range(size):
+                        after[i] = state[i] + h * (A21 * k1[i])
+                    model_derivative(after, inputs, k2)
+                    for i in range(size):
+                        after[i] = state[i] + h * (A31 * k1[i] + A32 * k2[i])
+                    model_derivative(after, inputs, k3)
+                    for i in range(size):
+                        after[i] = state[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
+                    model_derivative(after, inputs, k4)
+                    for i in range(size):
+                        after[i] = state[i] + h * (
+                            A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i]
+                        )
+                    model_derivative(after, inputs, k5)
+                    for i in range(size):
+                        after[i] = state[i] + h * (
+                            A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]
+                        )
+                    model_derivative(after, inputs, k6)
+                    for i in range(size):
+                        after[i] = state[i] + h * (
+                            B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i]
+                        )
+                    model_derivative(after, inputs, k7)
+                    # the error of the step, in units of the tolerance on each controller axis
+                    error = 0.0
+                    for k in range(d):
+                        slot = state_slot[k]
+                        estimate = h * (
+                            E1 * k1[slot]
+                            + E3 * k3[slot]
+                            + E4 * k4[slot]
+                            + E5 * k5[slot]
+                            + E6 * k6[slot]
+                            + E7 * k7[slot]
+                        )
+                        error = max(error, abs(estimate) / (STEP_TOLERANCE * axis_step[k]))
+                    if not np.isfinite(error):
+                        break  # too stiff to follow at this step: cost stays inf
+                    if error > 1.0:
+                        h *= max(0.2, 0.9 * error**-0.2)
+                        if h < MIN_STEP:
+                            break  # too stiff to follow: cost stays inf
+                        continue
+                    if record_mode == RECORD:
+                        r = first_row + record_count[segment_class, u]
+                        record_count[segment_class, u] += 1
+                        if record.shape[0] > 0:
+                            for i in range(size):
+                                record[r, i] = after[i] - shift[i]
+                                record[r, size + i] = k7[i]
+                            record[r, 2 * size] = h
                 if not state_is_sound(after):  # an accepted step (a nan input passes the error
                     segment_cost[row, u] = np.nan  # test): the caller reports it
                     break
                 if not pose_is_free(
-                    after, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
+                    after, pose_slot, outline, obstacle_vertices, obstacles, domain, body
                 ):
                     break  # hits an obstacle or leaves the domain polygon: cost stays inf
                 # the earliest crossing of the cell boundary within this step
                 crossing = 2.0
                 axis = -1
-                for k in range(d):
+                for k in range(d if last else 0):
                     slot = state_slot[k]
                     s = first_crossing(
                         state[slot],
@@ -365,7 +466,7 @@ def exit_transitions_template(
                         axis = k
                 if (
                     axis < 0
-                    and arrives
+                    and arriving
                     and stops_in_box(
                         after,
                         vehicle_slot,
@@ -384,10 +485,11 @@ def exit_transitions_template(
                     break
                 if axis < 0:
                     elapsed += h
-                    for i in range(size):
-                        state[i] = after[i]
-                        k1[i] = k7[i]
-                    h = min(max_step, h * min(5.0, 0.9 * max(error, 1e-10) ** -0.2))
+                    if record_mode != REPLAY:  # a replay reads both from the record
+                        for i in range(size):
+                            state[i] = after[i]
+                            k1[i] = k7[i]
+                        h = min(max_step, h * min(5.0, 0.9 * max(error, 1e-10) ** -0.2))
                     continue
                 for k in range(d):
                     slot = state_slot[k]
@@ -436,6 +538,58 @@ def exit_transitions_template(
                         exit_index[row, u, i] = corner_index[i]
                         exit_weight[row, u, i] = corner_weight[i] / total
                 break
+
+
+@njit(cache=True)
+def segment_boxes(
+    record,
+    record_start,
+    record_count,
+    pose_slot,
+    outline,
+    arrives,
+    vehicle_slot,
+    wheelbase,
+    wheel_radius,
+    brake,
+    state_slot,
+    out,
+):
+    """out (C, U, 8): for each class segment of a ``RECORD`` (``exit_transitions_template``),
+    the box [x low, x high, y low, y high] (m, relative to the start's reference point) that
+    holds its body (``pose_slot``, ``outline`` as ``geometry.pose_is_free`` takes them) at the
+    end of each of its steps, then the box that holds the points where full braking from them
+    would stop (``arrival.braking_stop``; where ``arrives``). An empty box (low inf, high -inf)
+    where there is nothing to test."""
+    size = (record.shape[1] - 1) // 2
+    body = np.empty_like(outline)
+    stop = np.empty(state_slot.shape[0])
+    x_axis = axis_of_slot(state_slot, vehicle_slot[0])
+    y_axis = axis_of_slot(state_slot, vehicle_slot[1])
+    for c in range(out.shape[0]):
+        for u in range(out.shape[1]):
+            for i in range(0, 8, 2):
+                out[c, u, i] = np.inf
+                out[c, u, i + 1] = -np.inf
+            for j in range(1, record_count[c, u]):
+                state = record[record_start[c, u] + j, :size]
+                if pose_slot[0] >= 0:
+                    place_outline(
+                        outline, state[pose_slot[0]], state[pose_slot[1]], state[pose_slot[2]], body
+                    )
+                    for i in range(body.shape[0]):
+                        out[c, u, 0] = min(out[c, u, 0], body[i, 0])
+                        out[c, u, 1] = max(out[c, u, 1], body[i, 0])
+                        out[c, u, 2] = min(out[c, u, 2], body[i, 1])
+                        out[c, u, 3] = max(out[c, u, 3], body[i, 1])
+                if arrives:
+                    braking_stop(
+                        state, vehicle_slot, wheelbase, wheel_radius, brake, state_slot, stop
+                    )
+                    out[c, u, 4] = min(out[c, u, 4], stop[x_axis])
+                    out[c, u, 5] = max(out[c, u, 5], stop[x_axis])
+                    out[c, u, 6] = min(out[c, u, 6], stop[y_axis])
+                    out[c, u, 7] = max(out[c, u, 7], stop[y_axis])
 
 
 @njit(cache=True)

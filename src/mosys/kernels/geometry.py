@@ -81,11 +81,38 @@ def place_outline(outline, x, y, heading, out):
         out[i, 1] = y + s * outline[i, 0] + c * outline[i, 1]
 
 
+@njit(cache=True, inline="always")
+def _apart(polygon, low_x, high_x, low_y, high_y):
+    """True when every vertex of polygon (V, 2) lies on one side of the box (m): the bounding
+    boxes are apart, so the shapes cannot overlap."""
+    right = left = above = below = True  # of the box, every vertex
+    for i in range(polygon.shape[0]):
+        right = right and polygon[i, 0] > high_x
+        left = left and polygon[i, 0] < low_x
+        above = above and polygon[i, 1] > high_y
+        below = below and polygon[i, 1] < low_y
+    return right or left or above or below
+
+
+@njit(cache=True)
+def box_is_clear(low_x, high_x, low_y, high_y, obstacle_vertices, obstacle_start):
+    """True when the box [low_x, high_x] × [low_y, high_y] (m) is apart from every obstacle's
+    bounding box (obstacles packed as in ``first_collision``): no shape inside it can touch
+    one."""
+    for k in range(obstacle_start.shape[0] - 1):
+        polygon = obstacle_vertices[obstacle_start[k] : obstacle_start[k + 1]]
+        if not _apart(polygon, low_x, high_x, low_y, high_y):
+            return False
+    return True
+
+
 @njit(cache=True)
 def first_collision(outline, x, y, heading, obstacle_vertices, obstacle_start, body):
     """The index of the first obstacle the body overlaps at pose (x, y, heading), or -1.
     obstacle_vertices: (M, 2) every obstacle's vertices in turn; obstacle_start: (K+1,) int64,
     obstacle k is rows obstacle_start[k]:obstacle_start[k+1]; body: (V, 2) work array."""
+    if obstacle_start.shape[0] <= 1:
+        return -1
     place_outline(outline, x, y, heading, body)
     low_x = high_x = body[0, 0]
     low_y = high_y = body[0, 1]
@@ -97,13 +124,7 @@ def first_collision(outline, x, y, heading, obstacle_vertices, obstacle_start, b
     for k in range(obstacle_start.shape[0] - 1):
         polygon = obstacle_vertices[obstacle_start[k] : obstacle_start[k + 1]]
         # bounding boxes apart: no overlap (the edge tests below cost far more)
-        right = left = above = below = True  # of the body's box, every vertex
-        for i in range(polygon.shape[0]):
-            right = right and polygon[i, 0] > high_x
-            left = left and polygon[i, 0] < low_x
-            above = above and polygon[i, 1] > high_y
-            below = below and polygon[i, 1] < low_y
-        if right or left or above or below:
+        if _apart(polygon, low_x, high_x, low_y, high_y):
             continue
         if polygons_overlap(body, polygon):
             return k

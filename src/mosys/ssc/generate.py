@@ -26,6 +26,9 @@ from mosys.kernels.dp import (
     DEAD_END_SECONDS,
     DESTINATION_MAX_SWEEPS,
     DESTINATION_TOLERANCE,
+    PLAIN,
+    RECORD,
+    REPLAY,
     UNKNOWN,
     best_controls,
     destination_indices,
@@ -36,6 +39,7 @@ from mosys.kernels.dp import (
     node_coordinates,
     prefetch_pays,
     reach_sweep,
+    segment_boxes,
     sweep_order,
 )
 from mosys.kernels.specialise import specialise
@@ -50,7 +54,7 @@ from mosys.ssc.grid import (
     figure_state_names,
 )
 from mosys.ssc.lookahead import vehicle_arrival
-from mosys.ssc.obstacles import Obstacles, blocked_reason, spec_obstacles
+from mosys.ssc.obstacles import NO_OBSTACLES, Obstacles, blocked_reason, spec_obstacles
 
 PROGRESS_CHUNKS = 20  # at most; fewer for small grids (each chunk wakes numba's threads)
 SIMULATIONS_PER_CHUNK = 20_000  # at least, but for the last chunk
@@ -295,8 +299,7 @@ def arrival_arguments(problem: Problem, dynamics: ModuleType) -> tuple:
     spec, grid = problem.spec, problem.grid
     terminal_node = int(np.flatnonzero(problem.is_destination)[0])
     if spec.policy is None or spec.policy.kind != "lookahead":
-        none = np.zeros((3, len(grid.names)))
-        return False, none, np.zeros(7, dtype=np.int64), 1.0, 1.0, 1.0, terminal_node
+        return no_arrival(len(grid.names), terminal_node)
     control = next(c for c in spec.controls if c.name == "wheel_accel")
     arrival = vehicle_arrival(
         dynamics,
@@ -316,6 +319,123 @@ def arrival_arguments(problem: Problem, dynamics: ModuleType) -> tuple:
     )
 
 
+def no_arrival(dimensions: int, terminal_node: int) -> tuple:
+    """The exit kernel's arrival arguments for a table without an arrival box."""
+    none = np.zeros((3, dimensions))
+    return False, none, np.zeros(7, dtype=np.int64), 1.0, 1.0, 1.0, terminal_node
+
+
+def plain_record(problem: Problem) -> tuple:
+    """The exit kernel's record arguments for integrating every (node, control) pair (``PLAIN``:
+    no classes)."""
+    size = problem.base_state.shape[0]
+    empty = np.zeros((0, 0), dtype=np.int64)
+    return (
+        PLAIN,
+        np.zeros(0, dtype=np.int64),
+        empty,
+        empty,
+        np.zeros((0, 2 * size + 1)),
+        np.zeros(size, dtype=np.bool_),
+        np.zeros((0, 0, 8)),
+    )
+
+
+@dataclass(frozen=True)
+class MotionClasses:
+    """The nodes that move alike: for a model whose equations read none of ``ignorable`` (d,)
+    bool of the controller axes (its ``IGNORABLE_STATES``, on axes that do not wrap), every node
+    of a class (the nodes differing only on those axes) moves the same way under a control,
+    shifted (``dp.exit_transitions_template``, ``RECORD`` and ``REPLAY``). class_of (N,) int64;
+    representative (C,) int64: a node of each class (the first on the ignorable axes);
+    relative_slot (S,) bool: the model-state slots of the ignorable axes."""
+
+    class_of: np.ndarray
+    representative: np.ndarray
+    relative_slot: np.ndarray
+
+    @classmethod
+    def of(cls, problem: Problem, dynamics: ModuleType) -> MotionClasses | None:
+        """The classes of ``problem``'s grid, or None when no controller axis is ignorable."""
+        grid = problem.grid
+        names = getattr(dynamics, "IGNORABLE_STATES", ())
+        ignorable = np.array(
+            [name in names and not wraps for name, wraps in zip(grid.names, grid.wrap, strict=True)]
+        )
+        if not ignorable.any():
+            return None
+        index = np.indices(grid.shape).reshape(len(grid.shape), -1)
+        class_shape = tuple(1 if ignorable[k] else n for k, n in enumerate(grid.shape))
+        index[ignorable] = 0
+        class_of = np.ravel_multi_index(tuple(index), class_shape).astype(np.int64)
+        classes = np.unravel_index(np.arange(int(np.prod(class_shape))), class_shape)
+        representative = np.ravel_multi_index(classes, grid.shape).astype(np.int64)
+        relative_slot = np.zeros(problem.base_state.shape[0], dtype=np.bool_)
+        relative_slot[grid.state_slot[ignorable]] = True
+        return cls(class_of, representative, relative_slot)
+
+
+def record_classes(
+    exit_transitions: Callable,
+    arguments: tuple,
+    problem: Problem,
+    classes: MotionClasses,
+) -> tuple:
+    """Integrate each class's segments once (``RECORD``: counted, then written) and return the
+    exit kernel's record arguments for replaying them at every node (``REPLAY``)."""
+    before, after = arguments
+    grid = problem.grid
+    size = problem.base_state.shape[0]
+    count = classes.representative.size
+    row_of = np.full(grid.node_count, -1, dtype=np.int64)
+    row_of[classes.representative] = np.arange(count)
+    free = (row_of, *NO_OBSTACLES.kernel_arguments(), *no_arrival(len(grid.names), after[-1]))
+    scratch = Transitions.empty(row_of >= 0, problem.control_samples.shape[0], len(grid.names))
+    record_start = np.zeros(scratch.segment_cost.shape, dtype=np.int64)
+    record_count = np.zeros_like(record_start)
+    record = np.zeros((0, 2 * size + 1))
+    for _ in range(2):  # count the rows, then write them
+        exit_transitions(
+            *before,
+            classes.representative,
+            *free,
+            *scratch.arrays(),
+            RECORD,
+            classes.class_of,
+            record_start,
+            record_count,
+            record,
+            classes.relative_slot,
+            np.zeros((0, 0, 8)),
+        )
+        if record.shape[0] == 0:
+            ends = np.cumsum(record_count.ravel())
+            record_start = (ends - record_count.ravel()).reshape(record_count.shape)
+            record = np.empty((int(ends[-1]), 2 * size + 1))
+    boxes = np.empty(record_count.shape + (8,))
+    arrival = after[6:]
+    segment_boxes(
+        record,
+        record_start,
+        record_count,
+        problem.obstacles.pose_slot,
+        problem.obstacles.outline,
+        *arrival[:1],
+        *arrival[2:6],
+        grid.state_slot,
+        boxes,
+    )
+    return (
+        REPLAY,
+        classes.class_of,
+        record_start,
+        record_count,
+        record,
+        classes.relative_slot,
+        boxes,
+    )
+
+
 def load_kernels(
     exit_transitions: Callable, arguments: tuple, problem: Problem, transitions: Transitions
 ) -> float:
@@ -325,7 +445,7 @@ def load_kernels(
     started = time.perf_counter()
     none = np.empty(0, dtype=np.int64)
     before, after = arguments
-    exit_transitions(*before, none, *after, *transitions.arrays())
+    exit_transitions(*before, none, *after, *transitions.arrays(), *plain_record(problem))
     flags = np.empty(0, dtype=np.bool_)
     empty = Transitions.empty(flags, problem.control_samples.shape[0], len(problem.grid.names))
     reach_sweep(*empty.arrays(), none, flags, none)
@@ -348,6 +468,18 @@ def load_kernels(
     )
     best_controls(*empty.arrays(), none, np.empty(0), none)
     sweep_order(problem.grid.axis_count, 0, none)
+    arrival = after[6:]
+    segment_boxes(
+        np.empty((0, 2 * problem.base_state.shape[0] + 1)),
+        empty.segment_cost.astype(np.int64),
+        empty.segment_cost.astype(np.int64),
+        problem.obstacles.pose_slot,
+        problem.obstacles.outline,
+        *arrival[:1],
+        *arrival[2:6],
+        problem.grid.state_slot,
+        np.empty((0, 0, 8)),
+    )
     if len(problem.spec.destinations) > 1:
         destination_indices(
             empty.exit_index,
@@ -371,19 +503,28 @@ def compute_transitions(
     arguments: tuple,
     problem: Problem,
     transitions: Transitions,
+    classes: MotionClasses | None,
     quiet: bool,
 ) -> None:
-    """Fill ``transitions`` in chunks of nodes, showing progress unless ``quiet``. arguments:
-    ``exit_transition_arguments``."""
+    """Fill ``transitions`` in chunks of nodes, showing progress unless ``quiet``; with
+    ``classes``, each class's segments are integrated once and replayed at its nodes
+    (``record_classes``). arguments: ``exit_transition_arguments``."""
     nodes = np.flatnonzero(transitions.row_of >= 0)
     controls = problem.control_samples.shape[0]
     before, after = arguments
+    record = (
+        plain_record(problem)
+        if classes is None
+        else record_classes(exit_transitions, arguments, problem, classes)
+    )
     progress = Progress("exit transitions", nodes.size * controls, "simulations")
     count = max(1, min(PROGRESS_CHUNKS, nodes.size * controls // SIMULATIONS_PER_CHUNK))
     chunks = np.array_split(nodes, count)
     done = 0
     for chunk in chunks:
-        exit_transitions(*before, np.ascontiguousarray(chunk), *after, *transitions.arrays())
+        exit_transitions(
+            *before, np.ascontiguousarray(chunk), *after, *transitions.arrays(), *record
+        )
         done += chunk.size * controls
         if not quiet:
             progress.update(done)
@@ -489,7 +630,8 @@ def solve(
     arguments = exit_transition_arguments(problem, dynamics, dt, transitions.row_of)
     kernel_load_seconds = load_kernels(exit_transitions, arguments, problem, transitions)
     started = time.perf_counter()
-    compute_transitions(exit_transitions, arguments, problem, transitions, quiet)
+    classes = MotionClasses.of(problem, dynamics)
+    compute_transitions(exit_transitions, arguments, problem, transitions, classes, quiet)
     check_transitions_finite(problem, transitions)
     transition_seconds = time.perf_counter() - started
     reachable = reachable_nodes(
