@@ -432,18 +432,19 @@ def test_a_run_that_touches_an_obstacle_is_a_failure_even_if_it_ends_parked():
 
 def transitions_of(problem, car, classes):
     """The exit transitions of ``problem``, its classes replayed or (None) every node
-    integrated."""
+    integrated, and each exit's corners (absolute flat node indices) and weights (R, U, K)."""
     from mosys.ssc import generate
 
-    transitions = generate.Transitions.empty(
-        problem.node_valid, problem.control_samples.shape[0], len(problem.grid.names)
-    )
     kernel = generate.specialise(generate.exit_transitions_template, car, parallel=True)
-    arguments = generate.exit_transition_arguments(
-        problem, car, problem.spec.dt, transitions.row_of
+    arguments = generate.exit_transition_arguments(problem, car, problem.spec.dt)
+    transitions = generate.compute_transitions(
+        kernel, arguments, problem, problem.node_valid, classes, quiet=True
     )
-    generate.compute_transitions(kernel, arguments, problem, transitions, classes, quiet=True)
-    return transitions
+    nodes = np.flatnonzero(transitions.row_of >= 0)
+    shapes = transitions.shape_row_of[nodes]
+    corners = nodes[:, None, None] + transitions.exit_index[shapes]
+    weights = transitions.exit_weight[shapes]
+    return transitions, np.where(weights > 0, corners, -1), weights
 
 
 @pytest.mark.parametrize("policy", ["", "policy lookahead x=0.3 y=0.2 heading=10\n"])
@@ -456,18 +457,25 @@ def test_replaying_each_class_gives_the_transitions_of_integrating_every_node(ca
     problem = build_problem(parse_controller_text(SMALL + policy, "small.ssc"), car)
     classes = MotionClasses.of(problem, car)
     assert classes is not None and classes.representative.size == 3 * 3 * 3
-    replayed = transitions_of(problem, car, classes)
-    integrated = transitions_of(problem, car, None)
+    replayed, replayed_corners, replayed_weights = transitions_of(problem, car, classes)
+    integrated, corners, weights = transitions_of(problem, car, None)
+    assert replayed.exit_index.shape[0] == 27  # one shape per class
     cost = integrated.segment_cost
     finite = np.isfinite(cost)
     assert 0 < finite.sum() < cost.size  # obstacles and the domain discard some segments
     np.testing.assert_array_equal(np.isfinite(replayed.segment_cost), finite)
     np.testing.assert_allclose(replayed.segment_cost[finite], cost[finite], rtol=1e-12)
-    weight = integrated.exit_weight
-    np.testing.assert_allclose(replayed.exit_weight, weight, atol=1e-6)
-    used = weight > 0
-    np.testing.assert_array_equal(replayed.exit_index[used], integrated.exit_index[used])
-    if policy:  # some segments end braking into the arrival box, at the destination node
-        terminal = np.flatnonzero(problem.is_destination)[0]
-        arrivals = (integrated.exit_index[..., 0] == terminal) & (weight[..., 0] == 1.0)
-        assert arrivals.sum() > 0
+    np.testing.assert_array_equal(replayed.to_destination, integrated.to_destination)
+    passing = finite & ~integrated.to_destination
+    for exit_corners, exit_weights, other_corners, other_weights in zip(
+        replayed_corners[passing],
+        replayed_weights[passing],
+        corners[passing],
+        weights[passing],
+        strict=True,
+    ):  # the same corners with the same weights, in whatever order
+        assert dict(zip(exit_corners, exit_weights, strict=True)) == pytest.approx(
+            dict(zip(other_corners, other_weights, strict=True)), abs=1e-6
+        )
+    if policy:  # some segments end braking into the arrival box, at the destination
+        assert integrated.to_destination.sum() > 0

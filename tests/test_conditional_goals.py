@@ -277,6 +277,7 @@ def test_destination_shares_solve_loops_of_exits():
     exits of 1, 2 and 3 split between their neighbours, 1 <-> 2 <-> 3 looping: shares
     a = share of line 0 solve a1 = (a2 + 1)/2, a2 = (a1 + a3)/2, a3 = a2/4."""
     corners = np.array([[[0, 0]], [[2, 0]], [[1, 3]], [[2, 4]], [[4, 4]], [[5, 5]]], np.int32)
+    corners -= np.arange(6, dtype=np.int32)[:, None, None]  # offsets from each node
     weights = np.array(
         [[[0, 0]], [[0.5, 0.5]], [[0.5, 0.5]], [[0.25, 0.75]], [[0, 0]], [[0, 0]]], np.float32
     )
@@ -289,8 +290,12 @@ def test_destination_shares_solve_loops_of_exits():
     sweeps = destination_indices(
         corners,
         weights,
+        np.zeros((6, 1), np.bool_),
+        row_of,
         row_of,
         best_control,
+        np.isfinite(value),
+        0,
         value,
         label,
         np.array([6, 1], np.int64),

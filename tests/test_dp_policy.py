@@ -22,14 +22,12 @@ from mosys.kernels.dp import (
 def solve(tables, axis_count, tolerance, policy_sweeps, bound=1e4, count=100_000):
     """Value iteration from ``bound`` as ``ssc.generate.value_iteration`` runs it: (values,
     Bellman sweeps, policy sweeps)."""
-    exit_index, exit_weight, cost, row_of, is_destination = tables
+    arrays, is_destination = tables
+    row_of = arrays[4]
     value = np.where(is_destination, 0.0, np.where(row_of >= 0, bound, np.inf))
-    rows, _, corners = exit_index.shape
+    rows, _, corners = arrays[0].shape
     bellman, policy, _ = gauss_seidel_sweeps(
-        exit_index,
-        exit_weight,
-        cost,
-        row_of,
+        *arrays,
         is_destination,
         value,
         np.asarray(axis_count, dtype=np.int64),
@@ -43,6 +41,7 @@ def solve(tables, axis_count, tolerance, policy_sweeps, bound=1e4, count=100_000
         np.zeros((rows, 1, corners), dtype=np.int32),
         np.zeros((rows, 1, corners), dtype=np.float32),
         np.empty((rows, 1)),
+        np.zeros((rows, 1), dtype=np.bool_),
         policy_sweeps,
     )
     return value, bellman, policy
@@ -52,29 +51,22 @@ def solve(tables, axis_count, tolerance, policy_sweeps, bound=1e4, count=100_000
 def test_a_policy_sweep_is_a_bellman_sweep_over_each_nodes_own_control(axis_count):
     rng = np.random.default_rng(7 + len(axis_count))
     counts = np.array(axis_count, dtype=np.int64)
-    exit_index, exit_weight, cost, row_of, is_destination = random_tables(rng, counts, 5)
+    arrays, is_destination = random_tables(rng, counts, 5)
+    exit_index, exit_weight, cost, to_destination, row_of, _ = arrays
     nodes = row_of.size
     value = np.where(is_destination, 0.0, np.where(row_of >= 0, 1e4, np.inf))
     order = np.empty(nodes, dtype=np.int64)
     control = np.zeros(nodes, dtype=np.int64)
     rows, _, corners = exit_index.shape
-    policy_index = np.zeros((rows, 1, corners), dtype=np.int32)
-    policy_weight = np.zeros((rows, 1, corners), dtype=np.float32)
-    policy_cost = np.empty((rows, 1))
+    policy = (
+        np.zeros((rows, 1, corners), dtype=np.int32),
+        np.zeros((rows, 1, corners), dtype=np.float32),
+        np.empty((rows, 1)),
+        np.zeros((rows, 1), dtype=np.bool_),
+    )
     for sweep in range(2**counts.size + 3):
         sweep_order(counts, sweep, order)
-        gauss_seidel_sweep(
-            exit_index,
-            exit_weight,
-            cost,
-            row_of,
-            is_destination,
-            value,
-            order,
-            np.inf,
-            False,
-            control,
-        )
+        gauss_seidel_sweep(*arrays, is_destination, value, order, np.inf, False, control)
         # the control recorded gives each node no more than its value (it gave it, onto
         # values that have only decreased since)
         kept = np.flatnonzero(row_of >= 0)
@@ -82,34 +74,27 @@ def test_a_policy_sweep_is_a_bellman_sweep_over_each_nodes_own_control(axis_coun
         chosen = control[kept]
         moved = (value[kept] < 1e4) & ~is_destination[kept]  # decreased at least once
         weights = exit_weight[held, chosen].astype(np.float64)
-        corners = np.where(weights != 0, value[exit_index[held, chosen]], 0.0)
-        promised = cost[held, chosen] + np.einsum("ij,ij->i", weights, corners)
+        corner_values = value[kept[:, None] + exit_index[held, chosen]]
+        known = (weights != 0) & np.isfinite(corner_values)
+        weights = np.where(known, weights, 0.0)
+        exit_value = np.einsum("ij,ij->i", weights, np.where(known, corner_values, 0.0))
+        exit_value = np.where(to_destination[held, chosen], 0.0, exit_value / weights.sum(1))
+        promised = cost[held, chosen] + exit_value
         assert np.all(promised[moved] <= value[kept][moved] * (1 + 1e-12))
-        gather_policy(
-            exit_index, exit_weight, cost, row_of, control, policy_index, policy_weight, policy_cost
-        )
+        gather_policy(*arrays, control, *policy)
         cut = (
             exit_index[held, chosen][:, None, :].copy(),
             exit_weight[held, chosen][:, None, :].copy(),
             cost[held, chosen][:, None].copy(),
+            to_destination[held, chosen][:, None].copy(),
         )
-        assert np.array_equal(policy_index, cut[0])
-        assert np.array_equal(policy_weight, cut[1])
-        assert np.array_equal(policy_cost, cut[2])
+        for gathered, expected in zip(policy, cut, strict=True):
+            assert np.array_equal(gathered, expected)
         swept = value.copy()
-        largest = policy_sweep(
-            policy_index,
-            policy_weight,
-            policy_cost,
-            row_of,
-            is_destination,
-            value,
-            order,
-            np.inf,
-        )
+        largest = policy_sweep(*policy, row_of, is_destination, value, order, np.inf)
         control_after = np.zeros(nodes, dtype=np.int64)
         expected_largest = gauss_seidel_sweep(
-            *cut, row_of, is_destination, swept, order, np.inf, False, control_after
+            *cut, row_of, row_of, is_destination, swept, order, np.inf, False, control_after
         )
         assert np.array_equal(value, swept)
         assert largest == expected_largest
@@ -142,25 +127,26 @@ def returning_chain(n: int, forward: float, controls: int):
     for i in range(n):
         for j in range(2):
             node = 2 * i + j
-            exit_index[node, :, 0] = 2 * max(i - 1, 0) + j
-            exit_index[node, :, 1] = 2 * min(i + 1, n - 1) + 1 - j
+            exit_index[node, :, 0] = 2 * max(i - 1, 0) + j - node
+            exit_index[node, :, 1] = 2 * min(i + 1, n - 1) + 1 - j - node
             exit_weight[node, :] = (1.0 - forward, forward)
     cost = np.full((nodes, controls), 2.0)
     cost[:, 0] = 1.0
     is_destination = np.zeros(nodes, dtype=np.bool_)
     is_destination[:2] = True
-    return exit_index, exit_weight, cost, row_of, is_destination
+    to_destination = np.zeros((nodes, controls), dtype=np.bool_)
+    return (exit_index, exit_weight, cost, to_destination, row_of, row_of), is_destination
 
 
 def test_policy_sweeps_take_over_the_slow_mode_of_a_returning_chain():
     tables = returning_chain(12, 0.55, 8)
-    exit_index, exit_weight, cost, row_of, is_destination = tables
+    (exit_index, exit_weight, _, _, row_of, _), is_destination = tables
     # the exact values: V = 1 + P V off the destination, solved directly
     nodes = row_of.size
     transition = np.zeros((nodes, nodes))
     for node in range(nodes):
         for i in range(2):
-            transition[node, exit_index[node, 0, i]] += exit_weight[node, 0, i]
+            transition[node, node + exit_index[node, 0, i]] += exit_weight[node, 0, i]
     free = ~is_destination
     exact = np.zeros(nodes)
     exact[free] = np.linalg.solve(

@@ -14,22 +14,30 @@ from mosys.kernels.dp import gauss_seidel_sweep, sweep_order
 from mosys.kernels.prefetch import prefetch
 
 
-def plain_sweep(exit_index, exit_weight, segment_cost, row_of, is_destination, value, order):
+def plain_sweep(tables, is_destination, value, order):
     """The sweep as ``gauss_seidel_sweep``'s docstring states it, in Python, without hints."""
+    exit_index, exit_weight, segment_cost, to_destination, row_of, shape_row_of = tables
     largest = 0.0
     for node in order:
         row = row_of[node]
         if row < 0 or is_destination[node]:
             continue
+        shape = shape_row_of[node]
         best = np.inf
         for u in range(segment_cost.shape[1]):
             if segment_cost[row, u] == np.inf:
                 continue
-            total = 0.0
-            for i in range(exit_index.shape[2]):
-                if exit_weight[row, u, i] != 0.0:
-                    total += exit_weight[row, u, i] * value[exit_index[row, u, i]]
-            best = min(best, segment_cost[row, u] + total)
+            candidate = segment_cost[row, u]
+            if not to_destination[row, u]:
+                total = known = 0.0
+                for i in range(exit_index.shape[2]):
+                    w = float(exit_weight[shape, u, i])
+                    corner = value[node + exit_index[shape, u, i]]
+                    if w != 0.0 and corner < np.inf:
+                        total += w * corner
+                        known += w
+                candidate += total / known
+            best = min(best, candidate)
         if best < value[node]:
             largest = max(largest, value[node] - best)
             value[node] = best
@@ -41,7 +49,8 @@ def plain_sweep(exit_index, exit_weight, segment_cost, row_of, is_destination, v
 def test_the_sweep_gives_the_plain_sweeps_values_bit_for_bit(axis_count, prefetching):
     rng = np.random.default_rng(len(axis_count))
     counts = np.array(axis_count, dtype=np.int64)
-    exit_index, exit_weight, cost, row_of, is_destination = random_tables(rng, counts, 5)
+    tables, is_destination = random_tables(rng, counts, 5)
+    row_of = tables[4]
     value = np.where(is_destination, 0.0, np.where(row_of >= 0, 1e4, np.inf))
     expected = value.copy()
     order = np.empty(value.size, dtype=np.int64)
@@ -49,20 +58,9 @@ def test_the_sweep_gives_the_plain_sweeps_values_bit_for_bit(axis_count, prefetc
     for sweep in range(2**counts.size + 3):
         sweep_order(counts, sweep, order)
         largest = gauss_seidel_sweep(
-            exit_index,
-            exit_weight,
-            cost,
-            row_of,
-            is_destination,
-            value,
-            order,
-            np.inf,
-            prefetching,
-            control,
+            *tables, is_destination, value, order, np.inf, prefetching, control
         )
-        expected_largest = plain_sweep(
-            exit_index, exit_weight, cost, row_of, is_destination, expected, order
-        )
+        expected_largest = plain_sweep(tables, is_destination, expected, order)
         assert np.array_equal(value, expected)
         assert largest == expected_largest
     assert np.isfinite(value).sum() > is_destination.sum()  # values really moved

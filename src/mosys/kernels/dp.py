@@ -59,9 +59,6 @@ def node_coordinates(axis_min, axis_step, axis_count, node, out):
         rest //= axis_count[k]
 
 
-PLAIN, RECORD, REPLAY = 0, 1, 2  # the exit kernel's record modes (``exit_transitions_template``)
-
-
 @njit(cache=True)
 def axis_of_slot(state_slot, slot):
     """The controller axis whose model-state slot is ``slot`` (state_slot (d,) int64), 0 if
@@ -225,17 +222,15 @@ def exit_transitions_template(
     wheelbase,
     wheel_radius,
     brake,
-    terminal_node,
     exit_index,
     exit_weight,
     segment_cost,
-    record_mode,
-    class_of,
+    to_destination,
+    recording,
     record_start,
     record_count,
     record,
     relative_slot,
-    segment_box,
 ):
     """Simulate every (node, control sample) pair until it leaves the node's cell; a template
     (``specialise.specialise``, with the model's ``derivative_into`` as ``model_derivative``).
@@ -265,36 +260,28 @@ def exit_transitions_template(
     soon as the point where full braking would stop it lies in ``arrival_box`` (3, d)
     (``arrival.stops_in_box``, with vehicle_slot (7,), wheelbase and wheel_radius m, brake
     rad/s²): then a segment that gets there before leaving its cell ends there, its cost the
-    seconds so far plus the braking time, its exit the destination node ``terminal_node``
-    (weight 1, value 0), so that the DP's cost-to-go is what that runtime takes.
-    Outputs, one row per node that is not removed: exit_index (R, U, 2**(d-1)) int32 and
-    exit_weight (R, U, 2**(d-1)) float32, the nodes and weights interpolating the exit state on
-    the face it crosses; segment_cost (R, U) float64, inf where the segment never leaves the
-    cell, leaves the domain or hits an obstacle, nan where its state became non-finite.
+    seconds so far plus the braking time (``braking_seconds``), and to_destination is True:
+    it goes on to the destination, whose cost-to-go is 0, so that the DP's cost-to-go is what
+    that runtime takes.
+    Outputs, one row per node that is not removed: the exit's *shape*, exit_index (R, U,
+    2**(d-1)) int32 and exit_weight (same shape) float32, the corners of the face it crosses
+    (as offsets from the node's flat index) and their interpolation weights; segment_cost (R,
+    U) float64, inf where the segment never leaves the cell, leaves the domain or hits an
+    obstacle, nan where its state became non-finite; to_destination (R, U) bool.
 
-    Models whose equations do not read some controller coordinates (``IGNORABLE_STATES``: the
-    car's x and y) move the same way from every node of a *class* (the nodes that differ only
-    in those coordinates), so the integration is done once per class and control and replayed
-    at each node, where only the obstacles, the arrival box and the domain differ.
-    record_mode ``RECORD`` integrates from ``nodes`` (one per class, ``row_of`` giving its
-    class; no obstacles, no arrival) and writes each segment's steps to ``record`` (T, 2S + 1)
-    from row record_start[class, u] (C, U) int64 on: row 0 holds the rate at the start (columns
-    S..2S-1), then a row per accepted step: its end state (the slots where relative_slot (S,)
-    bool is True relative to the start), the rate there and the step, s; record_count (C, U)
-    int64 gets the rows (with an empty ``record``, only they are counted). ``REPLAY`` takes
-    each node's steps from its class's rows (class_of (N,) int64) instead of integrating, and
-    tests a step for obstacles only where the box the class's body sweeps (segment_box (C, U,
-    8), ``segment_boxes``), moved to the node, meets one, and for arrival only where the box of
-    its braking points meets the arrival box. ``PLAIN`` (empty record arrays) integrates every
-    pair.
+    ``recording`` (for ``replay_classes``): also write each segment's accepted steps to
+    ``record`` (T, S + 1), from row record_start[row, u] on (record_start, record_count: (R, U)
+    int64): row 0 holds where the segment leaves its cell, as offsets from the node on the
+    controller axes (columns 0..d-1), and in column S 1 if its last step leaves the cell (even
+    beyond an axis's end), else 0; then one row per step: its end state (the slots where
+    relative_slot (S,) bool is True as offsets from the start) and its length, s; record_count
+    gets the rows. With an empty ``record`` only they are counted.
     """
     d = axis_min.shape[0]
     size = base_state.shape[0]
     n_controls = control_samples.shape[0]
     strides = np.empty(d, np.int64)
     grid_strides(axis_count, strides)
-    x_axis = axis_of_slot(state_slot, vehicle_slot[0])  # the vehicle's reference point
-    y_axis = axis_of_slot(state_slot, vehicle_slot[1])
     for p in prange(nodes.shape[0]):
         node = nodes[p]
         row = row_of[node]
@@ -308,150 +295,103 @@ def exit_transitions_template(
         k5 = stages[4]
         k6 = stages[5]
         k7 = stages[6]
+        start = np.empty(size)
         state = np.empty(size)
         after = np.empty(size)
         inputs = np.zeros(input_size)
         body = np.empty_like(outline)
-        shift = np.empty(size)  # a replayed step's offset: the start state on relative slots
         integer_scratch, fraction, corner_index, corner_weight = interpolation_scratch(d)
         node_coordinates(axis_min, axis_step, axis_count, node, center)
-        load_state(center, state_slot, base_state, shift)
-        for i in range(size):
-            if not relative_slot[i]:
-                shift[i] = 0.0
-        segment_class = class_of[node] if record_mode == REPLAY else row
+        load_state(center, state_slot, base_state, start)
         for u in range(n_controls):
-            load_state(center, state_slot, base_state, state)
+            for i in range(size):
+                state[i] = start[i]
             for i in range(input_size):
                 inputs[i] = 0.0
-            effort = 0.0
             for j in range(control_slot.shape[0]):
                 inputs[control_slot[j]] += control_samples[u, j]
-                effort += effort_weight[j] * abs(control_samples[u, j])
+            effort = control_effort(control_samples, effort_weight, u)
             segment_cost[row, u] = np.inf
+            to_destination[row, u] = False
             for i in range(exit_index.shape[2]):
-                exit_index[row, u, i] = node
+                exit_index[row, u, i] = 0
                 exit_weight[row, u, i] = 0.0
-            first_row = record_start[segment_class, u] if record_mode != PLAIN else 0
-            if record_mode == REPLAY:
-                for i in range(size):
-                    k1[i] = record[first_row, size + i]
-            else:
-                model_derivative(state, inputs, k1)
-            if record_mode == RECORD:
-                record_count[segment_class, u] = 1
-                if record.shape[0] > 0:
-                    for i in range(size):
-                        record[first_row, i] = state[i] - shift[i]
-                        record[first_row, size + i] = k1[i]
-                    record[first_row, 2 * size] = 0.0
+            writing = recording and record.shape[0] > 0
+            if recording:
+                record_count[row, u] = 1
+            if writing:
+                for i in range(size + 1):
+                    record[record_start[row, u], i] = 0.0
+            model_derivative(state, inputs, k1)
             elapsed = 0.0
             h = max_step
-            replayed = 0
-            obstacles = obstacle_start
-            arriving = arrives
-            if record_mode == REPLAY:
-                box = segment_box[segment_class, u]
-                if pose_slot[0] >= 0:
-                    x = shift[pose_slot[0]]
-                    y = shift[pose_slot[1]]
-                    if box_is_clear(
-                        box[0] + x, box[1] + x, box[2] + y, box[3] + y, obstacle_vertices, obstacles
-                    ):
-                        obstacles = obstacle_start[:1]  # none
-                if arrives:
-                    x = shift[vehicle_slot[0]]
-                    y = shift[vehicle_slot[1]]
-                    arriving = (
-                        box[4] + x <= arrival_box[1, x_axis]
-                        and box[5] + x >= arrival_box[0, x_axis]
-                        and box[6] + y <= arrival_box[1, y_axis]
-                        and box[7] + y >= arrival_box[0, y_axis]
-                    )
             while elapsed < MAX_SEGMENT_SECONDS:
-                if record_mode == REPLAY:
-                    replayed += 1
-                    if replayed == record_count[segment_class, u]:
-                        break  # where the class's integration ended: cost stays inf
-                    r = first_row + replayed
-                    for i in range(size):
-                        after[i] = record[r, i] + shift[i]
-                    h = record[r, 2 * size]
-                    last = replayed == record_count[segment_class, u] - 1
-                    if last:  # the only step that can cross: the class's last
+                for k in range(d):
+                    speed = abs(k1[state_slot[k]])
+                    if speed * h > CELL_FRACTION * axis_step[k]:
+                        h = CELL_FRACTION * axis_step[k] / speed
+                for i in range(size):
+                    after[i] = state[i] + h * (A21 * k1[i])
+                model_derivative(after, inputs, k2)
+                for i in range(size):
+                    after[i] = state[i] + h * (A31 * k1[i] + A32 * k2[i])
+                model_derivative(after, inputs, k3)
+                for i in range(size):
+                    after[i] = state[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
+                model_derivative(after, inputs, k4)
+                for i in range(size):
+                    after[i] = state[i] + h * (
+                        A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i]
+                    )
+                model_derivative(after, inputs, k5)
+                for i in range(size):
+                    after[i] = state[i] + h * (
+                        A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]
+                    )
+                model_derivative(after, inputs, k6)
+                for i in range(size):
+                    after[i] = state[i] + h * (
+                        B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i]
+                    )
+                model_derivative(after, inputs, k7)
+                # the error of the step, in units of the tolerance on each controller axis
+                error = 0.0
+                for k in range(d):
+                    slot = state_slot[k]
+                    estimate = h * (
+                        E1 * k1[slot]
+                        + E3 * k3[slot]
+                        + E4 * k4[slot]
+                        + E5 * k5[slot]
+                        + E6 * k6[slot]
+                        + E7 * k7[slot]
+                    )
+                    error = max(error, abs(estimate) / (STEP_TOLERANCE * axis_step[k]))
+                if not np.isfinite(error):
+                    break  # too stiff to follow at this step: cost stays inf
+                if error > 1.0:
+                    h *= max(0.2, 0.9 * error**-0.2)
+                    if h < MIN_STEP:
+                        break  # too stiff to follow: cost stays inf
+                    continue
+                if recording:
+                    r = record_start[row, u] + record_count[row, u]
+                    record_count[row, u] += 1
+                    if writing:
                         for i in range(size):
-                            state[i] = record[r - 1, i] + shift[i]
-                            k1[i] = record[r - 1, size + i]
-                            k7[i] = record[r, size + i]
-                else:
-                    last = True
-                    for k in range(d):
-                        speed = abs(k1[state_slot[k]])
-                        if speed * h > CELL_FRACTION * axis_step[k]:
-                            h = CELL_FRACTION * axis_step[k] / speed
-                    for i in range(size):
-                        after[i] = state[i] + h * (A21 * k1[i])
-                    model_derivative(after, inputs, k2)
-                    for i in range(size):
-                        after[i] = state[i] + h * (A31 * k1[i] + A32 * k2[i])
-                    model_derivative(after, inputs, k3)
-                    for i in range(size):
-                        after[i] = state[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
-                    model_derivative(after, inputs, k4)
-                    for i in range(size):
-                        after[i] = state[i] + h * (
-                            A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i]
-                        )
-                    model_derivative(after, inputs, k5)
-                    for i in range(size):
-                        after[i] = state[i] + h * (
-                            A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]
-                        )
-                    model_derivative(after, inputs, k6)
-                    for i in range(size):
-                        after[i] = state[i] + h * (
-                            B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i]
-                        )
-                    model_derivative(after, inputs, k7)
-                    # the error of the step, in units of the tolerance on each controller axis
-                    error = 0.0
-                    for k in range(d):
-                        slot = state_slot[k]
-                        estimate = h * (
-                            E1 * k1[slot]
-                            + E3 * k3[slot]
-                            + E4 * k4[slot]
-                            + E5 * k5[slot]
-                            + E6 * k6[slot]
-                            + E7 * k7[slot]
-                        )
-                        error = max(error, abs(estimate) / (STEP_TOLERANCE * axis_step[k]))
-                    if not np.isfinite(error):
-                        break  # too stiff to follow at this step: cost stays inf
-                    if error > 1.0:
-                        h *= max(0.2, 0.9 * error**-0.2)
-                        if h < MIN_STEP:
-                            break  # too stiff to follow: cost stays inf
-                        continue
-                    if record_mode == RECORD:
-                        r = first_row + record_count[segment_class, u]
-                        record_count[segment_class, u] += 1
-                        if record.shape[0] > 0:
-                            for i in range(size):
-                                record[r, i] = after[i] - shift[i]
-                                record[r, size + i] = k7[i]
-                            record[r, 2 * size] = h
+                            record[r, i] = after[i] - start[i] if relative_slot[i] else after[i]
+                        record[r, size] = h
                 if not state_is_sound(after):  # an accepted step (a nan input passes the error
                     segment_cost[row, u] = np.nan  # test): the caller reports it
                     break
                 if not pose_is_free(
-                    after, pose_slot, outline, obstacle_vertices, obstacles, domain, body
+                    after, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
                 ):
                     break  # hits an obstacle or leaves the domain polygon: cost stays inf
                 # the earliest crossing of the cell boundary within this step
                 crossing = 2.0
                 axis = -1
-                for k in range(d if last else 0):
+                for k in range(d):
                     slot = state_slot[k]
                     s = first_crossing(
                         state[slot],
@@ -466,7 +406,7 @@ def exit_transitions_template(
                         axis = k
                 if (
                     axis < 0
-                    and arriving
+                    and arrives
                     and stops_in_box(
                         after,
                         vehicle_slot,
@@ -478,18 +418,16 @@ def exit_transitions_template(
                         exit_state,
                     )
                 ):
-                    braking = abs(after[vehicle_slot[4]]) / (wheel_radius * brake)
+                    braking = braking_seconds(after, vehicle_slot, wheel_radius, brake)
                     segment_cost[row, u] = (elapsed + h + braking) * (1.0 + effort)
-                    exit_index[row, u, 0] = terminal_node
-                    exit_weight[row, u, 0] = 1.0
+                    to_destination[row, u] = True
                     break
                 if axis < 0:
                     elapsed += h
-                    if record_mode != REPLAY:  # a replay reads both from the record
-                        for i in range(size):
-                            state[i] = after[i]
-                            k1[i] = k7[i]
-                        h = min(max_step, h * min(5.0, 0.9 * max(error, 1e-10) ** -0.2))
+                    for i in range(size):
+                        state[i] = after[i]
+                        k1[i] = k7[i]
+                    h = min(max_step, h * min(5.0, 0.9 * max(error, 1e-10) ** -0.2))
                     continue
                 for k in range(d):
                     slot = state_slot[k]
@@ -504,15 +442,11 @@ def exit_transitions_template(
                     exit_state[axis] = center[axis] + axis_step[axis]
                 else:
                     exit_state[axis] = center[axis] - axis_step[axis]
-                leaves_domain = False
-                for k in range(d):
-                    if not wrap[k]:
-                        top = axis_min[k] + axis_step[k] * (axis_count[k] - 1)
-                        if exit_state[k] < axis_min[k] - 1e-9 * axis_step[k]:
-                            leaves_domain = True
-                        if exit_state[k] > top + 1e-9 * axis_step[k]:
-                            leaves_domain = True
-                if not leaves_domain:
+                if writing:  # where and that it crossed
+                    for k in range(d):
+                        record[record_start[row, u], k] = exit_state[k] - center[k]
+                    record[record_start[row, u], size] = 1.0
+                if not leaves_axes(axis_min, axis_step, axis_count, wrap, exit_state):
                     seconds = elapsed + crossing * h
                     segment_cost[row, u] = seconds * (1.0 + effort)
                     count = corner_weights(
@@ -535,9 +469,172 @@ def exit_transitions_template(
                             corner_weight[i] = 0.0
                         total += corner_weight[i]
                     for i in range(count):
-                        exit_index[row, u, i] = corner_index[i]
+                        exit_index[row, u, i] = corner_index[i] - node
                         exit_weight[row, u, i] = corner_weight[i] / total
                 break
+
+
+@njit(cache=True)
+def control_effort(control_samples, effort_weight, u):
+    """Σ K|u| of control sample u (control_samples (U, m), effort_weight (m,)): a segment of t
+    seconds under it costs t (1 + Σ K|u|)."""
+    effort = 0.0
+    for j in range(control_samples.shape[1]):
+        effort += effort_weight[j] * abs(control_samples[u, j])
+    return effort
+
+
+@njit(cache=True)
+def braking_seconds(state, vehicle_slot, wheel_radius, brake):
+    """The seconds a vehicle takes to brake to rest from model state ``state`` (wheel_radius m,
+    brake rad/s²; ``arrival.braking_stop``)."""
+    return abs(state[vehicle_slot[4]]) / (wheel_radius * brake)
+
+
+@njit(cache=True)
+def leaves_axes(axis_min, axis_step, axis_count, wrap, exit_state):
+    """True when the controller state exit_state (d,) lies beyond an end of an axis that does
+    not wrap (by more than 1e-9 of its step)."""
+    for k in range(axis_min.shape[0]):
+        if not wrap[k]:
+            top = axis_min[k] + axis_step[k] * (axis_count[k] - 1)
+            if exit_state[k] < axis_min[k] - 1e-9 * axis_step[k]:
+                return True
+            if exit_state[k] > top + 1e-9 * axis_step[k]:
+                return True
+    return False
+
+
+@njit(parallel=True, cache=True)
+def replay_classes(
+    axis_min,
+    axis_step,
+    axis_count,
+    wrap,
+    state_slot,
+    base_state,
+    control_samples,
+    effort_weight,
+    nodes,
+    row_of,
+    class_of,
+    pose_slot,
+    outline,
+    obstacle_vertices,
+    obstacle_start,
+    domain,
+    arrives,
+    arrival_box,
+    vehicle_slot,
+    wheelbase,
+    wheel_radius,
+    brake,
+    class_cost,
+    record_start,
+    record_count,
+    record,
+    relative_slot,
+    segment_box,
+    segment_cost,
+    to_destination,
+):
+    """The exit transitions of a model whose equations do not read some controller axes (the
+    car's x and y: ``IGNORABLE_STATES``) from the segments of one node of each *class* (the
+    nodes that differ only on those axes), which move alike: the exit kernel's ``recording``,
+    made without obstacles and arrival box (class_cost (C, U), record_start, record_count,
+    record, relative_slot as ``exit_transitions_template`` writes them; class_of (N,) int64,
+    each node's class). At each node of ``nodes`` (row ``row_of``) each class segment is moved
+    there and its step ends tested as ``exit_transitions_template`` tests them: a step that
+    hits an obstacle or leaves the domain polygon discards the segment, one whose braking point
+    lies in the arrival box ends it at the destination; and a segment whose exit lies beyond
+    the axes is discarded. Obstacles are tested only where the box the class's body sweeps
+    (segment_box (C, U, 8), ``segment_boxes``), moved to the node, meets one's bounding box,
+    and the arrival box only where the box of the class's braking points does. Outputs
+    segment_cost and to_destination (R, U); the exit's shape (its corners as offsets and their
+    weights) is the class's."""
+    d = axis_min.shape[0]
+    size = base_state.shape[0]
+    x_axis = axis_of_slot(state_slot, vehicle_slot[0])  # the vehicle's reference point
+    y_axis = axis_of_slot(state_slot, vehicle_slot[1])
+    for p in prange(nodes.shape[0]):
+        node = nodes[p]
+        row = row_of[node]
+        segment_class = class_of[node]
+        center = np.empty(d)
+        exit_state = np.empty(d)
+        shift = np.empty(size)  # the start state on the relative slots, else 0
+        after = np.empty(size)
+        body = np.empty_like(outline)
+        stop = np.empty(d)
+        node_coordinates(axis_min, axis_step, axis_count, node, center)
+        load_state(center, state_slot, base_state, shift)
+        for i in range(size):
+            if not relative_slot[i]:
+                shift[i] = 0.0
+        for u in range(control_samples.shape[0]):
+            cost = class_cost[segment_class, u]
+            to_destination[row, u] = False
+            segment_cost[row, u] = cost
+            if np.isnan(cost):
+                continue  # the class's segment diverged: the caller reports it
+            first = record_start[segment_class, u]
+            steps = record_count[segment_class, u] - 1
+            crossing_step = steps if record[first, size] != 0.0 else -1  # the step that leaves
+            box = segment_box[segment_class, u]
+            obstacles = obstacle_start
+            arriving = arrives
+            if pose_slot[0] >= 0:
+                x = shift[pose_slot[0]]
+                y = shift[pose_slot[1]]
+                if box_is_clear(
+                    box[0] + x, box[1] + x, box[2] + y, box[3] + y, obstacle_vertices, obstacles
+                ):
+                    obstacles = obstacle_start[:1]  # none
+            if arrives:
+                x = shift[vehicle_slot[0]]
+                y = shift[vehicle_slot[1]]
+                arriving = (
+                    box[4] + x <= arrival_box[1, x_axis]
+                    and box[5] + x >= arrival_box[0, x_axis]
+                    and box[6] + y <= arrival_box[1, y_axis]
+                    and box[7] + y >= arrival_box[0, y_axis]
+                )
+            if not cost < np.inf and not arriving:
+                continue  # discarded, and never stops in the arrival box either
+            elapsed = 0.0
+            for j in range(1, steps + 1):
+                for i in range(size):
+                    after[i] = record[first + j, i] + shift[i]
+                elapsed += record[first + j, size]
+                if not pose_is_free(
+                    after, pose_slot, outline, obstacle_vertices, obstacles, domain, body
+                ):
+                    segment_cost[row, u] = np.inf
+                    break
+                if (
+                    j != crossing_step
+                    and arriving
+                    and stops_in_box(
+                        after,
+                        vehicle_slot,
+                        wheelbase,
+                        wheel_radius,
+                        brake,
+                        state_slot,
+                        arrival_box,
+                        stop,
+                    )
+                ):
+                    braking = braking_seconds(after, vehicle_slot, wheel_radius, brake)
+                    effort = control_effort(control_samples, effort_weight, u)
+                    segment_cost[row, u] = (elapsed + braking) * (1.0 + effort)
+                    to_destination[row, u] = True
+                    break
+            if segment_cost[row, u] == cost < np.inf:
+                for k in range(d):
+                    exit_state[k] = center[k] + record[first, k]
+                if leaves_axes(axis_min, axis_step, axis_count, wrap, exit_state):
+                    segment_cost[row, u] = np.inf
 
 
 @njit(cache=True)
@@ -555,13 +652,13 @@ def segment_boxes(
     state_slot,
     out,
 ):
-    """out (C, U, 8): for each class segment of a ``RECORD`` (``exit_transitions_template``),
+    """out (C, U, 8): for each class segment of a recording (``exit_transitions_template``),
     the box [x low, x high, y low, y high] (m, relative to the start's reference point) that
     holds its body (``pose_slot``, ``outline`` as ``geometry.pose_is_free`` takes them) at the
     end of each of its steps, then the box that holds the points where full braking from them
     would stop (``arrival.braking_stop``; where ``arrives``). An empty box (low inf, high -inf)
     where there is nothing to test."""
-    size = (record.shape[1] - 1) // 2
+    size = record.shape[1] - 1
     body = np.empty_like(outline)
     stop = np.empty(state_slot.shape[0])
     x_axis = axis_of_slot(state_slot, vehicle_slot[0])
@@ -597,48 +694,59 @@ def sweep_order(axis_count, sweep, out):
     """The grid's nodes in the order of sweep number ``sweep`` (out: (N,) int64): C order with
     the axes whose bit is set in ``sweep mod 2**d`` run backwards. Successive sweeps take the
     2**d orders in turn (the fast sweeping method), so that what is known spreads along every
-    direction of the grid within a few sweeps, each running through memory in order."""
+    direction of the grid within a few sweeps, each running through memory in order. The node
+    index is carried from one node to the next (a step along the last axis that moves, back
+    to the start of the axes after it) rather than recomputed from the position."""
     d = axis_count.shape[0]
     backwards = sweep % (1 << d)
     strides = np.empty(d, np.int64)
     grid_strides(axis_count, strides)
+    step = np.empty(d, np.int64)  # the index change of one step along each axis
+    node = 0
+    for k in range(d):
+        if (backwards >> k) & 1:
+            step[k] = -strides[k]
+            node += (axis_count[k] - 1) * strides[k]
+        else:
+            step[k] = strides[k]
     position = np.zeros(d, np.int64)
     for p in range(out.shape[0]):
-        node = 0
-        for k in range(d):
-            i = position[k]
-            if (backwards >> k) & 1:
-                i = axis_count[k] - 1 - i
-            node += i * strides[k]
         out[p] = node
         k = d - 1
         while k >= 0:
             position[k] += 1
             if position[k] < axis_count[k]:
+                node += step[k]
                 break
             position[k] = 0
+            node -= (axis_count[k] - 1) * step[k]
             k -= 1
 
 
 @njit(cache=True)
-def reach_sweep(exit_index, exit_weight, segment_cost, row_of, reached, order):
+def reach_sweep(
+    exit_index, exit_weight, segment_cost, to_destination, row_of, shape_row_of, reached, order
+):
     """One sweep of reachability in ``order`` (``sweep_order``), in place: a node with a row
-    joins ``reached`` when some control leaves its cell (finite cost) onto a face with at least
-    one reached corner (weight > 0). Start from the destination nodes; repeat until nothing
-    joins. The nodes never reached cannot reach the destination: their cost-to-go is inf.
-    row_of: (N,) int64, each node's row in the exit tables (-1: removed); reached: (N,) bool.
-    Returns how many nodes joined."""
+    joins ``reached`` when some control leaves its cell (finite cost) for the destination or
+    onto a face with at least one reached corner (weight > 0). Start from the destination nodes;
+    repeat until nothing joins. The nodes never reached cannot reach the destination: their
+    cost-to-go is inf. The exit tables as ``gauss_seidel_sweep`` takes them; reached: (N,)
+    bool. Returns how many nodes joined."""
     joined = 0
     for p in range(order.shape[0]):
         node = order[p]
         row = row_of[node]
         if reached[node] or row < 0:
             continue
+        shape = shape_row_of[node]
         for u in range(segment_cost.shape[1]):
             if segment_cost[row, u] == np.inf:
                 continue
+            if to_destination[row, u]:
+                reached[node] = True
             for i in range(exit_index.shape[2]):
-                if exit_weight[row, u, i] > 0.0 and reached[exit_index[row, u, i]]:
+                if exit_weight[shape, u, i] > 0.0 and reached[node + exit_index[shape, u, i]]:
                     reached[node] = True
                     break
             if reached[node]:
@@ -648,53 +756,71 @@ def reach_sweep(exit_index, exit_weight, segment_cost, row_of, reached, order):
 
 
 @njit(cache=True)
-def interpolate_known_values_only(
-    exit_index, exit_weight, segment_cost, reachable, minimum_known_weight
+def discard_poorly_known_exits(
+    exit_index,
+    exit_weight,
+    segment_cost,
+    to_destination,
+    row_of,
+    shape_row_of,
+    reachable,
+    minimum_known_weight,
 ):
-    """Restrict every exit's interpolation to the reachable corners of its face (the paper's
-    Figure 10: the cost-to-go at the exit is interpolated between the neighbours whose values
-    are known) by zeroing the other weights and renormalising; an exit whose reachable corners
-    carry less than ``minimum_known_weight`` of its weight (in (0, 1]) gets cost inf.
-    Afterwards every finite transition rests on reachable nodes only."""
-    for row in range(segment_cost.shape[0]):
+    """The paper's Figure 10: the cost-to-go at an exit is interpolated between the neighbours
+    whose values are known, the reachable corners of its face (``known_value``, renormalising
+    their weights); an exit whose reachable corners carry less than ``minimum_known_weight`` of
+    its weight (in (0, 1]), or none, gets cost inf here. Afterwards every finite transition
+    rests on reachable nodes. The exit tables as ``gauss_seidel_sweep`` takes them; reachable:
+    (N,) bool."""
+    for node in range(row_of.shape[0]):
+        row = row_of[node]
+        if row < 0:
+            continue
+        shape = shape_row_of[node]
         for u in range(segment_cost.shape[1]):
-            if segment_cost[row, u] == np.inf:
+            if segment_cost[row, u] == np.inf or to_destination[row, u]:
                 continue
-            total = 0.0
+            known = 0.0
             for i in range(exit_index.shape[2]):
-                if exit_weight[row, u, i] > 0.0 and not reachable[exit_index[row, u, i]]:
-                    exit_weight[row, u, i] = 0.0
-                total += exit_weight[row, u, i]
-            if total == 0.0 or total < minimum_known_weight:
+                w = exit_weight[shape, u, i]
+                if w > 0.0 and reachable[node + exit_index[shape, u, i]]:
+                    known += w
+            if known == 0.0 or known < minimum_known_weight:
                 segment_cost[row, u] = np.inf
-            else:
-                for i in range(exit_index.shape[2]):
-                    exit_weight[row, u, i] /= total
 
 
 @njit(cache=True, inline="always")
-def _expected_value(exit_index, exit_weight, row, u, value):
-    """Σ w·V over the exit corners of (row, u); zero-weight corners are skipped."""
+def known_value(exit_index, exit_weight, shape, u, node, value):
+    """The cost-to-go at the exit of (node, u): Σ w·V over the corners of its shape (row
+    ``shape`` of the tables, corners as offsets from ``node``) whose value is known (finite:
+    reachable), over the sum of their weights. Zero-weight corners are skipped."""
     total = 0.0
+    known = 0.0
     for i in range(exit_index.shape[2]):
-        w = exit_weight[row, u, i]
+        w = exit_weight[shape, u, i]
         if w != 0.0:
-            total += w * value[exit_index[row, u, i]]
-    return total
+            v = value[node + exit_index[shape, u, i]]
+            if v < np.inf:
+                total += w * v
+                known += w
+    return total / known
 
 
 @njit(cache=True, inline="always")
-def _bellman(exit_index, exit_weight, segment_cost, value, row):
-    """(min over u of cost(row, u) + Σ w·V(corner), the first minimising u); (inf, 0) where
-    every control costs inf. Inlined where it is called (numba's ``inline="always"``): a call
-    per node would cost more than the node's arithmetic."""
+def _bellman(exit_index, exit_weight, segment_cost, to_destination, value, row, shape, node):
+    """(min over u of cost(row, u) + the exit's cost-to-go (``known_value``; 0 for an exit to
+    the destination), the first minimising u); (inf, 0) where every control costs inf. Inlined
+    where it is called (numba's ``inline="always"``): a call per node would cost more than the
+    node's arithmetic."""
     best = np.inf
     choice = 0
     for u in range(segment_cost.shape[1]):
         cost = segment_cost[row, u]
         if cost == np.inf:
             continue
-        candidate = cost + _expected_value(exit_index, exit_weight, row, u, value)
+        candidate = cost
+        if not to_destination[row, u]:
+            candidate += known_value(exit_index, exit_weight, shape, u, node, value)
         if candidate < best:
             best = candidate
             choice = u
@@ -702,11 +828,11 @@ def _bellman(exit_index, exit_weight, segment_cost, value, row):
 
 
 @njit(cache=True, inline="always")
-def _prefetch_exits(exit_index, exit_weight, segment_cost, row_of, value, order, p):
+def _prefetch_exits(exit_index, exit_weight, segment_cost, row_of, shape_row_of, value, order, p):
     """Ask the cache for what the sweep at position p of ``order`` reads soon, each a step
     before the next needs it: the segment costs of the node 2·PREFETCH_AHEAD places ahead, the
-    exits (corners and weights) of the finite-cost controls of the node PREFETCH_AHEAD ahead,
-    and the cost-to-go of the next node's corners."""
+    exit shapes (corners and weights) of the finite-cost controls of the node PREFETCH_AHEAD
+    ahead, and the cost-to-go of the next node's corners."""
     n = order.shape[0]
     if p + 2 * PREFETCH_AHEAD < n:
         far = row_of[order[p + 2 * PREFETCH_AHEAD]]
@@ -714,21 +840,25 @@ def _prefetch_exits(exit_index, exit_weight, segment_cost, row_of, value, order,
             for u in range(0, segment_cost.shape[1], CACHE_LINE // segment_cost.itemsize):
                 prefetch(segment_cost, (far, u))
     if p + PREFETCH_AHEAD < n:
-        ahead = row_of[order[p + PREFETCH_AHEAD]]
+        node = order[p + PREFETCH_AHEAD]
+        ahead = row_of[node]
         if ahead >= 0:
+            shape = shape_row_of[node]
             per_line = CACHE_LINE // exit_index.itemsize
             for u in range(segment_cost.shape[1]):
                 if segment_cost[ahead, u] != np.inf:
                     for i in range(0, exit_index.shape[2], per_line):
-                        prefetch(exit_index, (ahead, u, i))
-                        prefetch(exit_weight, (ahead, u, i))
+                        prefetch(exit_index, (shape, u, i))
+                        prefetch(exit_weight, (shape, u, i))
     if p + 1 < n:
-        following = row_of[order[p + 1]]
+        node = order[p + 1]
+        following = row_of[node]
         if following >= 0:
+            shape = shape_row_of[node]
             for u in range(segment_cost.shape[1]):
                 if segment_cost[following, u] != np.inf:
                     for i in range(exit_index.shape[2]):
-                        prefetch(value, (exit_index[following, u, i],))
+                        prefetch(value, (node + exit_index[shape, u, i],))
 
 
 @njit(cache=True)
@@ -736,7 +866,9 @@ def gauss_seidel_sweep(
     exit_index,
     exit_weight,
     segment_cost,
+    to_destination,
     row_of,
+    shape_row_of,
     is_destination,
     value,
     order,
@@ -750,12 +882,15 @@ def gauss_seidel_sweep(
     node's value decreases, the control sample that gave the new value (the policy that
     ``policy_sweep`` follows).
 
-    value: (N,) float64 cost-to-go, s, in place. Value iteration starts from an upper bound (0
-    at the destination nodes, a large finite ``UNKNOWN`` at the other reachable nodes: the
-    paper's "values not yet known"; inf at unreachable nodes, which no finite transition touches
-    after ``interpolate_known_values_only``), so values only decrease, as the paper describes.
-    row_of: (N,) int64, each node's row in the exit tables (-1: removed, skipped);
-    is_destination: (N,) bool, held at 0. A decrease to a value still at or above
+    The exit tables: segment_cost and to_destination (R, U), one row per node that is not
+    removed (row_of: (N,) int64, each node's row, -1: removed, skipped); the exits' shapes
+    exit_index (int32 corner offsets from the node) and exit_weight (float32), (E, U,
+    2**(d-1)), row shape_row_of[node] for a node's exits: its own row, or its class's
+    (``replay_classes``), whose nodes share them. value: (N,) float64 cost-to-go, s, in place.
+    Value iteration starts from an upper bound (0 at the destination nodes, a large finite
+    ``UNKNOWN`` at the other reachable nodes: the paper's "values not yet known"; inf at
+    unreachable nodes, which ``known_value`` leaves out), so values only decrease, as the paper
+    describes. is_destination: (N,) bool, held at 0. A decrease to a value still at or above
     ``settled_above`` (s; inf: none) does not count in the largest decrease: such a node is a
     dead end (``known_weight``), whatever its exact bound. One thread, in a fixed order: the
     same result on any machine whatever the thread count. ``prefetching``: ask the cache for
@@ -766,13 +901,24 @@ def gauss_seidel_sweep(
     largest = 0.0
     for p in range(order.shape[0]):
         if prefetching:
-            _prefetch_exits(exit_index, exit_weight, segment_cost, row_of, value, order, p)
+            _prefetch_exits(
+                exit_index, exit_weight, segment_cost, row_of, shape_row_of, value, order, p
+            )
         node = order[p]
         row = row_of[node]
         if row < 0 or is_destination[node]:
             continue
         old = value[node]
-        best, choice = _bellman(exit_index, exit_weight, segment_cost, value, row)
+        best, choice = _bellman(
+            exit_index,
+            exit_weight,
+            segment_cost,
+            to_destination,
+            value,
+            row,
+            shape_row_of[node],
+            node,
+        )
         if best < old:
             value[node] = best
             control[node] = choice
@@ -783,44 +929,66 @@ def gauss_seidel_sweep(
 
 @njit(cache=True)
 def gather_policy(
-    exit_index, exit_weight, segment_cost, row_of, control, policy_index, policy_weight, policy_cost
+    exit_index,
+    exit_weight,
+    segment_cost,
+    to_destination,
+    row_of,
+    shape_row_of,
+    control,
+    policy_index,
+    policy_weight,
+    policy_cost,
+    policy_to_destination,
 ):
-    """Copy each row's exit under its node's control (control: (N,) int64) into the compact
-    tables policy_index (R, 1, 2**(d-1)) int32, policy_weight (same shape) float32 and
-    policy_cost (R, 1) s, which ``policy_sweep`` reads in order instead of picking one control's
-    exit out of every row of the full tables."""
+    """Copy each node's exit under its control (control: (N,) int64) into the compact tables
+    policy_index (R, 1, 2**(d-1)) int32, policy_weight (same shape) float32, policy_cost and
+    policy_to_destination (R, 1), one row per node with a row (its own shape), which
+    ``policy_sweep`` reads in order instead of picking one control's exit out of every row of
+    the full tables."""
     for node in range(row_of.shape[0]):
         row = row_of[node]
         if row < 0:
             continue
         u = control[node]
+        shape = shape_row_of[node]
         policy_cost[row, 0] = segment_cost[row, u]
+        policy_to_destination[row, 0] = to_destination[row, u]
         for i in range(exit_index.shape[2]):
-            policy_index[row, 0, i] = exit_index[row, u, i]
-            policy_weight[row, 0, i] = exit_weight[row, u, i]
+            policy_index[row, 0, i] = exit_index[shape, u, i]
+            policy_weight[row, 0, i] = exit_weight[shape, u, i]
 
 
 @njit(cache=True)
 def policy_sweep(
-    policy_index, policy_weight, policy_cost, row_of, is_destination, value, order, settled_above
+    policy_index,
+    policy_weight,
+    policy_cost,
+    policy_to_destination,
+    row_of,
+    is_destination,
+    value,
+    order,
+    settled_above,
 ):
     """One Gauss–Seidel sweep in ``order`` of the Bellman update restricted to each node's
-    control in the compact tables of ``gather_policy``: ``min(old, cost + Σ w·V(corner))``
-    under that one control. Each update is the cost of a real control from the node, onto
-    values that are themselves upper bounds, so values stay upper bounds of the cost-to-go and
-    still only decrease; a sweep reads one control's exit per node instead of all of them.
-    Returns the largest decrease, s (decreases to values at or above ``settled_above`` not
-    counted, as in ``gauss_seidel_sweep``)."""
+    control in the compact tables of ``gather_policy``: ``min(old, cost + the exit's
+    cost-to-go)`` under that one control. Each update is the cost of a real control from the
+    node, onto values that are themselves upper bounds, so values stay upper bounds of the
+    cost-to-go and still only decrease; a sweep reads one control's exit per node instead of
+    all of them. Returns the largest decrease, s (decreases to values at or above
+    ``settled_above`` not counted, as in ``gauss_seidel_sweep``)."""
     largest = 0.0
     for p in range(order.shape[0]):
         node = order[p]
         row = row_of[node]
         if row < 0 or is_destination[node]:
             continue
-        cost = policy_cost[row, 0]
-        if cost == np.inf:
+        candidate = policy_cost[row, 0]
+        if candidate == np.inf:
             continue
-        candidate = cost + _expected_value(policy_index, policy_weight, row, 0, value)
+        if not policy_to_destination[row, 0]:
+            candidate += known_value(policy_index, policy_weight, row, 0, node, value)
         old = value[node]
         if candidate < old:
             value[node] = candidate
@@ -834,7 +1002,9 @@ def gauss_seidel_sweeps(
     exit_index,
     exit_weight,
     segment_cost,
+    to_destination,
     row_of,
+    shape_row_of,
     is_destination,
     value,
     axis_count,
@@ -848,6 +1018,7 @@ def gauss_seidel_sweeps(
     policy_index,
     policy_weight,
     policy_cost,
+    policy_to_destination,
     policy_sweeps,
 ):
     """Value iteration by modified policy iteration: Bellman sweeps (``gauss_seidel_sweep``),
@@ -859,11 +1030,11 @@ def gauss_seidel_sweeps(
     191 sweeps, most of the car's 222), the policy has nearly settled; the policy sweeps
     run that slow mode down reading one control's exit per node from a compact table instead
     of all of them (about a tenth of a Bellman sweep's time). Every sweep takes the next of
-    the orders of ``sweep_order``, counting from sweep number ``first``. order: (N,) int64
-    and control (N,) int64 work space (control: zeros before the first call, kept between
-    calls); policy_*: ``gather_policy``'s tables; settled_above, prefetching: as
-    ``gauss_seidel_sweep``. Returns (Bellman sweeps run, policy sweeps run, the last Bellman
-    sweep's largest decrease)."""
+    the orders of ``sweep_order``, counting from sweep number ``first``. The exit tables as
+    ``gauss_seidel_sweep`` takes them; order: (N,) int64 and control (N,) int64 work space
+    (control: zeros before the first call, kept between calls); policy_*: ``gather_policy``'s
+    tables; settled_above, prefetching: as ``gauss_seidel_sweep``. Returns (Bellman sweeps
+    run, policy sweeps run, the last Bellman sweep's largest decrease)."""
     largest = np.inf
     sweep = first
     policy = 0
@@ -874,7 +1045,9 @@ def gauss_seidel_sweeps(
             exit_index,
             exit_weight,
             segment_cost,
+            to_destination,
             row_of,
+            shape_row_of,
             is_destination,
             value,
             order,
@@ -889,11 +1062,14 @@ def gauss_seidel_sweeps(
                 exit_index,
                 exit_weight,
                 segment_cost,
+                to_destination,
                 row_of,
+                shape_row_of,
                 control,
                 policy_index,
                 policy_weight,
                 policy_cost,
+                policy_to_destination,
             )
         for _ in range(policy_sweeps):
             sweep_order(axis_count, sweep, order)
@@ -903,6 +1079,7 @@ def gauss_seidel_sweeps(
                 policy_index,
                 policy_weight,
                 policy_cost,
+                policy_to_destination,
                 row_of,
                 is_destination,
                 value,
@@ -915,13 +1092,26 @@ def gauss_seidel_sweeps(
 
 
 @njit(cache=True)
-def best_controls(exit_index, exit_weight, segment_cost, row_of, value, best_control):
+def best_controls(
+    exit_index, exit_weight, segment_cost, to_destination, row_of, shape_row_of, value, best_control
+):
     """The minimising control sample index of every node (the first on ties; 0 where every
     sample costs inf or the node is removed). best_control: (N,) int64 out."""
     for node in range(value.shape[0]):
         row = row_of[node]
         best_control[node] = (
-            0 if row < 0 else _bellman(exit_index, exit_weight, segment_cost, value, row)[1]
+            0
+            if row < 0
+            else _bellman(
+                exit_index,
+                exit_weight,
+                segment_cost,
+                to_destination,
+                value,
+                row,
+                shape_row_of[node],
+                node,
+            )[1]
         )
 
 
@@ -959,25 +1149,46 @@ DESTINATION_MAX_SWEEPS = 10_000  # a cap on them (a converged table needs tens)
 
 
 @njit(cache=True)
-def destination_share_sweep(exit_index, exit_weight, row_of, best_control, active, share, order):
+def destination_share_sweep(
+    exit_index,
+    exit_weight,
+    to_destination,
+    row_of,
+    shape_row_of,
+    best_control,
+    reachable,
+    terminal_node,
+    active,
+    share,
+    order,
+):
     """One Gauss–Seidel sweep, in ``order`` (``sweep_order``), of the destination shares
     (``destination_indices``): each ``active`` node's share of every destination becomes the
-    weighted sum of its best exit's corners' shares, at once, so that the nodes after it in
-    the sweep use it. active: (N,) bool; share: (N, D) float64, in place. Returns the largest
-    change of a share."""
+    weighted sum of its best exit's reachable corners' shares (weights renormalised over them,
+    as ``known_value`` does; the share of ``terminal_node`` for an exit to the destination), at
+    once, so that the nodes after it in the sweep use it. active: (N,) bool; share: (N, D)
+    float64, in place. Returns the largest change of a share."""
     largest = 0.0
     for p in range(order.shape[0]):
         node = order[p]
         if not active[node]:
             continue
         row = row_of[node]
+        shape = shape_row_of[node]
         u = best_control[node]
         for k in range(share.shape[1]):
-            total = 0.0
-            for i in range(exit_index.shape[2]):
-                w = exit_weight[row, u, i]
-                if w != 0.0:
-                    total += w * share[exit_index[row, u, i], k]
+            if to_destination[row, u]:
+                total = share[terminal_node, k]
+            else:
+                total = 0.0
+                known = 0.0
+                for i in range(exit_index.shape[2]):
+                    w = exit_weight[shape, u, i]
+                    corner = node + exit_index[shape, u, i]
+                    if w != 0.0 and reachable[corner]:
+                        total += w * share[corner, k]
+                        known += w
+                total /= known
             change = abs(total - share[node, k])
             if change > largest:
                 largest = change
@@ -989,8 +1200,12 @@ def destination_share_sweep(exit_index, exit_weight, row_of, best_control, activ
 def destination_indices(
     exit_index,
     exit_weight,
+    to_destination,
     row_of,
+    shape_row_of,
     best_control,
+    reachable,
+    terminal_node,
     value,
     destination_label,
     axis_count,
@@ -1004,13 +1219,13 @@ def destination_indices(
     lines (the contract's ``/destination_index``), written into out (N,) int64; returns the
     sweeps run.
 
-    exit_index (R, U, 2**(d-1)) int32, exit_weight (R, U, 2**(d-1)) float32: the exit
-    transitions as the value sweeps use them (after ``interpolate_known_values_only``); row_of
-    (N,) int64 (-1: removed); best_control (N,) int64 (``best_controls``); value (N,) float64,
-    the table's cost-to-go, s (inf: unreachable or dead end); destination_label (N,) int64,
-    the ``dest`` line (0 .. D-1) a destination node matches (the first, if several), -1 for
-    the other nodes; axis_count (d,) int64; order (N,) int64 work space; share (N, D) float64
-    out: the destination shares below.
+    The exit tables as ``gauss_seidel_sweep`` takes them (after ``discard_poorly_known_exits``);
+    best_control (N,) int64 (``best_controls``); reachable (N,) bool, the nodes whose value the
+    DP knew; terminal_node: the destination node an exit to the destination
+    (``to_destination``) ends at; value (N,) float64, the table's cost-to-go, s (inf:
+    unreachable or dead end); destination_label (N,) int64, the ``dest`` line (0 .. D-1) a
+    destination node matches (the first, if several), -1 for the other nodes; axis_count (d,)
+    int64; order (N,) int64 work space; share (N, D) float64 out: the destination shares below.
 
     The rule. The DP reads an exit as going on to the corners of the face it crosses in the
     proportions of their interpolation weights: the cost-to-go is the expected cost of that
@@ -1041,7 +1256,17 @@ def destination_indices(
     while sweeps < max_sweeps:
         sweep_order(axis_count, sweeps, order)
         largest = destination_share_sweep(
-            exit_index, exit_weight, row_of, best_control, active, share, order
+            exit_index,
+            exit_weight,
+            to_destination,
+            row_of,
+            shape_row_of,
+            best_control,
+            reachable,
+            terminal_node,
+            active,
+            share,
+            order,
         )
         sweeps += 1
         if largest <= tolerance:

@@ -165,7 +165,7 @@ def _cost_to_go(
     """Interpolated cost-to-go (s) at a controller state (d,); beyond the axes, the value at the
     nearest covered state plus OUTSIDE_PENALTY per grid step outside (summed over the axes), so
     that the way back in is the cheapest; inf where the corners whose value is known carry less
-    than ``minimum_known_weight`` of the weight (as the DP, ``dp.interpolate_known_values_only``)
+    than ``minimum_known_weight`` of the weight (as the DP, ``dp.discard_poorly_known_exits``)
     or none."""
     clamp_to_domain(axis_min, axis_step, axis_count, wrap, exit_state, clamped)
     known_weight = interpolate_with(

@@ -11,7 +11,7 @@ import json
 import resource
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from types import ModuleType
 
@@ -26,19 +26,17 @@ from mosys.kernels.dp import (
     DEAD_END_SECONDS,
     DESTINATION_MAX_SWEEPS,
     DESTINATION_TOLERANCE,
-    PLAIN,
-    RECORD,
-    REPLAY,
     UNKNOWN,
     best_controls,
     destination_indices,
+    discard_poorly_known_exits,
     exit_transitions_template,
     free_nodes,
     gauss_seidel_sweeps,
-    interpolate_known_values_only,
     node_coordinates,
     prefetch_pays,
     reach_sweep,
+    replay_classes,
     segment_boxes,
     sweep_order,
 )
@@ -196,22 +194,17 @@ def policy_attributes(spec: ControllerSpec) -> dict:
 
 
 def reachable_nodes(
-    exit_index: np.ndarray,
-    exit_weight: np.ndarray,
-    segment_cost: np.ndarray,
-    destination: np.ndarray,
-    row_of: np.ndarray,
-    axis_count: np.ndarray,
+    transitions: Transitions, destination: np.ndarray, axis_count: np.ndarray
 ) -> np.ndarray:
     """(N,) bool: the nodes from which some sequence of controls leads to the destination (every
     step onto a face with a weight on a node already known to lead there), by sweeps in the
-    orders of ``sweep_order`` until one adds nothing. row_of: ``Transitions.row_of``."""
-    reached = destination & (row_of >= 0)
+    orders of ``sweep_order`` until one adds nothing."""
+    reached = destination & (transitions.row_of >= 0)
     order = np.empty(reached.shape[0], dtype=np.int64)
     sweep = 0
     while True:
         sweep_order(axis_count, sweep, order)
-        if not reach_sweep(exit_index, exit_weight, segment_cost, row_of, reached, order):
+        if not reach_sweep(*transitions.arrays(), reached, order):
             return reached
         sweep += 1
 
@@ -239,19 +232,23 @@ class Solution:
 
 @dataclass(frozen=True)
 class Transitions:
-    """What the exit transitions give, one row per node that is not removed (a removed node
-    takes no memory): exit_index and exit_weight (R, U, 2**(d-1)) int32 and float32,
-    segment_cost (R, U) s (``dp.exit_transitions_template``); row_of (N,) int64, each node's
-    row, -1 for a removed node."""
+    """What the exit transitions give (``dp.gauss_seidel_sweep`` reads them): segment_cost (R,
+    U) s and to_destination (R, U) bool, one row per node that is not removed (row_of (N,)
+    int64, each node's row, -1 for a removed node, which takes no memory); the exits' shapes
+    exit_index (E, U, 2**(d-1)) int32 (corner offsets from the node) and exit_weight float32,
+    row shape_row_of[node] for a node's exits: its own row, or its class's
+    (``MotionClasses``)."""
 
     exit_index: np.ndarray
     exit_weight: np.ndarray
     segment_cost: np.ndarray
+    to_destination: np.ndarray
     row_of: np.ndarray
+    shape_row_of: np.ndarray
 
     @classmethod
     def empty(cls, valid: np.ndarray, controls: int, dimensions: int) -> Transitions:
-        """Tables for the nodes where ``valid`` (N,) bool is True."""
+        """Tables for the nodes where ``valid`` (N,) bool is True, a shape for each."""
         corners = 1 << (dimensions - 1)
         rows = int(valid.sum())
         row_of = np.full(valid.shape[0], -1, dtype=np.int64)
@@ -260,18 +257,34 @@ class Transitions:
             np.zeros((rows, controls, corners), dtype=np.int32),
             np.zeros((rows, controls, corners), dtype=np.float32),
             np.empty((rows, controls)),
+            np.zeros((rows, controls), dtype=np.bool_),
+            row_of,
             row_of,
         )
 
-    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        return self.exit_index, self.exit_weight, self.segment_cost
+    def arrays(self) -> tuple[np.ndarray, ...]:
+        """The tables as the kernels take them: exit_index, exit_weight, segment_cost,
+        to_destination, row_of, shape_row_of."""
+        return (
+            self.exit_index,
+            self.exit_weight,
+            self.segment_cost,
+            self.to_destination,
+            self.row_of,
+            self.shape_row_of,
+        )
+
+    def outputs(self) -> tuple[np.ndarray, ...]:
+        """What ``dp.exit_transitions_template`` writes: exit_index, exit_weight, segment_cost,
+        to_destination."""
+        return self.arrays()[:4]
 
 
 def exit_transition_arguments(
-    problem: Problem, dynamics: ModuleType, dt: float, row_of: np.ndarray
-) -> tuple:
-    """The arguments of the exit-transition kernel before ``nodes``, and those after it up to
-    the outputs (``dp.exit_transitions_template``), SI."""
+    problem: Problem, dynamics: ModuleType, dt: float
+) -> tuple[tuple, tuple, tuple]:
+    """The exit-transition kernel's arguments (``dp.exit_transitions_template``) before
+    ``nodes``, its obstacles and its arrival box (``arrival_arguments``), SI."""
     grid = problem.grid
     # the kernels take SI controls; K stays per spec unit: K |u_spec| = (K / scale) |u_SI|
     samples_si = np.ascontiguousarray(problem.control_samples * problem.control_scale)
@@ -289,17 +302,15 @@ def exit_transition_arguments(
         effort,
         float(dt),
     )
-    obstacles = problem.obstacles.kernel_arguments()
-    return before, (row_of, *obstacles, *arrival_arguments(problem, dynamics))
+    return before, problem.obstacles.kernel_arguments(), arrival_arguments(problem, dynamics)
 
 
 def arrival_arguments(problem: Problem, dynamics: ModuleType) -> tuple:
     """The exit kernel's arrival arguments (``dp.exit_transitions_template``): a lookahead
     table's arrival box and braking, else a disabled placeholder."""
     spec, grid = problem.spec, problem.grid
-    terminal_node = int(np.flatnonzero(problem.is_destination)[0])
     if spec.policy is None or spec.policy.kind != "lookahead":
-        return no_arrival(len(grid.names), terminal_node)
+        return no_arrival(len(grid.names))
     control = next(c for c in spec.controls if c.name == "wheel_accel")
     arrival = vehicle_arrival(
         dynamics,
@@ -315,40 +326,28 @@ def arrival_arguments(problem: Problem, dynamics: ModuleType) -> tuple:
         arrival.wheelbase,
         arrival.wheel_radius,
         arrival.brake,
-        terminal_node,
     )
 
 
-def no_arrival(dimensions: int, terminal_node: int) -> tuple:
+def no_arrival(dimensions: int) -> tuple:
     """The exit kernel's arrival arguments for a table without an arrival box."""
-    none = np.zeros((3, dimensions))
-    return False, none, np.zeros(7, dtype=np.int64), 1.0, 1.0, 1.0, terminal_node
+    return False, np.zeros((3, dimensions)), np.zeros(7, dtype=np.int64), 1.0, 1.0, 1.0
 
 
-def plain_record(problem: Problem) -> tuple:
-    """The exit kernel's record arguments for integrating every (node, control) pair (``PLAIN``:
-    no classes)."""
-    size = problem.base_state.shape[0]
+def no_record(size: int) -> tuple:
+    """The exit kernel's record arguments when it records nothing (model state size S)."""
     empty = np.zeros((0, 0), dtype=np.int64)
-    return (
-        PLAIN,
-        np.zeros(0, dtype=np.int64),
-        empty,
-        empty,
-        np.zeros((0, 2 * size + 1)),
-        np.zeros(size, dtype=np.bool_),
-        np.zeros((0, 0, 8)),
-    )
+    return False, empty, empty, np.zeros((0, size + 1)), np.zeros(size, dtype=np.bool_)
 
 
 @dataclass(frozen=True)
 class MotionClasses:
-    """The nodes that move alike: for a model whose equations read none of ``ignorable`` (d,)
-    bool of the controller axes (its ``IGNORABLE_STATES``, on axes that do not wrap), every node
-    of a class (the nodes differing only on those axes) moves the same way under a control,
-    shifted (``dp.exit_transitions_template``, ``RECORD`` and ``REPLAY``). class_of (N,) int64;
-    representative (C,) int64: a node of each class (the first on the ignorable axes);
-    relative_slot (S,) bool: the model-state slots of the ignorable axes."""
+    """The nodes that move alike: for a model whose equations read none of the controller axes
+    its ``IGNORABLE_STATES`` names (axes that do not wrap and have at least 3 nodes), every
+    node of a class (the nodes differing only on those axes) moves the same way under a
+    control, shifted (``dp.replay_classes``). class_of (N,) int64; representative (C,) int64: a
+    node of each class, in the middle of the ignorable axes, so that its exits stay on the
+    grid; relative_slot (S,) bool: the model-state slots of the ignorable axes."""
 
     class_of: np.ndarray
     representative: np.ndarray
@@ -360,7 +359,10 @@ class MotionClasses:
         grid = problem.grid
         names = getattr(dynamics, "IGNORABLE_STATES", ())
         ignorable = np.array(
-            [name in names and not wraps for name, wraps in zip(grid.names, grid.wrap, strict=True)]
+            [
+                name in names and not wraps and count >= 3
+                for name, wraps, count in zip(grid.names, grid.wrap, grid.axis_count, strict=True)
+            ]
         )
         if not ignorable.any():
             return None
@@ -368,91 +370,37 @@ class MotionClasses:
         class_shape = tuple(1 if ignorable[k] else n for k, n in enumerate(grid.shape))
         index[ignorable] = 0
         class_of = np.ravel_multi_index(tuple(index), class_shape).astype(np.int64)
-        classes = np.unravel_index(np.arange(int(np.prod(class_shape))), class_shape)
-        representative = np.ravel_multi_index(classes, grid.shape).astype(np.int64)
+        members = np.unravel_index(np.arange(int(np.prod(class_shape))), class_shape)
+        middle = tuple(
+            np.full_like(m, grid.shape[k] // 2) if ignorable[k] else m
+            for k, m in enumerate(members)
+        )
+        representative = np.ravel_multi_index(middle, grid.shape).astype(np.int64)
         relative_slot = np.zeros(problem.base_state.shape[0], dtype=np.bool_)
         relative_slot[grid.state_slot[ignorable]] = True
         return cls(class_of, representative, relative_slot)
 
 
-def record_classes(
+def load_kernels(
     exit_transitions: Callable,
     arguments: tuple,
     problem: Problem,
-    classes: MotionClasses,
-) -> tuple:
-    """Integrate each class's segments once (``RECORD``: counted, then written) and return the
-    exit kernel's record arguments for replaying them at every node (``REPLAY``)."""
-    before, after = arguments
-    grid = problem.grid
-    size = problem.base_state.shape[0]
-    count = classes.representative.size
-    row_of = np.full(grid.node_count, -1, dtype=np.int64)
-    row_of[classes.representative] = np.arange(count)
-    free = (row_of, *NO_OBSTACLES.kernel_arguments(), *no_arrival(len(grid.names), after[-1]))
-    scratch = Transitions.empty(row_of >= 0, problem.control_samples.shape[0], len(grid.names))
-    record_start = np.zeros(scratch.segment_cost.shape, dtype=np.int64)
-    record_count = np.zeros_like(record_start)
-    record = np.zeros((0, 2 * size + 1))
-    for _ in range(2):  # count the rows, then write them
-        exit_transitions(
-            *before,
-            classes.representative,
-            *free,
-            *scratch.arrays(),
-            RECORD,
-            classes.class_of,
-            record_start,
-            record_count,
-            record,
-            classes.relative_slot,
-            np.zeros((0, 0, 8)),
-        )
-        if record.shape[0] == 0:
-            ends = np.cumsum(record_count.ravel())
-            record_start = (ends - record_count.ravel()).reshape(record_count.shape)
-            record = np.empty((int(ends[-1]), 2 * size + 1))
-    boxes = np.empty(record_count.shape + (8,))
-    arrival = after[6:]
-    segment_boxes(
-        record,
-        record_start,
-        record_count,
-        problem.obstacles.pose_slot,
-        problem.obstacles.outline,
-        *arrival[:1],
-        *arrival[2:6],
-        grid.state_slot,
-        boxes,
-    )
-    return (
-        REPLAY,
-        classes.class_of,
-        record_start,
-        record_count,
-        record,
-        classes.relative_slot,
-        boxes,
-    )
-
-
-def load_kernels(
-    exit_transitions: Callable, arguments: tuple, problem: Problem, transitions: Transitions
+    classes: MotionClasses | None,
 ) -> float:
     """Load (or compile, on a cold cache) every kernel of ``solve`` and start numba's threads,
     by calling each on no nodes, so that the DP's timings are the DP's; returns the seconds.
     arguments: ``exit_transition_arguments``."""
     started = time.perf_counter()
     none = np.empty(0, dtype=np.int64)
-    before, after = arguments
-    exit_transitions(*before, none, *after, *transitions.arrays(), *plain_record(problem))
+    before, obstacles, arrival = arguments
     flags = np.empty(0, dtype=np.bool_)
     empty = Transitions.empty(flags, problem.control_samples.shape[0], len(problem.grid.names))
-    reach_sweep(*empty.arrays(), none, flags, none)
-    interpolate_known_values_only(*empty.arrays(), flags, 1.0)
+    size = problem.base_state.shape[0]
+    exit_transitions(*before, none, none, *obstacles, *arrival, *empty.outputs(), *no_record(size))
+    reach_sweep(*empty.arrays(), flags, none)
+    discard_poorly_known_exits(*empty.arrays(), flags, 1.0)
     gauss_seidel_sweeps(
         *empty.arrays(),
-        none,
         flags,
         np.empty(0),
         problem.grid.axis_count,
@@ -463,29 +411,51 @@ def load_kernels(
         1.0,
         False,  # prefetching: a flag, whose type is all that compiling needs
         none,
-        *empty.arrays(),
+        *empty.outputs(),
         0,
     )
-    best_controls(*empty.arrays(), none, np.empty(0), none)
+    best_controls(*empty.arrays(), np.empty(0), none)
     sweep_order(problem.grid.axis_count, 0, none)
-    arrival = after[6:]
-    segment_boxes(
-        np.empty((0, 2 * problem.base_state.shape[0] + 1)),
-        empty.segment_cost.astype(np.int64),
-        empty.segment_cost.astype(np.int64),
-        problem.obstacles.pose_slot,
-        problem.obstacles.outline,
-        *arrival[:1],
-        *arrival[2:6],
-        problem.grid.state_slot,
-        np.empty((0, 0, 8)),
-    )
+    if classes is not None:
+        _, record_start, record_count, record, relative_slot = no_record(size)
+        boxes = np.empty((0, 0, 8))
+        segment_boxes(
+            record,
+            record_start,
+            record_count,
+            *obstacles[:2],
+            arrival[0],
+            *arrival[2:],
+            before[4],
+            boxes,
+        )
+        replay_classes(
+            *before[:7],
+            before[9],
+            none,
+            none,
+            none,
+            *obstacles,
+            *arrival,
+            empty.segment_cost,
+            record_start,
+            record_count,
+            record,
+            relative_slot,
+            boxes,
+            empty.segment_cost,
+            empty.to_destination,
+        )
     if len(problem.spec.destinations) > 1:
         destination_indices(
             empty.exit_index,
             empty.exit_weight,
+            empty.to_destination,
             none,
             none,
+            none,
+            flags,
+            0,
             np.empty(0),
             none,
             problem.grid.axis_count,
@@ -502,34 +472,110 @@ def compute_transitions(
     exit_transitions: Callable,
     arguments: tuple,
     problem: Problem,
-    transitions: Transitions,
+    valid: np.ndarray,
     classes: MotionClasses | None,
     quiet: bool,
-) -> None:
-    """Fill ``transitions`` in chunks of nodes, showing progress unless ``quiet``; with
-    ``classes``, each class's segments are integrated once and replayed at its nodes
-    (``record_classes``). arguments: ``exit_transition_arguments``."""
-    nodes = np.flatnonzero(transitions.row_of >= 0)
+) -> Transitions:
+    """The exit transitions of the nodes where ``valid`` (N,) bool is True, in chunks of nodes,
+    showing progress unless ``quiet``; with ``classes``, each class's segments are integrated
+    once (``record_classes``) and replayed at its nodes (``dp.replay_classes``), which share
+    its exit shapes. arguments: ``exit_transition_arguments``."""
+    before, obstacles, arrival = arguments
     controls = problem.control_samples.shape[0]
-    before, after = arguments
-    record = (
-        plain_record(problem)
-        if classes is None
-        else record_classes(exit_transitions, arguments, problem, classes)
-    )
+    size = problem.base_state.shape[0]
+    transitions = Transitions.empty(valid, controls, len(problem.grid.names))
+    if classes is not None:
+        shapes, record = record_classes(exit_transitions, arguments, problem, classes)
+        transitions = replace(
+            transitions,
+            exit_index=shapes.exit_index,
+            exit_weight=shapes.exit_weight,
+            shape_row_of=np.where(transitions.row_of >= 0, classes.class_of, -1),
+        )
+    nodes = np.flatnonzero(transitions.row_of >= 0)
     progress = Progress("exit transitions", nodes.size * controls, "simulations")
     count = max(1, min(PROGRESS_CHUNKS, nodes.size * controls // SIMULATIONS_PER_CHUNK))
-    chunks = np.array_split(nodes, count)
     done = 0
-    for chunk in chunks:
-        exit_transitions(
-            *before, np.ascontiguousarray(chunk), *after, *transitions.arrays(), *record
-        )
+    for chunk in np.array_split(nodes, count):
+        chunk = np.ascontiguousarray(chunk)
+        if classes is None:
+            exit_transitions(
+                *before,
+                chunk,
+                transitions.row_of,
+                *obstacles,
+                *arrival,
+                *transitions.outputs(),
+                *no_record(size),
+            )
+        else:
+            replay_classes(
+                *before[:7],
+                before[9],
+                chunk,
+                transitions.row_of,
+                classes.class_of,
+                *obstacles,
+                *arrival,
+                shapes.segment_cost,
+                *record,
+                transitions.segment_cost,
+                transitions.to_destination,
+            )
         done += chunk.size * controls
         if not quiet:
             progress.update(done)
     if not quiet:
         progress.finish()
+    return transitions
+
+
+def record_classes(
+    exit_transitions: Callable, arguments: tuple, problem: Problem, classes: MotionClasses
+) -> tuple[Transitions, tuple]:
+    """Integrate each class's segments once from its representative, without obstacles or
+    arrival box (``recording``: the steps counted, then written) and return the class's exits
+    (one row per class: its shapes and costs) and ``dp.replay_classes``'s record arguments
+    (record_start, record_count, record, relative_slot, the segment boxes)."""
+    before, obstacles, arrival = arguments
+    grid = problem.grid
+    size = problem.base_state.shape[0]
+    row_of = np.full(grid.node_count, -1, dtype=np.int64)
+    row_of[classes.representative] = np.arange(classes.representative.size)
+    shapes = Transitions.empty(row_of >= 0, problem.control_samples.shape[0], len(grid.names))
+    record_start = np.zeros(shapes.segment_cost.shape, dtype=np.int64)
+    record_count = np.zeros_like(record_start)
+    record = np.zeros((0, size + 1))
+    free = (*NO_OBSTACLES.kernel_arguments(), *no_arrival(len(grid.names)))
+    for _ in range(2):  # count the rows, then write them
+        exit_transitions(
+            *before,
+            classes.representative,
+            row_of,
+            *free,
+            *shapes.outputs(),
+            True,
+            record_start,
+            record_count,
+            record,
+            classes.relative_slot,
+        )
+        if record.shape[0] == 0:
+            ends = np.cumsum(record_count.ravel())
+            record_start = (ends - record_count.ravel()).reshape(record_count.shape)
+            record = np.empty((int(ends[-1]), size + 1))
+    boxes = np.empty(record_count.shape + (8,))
+    segment_boxes(
+        record,
+        record_start,
+        record_count,
+        *obstacles[:2],
+        arrival[0],
+        *arrival[2:],
+        grid.state_slot,
+        boxes,
+    )
+    return shapes, (record_start, record_count, record, classes.relative_slot, boxes)
 
 
 def check_transitions_finite(problem: Problem, transitions: Transitions) -> None:
@@ -584,7 +630,6 @@ def value_iteration(
     while iterations < max_iterations and not residual < tolerance:
         swept, followed, residual = gauss_seidel_sweeps(
             *transitions.arrays(),
-            transitions.row_of,
             problem.is_destination,
             value,
             grid.axis_count,
@@ -595,7 +640,7 @@ def value_iteration(
             DEAD_END_SECONDS if problem.spec.known_weight else np.inf,
             prefetching,
             control,
-            *policy.arrays(),
+            *policy.outputs(),
             POLICY_SWEEPS,
         )
         iterations += swept
@@ -625,24 +670,21 @@ def solve(
     """
     grid = problem.grid
     valid = problem.node_valid if node_valid is None else problem.node_valid & node_valid
-    transitions = Transitions.empty(valid, problem.control_samples.shape[0], len(grid.names))
     exit_transitions = specialise(exit_transitions_template, dynamics, parallel=True)
-    arguments = exit_transition_arguments(problem, dynamics, dt, transitions.row_of)
-    kernel_load_seconds = load_kernels(exit_transitions, arguments, problem, transitions)
-    started = time.perf_counter()
+    arguments = exit_transition_arguments(problem, dynamics, dt)
     classes = MotionClasses.of(problem, dynamics)
-    compute_transitions(exit_transitions, arguments, problem, transitions, classes, quiet)
+    kernel_load_seconds = load_kernels(exit_transitions, arguments, problem, classes)
+    started = time.perf_counter()
+    transitions = compute_transitions(exit_transitions, arguments, problem, valid, classes, quiet)
     check_transitions_finite(problem, transitions)
     transition_seconds = time.perf_counter() - started
-    reachable = reachable_nodes(
-        *transitions.arrays(), problem.is_destination, transitions.row_of, grid.axis_count
-    )
-    interpolate_known_values_only(*transitions.arrays(), reachable, problem.spec.known_weight)
+    reachable = reachable_nodes(transitions, problem.is_destination, grid.axis_count)
+    discard_poorly_known_exits(*transitions.arrays(), reachable, problem.spec.known_weight)
     value, iterations, policy_sweeps, residual = value_iteration(
         problem, transitions, reachable, tolerance, max_iterations, quiet
     )
     best_control = np.empty(grid.node_count, dtype=np.int64)
-    best_controls(*transitions.arrays(), transitions.row_of, value, best_control)
+    best_controls(*transitions.arrays(), value, best_control)
     iteration_seconds = time.perf_counter() - started - transition_seconds
     dead_end = reachable & (value >= DEAD_END_SECONDS) & bool(problem.spec.known_weight)
     value = np.where(reachable & ~dead_end, value, np.inf)
@@ -652,8 +694,12 @@ def solve(
         destination_indices(
             transitions.exit_index,
             transitions.exit_weight,
+            transitions.to_destination,
             transitions.row_of,
+            transitions.shape_row_of,
             best_control,
+            reachable,
+            int(np.flatnonzero(problem.is_destination)[0]),
             value,
             problem.destination_label,
             grid.axis_count,
