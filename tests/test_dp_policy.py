@@ -19,13 +19,24 @@ from mosys.kernels.dp import (
 )
 
 
-def solve(tables, axis_count, tolerance, policy_sweeps, bound=1e4, count=100_000):
+def compact_policy_tables(arrays):
+    """``dp.gather_policy``'s tables for a compact copy of one exit per node."""
+    rows, _, corners = arrays[0].shape
+    return (
+        np.zeros((rows, 1, corners), dtype=np.int32),
+        np.zeros((rows, 1, corners), dtype=np.float32),
+        np.zeros(rows, dtype=np.int64),
+        np.empty((rows, 1)),
+        np.zeros((rows, 1), dtype=np.bool_),
+    )
+
+
+def solve(tables, axis_count, tolerance, policy_sweeps, bound=1e4, count=100_000, policy=None):
     """Value iteration from ``bound`` as ``ssc.generate.value_iteration`` runs it: (values,
-    Bellman sweeps, policy sweeps)."""
+    Bellman sweeps, policy sweeps). policy: ``dp.gather_policy``'s tables (default: compact)."""
     arrays, is_destination = tables
     row_of = arrays[4]
     value = np.where(is_destination, 0.0, np.where(row_of >= 0, bound, np.inf))
-    rows, _, corners = arrays[0].shape
     bellman, policy, _ = gauss_seidel_sweeps(
         *arrays,
         is_destination,
@@ -38,10 +49,7 @@ def solve(tables, axis_count, tolerance, policy_sweeps, bound=1e4, count=100_000
         np.inf,
         False,
         np.zeros(value.size, dtype=np.int64),
-        np.zeros((rows, 1, corners), dtype=np.int32),
-        np.zeros((rows, 1, corners), dtype=np.float32),
-        np.empty((rows, 1)),
-        np.zeros((rows, 1), dtype=np.bool_),
+        *(compact_policy_tables(arrays) if policy is None else policy),
         policy_sweeps,
     )
     return value, bellman, policy
@@ -57,13 +65,8 @@ def test_a_policy_sweep_is_a_bellman_sweep_over_each_nodes_own_control(axis_coun
     value = np.where(is_destination, 0.0, np.where(row_of >= 0, 1e4, np.inf))
     order = np.empty(nodes, dtype=np.int64)
     control = np.zeros(nodes, dtype=np.int64)
-    rows, _, corners = exit_index.shape
-    policy = (
-        np.zeros((rows, 1, corners), dtype=np.int32),
-        np.zeros((rows, 1, corners), dtype=np.float32),
-        np.empty((rows, 1)),
-        np.zeros((rows, 1), dtype=np.bool_),
-    )
+    rows = exit_index.shape[0]
+    policy = compact_policy_tables(arrays)
     for sweep in range(2**counts.size + 3):
         sweep_order(counts, sweep, order)
         gauss_seidel_sweep(*arrays, is_destination, value, order, np.inf, False, control)
@@ -88,7 +91,8 @@ def test_a_policy_sweep_is_a_bellman_sweep_over_each_nodes_own_control(axis_coun
             cost[held, chosen][:, None].copy(),
             to_destination[held, chosen][:, None].copy(),
         )
-        for gathered, expected in zip(policy, cut, strict=True):
+        assert np.array_equal(policy[2], np.arange(rows))  # compact: each row its own copy
+        for gathered, expected in zip(policy[:2] + policy[3:], cut, strict=True):
             assert np.array_equal(gathered, expected)
         swept = value.copy()
         largest = policy_sweep(*policy, row_of, is_destination, value, order, np.inf)
@@ -160,3 +164,22 @@ def test_policy_sweeps_take_over_the_slow_mode_of_a_returning_chain():
     for found in (plain, value):
         assert np.all(found >= exact - 1e-9)
         assert np.max((found - exact) / np.maximum(exact, 1.0)) < 1e-3
+
+
+def test_policy_exits_read_in_place_from_the_shape_tables_give_the_compact_copys_values():
+    """Where the nodes of a class share their exit shapes (``replay_classes``), the policy's
+    exits point into the full shape tables (seen as one control a row) instead of being
+    copied: the same values, bit for bit."""
+    counts = np.array((6, 5, 4), dtype=np.int64)
+    tables = random_tables(np.random.default_rng(3), counts, 4)
+    arrays, _ = tables
+    rows, _, corners = arrays[0].shape
+    in_place = (
+        arrays[0].reshape(-1, 1, corners),
+        arrays[1].reshape(-1, 1, corners),
+        *compact_policy_tables(arrays)[2:],
+    )
+    compact, _, policy_sweeps = solve(tables, counts, 1e-6, 16)
+    shared, _, shared_policy_sweeps = solve(tables, counts, 1e-6, 16, policy=in_place)
+    assert policy_sweeps == shared_policy_sweeps > 0
+    assert np.array_equal(shared, compact)

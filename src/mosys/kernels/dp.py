@@ -938,14 +938,19 @@ def gather_policy(
     control,
     policy_index,
     policy_weight,
+    policy_shape,
     policy_cost,
     policy_to_destination,
 ):
-    """Copy each node's exit under its control (control: (N,) int64) into the compact tables
-    policy_index (R, 1, 2**(d-1)) int32, policy_weight (same shape) float32, policy_cost and
-    policy_to_destination (R, 1), one row per node with a row (its own shape), which
-    ``policy_sweep`` reads in order instead of picking one control's exit out of every row of
-    the full tables."""
+    """The exit of each node under its control (control: (N,) int64), for ``policy_sweep`` to
+    read in order instead of picking one control's exit out of every row of the full tables:
+    policy_cost and policy_to_destination (R, 1), and policy_shape (R,) int64, the row of the
+    exit's shape in policy_index and policy_weight (S, 1, 2**(d-1)). Where each node has its
+    own shapes, the shape is copied there (S = R, one row per node: compact, in order); where
+    the nodes of a class share theirs (``replay_classes``), policy_index and policy_weight are
+    the full shape tables seen as (E·U, 1, 2**(d-1)), and policy_shape points into them: the
+    tables passed say which (they are the full ones when they have E·U rows)."""
+    copying = policy_index.shape[0] != exit_index.shape[0] * exit_index.shape[1]
     for node in range(row_of.shape[0]):
         row = row_of[node]
         if row < 0:
@@ -954,15 +959,20 @@ def gather_policy(
         shape = shape_row_of[node]
         policy_cost[row, 0] = segment_cost[row, u]
         policy_to_destination[row, 0] = to_destination[row, u]
-        for i in range(exit_index.shape[2]):
-            policy_index[row, 0, i] = exit_index[shape, u, i]
-            policy_weight[row, 0, i] = exit_weight[shape, u, i]
+        if copying:
+            policy_shape[row] = row
+            for i in range(exit_index.shape[2]):
+                policy_index[row, 0, i] = exit_index[shape, u, i]
+                policy_weight[row, 0, i] = exit_weight[shape, u, i]
+        else:
+            policy_shape[row] = shape * exit_index.shape[1] + u
 
 
 @njit(cache=True)
 def policy_sweep(
     policy_index,
     policy_weight,
+    policy_shape,
     policy_cost,
     policy_to_destination,
     row_of,
@@ -988,7 +998,8 @@ def policy_sweep(
         if candidate == np.inf:
             continue
         if not policy_to_destination[row, 0]:
-            candidate += known_value(policy_index, policy_weight, row, 0, node, value)
+            shape = policy_shape[row]
+            candidate += known_value(policy_index, policy_weight, shape, 0, node, value)
         old = value[node]
         if candidate < old:
             value[node] = candidate
@@ -1017,6 +1028,7 @@ def gauss_seidel_sweeps(
     control,
     policy_index,
     policy_weight,
+    policy_shape,
     policy_cost,
     policy_to_destination,
     policy_sweeps,
@@ -1068,6 +1080,7 @@ def gauss_seidel_sweeps(
                 control,
                 policy_index,
                 policy_weight,
+                policy_shape,
                 policy_cost,
                 policy_to_destination,
             )
@@ -1078,6 +1091,7 @@ def gauss_seidel_sweeps(
             change = policy_sweep(
                 policy_index,
                 policy_weight,
+                policy_shape,
                 policy_cost,
                 policy_to_destination,
                 row_of,

@@ -411,7 +411,7 @@ def load_kernels(
         1.0,
         False,  # prefetching: a flag, whose type is all that compiling needs
         none,
-        *empty.outputs(),
+        *policy_tables(empty),
         0,
     )
     best_controls(*empty.arrays(), np.empty(0), none)
@@ -621,7 +621,7 @@ def value_iteration(
     value = np.where(problem.is_destination, 0.0, np.where(reachable, bound, np.inf))
     order = np.empty(grid.node_count, dtype=np.int64)
     control = np.zeros(grid.node_count, dtype=np.int64)
-    policy = Transitions.empty(transitions.row_of >= 0, 1, len(grid.names))
+    policy = policy_tables(transitions)
     prefetching = prefetch_pays(transitions.exit_index, transitions.exit_weight)
     progress = Progress("value iteration", max_iterations, "sweeps")
     residual = np.inf
@@ -640,7 +640,7 @@ def value_iteration(
             DEAD_END_SECONDS if problem.spec.known_weight else np.inf,
             prefetching,
             control,
-            *policy.outputs(),
+            *policy,
             POLICY_SWEEPS,
         )
         iterations += swept
@@ -650,6 +650,28 @@ def value_iteration(
     if not quiet:
         progress.finish(f"largest change {residual:.3g} s")
     return value, iterations, policy_sweeps, float(residual)
+
+
+def policy_tables(transitions: Transitions) -> tuple[np.ndarray, ...]:
+    """The tables ``dp.gather_policy`` fills for the policy sweeps (policy_index, policy_weight,
+    policy_shape, policy_cost, policy_to_destination): where each node has shapes of its own,
+    a compact copy of one exit per node; where classes share theirs (or there is one control),
+    the full shape tables themselves, which the policy's exits point into."""
+    rows, controls = transitions.segment_cost.shape
+    corners = transitions.exit_index.shape[2]
+    if transitions.exit_index.shape[0] == rows and controls > 1:
+        index = np.zeros((rows, 1, corners), dtype=np.int32)
+        weight = np.zeros((rows, 1, corners), dtype=np.float32)
+    else:
+        index = transitions.exit_index.reshape(-1, 1, corners)
+        weight = transitions.exit_weight.reshape(-1, 1, corners)
+    return (
+        index,
+        weight,
+        np.zeros(rows, dtype=np.int64),
+        np.empty((rows, 1)),
+        np.zeros((rows, 1), dtype=np.bool_),
+    )
 
 
 def solve(
