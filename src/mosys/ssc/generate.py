@@ -496,7 +496,7 @@ def compute_transitions(
     progress = Progress("exit transitions", nodes.size * controls, "simulations")
     count = max(1, min(PROGRESS_CHUNKS, nodes.size * controls // SIMULATIONS_PER_CHUNK))
     done = 0
-    for chunk in np.array_split(nodes, count):
+    for chunk in (nodes[k::count] for k in range(count)):
         chunk = np.ascontiguousarray(chunk)
         if classes is None:
             exit_transitions(
