@@ -5,8 +5,12 @@ constant until its state leaves S's cell — the box of half-width one grid step
 boundary carries S's neighbours (points A, B, C, F of the paper's Figure 10). The exit state E, the
 segment cost ``t + Σ K|u| t`` and E's interpolation weights over the nodes of the face it crosses do
 not depend on the cost-to-go, so they are computed once (``exit_transitions_template``, specialised
-to each model). Value iteration then repeats Bellman sweeps ``V(S) = min_u [cost(S,u) + Σ w
-V(corner)]`` until the largest change is below a tolerance (``gauss_seidel_sweep``). The paper: "It
+to each model), E's corners and weights as a *shape* (corners as offsets from S). A model whose
+equations do not read some coordinates (the car's x and y) moves alike from every node of a
+*class* (the nodes differing only there): its segments are integrated once per class and
+replayed at each node (``replay_classes``), whose exits share the class's shapes. Value
+iteration then repeats Bellman sweeps ``V(S) = min_u [cost(S,u) + Σ w V(corner)]`` until the
+largest change is below a tolerance (``gauss_seidel_sweep``). The paper: "It
 is difficult to sequence local optimizations such that each local optimization always uses accurate
 information. It is simpler to approximate this order and repeat this for several iterations" —
 the sweeps run through the grid in the 2**d orders of the fast sweeping method in turn
