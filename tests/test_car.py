@@ -441,7 +441,8 @@ def transitions_of(problem, car, classes):
         kernel, arguments, problem, problem.node_valid, classes, quiet=True
     )
     nodes = np.flatnonzero(transitions.row_of >= 0)
-    shapes = transitions.shape_row_of[nodes]
+    own = transitions.shape_row_of is None  # each node its own shapes (integrated)
+    shapes = transitions.row_of[nodes] if own else transitions.shape_row_of[nodes]
     corners = nodes[:, None, None] + transitions.exit_index[shapes]
     weights = transitions.exit_weight[shapes]
     return transitions, np.where(weights > 0, corners, -1), weights

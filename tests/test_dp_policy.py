@@ -76,12 +76,10 @@ def test_a_policy_sweep_is_a_bellman_sweep_over_each_nodes_own_control(axis_coun
         held = row_of[kept]
         chosen = control[kept]
         moved = (value[kept] < 1e4) & ~is_destination[kept]  # decreased at least once
-        weights = exit_weight[held, chosen].astype(np.float64)
+        weights = exit_weight[held, chosen].astype(np.float64)  # renormalised: Σ w·V
         corner_values = value[kept[:, None] + exit_index[held, chosen]]
-        known = (weights != 0) & np.isfinite(corner_values)
-        weights = np.where(known, weights, 0.0)
-        exit_value = np.einsum("ij,ij->i", weights, np.where(known, corner_values, 0.0))
-        exit_value = np.where(to_destination[held, chosen], 0.0, exit_value / weights.sum(1))
+        exit_value = np.einsum("ij,ij->i", weights, np.where(weights != 0, corner_values, 0.0))
+        exit_value = np.where(to_destination[held, chosen], 0.0, exit_value)
         promised = cost[held, chosen] + exit_value
         assert np.all(promised[moved] <= value[kept][moved] * (1 + 1e-12))
         gather_policy(*arrays, control, *policy)
@@ -95,10 +93,10 @@ def test_a_policy_sweep_is_a_bellman_sweep_over_each_nodes_own_control(axis_coun
         for gathered, expected in zip(policy[:2] + policy[3:], cut, strict=True):
             assert np.array_equal(gathered, expected)
         swept = value.copy()
-        largest = policy_sweep(*policy, row_of, is_destination, value, order, np.inf)
+        largest = policy_sweep(*policy, None, row_of, is_destination, value, order, np.inf)
         control_after = np.zeros(nodes, dtype=np.int64)
         expected_largest = gauss_seidel_sweep(
-            *cut, row_of, row_of, is_destination, swept, order, np.inf, False, control_after
+            *cut, row_of, None, is_destination, swept, order, np.inf, False, control_after
         )
         assert np.array_equal(value, swept)
         assert largest == expected_largest
@@ -139,7 +137,7 @@ def returning_chain(n: int, forward: float, controls: int):
     is_destination = np.zeros(nodes, dtype=np.bool_)
     is_destination[:2] = True
     to_destination = np.zeros((nodes, controls), dtype=np.bool_)
-    return (exit_index, exit_weight, cost, to_destination, row_of, row_of), is_destination
+    return (exit_index, exit_weight, cost, to_destination, row_of, None), is_destination
 
 
 def test_policy_sweeps_take_over_the_slow_mode_of_a_returning_chain():
@@ -166,20 +164,27 @@ def test_policy_sweeps_take_over_the_slow_mode_of_a_returning_chain():
         assert np.max((found - exact) / np.maximum(exact, 1.0)) < 1e-3
 
 
-def test_policy_exits_read_in_place_from_the_shape_tables_give_the_compact_copys_values():
-    """Where the nodes of a class share their exit shapes (``replay_classes``), the policy's
-    exits point into the full shape tables (seen as one control a row) instead of being
-    copied: the same values, bit for bit."""
+def test_shared_exit_shapes_reach_the_fixed_point_of_each_nodes_own_copy():
+    """Where the nodes of a class share their exit shapes (``replay_classes``: shape_row_of an
+    array), the exits' values are renormalised over the known corners as they are read and the
+    policy's exits point into the full shape tables (seen as one control a row) instead of
+    being copied: the same fixed point, to rounding, as each node with a copy of its own."""
     counts = np.array((6, 5, 4), dtype=np.int64)
-    tables = random_tables(np.random.default_rng(3), counts, 4)
-    arrays, _ = tables
-    rows, _, corners = arrays[0].shape
-    in_place = (
-        arrays[0].reshape(-1, 1, corners),
-        arrays[1].reshape(-1, 1, corners),
-        *compact_policy_tables(arrays)[2:],
+    (exit_index, exit_weight, cost, to_destination, row_of, _), is_destination = random_tables(
+        np.random.default_rng(3), counts, 4
     )
-    compact, _, policy_sweeps = solve(tables, counts, 1e-6, 16)
-    shared, _, shared_policy_sweeps = solve(tables, counts, 1e-6, 16, policy=in_place)
-    assert policy_sweeps == shared_policy_sweeps > 0
-    assert np.array_equal(shared, compact)
+    corners = exit_index.shape[2]
+    shared = (exit_index, exit_weight, cost, to_destination, row_of, row_of)
+    in_place = (
+        exit_index.reshape(-1, 1, corners),
+        exit_weight.reshape(-1, 1, corners),
+        *compact_policy_tables(shared)[2:],
+    )
+    own, _, policy_sweeps = solve(((*shared[:5], None), is_destination), counts, 1e-9, 16)
+    value, _, shared_policy_sweeps = solve(
+        (shared, is_destination), counts, 1e-9, 16, policy=in_place
+    )
+    assert policy_sweeps > 0 and shared_policy_sweeps > 0
+    finite = np.isfinite(own)
+    assert np.array_equal(np.isfinite(value), finite)
+    np.testing.assert_allclose(value[finite], own[finite], rtol=1e-6)

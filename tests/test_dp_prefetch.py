@@ -22,21 +22,19 @@ def plain_sweep(tables, is_destination, value, order):
         row = row_of[node]
         if row < 0 or is_destination[node]:
             continue
-        shape = shape_row_of[node]
+        shape = row if shape_row_of is None else shape_row_of[node]
         best = np.inf
         for u in range(segment_cost.shape[1]):
             if segment_cost[row, u] == np.inf:
                 continue
             candidate = segment_cost[row, u]
-            if not to_destination[row, u]:
-                total = known = 0.0
+            if not to_destination[row, u]:  # own shapes: renormalised already, Σ w·V
+                total = 0.0
                 for i in range(exit_index.shape[2]):
                     w = float(exit_weight[shape, u, i])
-                    corner = value[node + exit_index[shape, u, i]]
-                    if w != 0.0 and corner < np.inf:
-                        total += w * corner
-                        known += w
-                candidate += total / known
+                    if w != 0.0:
+                        total += w * value[node + exit_index[shape, u, i]]
+                candidate += total
             best = min(best, candidate)
         if best < value[node]:
             largest = max(largest, value[node] - best)

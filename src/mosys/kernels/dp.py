@@ -727,6 +727,17 @@ def sweep_order(axis_count, sweep, out):
             k -= 1
 
 
+@njit(cache=True, inline="always")
+def shape_of(shape_row_of, row_of, node):
+    """The row of a node's exit shapes: its own row (shape_row_of None: each node has shapes of
+    its own, renormalised once by ``discard_poorly_known_exits``) or its class's
+    (shape_row_of (N,) int64: the nodes of a class share them, ``replay_classes``). Which it is,
+    is a type, so that the kernels are compiled for each and hold no test of it."""
+    if shape_row_of is None:
+        return row_of[node]
+    return shape_row_of[node]
+
+
 @njit(cache=True)
 def reach_sweep(
     exit_index, exit_weight, segment_cost, to_destination, row_of, shape_row_of, reached, order
@@ -743,7 +754,7 @@ def reach_sweep(
         row = row_of[node]
         if reached[node] or row < 0:
             continue
-        shape = shape_row_of[node]
+        shape = shape_of(shape_row_of, row_of, node)
         for u in range(segment_cost.shape[1]):
             if segment_cost[row, u] == np.inf:
                 continue
@@ -771,16 +782,17 @@ def discard_poorly_known_exits(
     minimum_known_weight,
 ):
     """The paper's Figure 10: the cost-to-go at an exit is interpolated between the neighbours
-    whose values are known, the reachable corners of its face (``known_value``, renormalising
-    their weights); an exit whose reachable corners carry less than ``minimum_known_weight`` of
-    its weight (in (0, 1]), or none, gets cost inf here. Afterwards every finite transition
+    whose values are known, the reachable corners of its face, their weights renormalised (here,
+    once, for nodes with shapes of their own, ``shape_of``; as they are read for shared shapes,
+    ``known_value``); an exit whose reachable corners carry less than ``minimum_known_weight``
+    of its weight (in (0, 1]), or none, gets cost inf here. Afterwards every finite transition
     rests on reachable nodes. The exit tables as ``gauss_seidel_sweep`` takes them; reachable:
     (N,) bool."""
     for node in range(row_of.shape[0]):
         row = row_of[node]
         if row < 0:
             continue
-        shape = shape_row_of[node]
+        shape = shape_of(shape_row_of, row_of, node)
         for u in range(segment_cost.shape[1]):
             if segment_cost[row, u] == np.inf or to_destination[row, u]:
                 continue
@@ -789,16 +801,28 @@ def discard_poorly_known_exits(
                 w = exit_weight[shape, u, i]
                 if w > 0.0 and reachable[node + exit_index[shape, u, i]]:
                     known += w
+                elif shape_row_of is None:
+                    exit_weight[shape, u, i] = 0.0
             if known == 0.0 or known < minimum_known_weight:
                 segment_cost[row, u] = np.inf
+            elif shape_row_of is None:
+                for i in range(exit_index.shape[2]):
+                    exit_weight[shape, u, i] /= known
 
 
 @njit(cache=True, inline="always")
-def known_value(exit_index, exit_weight, shape, u, node, value):
+def known_value(exit_index, exit_weight, shape, u, node, value, shape_row_of):
     """The cost-to-go at the exit of (node, u): Σ w·V over the corners of its shape (row
     ``shape`` of the tables, corners as offsets from ``node``) whose value is known (finite:
-    reachable), over the sum of their weights. Zero-weight corners are skipped."""
+    reachable), over the sum of their weights; zero-weight corners are skipped. Shapes of a
+    node's own (shape_row_of None, ``shape_of``) have been renormalised already: Σ w·V."""
     total = 0.0
+    if shape_row_of is None:
+        for i in range(exit_index.shape[2]):
+            w = exit_weight[shape, u, i]
+            if w != 0.0:
+                total += w * value[node + exit_index[shape, u, i]]
+        return total
     known = 0.0
     for i in range(exit_index.shape[2]):
         w = exit_weight[shape, u, i]
@@ -811,7 +835,9 @@ def known_value(exit_index, exit_weight, shape, u, node, value):
 
 
 @njit(cache=True, inline="always")
-def _bellman(exit_index, exit_weight, segment_cost, to_destination, value, row, shape, node):
+def _bellman(
+    exit_index, exit_weight, segment_cost, to_destination, value, row, shape, node, shape_row_of
+):
     """(min over u of cost(row, u) + the exit's cost-to-go (``known_value``; 0 for an exit to
     the destination), the first minimising u); (inf, 0) where every control costs inf. Inlined
     where it is called (numba's ``inline="always"``): a call per node would cost more than the
@@ -824,7 +850,7 @@ def _bellman(exit_index, exit_weight, segment_cost, to_destination, value, row, 
             continue
         candidate = cost
         if not to_destination[row, u]:
-            candidate += known_value(exit_index, exit_weight, shape, u, node, value)
+            candidate += known_value(exit_index, exit_weight, shape, u, node, value, shape_row_of)
         if candidate < best:
             best = candidate
             choice = u
@@ -847,7 +873,7 @@ def _prefetch_exits(exit_index, exit_weight, segment_cost, row_of, shape_row_of,
         node = order[p + PREFETCH_AHEAD]
         ahead = row_of[node]
         if ahead >= 0:
-            shape = shape_row_of[node]
+            shape = shape_of(shape_row_of, row_of, node)
             per_line = CACHE_LINE // exit_index.itemsize
             for u in range(segment_cost.shape[1]):
                 if segment_cost[ahead, u] != np.inf:
@@ -858,7 +884,7 @@ def _prefetch_exits(exit_index, exit_weight, segment_cost, row_of, shape_row_of,
         node = order[p + 1]
         following = row_of[node]
         if following >= 0:
-            shape = shape_row_of[node]
+            shape = shape_of(shape_row_of, row_of, node)
             for u in range(segment_cost.shape[1]):
                 if segment_cost[following, u] != np.inf:
                     for i in range(exit_index.shape[2]):
@@ -889,8 +915,8 @@ def gauss_seidel_sweep(
     The exit tables: segment_cost and to_destination (R, U), one row per node that is not
     removed (row_of: (N,) int64, each node's row, -1: removed, skipped); the exits' shapes
     exit_index (int32 corner offsets from the node) and exit_weight (float32), (E, U,
-    2**(d-1)), row shape_row_of[node] for a node's exits: its own row, or its class's
-    (``replay_classes``), whose nodes share them. value: (N,) float64 cost-to-go, s, in place.
+    2**(d-1)), the row of a node's exits its own or, where shape_row_of is an array, its
+    class's (``shape_of``). value: (N,) float64 cost-to-go, s, in place.
     Value iteration starts from an upper bound (0 at the destination nodes, a large finite
     ``UNKNOWN`` at the other reachable nodes: the paper's "values not yet known"; inf at
     unreachable nodes, which ``known_value`` leaves out), so values only decrease, as the paper
@@ -920,8 +946,9 @@ def gauss_seidel_sweep(
             to_destination,
             value,
             row,
-            shape_row_of[node],
+            shape_of(shape_row_of, row_of, node),
             node,
+            shape_row_of,
         )
         if best < old:
             value[node] = best
@@ -952,18 +979,17 @@ def gather_policy(
     exit's shape in policy_index and policy_weight (S, 1, 2**(d-1)). Where each node has its
     own shapes, the shape is copied there (S = R, one row per node: compact, in order); where
     the nodes of a class share theirs (``replay_classes``), policy_index and policy_weight are
-    the full shape tables seen as (E·U, 1, 2**(d-1)), and policy_shape points into them: the
-    tables passed say which (they are the full ones when they have E·U rows)."""
-    copying = policy_index.shape[0] != exit_index.shape[0] * exit_index.shape[1]
+    the full shape tables seen as (E·U, 1, 2**(d-1)), and policy_shape points into them
+    (``shape_of``)."""
     for node in range(row_of.shape[0]):
         row = row_of[node]
         if row < 0:
             continue
         u = control[node]
-        shape = shape_row_of[node]
+        shape = shape_of(shape_row_of, row_of, node)
         policy_cost[row, 0] = segment_cost[row, u]
         policy_to_destination[row, 0] = to_destination[row, u]
-        if copying:
+        if shape_row_of is None:
             policy_shape[row] = row
             for i in range(exit_index.shape[2]):
                 policy_index[row, 0, i] = exit_index[shape, u, i]
@@ -979,6 +1005,7 @@ def policy_sweep(
     policy_shape,
     policy_cost,
     policy_to_destination,
+    shape_row_of,
     row_of,
     is_destination,
     value,
@@ -1003,7 +1030,9 @@ def policy_sweep(
             continue
         if not policy_to_destination[row, 0]:
             shape = policy_shape[row]
-            candidate += known_value(policy_index, policy_weight, shape, 0, node, value)
+            candidate += known_value(
+                policy_index, policy_weight, shape, 0, node, value, shape_row_of
+            )
         old = value[node]
         if candidate < old:
             value[node] = candidate
@@ -1098,6 +1127,7 @@ def gauss_seidel_sweeps(
                 policy_shape,
                 policy_cost,
                 policy_to_destination,
+                shape_row_of,
                 row_of,
                 is_destination,
                 value,
@@ -1127,8 +1157,9 @@ def best_controls(
                 to_destination,
                 value,
                 row,
-                shape_row_of[node],
+                shape_of(shape_row_of, row_of, node),
                 node,
+                shape_row_of,
             )[1]
         )
 
@@ -1192,7 +1223,7 @@ def destination_share_sweep(
         if not active[node]:
             continue
         row = row_of[node]
-        shape = shape_row_of[node]
+        shape = shape_of(shape_row_of, row_of, node)
         u = best_control[node]
         for k in range(share.shape[1]):
             if to_destination[row, u]:

@@ -235,16 +235,16 @@ class Transitions:
     """What the exit transitions give (``dp.gauss_seidel_sweep`` reads them): segment_cost (R,
     U) s and to_destination (R, U) bool, one row per node that is not removed (row_of (N,)
     int64, each node's row, -1 for a removed node, which takes no memory); the exits' shapes
-    exit_index (E, U, 2**(d-1)) int32 (corner offsets from the node) and exit_weight float32,
-    row shape_row_of[node] for a node's exits: its own row, or its class's
-    (``MotionClasses``)."""
+    exit_index (E, U, 2**(d-1)) int32 (corner offsets from the node) and exit_weight float32:
+    each node's own (shape_row_of None: E = R) or its class's, row shape_row_of[node]
+    (``MotionClasses``; ``dp.shape_of``)."""
 
     exit_index: np.ndarray
     exit_weight: np.ndarray
     segment_cost: np.ndarray
     to_destination: np.ndarray
     row_of: np.ndarray
-    shape_row_of: np.ndarray
+    shape_row_of: np.ndarray | None
 
     @classmethod
     def empty(cls, valid: np.ndarray, controls: int, dimensions: int) -> Transitions:
@@ -259,7 +259,7 @@ class Transitions:
             np.empty((rows, controls)),
             np.zeros((rows, controls), dtype=np.bool_),
             row_of,
-            row_of,
+            None,
         )
 
     def arrays(self) -> tuple[np.ndarray, ...]:
@@ -395,6 +395,8 @@ def load_kernels(
     before, obstacles, arrival = arguments
     flags = np.empty(0, dtype=np.bool_)
     empty = Transitions.empty(flags, problem.control_samples.shape[0], len(problem.grid.names))
+    if classes is not None:  # the sweeps' variant for shared shapes (``dp.shape_of``)
+        empty = replace(empty, shape_row_of=empty.row_of)
     size = problem.base_state.shape[0]
     exit_transitions(*before, none, none, *obstacles, *arrival, *empty.outputs(), *no_record(size))
     reach_sweep(*empty.arrays(), flags, none)
@@ -452,7 +454,7 @@ def load_kernels(
             empty.exit_weight,
             empty.to_destination,
             none,
-            none,
+            empty.shape_row_of,
             none,
             flags,
             0,
@@ -655,11 +657,11 @@ def value_iteration(
 def policy_tables(transitions: Transitions) -> tuple[np.ndarray, ...]:
     """The tables ``dp.gather_policy`` fills for the policy sweeps (policy_index, policy_weight,
     policy_shape, policy_cost, policy_to_destination): where each node has shapes of its own,
-    a compact copy of one exit per node; where classes share theirs (or there is one control),
-    the full shape tables themselves, which the policy's exits point into."""
-    rows, controls = transitions.segment_cost.shape
+    a compact copy of one exit per node; where classes share theirs, the full shape tables
+    themselves, which the policy's exits point into."""
+    rows = transitions.segment_cost.shape[0]
     corners = transitions.exit_index.shape[2]
-    if transitions.exit_index.shape[0] == rows and controls > 1:
+    if transitions.shape_row_of is None:
         index = np.zeros((rows, 1, corners), dtype=np.int32)
         weight = np.zeros((rows, 1, corners), dtype=np.float32)
     else:
