@@ -262,7 +262,7 @@ class Transitions:
             None,
         )
 
-    def arrays(self) -> tuple[np.ndarray, ...]:
+    def arrays(self) -> tuple[np.ndarray | None, ...]:
         """The tables as the kernels take them: exit_index, exit_weight, segment_cost,
         to_destination, row_of, shape_row_of."""
         return (
@@ -274,7 +274,7 @@ class Transitions:
             self.shape_row_of,
         )
 
-    def outputs(self) -> tuple[np.ndarray, ...]:
+    def outputs(self) -> tuple[np.ndarray | None, ...]:
         """What ``dp.exit_transitions_template`` writes: exit_index, exit_weight, segment_cost,
         to_destination."""
         return self.arrays()[:4]
