@@ -36,6 +36,13 @@ def braking_stop(state, vehicle_slot, wheelbase, wheel_radius, brake, state_slot
 
 
 @njit(cache=True)
+def braking_seconds(state, vehicle_slot, wheel_radius, brake):
+    """The seconds a vehicle takes to brake to rest from model state ``state`` (wheel_radius m,
+    brake rad/s², as ``braking_stop``)."""
+    return abs(state[vehicle_slot[4]]) / (wheel_radius * brake)
+
+
+@njit(cache=True)
 def stops_in_box(state, vehicle_slot, wheelbase, wheel_radius, brake, state_slot, box, stop):
     """True when the state where full braking from ``state`` ends (``braking_stop``) lies in the
     arrival box (``box`` (3, d): lower, upper and period over the controller's axes, as

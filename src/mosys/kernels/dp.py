@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from mosys.kernels.arrival import braking_stop, stops_in_box
+from mosys.kernels.arrival import braking_seconds, braking_stop, stops_in_box
 from mosys.kernels.figure_state import load_state
 from mosys.kernels.geometry import box_is_clear, place_outline, pose_is_free
 from mosys.kernels.interpolate import corner_weights, grid_strides, interpolation_scratch
@@ -486,13 +486,6 @@ def control_effort(control_samples, effort_weight, u):
     for j in range(control_samples.shape[1]):
         effort += effort_weight[j] * abs(control_samples[u, j])
     return effort
-
-
-@njit(cache=True)
-def braking_seconds(state, vehicle_slot, wheel_radius, brake):
-    """The seconds a vehicle takes to brake to rest from model state ``state`` (wheel_radius m,
-    brake rad/s²; ``arrival.braking_stop``)."""
-    return abs(state[vehicle_slot[4]]) / (wheel_radius * brake)
 
 
 @njit(cache=True)

@@ -22,7 +22,7 @@ import math
 import numpy as np
 from numba import njit, types
 
-from mosys.kernels.arrival import stops_in_box
+from mosys.kernels.arrival import braking_seconds, stops_in_box
 from mosys.kernels.figure_state import read_state
 from mosys.kernels.geometry import pose_is_free
 from mosys.kernels.integrate import (
@@ -392,7 +392,7 @@ def _choose(
             continue
         read_state(first, state_slot, here)
         if arrived:  # it brakes to rest from here
-            onward = abs(first[vehicle_slot[4]]) / (wheel_radius * brake)
+            onward = braking_seconds(first, vehicle_slot, wheel_radius, brake)
         else:
             onward = _cost_to_go(
                 axis_min,
