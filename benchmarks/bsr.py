@@ -14,7 +14,6 @@ search alone, not the imports) and by the process.
 from __future__ import annotations
 
 import argparse
-import os
 import subprocess
 import sys
 import tempfile
@@ -22,7 +21,7 @@ import time
 from pathlib import Path
 
 import pandas as pd
-from generation import write_results
+from generation import cache_environment, numba_cache, write_results
 
 from mosys.io.bsr_result import read_bsr_result
 
@@ -31,8 +30,9 @@ PAPER_SECONDS = {"sense": "180-360 s (DEC 3000/400)", "time": "tens of seconds (
 TARGET = {"sense": "<= 60 s on 2 cores", "time": "<= 20 s on 2 cores"}
 
 
-def search(spec: str, generations: int, threads: int, cache: Path, out: Path) -> dict:
-    """One search in a new process; returns its wall times and the result's numbers."""
+def search(spec: str, generations: int, threads: int, cache: Path | None, out: Path) -> dict:
+    """One search in a new process with the numba cache ``cache`` (``cache_environment``);
+    returns its wall times and the result's numbers."""
     started = time.perf_counter()
     subprocess.run(
         [
@@ -52,7 +52,7 @@ def search(spec: str, generations: int, threads: int, cache: Path, out: Path) ->
             "-o",
             str(out),
         ],
-        env=dict(os.environ, NUMBA_CACHE_DIR=str(cache)),
+        env=cache_environment(cache),
         check=True,
         capture_output=True,
         text=True,
@@ -76,7 +76,7 @@ def main() -> None:
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        warm = tmp / "warm_cache"
+        warm = numba_cache(tmp, args.smoke)
         if not args.smoke:
             cold = search("starman_cartwheel.bsr", 20, 1, tmp / "cold_cache", tmp / "cold.h5")
             rows.append(

@@ -6,7 +6,8 @@ paper: 300 ms on a DEC 3000/400 AXP; target <= 1 ms), and the same per 1,000 ste
 search of a fresh install (cold numba cache: JIT compilation included).
 
     python benchmarks/bsr3d.py            # full: G = 300, the cold start
-    python benchmarks/bsr3d.py --smoke    # CI: the same code paths, G = 5, no cold start
+    python benchmarks/bsr3d.py --smoke    # CI: the same code paths, G = 5, no cold start, the
+                                          # install's numba cache
 
 Writes results/benchmarks/bsr3d.{csv,md} (bsr3d_smoke.* with --smoke) and prints them. The
 populations run in this process (``run_population`` called once first, untimed): C random
@@ -40,7 +41,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pandas as pd
 from bsr import search
-from generation import write_results
+from generation import numba_cache, write_results
 
 from mosys.io.bsr_result import read_bsr_result
 
@@ -209,7 +210,7 @@ def same_curves(paths: list[Path]) -> bool:
     )
 
 
-def search_rows(generations: int, repeats: int, cache: Path, tmp: Path) -> list[dict]:
+def search_rows(generations: int, repeats: int, cache: Path | None, tmp: Path) -> list[dict]:
     """The whole search of SEARCH_SPEC on 1 and 2 threads, ``repeats`` times each (the thread
     counts alternating, so that a change of the machine's load falls on both)."""
     search(SEARCH_SPEC, 2, 1, cache, tmp / "fill.h5")  # fill the cache
@@ -265,10 +266,11 @@ def main() -> None:
     generations = 5 if args.smoke else 300
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        warm = tmp / "warm_cache"
-        # numba reads it when first imported (the kernels are imported in the functions above),
-        # so this process fills the cache the searches use: the 3-D kernels compile once
-        os.environ["NUMBA_CACHE_DIR"] = str(warm)
+        warm = numba_cache(tmp, args.smoke)
+        if warm is not None:
+            # numba reads it when first imported (the kernels are imported in the functions
+            # above), so this process fills the cache the searches use: the kernels compile once
+            os.environ["NUMBA_CACHE_DIR"] = str(warm)
         rows = population_rows(population_repeats)
         rows += search_rows(generations, search_repeats, warm, tmp)
         if args.smoke:

@@ -19,7 +19,7 @@ import tempfile
 from pathlib import Path
 
 import pandas as pd
-from generation import generate, write_results
+from generation import generate, numba_cache, write_results
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = ROOT / "specs/controllers/car/park.ssc"
@@ -61,7 +61,7 @@ def main() -> None:
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        cache = tmp / "cache"
+        cache = numba_cache(tmp, args.smoke)
         dynamics = tmp / "car.py"
         compile_figure(ROOT / "specs/figures/car.fig", dynamics)
         paper = paper_spec(SPEC.read_text())

@@ -65,7 +65,7 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
-from generation import generate, write_results
+from generation import generate, numba_cache, write_results
 
 from mosys.io.controller_table import read_controller_table
 
@@ -129,7 +129,7 @@ def table_value_at(path: Path, angle: float, omega: float) -> float:
     return float(np.interp(angle, angles, along_omega))
 
 
-def time_mosys(factor: int, repeats: int, dynamics: Path, work: Path, cache: Path) -> dict:
+def time_mosys(factor: int, repeats: int, dynamics: Path, work: Path, cache: Path | None) -> dict:
     """Generate the grid ``factor`` once untimed, then ``repeats`` times; mosys's columns."""
     spec = work / f"A_x{factor}.ssc"
     spec.write_text(spec_text(factor))
@@ -273,7 +273,7 @@ def main() -> None:
         dynamics = tmp / "link1.py"
         compile_dynamics(dynamics)
         for factor in factors:
-            mosys = time_mosys(factor, repeats, dynamics, tmp, tmp / "numba_cache")
+            mosys = time_mosys(factor, repeats, dynamics, tmp, numba_cache(tmp, args.smoke))
             drake = time_drake(factor, repeats) if with_drake else None
             rows.append(grid_row(mosys, drake, factor))
     write_results(pd.DataFrame(rows), "dp_peers", args.smoke)

@@ -37,13 +37,24 @@ print(json.dumps({"dp_seconds": dp_seconds,
 """
 
 
-def generate(dynamics: Path, spec: Path, out: Path, cache: Path) -> dict:
+def numba_cache(tmp: Path, smoke: bool) -> Path | None:
+    """The numba cache a benchmark's processes share: a new one under ``tmp``, filled by the
+    benchmark's first (untimed) run; with ``smoke``, None: the install's own, which CI's tests
+    have filled, so that a smoke run compiles no kernel a second time (minutes of CI)."""
+    return None if smoke else tmp / "warm_cache"
+
+
+def cache_environment(cache: Path | None) -> dict[str, str]:
+    """This process's environment with NUMBA_CACHE_DIR set to ``cache`` (None: left as it is)."""
+    return dict(os.environ) if cache is None else dict(os.environ, NUMBA_CACHE_DIR=str(cache))
+
+
+def generate(dynamics: Path, spec: Path, out: Path, cache: Path | None) -> dict:
     """Generate ``spec`` with ``dynamics`` into ``out`` in a new process whose numba cache is
-    ``cache``; returns the figures above."""
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
+    ``cache`` (``cache_environment``); returns the figures above."""
     done = subprocess.run(
         [sys.executable, "-c", GENERATE, str(dynamics), str(spec), str(out)],
-        env=env,
+        env=cache_environment(cache),
         check=True,
         capture_output=True,
         text=True,

@@ -15,14 +15,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
 import pandas as pd
-from generation import generate, write_results
+from generation import cache_environment, generate, numba_cache, write_results
 
 ROOT = Path(__file__).resolve().parents[1]
 DT = 0.0005  # s, config/config.yaml's luxo dt
@@ -59,12 +58,14 @@ sim 3 until=dest
 """
 
 
-def simulate(script: Path, controllers: Path, dynamics: Path, out: Path, cache: Path) -> dict:
+def simulate(
+    script: Path, controllers: Path, dynamics: Path, out: Path, cache: Path | None
+) -> dict:
     """Run ``script`` twice in one new process with the numba cache ``cache``."""
     done = subprocess.run(
         [sys.executable, "-c", SIMULATE, str(script), str(controllers), str(dynamics), str(out)]
         + [str(DT), str(ROOT / "specs" / "motor")],
-        env=dict(os.environ, NUMBA_CACHE_DIR=str(cache)),
+        env=cache_environment(cache),
         check=True,
         capture_output=True,
         text=True,
@@ -81,7 +82,7 @@ def main() -> None:
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        cold_cache, warm_cache = tmp / "cold_cache", tmp / "warm_cache"
+        cold_cache, warm_cache = tmp / "cold_cache", numba_cache(tmp, args.smoke)
         dynamics, controllers = tmp / "dynamics", tmp / "controllers"
         controllers.mkdir()
         for figure in ("luxo", "luxo_grounded"):
