@@ -31,16 +31,31 @@ def compact_policy_tables(arrays):
     )
 
 
-def solve(tables, axis_count, tolerance, policy_sweeps, bound=1e4, count=100_000, policy=None):
+def solve(
+    tables,
+    axis_count,
+    tolerance,
+    policy_sweeps,
+    bound=1e4,
+    count=100_000,
+    policy=None,
+    blocks=None,
+):
     """Value iteration from ``bound`` as ``ssc.generate.value_iteration`` runs it: (values,
-    Bellman sweeps, policy sweeps). policy: ``dp.gather_policy``'s tables (default: compact)."""
+    Bellman sweeps, policy sweeps). policy: ``dp.gather_policy``'s tables (default: compact);
+    blocks: ``dp.blocked_gauss_seidel_sweep``'s, each sweep's snapshot a full copy (default:
+    one block, the plain sweeps)."""
     arrays, is_destination = tables
     row_of = arrays[4]
     value = np.where(is_destination, 0.0, np.where(row_of >= 0, bound, np.inf))
+    edges = None if blocks is None else np.array([[0, value.size]], dtype=np.int64)
     bellman, policy, _ = gauss_seidel_sweeps(
         *arrays,
         is_destination,
         value,
+        value.copy(),
+        np.array([0, value.size], dtype=np.int64) if blocks is None else blocks,
+        edges,
         np.asarray(axis_count, dtype=np.int64),
         0,
         count,

@@ -804,23 +804,37 @@ def discard_poorly_known_exits(
 
 
 @njit(cache=True, inline="always")
-def known_value(exit_index, exit_weight, shape, u, node, value, shape_row_of):
+def block_read(value, snapshot, low, high, corner):
+    """The cost-to-go at ``corner`` as a sweep block [low, high) of node indices sees it
+    (``blocked_gauss_seidel_sweep``): its own nodes' values as the sweep leaves them
+    (``value``), the other blocks' as they stood when the sweep began (``snapshot``).
+    snapshot None: one block, ``value`` alone (a type: compiled without the test, which in
+    the plain sweep's loop cost four times its time)."""
+    if snapshot is None:
+        return value[corner]
+    return value[corner] if low <= corner < high else snapshot[corner]
+
+
+@njit(cache=True, inline="always")
+def known_value(exit_index, exit_weight, shape, u, node, value, shape_row_of, snapshot, low, high):
     """The cost-to-go at the exit of (node, u): Σ w·V over the corners of its shape (row
     ``shape`` of the tables, corners as offsets from ``node``) whose value is known (finite:
     reachable), over the sum of their weights; zero-weight corners are skipped. Shapes of a
-    node's own (shape_row_of None, ``shape_of``) have been renormalised already: Σ w·V."""
+    node's own (shape_row_of None, ``shape_of``) have been renormalised already: Σ w·V. Values
+    are read as the sweep block [low, high) sees them (``block_read``; snapshot None: all from
+    ``value``)."""
     total = 0.0
     if shape_row_of is None:
         for i in range(exit_index.shape[2]):
             w = exit_weight[shape, u, i]
             if w != 0.0:
-                total += w * value[node + exit_index[shape, u, i]]
+                total += w * block_read(value, snapshot, low, high, node + exit_index[shape, u, i])
         return total
     known = 0.0
     for i in range(exit_index.shape[2]):
         w = exit_weight[shape, u, i]
         if w != 0.0:
-            v = value[node + exit_index[shape, u, i]]
+            v = block_read(value, snapshot, low, high, node + exit_index[shape, u, i])
             if v < np.inf:
                 total += w * v
                 known += w
@@ -829,12 +843,23 @@ def known_value(exit_index, exit_weight, shape, u, node, value, shape_row_of):
 
 @njit(cache=True, inline="always")
 def _bellman(
-    exit_index, exit_weight, segment_cost, to_destination, value, row, shape, node, shape_row_of
+    exit_index,
+    exit_weight,
+    segment_cost,
+    to_destination,
+    value,
+    row,
+    shape,
+    node,
+    shape_row_of,
+    snapshot,
+    low,
+    high,
 ):
-    """(min over u of cost(row, u) + the exit's cost-to-go (``known_value``; 0 for an exit to
-    the destination), the first minimising u); (inf, 0) where every control costs inf. Inlined
-    where it is called (numba's ``inline="always"``): a call per node would cost more than the
-    node's arithmetic."""
+    """(min over u of cost(row, u) + the exit's cost-to-go (``known_value``, read as the block
+    [low, high) sees it; 0 for an exit to the destination), the first minimising u); (inf, 0)
+    where every control costs inf. Inlined where it is called (numba's ``inline="always"``): a
+    call per node would cost more than the node's arithmetic."""
     best = np.inf
     choice = 0
     for u in range(segment_cost.shape[1]):
@@ -843,7 +868,9 @@ def _bellman(
             continue
         candidate = cost
         if not to_destination[row, u]:
-            candidate += known_value(exit_index, exit_weight, shape, u, node, value, shape_row_of)
+            candidate += known_value(
+                exit_index, exit_weight, shape, u, node, value, shape_row_of, snapshot, low, high
+            )
         if candidate < best:
             best = candidate
             choice = u
@@ -884,6 +911,74 @@ def _prefetch_exits(exit_index, exit_weight, segment_cost, row_of, shape_row_of,
                         prefetch(value, (node + exit_index[shape, u, i],))
 
 
+@njit(cache=True, inline="always")
+def block_positions(blocks, k, order):
+    """(first, end): the positions in ``order`` (``sweep_order``) of sweep block k, the nodes
+    [blocks[k], blocks[k + 1]) (blocks: (K + 1,) int64, node indices at boundaries between
+    the first axis's layers, 0 and N at the ends). Each order runs through the first axis's
+    layers forwards or backwards, so each block is a run of positions: forwards where the
+    order starts in the first block."""
+    n = order.shape[0]
+    if blocks.shape[0] == 2 or order[0] < blocks[1]:
+        return blocks[k], blocks[k + 1]
+    return n - blocks[k + 1], n - blocks[k]
+
+
+@njit(cache=True, inline="always")
+def _bellman_block(
+    exit_index,
+    exit_weight,
+    segment_cost,
+    to_destination,
+    row_of,
+    shape_row_of,
+    is_destination,
+    value,
+    snapshot,
+    order,
+    first,
+    end,
+    low,
+    high,
+    settled_above,
+    prefetching,
+    control,
+):
+    """``gauss_seidel_sweep`` over the positions [first, end) of ``order``, reading values as
+    the block of nodes [low, high) sees them (``block_read``); returns the largest decrease."""
+    largest = 0.0
+    for p in range(first, end):
+        if prefetching:
+            _prefetch_exits(
+                exit_index, exit_weight, segment_cost, row_of, shape_row_of, value, order, p
+            )
+        node = order[p]
+        row = row_of[node]
+        if row < 0 or is_destination[node]:
+            continue
+        old = value[node]
+        best, choice = _bellman(
+            exit_index,
+            exit_weight,
+            segment_cost,
+            to_destination,
+            value,
+            row,
+            shape_of(shape_row_of, row_of, node),
+            node,
+            shape_row_of,
+            snapshot,
+            low,
+            high,
+        )
+        if best < old:
+            value[node] = best
+            control[node] = choice
+            if old - best > largest and best < settled_above:
+                largest = old - best
+    return largest
+
+
 @njit(cache=True)
 def gauss_seidel_sweep(
     exit_index,
@@ -916,39 +1011,81 @@ def gauss_seidel_sweep(
     describes. is_destination: (N,) bool, held at 0. A decrease to a value still at or above
     ``settled_above`` (s; inf: none) does not count in the largest decrease: such a node is a
     dead end (``known_weight``), whatever its exact bound. One thread, in a fixed order: the
-    same result on any machine whatever the thread count. ``prefetching``: ask the cache for
-    the rows a few nodes ahead (``_prefetch_exits``; ``prefetch_pays``): half the orders run
-    backwards through memory, where the processor's own prefetch falls behind on tables larger
-    than its caches. The hint changes no value.
+    same result on any machine whatever the thread count (``blocked_gauss_seidel_sweep``: two
+    threads, the same). ``prefetching``: ask the cache for the rows a few nodes ahead
+    (``_prefetch_exits``; ``prefetch_pays``): half the orders run backwards through memory,
+    where the processor's own prefetch falls behind on tables larger than its caches. The hint
+    changes no value.
     """
-    largest = 0.0
-    for p in range(order.shape[0]):
-        if prefetching:
-            _prefetch_exits(
-                exit_index, exit_weight, segment_cost, row_of, shape_row_of, value, order, p
-            )
-        node = order[p]
-        row = row_of[node]
-        if row < 0 or is_destination[node]:
-            continue
-        old = value[node]
-        best, choice = _bellman(
+    n = order.shape[0]
+    return _bellman_block(
+        exit_index,
+        exit_weight,
+        segment_cost,
+        to_destination,
+        row_of,
+        shape_row_of,
+        is_destination,
+        value,
+        None,
+        order,
+        0,
+        n,
+        0,
+        value.shape[0],
+        settled_above,
+        prefetching,
+        control,
+    )
+
+
+@njit(cache=True, parallel=True)
+def blocked_gauss_seidel_sweep(
+    exit_index,
+    exit_weight,
+    segment_cost,
+    to_destination,
+    row_of,
+    shape_row_of,
+    is_destination,
+    value,
+    snapshot,
+    order,
+    blocks,
+    largest,
+    settled_above,
+    prefetching,
+    control,
+):
+    """``gauss_seidel_sweep`` in blocks (``block_positions``; blocks (K + 1,) int64): the K
+    blocks are swept side by side on numba's threads, each in its own part of the order,
+    reading its own nodes' values as it updates them and the other blocks' from ``snapshot``
+    (N,), ``value`` as it stood when the sweep began (``copy_block_edges``: at least every
+    node read across a block's edge). Nothing a block reads depends on how the blocks are
+    scheduled: the same result whatever the thread count. largest: (K,) work space. Returns
+    the largest decrease, s."""
+    for k in prange(blocks.shape[0] - 1):
+        first, end = block_positions(blocks, k, order)
+        largest[k] = _bellman_block(
             exit_index,
             exit_weight,
             segment_cost,
             to_destination,
-            value,
-            row,
-            shape_of(shape_row_of, row_of, node),
-            node,
+            row_of,
             shape_row_of,
+            is_destination,
+            value,
+            snapshot,
+            order,
+            first,
+            end,
+            blocks[k],
+            blocks[k + 1],
+            settled_above,
+            prefetching,
+            control,
         )
-        if best < old:
-            value[node] = best
-            control[node] = choice
-            if old - best > largest and best < settled_above:
-                largest = old - best
-    return largest
+    return largest.max()
 
 
 @njit(cache=True)
@@ -991,6 +1128,57 @@ def gather_policy(
             policy_shape[row] = shape * exit_index.shape[1] + u
 
 
+@njit(cache=True, inline="always")
+def _policy_block(
+    policy_index,
+    policy_weight,
+    policy_shape,
+    policy_cost,
+    policy_to_destination,
+    shape_row_of,
+    row_of,
+    is_destination,
+    value,
+    snapshot,
+    order,
+    first,
+    end,
+    low,
+    high,
+    settled_above,
+):
+    """``policy_sweep`` over the positions [first, end) of ``order``, reading values as the
+    block of nodes [low, high) sees them (``block_read``); returns the largest decrease."""
+    largest = 0.0
+    for p in range(first, end):
+        node = order[p]
+        row = row_of[node]
+        if row < 0 or is_destination[node]:
+            continue
+        candidate = policy_cost[row, 0]
+        if candidate == np.inf:
+            continue
+        if not policy_to_destination[row, 0]:
+            candidate += known_value(
+                policy_index,
+                policy_weight,
+                policy_shape[row],
+                0,
+                node,
+                value,
+                shape_row_of,
+                snapshot,
+                low,
+                high,
+            )
+        old = value[node]
+        if candidate < old:
+            value[node] = candidate
+            if old - candidate > largest and candidate < settled_above:
+                largest = old - candidate
+    return largest
+
+
 @njit(cache=True)
 def policy_sweep(
     policy_index,
@@ -1012,26 +1200,74 @@ def policy_sweep(
     cost-to-go and still only decrease; a sweep reads one control's exit per node instead of
     all of them. Returns the largest decrease, s (decreases to values at or above
     ``settled_above`` not counted, as in ``gauss_seidel_sweep``)."""
-    largest = 0.0
-    for p in range(order.shape[0]):
-        node = order[p]
-        row = row_of[node]
-        if row < 0 or is_destination[node]:
-            continue
-        candidate = policy_cost[row, 0]
-        if candidate == np.inf:
-            continue
-        if not policy_to_destination[row, 0]:
-            shape = policy_shape[row]
-            candidate += known_value(
-                policy_index, policy_weight, shape, 0, node, value, shape_row_of
-            )
-        old = value[node]
-        if candidate < old:
-            value[node] = candidate
-            if old - candidate > largest and candidate < settled_above:
-                largest = old - candidate
-    return largest
+    return _policy_block(
+        policy_index,
+        policy_weight,
+        policy_shape,
+        policy_cost,
+        policy_to_destination,
+        shape_row_of,
+        row_of,
+        is_destination,
+        value,
+        None,
+        order,
+        0,
+        order.shape[0],
+        0,
+        value.shape[0],
+        settled_above,
+    )
+
+
+@njit(cache=True, parallel=True)
+def blocked_policy_sweep(
+    policy_index,
+    policy_weight,
+    policy_shape,
+    policy_cost,
+    policy_to_destination,
+    shape_row_of,
+    row_of,
+    is_destination,
+    value,
+    snapshot,
+    order,
+    blocks,
+    largest,
+    settled_above,
+):
+    """``policy_sweep`` in blocks, as ``blocked_gauss_seidel_sweep`` runs them."""
+    for k in prange(blocks.shape[0] - 1):
+        first, end = block_positions(blocks, k, order)
+        largest[k] = _policy_block(
+            policy_index,
+            policy_weight,
+            policy_shape,
+            policy_cost,
+            policy_to_destination,
+            shape_row_of,
+            row_of,
+            is_destination,
+            value,
+            snapshot,
+            order,
+            first,
+            end,
+            blocks[k],
+            blocks[k + 1],
+            settled_above,
+        )
+    return largest.max()
+
+
+@njit(cache=True)
+def copy_block_edges(value, snapshot, edges):
+    """snapshot[a:b] = value[a:b] for each row (a, b) of ``edges`` ((M, 2) int64): the nodes
+    that some sweep block reads across its edge (``gauss_seidel_sweep``)."""
+    for m in range(edges.shape[0]):
+        for node in range(edges[m, 0], edges[m, 1]):
+            snapshot[node] = value[node]
 
 
 @njit(cache=True)
@@ -1044,6 +1280,9 @@ def gauss_seidel_sweeps(
     shape_row_of,
     is_destination,
     value,
+    snapshot,
+    blocks,
+    edges,
     axis_count,
     first,
     count,
@@ -1071,28 +1310,53 @@ def gauss_seidel_sweeps(
     the orders of ``sweep_order``, counting from sweep number ``first``. The exit tables as
     ``gauss_seidel_sweep`` takes them; order: (N,) int64 and control (N,) int64 work space
     (control: zeros before the first call, kept between calls); policy_*: ``gather_policy``'s
-    tables; settled_above, prefetching: as ``gauss_seidel_sweep``. Returns (Bellman sweeps
-    run, policy sweeps run, the last Bellman sweep's largest decrease)."""
+    tables; settled_above, prefetching: as ``gauss_seidel_sweep``. edges None: one block, each
+    sweep ``gauss_seidel_sweep`` or ``policy_sweep`` (snapshot and blocks unread); else the
+    blocked sweeps (``blocked_gauss_seidel_sweep``; snapshot, blocks as they take them), each
+    from ``copy_block_edges`` (edges). Which it is, is a type: a grid swept in one block
+    compiles no parallel sweep. Returns (Bellman sweeps run, policy sweeps run, the last
+    Bellman sweep's largest decrease)."""
+    block_largest = np.empty(blocks.shape[0] - 1)
     largest = np.inf
     sweep = first
     policy = 0
     for k in range(count):
         sweep_order(axis_count, sweep, order)
         sweep += 1
-        largest = gauss_seidel_sweep(
-            exit_index,
-            exit_weight,
-            segment_cost,
-            to_destination,
-            row_of,
-            shape_row_of,
-            is_destination,
-            value,
-            order,
-            settled_above,
-            prefetching,
-            control,
-        )
+        if edges is None:
+            largest = gauss_seidel_sweep(
+                exit_index,
+                exit_weight,
+                segment_cost,
+                to_destination,
+                row_of,
+                shape_row_of,
+                is_destination,
+                value,
+                order,
+                settled_above,
+                prefetching,
+                control,
+            )
+        else:
+            copy_block_edges(value, snapshot, edges)
+            largest = blocked_gauss_seidel_sweep(
+                exit_index,
+                exit_weight,
+                segment_cost,
+                to_destination,
+                row_of,
+                shape_row_of,
+                is_destination,
+                value,
+                snapshot,
+                order,
+                blocks,
+                block_largest,
+                settled_above,
+                prefetching,
+                control,
+            )
         if largest < tolerance:
             return k + 1, policy, largest
         if policy_sweeps > 0:
@@ -1114,19 +1378,38 @@ def gauss_seidel_sweeps(
             sweep_order(axis_count, sweep, order)
             sweep += 1
             policy += 1
-            change = policy_sweep(
-                policy_index,
-                policy_weight,
-                policy_shape,
-                policy_cost,
-                policy_to_destination,
-                shape_row_of,
-                row_of,
-                is_destination,
-                value,
-                order,
-                settled_above,
-            )
+            if edges is None:
+                change = policy_sweep(
+                    policy_index,
+                    policy_weight,
+                    policy_shape,
+                    policy_cost,
+                    policy_to_destination,
+                    shape_row_of,
+                    row_of,
+                    is_destination,
+                    value,
+                    order,
+                    settled_above,
+                )
+            else:
+                copy_block_edges(value, snapshot, edges)
+                change = blocked_policy_sweep(
+                    policy_index,
+                    policy_weight,
+                    policy_shape,
+                    policy_cost,
+                    policy_to_destination,
+                    shape_row_of,
+                    row_of,
+                    is_destination,
+                    value,
+                    snapshot,
+                    order,
+                    blocks,
+                    block_largest,
+                    settled_above,
+                )
             if change < tolerance:
                 break
     return count, policy, largest
@@ -1153,6 +1436,9 @@ def best_controls(
                 shape_of(shape_row_of, row_of, node),
                 node,
                 shape_row_of,
+                None,
+                0,
+                value.shape[0],
             )[1]
         )
 

@@ -58,6 +58,9 @@ PROGRESS_CHUNKS = 20  # at most; fewer for small grids (each chunk wakes numba's
 SIMULATIONS_PER_CHUNK = 20_000  # at least, but for the last chunk
 SWEEPS_PER_CALL = 8  # value-iteration (Bellman) sweeps between progress updates
 POLICY_SWEEPS = 16  # at most, after each Bellman sweep (``dp.gauss_seidel_sweeps``)
+BLOCKED_SWEEP_NODES = 200_000  # grids with at least this many nodes are swept in two blocks
+# side by side (``sweep_blocks``); a smaller one's sweeps take milliseconds on one thread, and
+# one block converges in fewer of them
 
 
 @dataclass(frozen=True)
@@ -405,6 +408,10 @@ def load_kernels(
         *empty.arrays(),
         flags,
         np.empty(0),
+        np.empty(0),
+        np.zeros(2, dtype=np.int64),
+        # edges: the variant that ``sweep_blocks`` is likely to choose (one block: None)
+        None if problem.grid.node_count < BLOCKED_SWEEP_NODES else np.empty((0, 2), np.int64),
         problem.grid.axis_count,
         0,
         0,
@@ -605,6 +612,35 @@ def check_transitions_finite(problem: Problem, transitions: Transitions) -> None
     )
 
 
+def sweep_blocks(
+    axis_count: np.ndarray, transitions: Transitions
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """(blocks, edges) for the value iteration's sweeps (``dp.gauss_seidel_sweeps``): on a grid
+    of at least BLOCKED_SWEEP_NODES nodes, two blocks of the first axis's layers, split where
+    each holds about half the nodes that are not removed (each block is one thread's work),
+    and the node ranges a block reads across the split: as many layers on each side of it as
+    the farthest exit corner (with a weight) lies from its node, in node indices. Else, or
+    where those ranges would cover the grid (an exit corner wrapping around the first axis),
+    one block [0, N] and edges None: the plain sweeps. Depends on the problem alone, so the
+    tables are the same whatever the thread count."""
+    nodes = int(np.prod(axis_count))
+    layers = int(axis_count[0])
+    layer = nodes // layers
+    one_block = np.array([0, nodes], dtype=np.int64), None
+    if nodes < BLOCKED_SWEEP_NODES:
+        return one_block
+    weighted = transitions.exit_weight != 0
+    reach = int(np.abs(transitions.exit_index[weighted]).max()) if weighted.any() else 0
+    span = -(-reach // layer)  # layers a read may cross
+    rows = np.cumsum((transitions.row_of >= 0).reshape(layers, layer).sum(axis=1))
+    split = int(np.searchsorted(rows, rows[-1] / 2)) + 1
+    if split - span < 0 or split + span > layers or split >= layers:
+        return one_block
+    blocks = np.array([0, split * layer, nodes], dtype=np.int64)
+    edges = np.array([[(split - span) * layer, (split + span) * layer]], dtype=np.int64)
+    return blocks, edges
+
+
 def value_iteration(
     problem: Problem,
     transitions: Transitions,
@@ -621,6 +657,8 @@ def value_iteration(
     grid = problem.grid
     bound = DEAD_END_BOUND if problem.spec.known_weight else UNKNOWN
     value = np.where(problem.is_destination, 0.0, np.where(reachable, bound, np.inf))
+    blocks, edges = sweep_blocks(grid.axis_count, transitions)
+    snapshot = value.copy() if edges is not None else value  # one block reads value alone
     order = np.empty(grid.node_count, dtype=np.int64)
     control = np.zeros(grid.node_count, dtype=np.int64)
     policy = policy_tables(transitions)
@@ -634,6 +672,9 @@ def value_iteration(
             *transitions.arrays(),
             problem.is_destination,
             value,
+            snapshot,
+            blocks,
+            edges,
             grid.axis_count,
             iterations + policy_sweeps,
             min(SWEEPS_PER_CALL, max_iterations - iterations),
