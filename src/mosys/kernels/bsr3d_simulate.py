@@ -792,9 +792,23 @@ def contact_impulses(
             response(r, i, j, inverse_mass, world_inverse, responses)
     # three or more points: a rigid body often leaves their split undecided
     compliance = 0.0 if n < 3 else COMPLIANCE * (responses[0, 0, 0, 0] + responses[0, 0, 1, 1])
+    # np.int64 and np.bool_: types, not literals (each literal a signature of its own: the
+    # shared friction compiled four times over, 40 s of a cold start)
+    count = np.int64(count)
     while n >= 2:
         worst = _shared_friction(
-            u, r, active, count, responses, impulse, system, mixing, weight, compliance, share, True
+            u,
+            r,
+            active,
+            count,
+            responses,
+            impulse,
+            system,
+            mixing,
+            weight,
+            compliance,
+            share,
+            np.bool_(True),
         )
         if worst == -1 and _twist_too_strong(impulse, active, count) or worst == -3:
             # slide only: the paper's rule as it is
@@ -810,7 +824,7 @@ def contact_impulses(
                 weight,
                 compliance,
                 share,
-                False,
+                np.bool_(False),
             )
         if worst == -2 and compliance == 0.0:
             # the rigid body leaves the split undecided: a little compliance decides it

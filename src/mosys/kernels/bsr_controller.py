@@ -327,5 +327,13 @@ def run_population(
             np.empty(n_ends),
         )
         taken_out[c] = run_controller(
-            figure, controller, starts[c], np.zeros(n_ends), False, steps, dt, falls, record
+            figure,
+            controller,
+            starts[c],
+            np.zeros(n_ends),
+            np.bool_(False),  # a bool, not the literal False: the run_controller a call
+            steps,  # from Python compiles (a literal is a signature of its own)
+            dt,
+            falls,
+            record,
         )
