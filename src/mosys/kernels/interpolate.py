@@ -175,7 +175,7 @@ def interpolate_with(
         wrap,
         strides,
         state,
-        -1,
+        np.int64(-1),  # not the literal -1: the signature the DP's exits compile too
         corner_index,
         corner_weight,
         integer_scratch,
