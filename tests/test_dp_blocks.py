@@ -11,44 +11,13 @@ from __future__ import annotations
 import numba
 import numpy as np
 import pytest
-from exit_tables import random_tables
+from exit_tables import random_tables, reference_sweep
 from test_car import SMALL
 from test_dp_policy import solve
 
 from mosys.kernels.dp import blocked_gauss_seidel_sweep, sweep_order
 from mosys.parsing.controller import parse_controller_text
 from mosys.ssc import generate
-
-
-def block_sweep(tables, is_destination, value, order, blocks):
-    """The sweep in blocks as ``blocked_gauss_seidel_sweep``'s docstring states it, in Python."""
-    exit_index, exit_weight, segment_cost, to_destination, row_of, _ = tables
-    snapshot = value.copy()
-    largest = 0.0
-    for low, high in zip(blocks[:-1], blocks[1:], strict=True):
-        for node in order[(order >= low) & (order < high)]:  # the block's part, in order
-            row = row_of[node]
-            if row < 0 or is_destination[node]:
-                continue
-            best = np.inf
-            for u in range(segment_cost.shape[1]):
-                if segment_cost[row, u] == np.inf:
-                    continue
-                candidate = segment_cost[row, u]
-                if not to_destination[row, u]:  # own shapes: renormalised already, Σ w·V
-                    total = 0.0
-                    for i in range(exit_index.shape[2]):
-                        w = float(exit_weight[row, u, i])
-                        corner = node + exit_index[row, u, i]
-                        if w != 0.0:
-                            seen = value if low <= corner < high else snapshot
-                            total += w * seen[corner]
-                    candidate += total
-                best = min(best, candidate)
-            if best < value[node]:
-                largest = max(largest, value[node] - best)
-                value[node] = best
-    return largest
 
 
 @pytest.mark.parametrize("threads", [1, 2])
@@ -82,7 +51,7 @@ def test_a_sweep_in_two_blocks_reads_the_other_blocks_values_as_they_stood(axis_
                 False,
                 control,
             )
-            expected_largest = block_sweep(tables, is_destination, expected, order, blocks)
+            expected_largest = reference_sweep(tables, is_destination, expected, order, blocks)
             assert np.array_equal(value, expected)
             assert largest == expected_largest
     finally:

@@ -7,39 +7,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from exit_tables import random_tables
+from exit_tables import random_tables, reference_sweep
 from numba import njit
 
 from mosys.kernels.dp import gauss_seidel_sweep, sweep_order
 from mosys.kernels.prefetch import prefetch
-
-
-def plain_sweep(tables, is_destination, value, order):
-    """The sweep as ``gauss_seidel_sweep``'s docstring states it, in Python, without hints."""
-    exit_index, exit_weight, segment_cost, to_destination, row_of, shape_row_of = tables
-    largest = 0.0
-    for node in order:
-        row = row_of[node]
-        if row < 0 or is_destination[node]:
-            continue
-        shape = row if shape_row_of is None else shape_row_of[node]
-        best = np.inf
-        for u in range(segment_cost.shape[1]):
-            if segment_cost[row, u] == np.inf:
-                continue
-            candidate = segment_cost[row, u]
-            if not to_destination[row, u]:  # own shapes: renormalised already, Σ w·V
-                total = 0.0
-                for i in range(exit_index.shape[2]):
-                    w = float(exit_weight[shape, u, i])
-                    if w != 0.0:
-                        total += w * value[node + exit_index[shape, u, i]]
-                candidate += total
-            best = min(best, candidate)
-        if best < value[node]:
-            largest = max(largest, value[node] - best)
-            value[node] = best
-    return largest
 
 
 @pytest.mark.parametrize("prefetching", [True, False])
@@ -58,7 +30,7 @@ def test_the_sweep_gives_the_plain_sweeps_values_bit_for_bit(axis_count, prefetc
         largest = gauss_seidel_sweep(
             *tables, is_destination, value, order, np.inf, prefetching, control
         )
-        expected_largest = plain_sweep(tables, is_destination, expected, order)
+        expected_largest = reference_sweep(tables, is_destination, expected, order)
         assert np.array_equal(value, expected)
         assert largest == expected_largest
     assert np.isfinite(value).sum() > is_destination.sum()  # values really moved

@@ -794,38 +794,12 @@ def contact_impulses(
     compliance = 0.0 if n < 3 else COMPLIANCE * (responses[0, 0, 0, 0] + responses[0, 0, 1, 1])
     # np.int64 and np.bool_: types, not literals (each literal a signature of its own: the
     # shared friction compiled four times over, 40 s of a cold start)
-    count = np.int64(count)
+    points = (u, r, active, np.int64(count), responses, impulse, system, mixing, weight)
     while n >= 2:
-        worst = _shared_friction(
-            u,
-            r,
-            active,
-            count,
-            responses,
-            impulse,
-            system,
-            mixing,
-            weight,
-            compliance,
-            share,
-            np.bool_(True),
-        )
+        worst = _shared_friction(*points, compliance, share, np.bool_(True))
         if worst == -1 and _twist_too_strong(impulse, active, count) or worst == -3:
             # slide only: the paper's rule as it is
-            worst = _shared_friction(
-                u,
-                r,
-                active,
-                count,
-                responses,
-                impulse,
-                system,
-                mixing,
-                weight,
-                compliance,
-                share,
-                np.bool_(False),
-            )
+            worst = _shared_friction(*points, compliance, share, np.bool_(False))
         if worst == -2 and compliance == 0.0:
             # the rigid body leaves the split undecided: a little compliance decides it
             compliance = COMPLIANCE * (responses[0, 0, 0, 0] + responses[0, 0, 1, 1])
