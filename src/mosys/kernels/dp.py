@@ -16,7 +16,9 @@ information. It is simpler to approximate this order and repeat this for several
 the sweeps run through the grid in the 2**d orders of the fast sweeping method in turn
 (``sweep_order``), each node using the values the sweep has just updated; between them, sweeps
 of the policy the last one left, each node under its own control only (modified policy
-iteration: ``policy_sweep``), run down the slow tail at a fraction of the cost. For a spec with
+iteration: ``policy_sweep``), run down the slow tail at a fraction of the cost. On large grids
+both run in two blocks of the first axis side by side (``blocked_gauss_seidel_sweep``), each
+reading the other's values as they stood when the sweep began. For a spec with
 several destinations (the paper's "conditional" goals), ``destination_indices`` then finds
 which destination each node's optimal path ends at, by the same sweeps over the exits.
 
