@@ -234,3 +234,28 @@ def test_the_server_stops_on_sigterm_and_removes_its_socket(server):
     server.process.send_signal(signal.SIGTERM)
     assert server.process.wait(timeout=20) == 0
     assert not server.socket.exists()
+
+
+def test_the_socket_appears_only_once_it_listens(tmp_path, monkeypatch):
+    """The fixture (and Snakemake's onstart) connect the moment the socket's path exists: the
+    server binds and listens under another name and renames, so that moment never refuses."""
+    from mosys.cli import job_server
+
+    path = tmp_path / "server.sock"
+    path.write_text("stale")
+    seen: list[bool] = []
+    rename = os.replace
+
+    def replace(source, target):
+        seen.append(Path(target).exists())  # the stale file, still there until the rename
+        with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as early:
+            early.connect(source)  # already listening before it gets its name
+        rename(source, target)
+
+    monkeypatch.setattr(job_server.os, "replace", replace)
+    with job_server._listening_socket(str(path)) as listener:
+        with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as client:
+            client.connect(str(path))
+        assert seen == [True]
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["server.sock"]
+        listener.accept()[0].close()

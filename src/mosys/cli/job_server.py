@@ -77,11 +77,7 @@ def serve(path: str, idle_seconds: float) -> None:
     stopping: list[int] = []
     for number in FORWARDED_SIGNALS:  # before the socket exists: a stop is never missed
         signal.signal(number, lambda received, frame: stopping.append(received))
-    listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
-    with contextlib.suppress(FileNotFoundError):
-        os.unlink(path)
-    listener.bind(path)
-    listener.listen(64)
+    listener = _listening_socket(path)
     _log(f"listening on {path}")
     selector = selectors.DefaultSelector()
     selector.register(listener, selectors.EVENT_READ, ("listener", 0))
@@ -92,6 +88,26 @@ def serve(path: str, idle_seconds: float) -> None:
         listener.close()
         with contextlib.suppress(FileNotFoundError):
             os.unlink(path)
+
+
+def _listening_socket(path: str) -> socket.socket:
+    """A Unix socket listening at ``path`` (replacing a stale one). It is bound and listening
+    under a name of its own first, then renamed: a client that sees ``path`` can connect (a
+    socket bound at ``path`` refuses connections until ``listen``)."""
+    listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    unready = os.path.join(os.path.dirname(path), f".mosys-job-server-{os.getpid()}")
+    with contextlib.suppress(FileNotFoundError):
+        os.unlink(unready)
+    try:
+        listener.bind(unready)
+        listener.listen(64)
+        os.replace(unready, path)
+    except BaseException:
+        listener.close()
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(unready)
+        raise
+    return listener
 
 
 def _serve_requests(selector, listener, parent: int, idle_seconds: float, stopping) -> None:
