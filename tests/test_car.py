@@ -301,6 +301,23 @@ def test_specs_that_do_not_fit_the_car_name_the_line(car, old, new, message):
             "x.ssc:15:18: expected a 'name=tolerance' arrival tolerance, found 'x'",
         ),
         (
+            "policy lookahead x=0.1 aim=0",
+            "x.ssc:15:28: expected an aim above 0 and at most 1, found '0'",
+        ),
+        (
+            "policy lookahead aim=1.5 x=0.1",
+            "x.ssc:15:22: expected an aim above 0 and at most 1, found '1.5'",
+        ),
+        (
+            "policy lookahead x=0.1 aim=0.5 aim=0.6",
+            "x.ssc:15:32: expected 'aim=' only once, found 'aim=0.6'",
+        ),
+        (
+            "policy lookahead aim=0.5",
+            "x.ssc:15:25: expected a 'name=tolerance' arrival tolerance of a dest dimension "
+            "after 'lookahead', found end of line",
+        ),
+        (
             "policy interpolate x=0.1",
             "x.ssc:15:20: expected the end of the line after 'interpolate', found 'x=0.1'",
         ),
@@ -322,6 +339,11 @@ def test_a_policy_line_round_trips_and_lookahead_needs_a_vehicle(link1):
     assert spec.policy.arrival == (("x", 0.1), ("heading", 4.0))
     again = parse_controller_text(render_controller_spec(spec), "x.ssc")
     assert again.policy.arrival == spec.policy.arrival
+    assert spec.policy.aim == again.policy.aim == 1.0
+    aimed = parse_controller_text(SMALL + "policy lookahead x=0.1 aim=0.25 heading=4\n", "x.ssc")
+    assert (aimed.policy.arrival, aimed.policy.aim) == (spec.policy.arrival, 0.25)
+    again = parse_controller_text(render_controller_spec(aimed), "x.ssc")
+    assert again.policy == aimed.policy
     pendulum = parse_controller_text(
         "dyn link1\nssd angle -180 170 36 wrap\nssd omega -500 500 21\n"
         "torq torque -10 10 11 0.1\ndest angle=0 omega=0\npolicy lookahead angle=5\n",

@@ -283,3 +283,80 @@ def test_a_start_grid_whose_pose_search_would_not_fit_in_memory_is_refused(car, 
     wide = Controller("wide", generate_controller(spec, car, tmp_path / "wide.h5", quiet=True), car)
     with pytest.raises(InputError, match=r"^controller wide: the pose search: the lattice would"):
         evaluate_starts(wide, np.array([[1.5, 2.0, 0.0, 0.0, 0.0]]), 1.0, DT)
+
+
+def test_an_aim_shrinks_the_dps_arrival_box_so_values_only_grow(small, car, tmp_path):
+    """aim=0.5: the DP ends its segments in half the arrival box, a smaller target, so no node's
+    cost-to-go falls below the same table's aiming at the whole box (within the sweeps'
+    tolerance), some rise, and the runtime still brakes in the whole box."""
+    spec = parse_controller_text(SMALL + ARRIVAL.replace("\n", " aim=0.5\n"), "aimed.ssc")
+    aimed = Controller("aimed", generate_controller(spec, car, tmp_path / "a.h5", quiet=True), car)
+    assert (aimed.table.attrs["arrival_aim"], small.table.attrs["arrival_aim"]) == (0.5, 1.0)
+    np.testing.assert_array_equal(aimed.lookahead.arrival_box, small.lookahead.arrival_box)
+    both = np.isfinite(aimed.table.value) & np.isfinite(small.table.value)
+    assert both.sum() > 0.9 * np.isfinite(small.table.value).sum()
+    tolerance = float(small.table.attrs["tolerance"])
+    assert np.all(aimed.table.value[both] >= small.table.value[both] - 2 * tolerance)
+    assert np.sum(aimed.table.value[both] > small.table.value[both] + 0.05) > 10
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_choice_that_costs_more_than_promised_raises_the_runs_table_there(seed):
+    """``_learn`` (the runtime's LRTA* step) on a 3-D grid with some unknown nodes: where the
+    best choice costs more than the interpolation promises, the known corners around the state
+    rise (only they, none falls) until the interpolation there equals the choice's cost; where
+    it costs less, or nothing is admissible (inf), or too little weight is known, nothing
+    changes."""
+    from mosys.kernels.interpolate import (
+        clamp_to_domain,
+        grid_strides,
+        interpolate_with,
+        interpolation_scratch,
+    )
+    from mosys.kernels.lookahead import _learn
+
+    rng = np.random.default_rng(seed)
+    axis_min, axis_step = np.array([0.0, -1.0, 0.0]), np.array([0.5, 0.25, 0.1])
+    axis_count = np.array([5, 9, 4], np.int64)
+    wrap = np.zeros(3, np.bool_)
+    strides = np.empty(3, np.int64)
+    grid_strides(axis_count, strides)
+    nodes = int(np.prod(axis_count))
+    known = rng.random(nodes) > 0.2
+    scratch, clamped, out = interpolation_scratch(3), np.empty(3), np.empty(1)
+
+    def promised(value, state):
+        clamp_to_domain(axis_min, axis_step, axis_count, wrap, state, clamped)
+        weight = interpolate_with(
+            axis_min, axis_step, axis_count, wrap, strides, value, known, clamped, scratch, out
+        )
+        return out[0], weight
+
+    def learn(value, state, cost, minimum=0.0):
+        _learn(axis_min, axis_step, axis_count, wrap, strides, value, known, minimum, state,
+               cost, scratch, clamped, out)  # fmt: skip
+
+    for _ in range(20):
+        value = rng.uniform(0, 10, (nodes, 1))
+        state = axis_min + axis_step * (axis_count - 1) * rng.random(3)
+        before, weight = promised(value, state)
+        if weight == 0.0:
+            continue
+        for cost, minimum in ((before - 1.0, 0.0), (np.inf, 0.0), (before + 3.0, weight + 0.01)):
+            learned = value.copy()
+            learn(learned, state, cost, minimum)
+            np.testing.assert_array_equal(learned, value)
+        learned = value.copy()
+        learn(learned, state, before + 3.0)
+        assert promised(learned, state)[0] == pytest.approx(before + 3.0, abs=1e-9)
+        rise = (learned - value)[:, 0]
+        assert np.all(rise >= 0) and not np.any(rise[~known])
+        assert 1 <= np.count_nonzero(rise) <= 8  # the state's corners only
+
+
+def test_a_run_learns_on_its_own_copy_so_runs_do_not_depend_on_each_other(small):
+    start = small.figure_state(np.array([1.5, 1.8, 10.0, 0.0, 0.0]))
+    value = small.lookahead.value.copy()
+    first = small.simulate(start, 8.0, DT).states
+    np.testing.assert_array_equal(small.lookahead.value, value)
+    np.testing.assert_array_equal(small.simulate(start, 8.0, DT).states, first)

@@ -6,7 +6,10 @@ asks the DP's own question at the vehicle's actual state instead: for every cont
 it until the state leaves the box of ±1 grid step around the state where the choice is made (the
 DP's cell), and cost that segment as the DP does (its seconds plus the interpolated cost-to-go
 where it leaves). It takes the cheapest sample and holds it to that exit, as the DP's transition
-assumes, then chooses again. A segment is admissible only if no step of it touches an obstacle or
+assumes, then chooses again; where the cheapest choice costs more than the interpolated
+cost-to-go at the state promised, the run raises its own copy of the table there (``_learn``), so
+that a spot where interpolation promises too much does not hold the vehicle dithering in it.
+A segment is admissible only if no step of it touches an obstacle or
 leaves the domain polygon, and if braking to rest from its exit, steering held, touches nothing
 either; so the vehicle can always stop. Once the point where full braking would bring the
 vehicle to rest lies in the arrival box around the destination, it brakes to rest there and
@@ -35,6 +38,7 @@ from mosys.kernels.integrate import (
 )
 from mosys.kernels.interpolate import (
     clamp_to_domain,
+    corner_weights,
     grid_strides,
     interpolate_with,
     interpolation_scratch,
@@ -332,9 +336,10 @@ def _choose(
     dt,
     state,
 ):
-    """(sample, steps): the cheapest admissible control sample from ``state`` (its segment's
-    seconds plus the cost-to-go at its exit, or, for a segment that arrives, plus the time to
-    brake to rest) and the length of its segment; (-1, 1) when none is admissible."""
+    """(sample, steps, cost): the cheapest admissible control sample from ``state``, the length
+    of its segment and its cost (s: the segment's seconds plus the cost-to-go at its exit, or,
+    for a segment that arrives, plus the time to brake to rest); (-1, 1, inf) when none is
+    admissible."""
     size = state.shape[0]
     d = axis_min.shape[0]
     n = control_samples.shape[0]
@@ -439,7 +444,63 @@ def _choose(
             best = cost
             best_sample = u
             best_steps = taken
-    return best_sample, best_steps
+    return best_sample, best_steps, best
+
+
+@njit(cache=True)
+def _learn(
+    axis_min,
+    axis_step,
+    axis_count,
+    wrap,
+    strides,
+    value,
+    known,
+    minimum_known_weight,
+    state,
+    cost,
+    scratch,
+    clamped,
+    out,
+):
+    """Raise the cost-to-go where a choice found it too low (learning real-time search: Korf's
+    LRTA*, 1990). When ``cost`` (s), the cheapest choice at controller state ``state`` (d,),
+    exceeds the cost-to-go interpolated there, the known corners around the state rise by the
+    least change (least squares) that makes the interpolation there equal ``cost``: each by
+    shortfall · w / Σw², w its renormalised weight. value: (N, 1), the run's own copy; scratch:
+    ``interpolation_scratch(d)``; clamped: (d,), out: (1,) work arrays. Nothing changes where
+    the known corners carry less than ``minimum_known_weight``."""
+    clamp_to_domain(axis_min, axis_step, axis_count, wrap, state, clamped)
+    known_weight = interpolate_with(
+        axis_min, axis_step, axis_count, wrap, strides, value, known, clamped, scratch, out
+    )
+    shortfall = cost - out[0]
+    if known_weight < minimum_known_weight or known_weight == 0.0 or not shortfall > 0.0:
+        return
+    if not shortfall < np.inf:
+        return
+    integer_scratch, fraction, corner_index, corner_weight = scratch
+    count = corner_weights(
+        axis_min,
+        axis_step,
+        axis_count,
+        wrap,
+        strides,
+        clamped,
+        np.int64(-1),
+        corner_index,
+        corner_weight,
+        integer_scratch,
+        fraction,
+    )
+    squares = 0.0
+    for c in range(count):
+        if known[corner_index[c]]:
+            squares += (corner_weight[c] / known_weight) ** 2
+    for c in range(count):
+        if known[corner_index[c]]:
+            rise = shortfall * corner_weight[c] / known_weight / squares
+            value[corner_index[c], 0] += rise
 
 
 @njit(LOOKAHEAD_SIGNATURE, cache=True, nogil=True)
@@ -517,6 +578,11 @@ def simulate_lookahead(
     membership = np.empty(regions, np.bool_)
     region_membership(state, region_lower, region_upper, region_period, start_membership)
     scratch = rk4_scratch(size)
+    value = value.copy()  # this run's own: raised where a choice finds it too low (_learn)
+    strides = np.empty(d, np.int64)
+    grid_strides(axis_count, strides)
+    interpolation = interpolation_scratch(d)
+    out = np.empty(1)
     held_until = 0  # the step at which the held sample's segment ends
     arrived = False
     for step in range(record_state.shape[0]):
@@ -539,7 +605,7 @@ def simulate_lookahead(
         if arrived:
             _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs)
         elif step >= held_until:
-            sample, steps = _choose(
+            sample, steps, cost = _choose(
                 derivative_into,
                 axis_min,
                 axis_step,
@@ -566,6 +632,22 @@ def simulate_lookahead(
                 max_segment_steps,
                 segment_dt,
                 state,
+            )
+            read_state(state, state_slot, here)  # stops_in_box used it for the braking point
+            _learn(
+                axis_min,
+                axis_step,
+                axis_count,
+                wrap,
+                strides,
+                value,
+                known,
+                minimum_known_weight,
+                here,
+                cost,
+                interpolation,
+                clamped,
+                out,
             )
             if sample < 0:  # nothing admissible: brake, and choose again next step
                 _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs)

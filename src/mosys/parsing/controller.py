@@ -171,11 +171,13 @@ class Policy:
     """The ``policy`` line: how the table runs. ``kind`` is one of POLICIES; ``arrival`` the
     ``name=tolerance`` pairs (spec units, > 0, names from ``dest``) of ``lookahead``: where the
     vehicle's braking point lies within them of the destination, it brakes to rest and holds.
-    ``token`` is the kind's token."""
+    ``aim`` (in (0, 1], from ``aim=``): the DP's segments end in the arrival box scaled by it
+    about the destination. ``token`` is the kind's token."""
 
     kind: str
     arrival: tuple[tuple[str, float], ...]
     token: Token
+    aim: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -632,8 +634,16 @@ class _Parser:
                 line.tokens[2], "the end of the line after 'interpolate'", line.tokens[2].text
             )
         arrival: list[tuple[str, float]] = []
+        aim, pairs = 1.0, [token for token in line.tokens[2:] if token.text[:4] != "aim="]
+        for number, token in enumerate(t for t in line.tokens[2:] if t.text[:4] == "aim="):
+            if number:
+                raise self.error(token, "'aim=' only once", token.text)
+            part = value_token(token, "aim")
+            aim = parse_number(part, self.path, "aim")
+            if not 0 < aim <= 1:
+                raise self.error(part, "an aim above 0 and at most 1", part.text)
         for name, part, _ in self.named_pairs(
-            line.tokens[2:],
+            pairs,
             tuple(entry.name for entry in destination),
             "a 'name=tolerance' arrival tolerance",
             "a dest name",
@@ -650,7 +660,7 @@ class _Parser:
                 "a 'name=tolerance' arrival tolerance of a dest dimension after 'lookahead'",
                 None,
             )
-        return Policy(kind.text, tuple(arrival), kind)
+        return Policy(kind.text, tuple(arrival), kind, aim)
 
     def line_maxiter(self, line: Line) -> None:
         reader = line.reader()
@@ -740,5 +750,6 @@ def render_controller_spec(spec: ControllerSpec) -> str:
         lines.append("hold")
     if spec.policy is not None:
         arrival = "".join(f" {name}={number(value)}" for name, value in spec.policy.arrival)
-        lines.append(f"policy {spec.policy.kind}{arrival}")
+        aim = f" aim={number(spec.policy.aim)}" if spec.policy.aim != 1.0 else ""
+        lines.append(f"policy {spec.policy.kind}{arrival}{aim}")
     return "\n".join(lines) + "\n"

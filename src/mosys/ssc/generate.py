@@ -190,10 +190,15 @@ def check_policy(spec: ControllerSpec, dynamics: ModuleType) -> None:
 
 def policy_attributes(spec: ControllerSpec) -> dict:
     """Root attrs ``policy`` (how the table runs) and, for ``lookahead``,
-    ``arrival_tolerance`` (JSON object: dest name -> tolerance, spec units)."""
+    ``arrival_tolerance`` (JSON object: dest name -> tolerance, spec units) and
+    ``arrival_aim`` (the DP's box: the arrival box scaled by it)."""
     if spec.policy is None or spec.policy.kind == "interpolate":
         return {"policy": "interpolate"}
-    return {"policy": "lookahead", "arrival_tolerance": json.dumps(dict(spec.policy.arrival))}
+    return {
+        "policy": "lookahead",
+        "arrival_tolerance": json.dumps(dict(spec.policy.arrival)),
+        "arrival_aim": spec.policy.aim,
+    }
 
 
 def reachable_nodes(
@@ -310,7 +315,8 @@ def exit_transition_arguments(
 
 def arrival_arguments(problem: Problem, dynamics: ModuleType) -> tuple:
     """The exit kernel's arrival arguments (``dp.exit_transitions_template``): a lookahead
-    table's arrival box and braking, else a disabled placeholder."""
+    table's arrival box scaled by its ``aim`` (README, "The self-parking car") and braking, else
+    a disabled placeholder."""
     spec, grid = problem.spec, problem.grid
     if spec.policy is None or spec.policy.kind != "lookahead":
         return no_arrival(len(grid.names))
@@ -319,7 +325,7 @@ def arrival_arguments(problem: Problem, dynamics: ModuleType) -> tuple:
         dynamics,
         grid,
         spec.destination_values(),
-        dict(spec.policy.arrival),
+        {name: spec.policy.aim * tolerance for name, tolerance in spec.policy.arrival},
         min(abs(control.minimum), abs(control.maximum)),
     )
     return (
