@@ -331,8 +331,8 @@ def run_population(
             controller,
             starts[c],
             np.zeros(n_ends),
-            np.bool_(False),  # a bool, not the literal False: the run_controller a call
-            steps,  # from Python compiles (a literal is a signature of its own)
+            False,  # the literal: numba prunes the carry-over branch, and the search runs
+            steps,  # 2x faster with 10,000 rules (7.4 s against 15 s for a generation of 50)
             dt,
             falls,
             record,
