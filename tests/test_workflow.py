@@ -260,7 +260,8 @@ def test_the_car_parks_from_every_figure_19_start(workflow):
     collision at any instant) within 20 s, and some case backs up past the destination and
     then pulls forward into it; no sample of a run lies beyond an end of the table's axes by
     more than 1 % of a grid step. The start grid (CI's, every 1 m): no run collides, the
-    excluded starts carry a reason, and every start records the table's cost-to-go."""
+    excluded starts carry a reason, at least 90 % of the others park (all of them, 2026-12-03), and
+    every start records the table's cost-to-go."""
     snakemake(workflow, "results/car_all", *CI)
     table = read_controller_table(workflow / "results/controllers/car/park.h5")
     backed_past = []
@@ -289,7 +290,7 @@ def test_the_car_parks_from_every_figure_19_start(workflow):
     assert not grid.collided.any()
     assert set(grid.excluded) <= {"", NOT_FREE, NO_WAY}
     assert not np.isnan(grid.cost_to_go).any()  # recorded for every start (inf: unknown)
-    assert grid.counted.sum() >= 40 and grid.success_rate >= 0.5
+    assert grid.counted.sum() >= 40 and grid.success_rate >= 0.9  # issue 24: 90 %; 100 % in CI
 
 
 @pytest.mark.slow
