@@ -551,7 +551,8 @@ def simulate_lookahead(
     value (interpolation renormalises over them, as ``interpolate_with``, and an exit whose
     known corners carry less than minimum_known_weight of its weight costs inf, as in the DP);
     the run works on a copy of it, which ``_learn`` raises where a choice costs more than it
-    promised (``value`` itself is left as it was). Steer and speed stop at the ends of their axes (``_limit_inputs``), and from a state within
+    promised (``value`` itself is left as it was). Steer and speed stop at the ends of their
+    axes (``_limit_inputs``), and from a state within
     the table's axes a sample is admissible only if its segment, and braking from its exit,
     stay within them: the run stays on the table. control_samples:
     (U, m) the DP's control samples, SI, driving ``control_slot`` (m,) of the model's
