@@ -165,7 +165,8 @@ def interpolate_with(
     (the paper's Figure 10: interpolate between the neighbours whose values are known); where no
     corner with weight is known, every corner counts. strides: from ``grid_strides``; state:
     (d,), inside the domain (clamp first with ``clamp_to_domain``); out: (m,) float64. Returns
-    the weight of the known corners (in [0, 1]).
+    the weight of the known corners (in [0, 1]); scratch's corner_index and corner_weight hold
+    the 2**d corners and their weights (``corner_weights``).
     """
     integer_scratch, fraction, corner_index, corner_weight = scratch
     count = corner_weights(

@@ -38,7 +38,6 @@ from mosys.kernels.integrate import (
 )
 from mosys.kernels.interpolate import (
     clamp_to_domain,
-    corner_weights,
     grid_strides,
     interpolate_with,
     interpolation_scratch,
@@ -469,30 +468,17 @@ def _learn(
     least change (least squares) that makes the interpolation there equal ``cost``: each by
     shortfall · w / Σw², w its renormalised weight. value: (N, 1), the run's own copy; scratch:
     ``interpolation_scratch(d)``; clamped: (d,), out: (1,) work arrays. Nothing changes where
-    the known corners carry less than ``minimum_known_weight``."""
+    the known corners carry less than ``minimum_known_weight``, nor where ``cost`` is inf."""
     clamp_to_domain(axis_min, axis_step, axis_count, wrap, state, clamped)
     known_weight = interpolate_with(
         axis_min, axis_step, axis_count, wrap, strides, value, known, clamped, scratch, out
     )
     shortfall = cost - out[0]
-    if known_weight < minimum_known_weight or known_weight == 0.0 or not shortfall > 0.0:
+    if known_weight < minimum_known_weight or known_weight == 0.0 or not 0.0 < shortfall < np.inf:
         return
-    if not shortfall < np.inf:
-        return
-    integer_scratch, fraction, corner_index, corner_weight = scratch
-    count = corner_weights(
-        axis_min,
-        axis_step,
-        axis_count,
-        wrap,
-        strides,
-        clamped,
-        np.int64(-1),
-        corner_index,
-        corner_weight,
-        integer_scratch,
-        fraction,
-    )
+    # the corners of ``clamped`` and their weights, as interpolate_with left them in scratch
+    corner_index, corner_weight = scratch[2], scratch[3]
+    count = corner_index.shape[0]
     squares = 0.0
     for c in range(count):
         if known[corner_index[c]]:
