@@ -538,12 +538,12 @@ def simulate_lookahead(
     known corners carry less than minimum_known_weight of its weight costs inf, as in the DP);
     the run works on a copy of it, which ``_learn`` raises where a choice costs more than it
     promised (``value`` itself is left as it was). Steer and speed stop at the ends of their
-    axes (``_limit_inputs``), and from a state within
-    the table's axes a sample is admissible only if its segment, and braking from its exit,
-    stay within them: the run stays on the table. control_samples:
-    (U, m) the DP's control samples, SI, driving ``control_slot`` (m,) of the model's
-    ``input_size`` inputs. state_slot: (d,) the controller's axes in the model's state.
-    pose_slot, outline, obstacle_vertices, obstacle_start, domain: the obstacles.
+    axes (``_limit_inputs``), and from a state within the table's axes a sample is admissible
+    only if its segment, and braking from its exit, stay within them: the run stays on the
+    table. control_samples: (U, m) the DP's control samples, SI, driving ``control_slot`` (m,)
+    of the model's ``input_size`` inputs. state_slot: (d,) the controller's axes in the
+    model's state. pose_slot, outline, obstacle_vertices, obstacle_start, domain: the
+    obstacles.
     vehicle_slot: (7,) int64, the state slots of x, y, heading, steer and speed, then the
     input slots of steer_rate and wheel_accel; wheelbase and wheel_radius (m); brake: the
     largest wheel deceleration, rad/s². arrival_box: (3, d) lower, upper (SI, ±inf where free)
