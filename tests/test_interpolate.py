@@ -7,7 +7,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from mosys.kernels.interpolate import interpolate_into
+from mosys.kernels.interpolate import falls_short, interpolate_into
 
 settings.register_profile("mosys", deadline=None, max_examples=60)
 settings.load_profile("mosys")
@@ -78,3 +78,23 @@ def test_wrap_axis_interpolates_across_the_seam():
         np.array([[1.0], [2.0], [3.0], [5.0]]),
     )
     assert interpolate(grid, [3.5])[0] == 3.0
+
+
+def test_a_known_weight_that_rounds_below_its_threshold_still_meets_it():
+    """A state at 0.8 of a cell whose lower node is unknown (the car's y axis, 0.9 + 0.125 k):
+    its known corner carries 0.8 of the weight, which sums to a hair below 0.8 in floating
+    point. A ``known_weight 0.8`` counts it (``falls_short`` allows for rounding: until
+    2026-12-03 25 of the car's parked starts had no cost-to-go for it), and not 0.79."""
+    axis_min, axis_step, count = np.array([0.9]), np.array([0.125]), np.array([26])
+    known = np.ones(26, dtype=np.bool_)
+    known[2] = False  # the node at y = 1.15, below 1.25
+    out = np.empty(1)
+    table = np.arange(26.0)[:, None]
+    weight = interpolate_into(
+        axis_min, axis_step, count, np.array([False]), table, known, np.array([1.25]), out
+    )
+    assert 0.8 - 1e-15 < weight < 0.8  # 0.8, rounded below it
+    assert not falls_short(weight, 0.8)
+    assert out[0] == 3.0  # the known node's value alone
+    assert falls_short(0.79, 0.8)
+    assert not falls_short(0.0, 0.0)  # no threshold: nothing falls short

@@ -33,7 +33,12 @@ from numba import njit, prange
 from mosys.kernels.arrival import braking_seconds, braking_stop, stops_in_box
 from mosys.kernels.figure_state import load_state
 from mosys.kernels.geometry import box_is_clear, place_outline, pose_is_free
-from mosys.kernels.interpolate import corner_weights, grid_strides, interpolation_scratch
+from mosys.kernels.interpolate import (
+    corner_weights,
+    falls_short,
+    grid_strides,
+    interpolation_scratch,
+)
 from mosys.kernels.prefetch import prefetch
 from mosys.kernels.soundness import state_is_sound
 from mosys.kernels.specialise import model_derivative
@@ -780,7 +785,8 @@ def discard_poorly_known_exits(
     whose values are known, the reachable corners of its face, their weights renormalised (here,
     once, for nodes with shapes of their own, ``shape_of``; as they are read for shared shapes,
     ``known_value``); an exit whose reachable corners carry less than ``minimum_known_weight``
-    of its weight (in (0, 1]), or none, gets cost inf here. Afterwards every finite transition
+    of its weight (in (0, 1]; up to rounding, ``interpolate.falls_short``), or none, gets cost
+    inf here. Afterwards every finite transition
     rests on reachable nodes. The exit tables as ``gauss_seidel_sweep`` takes them; reachable:
     (N,) bool."""
     for node in range(row_of.shape[0]):
@@ -798,7 +804,7 @@ def discard_poorly_known_exits(
                     known += w
                 elif shape_row_of is None:
                     exit_weight[shape, u, i] = 0.0
-            if known == 0.0 or known < minimum_known_weight:
+            if known == 0.0 or falls_short(known, minimum_known_weight):
                 segment_cost[row, u] = np.inf
             elif shape_row_of is None:
                 for i in range(exit_index.shape[2]):

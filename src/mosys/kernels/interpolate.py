@@ -14,6 +14,19 @@ from numba import njit
 # A wrap coordinate beyond this many grid steps from the first node (2**52: where a float64 holds
 # no fraction of a step) cannot be placed within its period: ``corner_weights`` gives NaN there.
 WRAP_LIMIT = 2.0**52
+# A sum of interpolation weights this far below a known-weight threshold still meets it: weights
+# are products of fractions (and float32 in the DP's exit tables), so a state at 0.8 of a cell
+# sums to 0.7999999999999998, and was refused by a threshold of 0.8 that it meets.
+KNOWN_WEIGHT_ROUNDING = 1e-6
+
+
+@njit(cache=True)
+def falls_short(known_weight, minimum_known_weight):
+    """True when corners carrying ``known_weight`` of the interpolation weight (in [0, 1]) carry
+    less than ``minimum_known_weight`` of it, beyond rounding (``KNOWN_WEIGHT_ROUNDING``): the
+    one test of the spec's ``known_weight`` in the DP, the lookahead runtime and the
+    controller's cost-to-go."""
+    return known_weight < minimum_known_weight - KNOWN_WEIGHT_ROUNDING
 
 
 @njit(cache=True)

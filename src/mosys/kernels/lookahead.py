@@ -38,6 +38,7 @@ from mosys.kernels.integrate import (
 )
 from mosys.kernels.interpolate import (
     clamp_to_domain,
+    falls_short,
     grid_strides,
     interpolate_with,
     interpolation_scratch,
@@ -174,7 +175,7 @@ def _cost_to_go(
     known_weight = interpolate_with(
         axis_min, axis_step, axis_count, wrap, strides, value, known, clamped, scratch, out
     )
-    if known_weight < minimum_known_weight:
+    if falls_short(known_weight, minimum_known_weight):
         return np.inf
     steps_outside = 0.0
     for k in range(exit_state.shape[0]):
@@ -474,7 +475,11 @@ def _learn(
         axis_min, axis_step, axis_count, wrap, strides, value, known, clamped, scratch, out
     )
     shortfall = cost - out[0]
-    if known_weight < minimum_known_weight or known_weight == 0.0 or not 0.0 < shortfall < np.inf:
+    if (
+        falls_short(known_weight, minimum_known_weight)
+        or known_weight == 0.0
+        or not 0.0 < shortfall < np.inf
+    ):
         return
     # the corners of ``clamped`` and their weights, as interpolate_with left them in scratch
     corner_index, corner_weight = scratch[2], scratch[3]

@@ -18,7 +18,7 @@ import numpy as np
 
 from mosys.errors import NonFiniteStateError
 from mosys.io.controller_table import ControllerTable, read_controller_table
-from mosys.kernels.interpolate import clamp_to_domain, interpolate_into
+from mosys.kernels.interpolate import clamp_to_domain, falls_short, interpolate_into
 from mosys.kernels.simulate import simulate_controlled
 from mosys.kernels.soundness import steps_before_blow_up, unsoundness
 from mosys.ssc.grid import FigureGrid, control_scale, figure_grid, figure_state_names, state_unit
@@ -135,7 +135,8 @@ class Controller:
         """The table's cost-to-go (s) at a controller state (d,) in spec units, interpolated as
         the lookahead runtime does: over the corners whose value is known (a dead end's at the
         DP's bound ``dp.DEAD_END_BOUND``), inf where those carry less than the table's
-        ``minimum_known_weight`` (0 when absent) of the weight; beyond the axes, at the nearest
+        ``minimum_known_weight`` (0 when absent) of the weight (up to rounding,
+        ``interpolate.falls_short``); beyond the axes, at the nearest
         covered state."""
         grid = self.grid
         clamped, _ = self._clamped(state)
@@ -152,7 +153,8 @@ class Controller:
             out,
         )
         minimum = float(self.table.attrs.get("minimum_known_weight", 0.0))
-        return float(out[0]) if known_weight > 0.0 and known_weight >= minimum else math.inf
+        enough = known_weight > 0.0 and not falls_short(known_weight, minimum)
+        return float(out[0]) if enough else math.inf
 
     def domain_violation(self, figure_state: np.ndarray) -> str | None:
         """Why the model state ``figure_state`` (S,) SI lies outside this controller's domain
