@@ -786,9 +786,8 @@ def discard_poorly_known_exits(
     once, for nodes with shapes of their own, ``shape_of``; as they are read for shared shapes,
     ``known_value``); an exit whose reachable corners carry less than ``minimum_known_weight``
     of its weight (in (0, 1]; up to rounding, ``interpolate.falls_short``), or none, gets cost
-    inf here. Afterwards every finite transition
-    rests on reachable nodes. The exit tables as ``gauss_seidel_sweep`` takes them; reachable:
-    (N,) bool."""
+    inf here. Afterwards every finite transition rests on reachable nodes. The exit tables as
+    ``gauss_seidel_sweep`` takes them; reachable: (N,) bool."""
     for node in range(row_of.shape[0]):
         row = row_of[node]
         if row < 0:

@@ -20,7 +20,7 @@ WRAP_LIMIT = 2.0**52
 KNOWN_WEIGHT_ROUNDING = 1e-6
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")  # inside the DP's loop over every exit
 def falls_short(known_weight, minimum_known_weight):
     """True when corners carrying ``known_weight`` of the interpolation weight (in [0, 1]) carry
     less than ``minimum_known_weight`` of it, beyond rounding (``KNOWN_WEIGHT_ROUNDING``): the
