@@ -136,8 +136,7 @@ class Controller:
         the lookahead runtime does: over the corners whose value is known (a dead end's at the
         DP's bound ``dp.DEAD_END_BOUND``), inf where those carry less than the table's
         ``minimum_known_weight`` (0 when absent) of the weight (up to rounding,
-        ``interpolate.falls_short``); beyond the axes, at the nearest
-        covered state."""
+        ``interpolate.falls_short``); beyond the axes, at the nearest covered state."""
         grid = self.grid
         clamped, _ = self._clamped(state)
         known_values, known = self._known_values
