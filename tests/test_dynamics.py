@@ -92,6 +92,43 @@ def test_header_and_imports() -> None:
     assert generate_source(spec) == text  # deterministic
 
 
+def trig_calls(text: str, function: str) -> list[str]:
+    """The ``math.sin``/``math.cos`` calls in the generated ``function``, as source."""
+    tree = ast.parse(text)
+    body = next(n for n in tree.body if isinstance(n, ast.FunctionDef) and n.name == function)
+    return [
+        ast.unparse(node)
+        for node in ast.walk(body)
+        if isinstance(node, ast.Call)
+        and isinstance(node.func, ast.Attribute)
+        and node.func.attr in ("sin", "cos")
+    ]
+
+
+@pytest.mark.parametrize(
+    ("figure", "expected"),
+    [
+        ("double_pendulum", ["math.sin(q_0)", "math.cos(q_0)", "math.sin(q_1)", "math.cos(q_1)"]),
+        (
+            "luxo_grounded",
+            [
+                "math.sin(q_1)",
+                "math.cos(q_1)",
+                "math.sin(offset_lower + q_0)",
+                "math.cos(offset_lower + q_0)",
+            ],
+        ),
+    ],
+)
+def test_a_sum_of_angles_takes_its_sine_and_cosine_from_its_parts(
+    figure: str, expected: list[str]
+) -> None:
+    """The outer rod's absolute angle is the sum of the joints' (plus a constant): its sine and
+    cosine come from the angle-sum formulas, not two more calls (the textbook test above checks
+    the values)."""
+    assert trig_calls(generate_source(FIGURES / f"{figure}.fig"), "_qdd_fill") == expected
+
+
 def test_link1_constants(built: dict[str, ModuleType]) -> None:
     link = built["link1"]
     assert link.Q_NAMES == ("angle",) and link.QD_NAMES == ("omega",)

@@ -57,6 +57,7 @@ class _Body:
         self.lines: list[str] = []
         self.used: set[sp.Symbol] = set()
         self.zero: set[str] = set()  # names whose value is exactly 0
+        self.trig_count = 0  # sinK, cosK names made by _share_trig
 
     def compute(self, outputs: Sequence[tuple[str, sp.Expr]]) -> None:
         """Assign each (name, expr), sharing common subexpressions (temporaries t0, t1...)."""
@@ -66,6 +67,7 @@ class _Body:
         exprs = [sp.sympify(expr) for _, expr in outputs]
         for expr in exprs:
             self.used |= expr.free_symbols
+        exprs = self._share_trig(exprs)
         temporaries, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("t"))
         for symbol, expr in temporaries:
             self.lines.append(f"{symbol} = {_code(expr)}")
@@ -74,6 +76,78 @@ class _Body:
                 self.zero.add(name)  # not assigned: users go through ref()
             else:
                 self.lines.append(f"{name} = {_code(expr)}")
+
+    def _share_trig(self, exprs: list[sp.Expr]) -> list[sp.Expr]:
+        """``exprs`` with the sine and cosine of each angle that depends on the coordinates
+        replaced by names (``sinK``, ``cosK``) assigned first, as lines of this body. An angle
+        that differs from a smaller one by a constant, or by an angle whose sine and cosine are
+        needed anyway, gets them from those by the angle-sum formulas rather than by two more
+        calls: a chain's absolute rod angles are sums of its joint angles (the grounded Luxo's
+        equations: 4 calls where they made 6, about 30 % of their time)."""
+        coordinates = set(self.model.q)
+
+        def depth(angle: sp.Expr) -> tuple:
+            return (
+                len(angle.free_symbols & coordinates),
+                sp.count_ops(angle),
+                sp.default_sort_key(angle),
+            )
+
+        angles = sorted(
+            {
+                f.args[0]
+                for expr in exprs
+                for f in expr.atoms(sp.sin, sp.cos)
+                if f.args[0].free_symbols & coordinates
+            },
+            key=depth,
+        )
+        pairs: dict[sp.Expr, tuple[sp.Symbol, sp.Symbol]] = {}
+        definitions: dict[sp.Symbol, sp.Expr] = {}
+
+        def sine_cosine(angle: sp.Expr) -> tuple[sp.Expr, sp.Expr] | None:
+            """(sin, cos) of ``angle`` without a call, or None."""
+            if not angle.free_symbols & coordinates:
+                return sp.sin(angle), sp.cos(angle)  # constants: numba folds them
+            if angle in pairs:
+                return pairs[angle]
+            if -angle in pairs:
+                sine, cosine = pairs[-angle]
+                return -sine, cosine
+            return None
+
+        for angle in angles:
+            sine, cosine = (sp.Symbol(f"{f}{self.trig_count}") for f in ("sin", "cos"))
+            self.trig_count += 1
+            definitions[sine], definitions[cosine] = sp.sin(angle), sp.cos(angle)
+            for smaller, (sine_b, cosine_b) in pairs.items():
+                rest = sine_cosine(sp.expand(angle - smaller))
+                if rest is not None:
+                    sine_r, cosine_r = rest
+                    definitions[sine] = sine_b * cosine_r + cosine_b * sine_r
+                    definitions[cosine] = cosine_b * cosine_r - sine_b * sine_r
+                    break
+            pairs[angle] = (sine, cosine)
+        replaced = [
+            expr.xreplace(
+                {
+                    f: pairs[f.args[0]][f.func is sp.cos]
+                    for f in expr.atoms(sp.sin, sp.cos)
+                    if f.args[0] in pairs
+                }
+            )
+            for expr in exprs
+        ]
+        needed = set().union(*(expr.free_symbols for expr in replaced))
+        for name in reversed(definitions):  # a definition uses only earlier ones
+            if name in needed:
+                needed |= definitions[name].free_symbols
+        self.lines.extend(
+            f"{name} = {_code(definition)}"
+            for name, definition in definitions.items()
+            if name in needed
+        )
+        return replaced
 
     def ref(self, name: str) -> str:
         """``name``, or ``0.0`` if ``compute`` found it to be exactly 0 (and left it out)."""
