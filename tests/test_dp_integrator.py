@@ -70,6 +70,54 @@ def test_each_sweep_order_visits_every_node_once_in_its_directions(counts):
         assert np.array_equal(order, flipped.ravel())
 
 
+def test_a_segment_too_stiff_to_follow_stops_trying(tmp_path):
+    """Luxo pressing into a joint limit or the ground shakes at the integrator's stability limit
+    and never leaves its cell: such a segment gives up after the steps a tenth of ``dt`` would
+    take for MAX_SEGMENT_SECONDS (400 at 50 ms; before, 25 of Luxo's segments took 500 to
+    22,087 steps each to be discarded at 2 s), discarded (cost inf); none that leaves its cell
+    comes near that."""
+    from mosys.dynamics.compile import compile_figure
+    from mosys.dynamics.load import load_dynamics
+    from mosys.kernels.dp import (
+        MAX_SEGMENT_SECONDS,
+        STIFF_STEP_FRACTION,
+        exit_transitions_template,
+    )
+    from mosys.kernels.specialise import specialise
+    from mosys.ssc.generate import Transitions, build_problem, exit_transition_arguments
+
+    compile_figure(SPECS / "figures" / "luxo_grounded.fig", tmp_path / "luxo_grounded.py")
+    dynamics = load_dynamics(tmp_path / "luxo_grounded.py")
+    spec = parse_controller_spec(SPECS / "controllers" / "luxo" / "land.ssc")
+    problem = build_problem(spec, dynamics)
+    before, obstacles, arrival = exit_transition_arguments(problem, dynamics, spec.dt)
+    transitions = Transitions.empty(
+        problem.node_valid, problem.control_samples.shape[0], len(problem.grid.names)
+    )
+    count = np.zeros(transitions.segment_cost.shape, dtype=np.int64)
+    size = problem.base_state.shape[0]
+    specialise(exit_transitions_template, dynamics, parallel=True)(
+        *before,
+        np.flatnonzero(transitions.row_of >= 0),
+        transitions.row_of,
+        *obstacles,
+        *arrival,
+        *transitions.outputs(),
+        True,  # recording: count each segment's accepted steps (record_count - 1)
+        np.zeros_like(count),
+        count,
+        np.zeros((0, size + 1)),
+        np.zeros(size, dtype=np.bool_),
+    )
+    steps = count - 1
+    cap = MAX_SEGMENT_SECONDS / (STIFF_STEP_FRACTION * spec.dt)
+    assert cap == pytest.approx(400)
+    assert steps.max() <= cap
+    assert np.all(np.isinf(transitions.segment_cost[steps > cap / 2]))
+    assert (steps > cap / 2).sum() >= 10  # the stiff ones are there, and stopped
+    assert steps[np.isfinite(transitions.segment_cost)].max() < cap / 2
+
+
 @pytest.fixture(scope="module")
 def figure_12_tables(link1, tmp_path_factory):
     """Controller A (the Figure 12 grid) as shipped, and with a step cap 500 times shorter."""

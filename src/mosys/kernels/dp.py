@@ -86,6 +86,8 @@ CELL_FRACTION = 1.0  # an integration step moves no controller coordinate furthe
 STEP_TOLERANCE = 1e-3  # the integrator's error per step on each controller axis, in grid steps
 MIN_STEP = 1e-7  # s: a segment that needs shorter steps than this is discarded
 MAX_SEGMENT_SECONDS = 2.0  # a segment still in its cell after this long is discarded
+STIFF_STEP_FRACTION = 0.1  # a segment whose steps (tried) average under this fraction of the
+# longest step over MAX_SEGMENT_SECONDS is too stiff to follow and is discarded
 # Dormand–Prince 5(4) (Hairer, Nørsett and Wanner, Solving ODEs I, Table 5.2): the stages'
 # weights (stage i's state from k1..k_(i-1)); the last stage is the fifth-order solution B, so k7
 # is the derivative at the step's end; E = B minus the fourth-order weights (the error estimate)
@@ -258,10 +260,12 @@ def exit_transitions_template(
     control_samples: (U, m) sampled controls; control_slot: (m,) int64 entry of the model's
     inputs (input_size of them) each control drives; effort_weight: (m,) K of the cost
     t + Σ K|u| t. max_step: the longest integration step, s. A segment still in its cell after
-    ``MAX_SEGMENT_SECONDS``, or whose step error is not finite (too stiff to follow), is
-    discarded (cost inf); one whose accepted step's state is not sound
-    (``soundness.state_is_sound``: NaN, inf or beyond 1e150) has cost nan, for the caller to
-    report.
+    ``MAX_SEGMENT_SECONDS``, or whose step error is not finite, or that has tried as many
+    steps as ``STIFF_STEP_FRACTION`` of ``max_step`` would take for all of that time (too
+    stiff to follow: resting against a joint limit or the ground, shaking at the integrator's
+    stability limit until it is discarded anyway), is discarded (cost inf); one whose accepted
+    step's state is not sound (``soundness.state_is_sound``: NaN, inf or beyond 1e150) has cost
+    nan, for the caller to report.
     nodes: (P,) int64 flat node indices to process, each with a row (``row_of``: (N,) int64,
     the row of each node in the outputs, -1 for a removed node, which has none).
     pose_slot, outline, obstacle_vertices, obstacle_start, domain: the obstacles, as
@@ -293,6 +297,7 @@ def exit_transitions_template(
     n_controls = control_samples.shape[0]
     strides = np.empty(d, np.int64)
     grid_strides(axis_count, strides)
+    max_steps = np.ceil(MAX_SEGMENT_SECONDS / (STIFF_STEP_FRACTION * max_step))
     for p in prange(nodes.shape[0]):
         node = nodes[p]
         row = row_of[node]
@@ -336,7 +341,9 @@ def exit_transitions_template(
             model_derivative(state, inputs, k1)
             elapsed = 0.0
             h = max_step
-            while elapsed < MAX_SEGMENT_SECONDS:
+            tried = 0
+            while elapsed < MAX_SEGMENT_SECONDS and tried < max_steps:
+                tried += 1
                 for k in range(d):
                     speed = abs(k1[state_slot[k]])
                     if speed * h > CELL_FRACTION * axis_step[k]:
