@@ -88,16 +88,15 @@ MIN_STEP = 1e-7  # s: a segment that needs shorter steps than this is discarded
 MAX_SEGMENT_SECONDS = 2.0  # a segment still in its cell after this long is discarded
 STIFF_STEP_FRACTION = 0.1  # a segment whose steps (tried) average under this fraction of the
 # longest step over MAX_SEGMENT_SECONDS is too stiff to follow and is discarded
-# Dormand–Prince 5(4) (Hairer, Nørsett and Wanner, Solving ODEs I, Table 5.2): the stages'
-# weights (stage i's state from k1..k_(i-1)); the last stage is the fifth-order solution B, so k7
-# is the derivative at the step's end; E = B minus the fourth-order weights (the error estimate)
-A21 = 1 / 5
-A31, A32 = 3 / 40, 9 / 40
-A41, A42, A43 = 44 / 45, -56 / 15, 32 / 9
-A51, A52, A53, A54 = 19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729
-A61, A62, A63, A64, A65 = 9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656
-B1, B3, B4, B5, B6 = 35 / 384, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84
-E1, E3, E4, E5, E6, E7 = 71 / 57600, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40
+# Bogacki–Shampine 3(2) (Bogacki and Shampine 1989, "A 3(2) pair of Runge–Kutta formulas",
+# Appl. Math. Lett. 2(4)): stage 2 at y + h A21 k1, stage 3 at y + h A32 k2; the third-order
+# solution B; k4, the derivative there, serves as the next step's k1 (first same as last); E = B
+# minus the second-order weights (the error estimate, E4 on k4); the step grows or shrinks with
+# the error to the power ERROR_EXPONENT = -1/(2 + 1).
+A21, A32 = 1 / 2, 3 / 4
+B1, B2, B3 = 2 / 9, 1 / 3, 4 / 9
+E1, E2, E3, E4 = -5 / 72, 1 / 12, 1 / 9, -1 / 8
+ERROR_EXPONENT = -1 / 3
 
 
 @njit(cache=True)
@@ -248,12 +247,13 @@ def exit_transitions_template(
     """Simulate every (node, control sample) pair until it leaves the node's cell; a template
     (``specialise.specialise``, with the model's ``derivative_into`` as ``model_derivative``).
 
-    The integrator is Dormand–Prince 5(4) with a step sized to the cell: at most ``max_step``
-    seconds, short enough that no controller coordinate moves further than ``CELL_FRACTION`` of
-    its grid step at the rate it has at the step's start, and shortened (the step repeated)
-    where its error on some controller coordinate exceeds ``STEP_TOLERANCE`` grid steps. Where
-    the state leaves the cell within a step, the crossing is found on the step's cubic Hermite
-    (the states and rates at both ends), not on the chord between them.
+    The integrator is Bogacki–Shampine 3(2) (three evaluations of the model a step) with a step
+    sized to the cell: at most ``max_step`` seconds, short enough that no controller coordinate
+    moves further than ``CELL_FRACTION`` of its grid step at the rate it has at the step's
+    start, and shortened (the step repeated) where its error on some controller coordinate
+    exceeds ``STEP_TOLERANCE`` grid steps. Where the state leaves the cell within a step, the
+    crossing is found on the step's cubic Hermite (the states and rates at both ends: the
+    method's own third-order dense output), not on the chord between them.
 
     axis_*: (d,) the controller grid, SI; state_slot: (d,) int64 index of each controller axis in
     the model's state (length S); base_state: (S,) values of the uncovered slots.
@@ -303,14 +303,11 @@ def exit_transitions_template(
         row = row_of[node]
         center = np.empty(d)
         exit_state = np.empty(d)
-        stages = np.empty((7, size))  # Dormand–Prince's k1..k7, k7 at the step's end
+        stages = np.empty((4, size))  # Bogacki–Shampine's k1..k4, k4 at the step's end
         k1 = stages[0]
         k2 = stages[1]
         k3 = stages[2]
         k4 = stages[3]
-        k5 = stages[4]
-        k6 = stages[5]
-        k7 = stages[6]
         start = np.empty(size)
         state = np.empty(size)
         after = np.empty(size)
@@ -352,43 +349,21 @@ def exit_transitions_template(
                     after[i] = state[i] + h * (A21 * k1[i])
                 model_derivative(after, inputs, k2)
                 for i in range(size):
-                    after[i] = state[i] + h * (A31 * k1[i] + A32 * k2[i])
+                    after[i] = state[i] + h * (A32 * k2[i])
                 model_derivative(after, inputs, k3)
                 for i in range(size):
-                    after[i] = state[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
+                    after[i] = state[i] + h * (B1 * k1[i] + B2 * k2[i] + B3 * k3[i])
                 model_derivative(after, inputs, k4)
-                for i in range(size):
-                    after[i] = state[i] + h * (
-                        A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i]
-                    )
-                model_derivative(after, inputs, k5)
-                for i in range(size):
-                    after[i] = state[i] + h * (
-                        A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]
-                    )
-                model_derivative(after, inputs, k6)
-                for i in range(size):
-                    after[i] = state[i] + h * (
-                        B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i]
-                    )
-                model_derivative(after, inputs, k7)
                 # the error of the step, in units of the tolerance on each controller axis
                 error = 0.0
                 for k in range(d):
                     slot = state_slot[k]
-                    estimate = h * (
-                        E1 * k1[slot]
-                        + E3 * k3[slot]
-                        + E4 * k4[slot]
-                        + E5 * k5[slot]
-                        + E6 * k6[slot]
-                        + E7 * k7[slot]
-                    )
+                    estimate = h * (E1 * k1[slot] + E2 * k2[slot] + E3 * k3[slot] + E4 * k4[slot])
                     error = max(error, abs(estimate) / (STEP_TOLERANCE * axis_step[k]))
                 if not np.isfinite(error):
                     break  # too stiff to follow at this step: cost stays inf
                 if error > 1.0:
-                    h *= max(0.2, 0.9 * error**-0.2)
+                    h *= max(0.2, 0.9 * error**ERROR_EXPONENT)
                     if h < MIN_STEP:
                         break  # too stiff to follow: cost stays inf
                     continue
@@ -415,7 +390,7 @@ def exit_transitions_template(
                         state[slot],
                         after[slot],
                         h * k1[slot],
-                        h * k7[slot],
+                        h * k4[slot],
                         center[k] - axis_step[k],
                         center[k] + axis_step[k],
                     )
@@ -444,8 +419,8 @@ def exit_transitions_template(
                     elapsed += h
                     for i in range(size):
                         state[i] = after[i]
-                        k1[i] = k7[i]
-                    h = min(max_step, h * min(5.0, 0.9 * max(error, 1e-10) ** -0.2))
+                        k1[i] = k4[i]
+                    h = min(max_step, h * min(5.0, 0.9 * max(error, 1e-10) ** ERROR_EXPONENT))
                     continue
                 for k in range(d):
                     slot = state_slot[k]
@@ -453,7 +428,7 @@ def exit_transitions_template(
                         state[slot],
                         after[slot],
                         h * k1[slot],
-                        h * k7[slot],
+                        h * k4[slot],
                         crossing,
                     )
                 if exit_state[axis] > center[axis]:
