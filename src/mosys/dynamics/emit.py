@@ -20,11 +20,12 @@ from mosys.dynamics.derive import Equations
 from mosys.parsing.figure import ContactPoint, Figure
 
 INDENT = "    "
-# The equations and the contact helpers are inlined (numba's IR inlining) into their callers,
+# The equations (``_qdd_fill``) are inlined (numba's IR inlining) into their callers,
 # derivative_into among them, which LLVM then inlines into the DP's kernel specialised to the
-# model (``kernels.specialise``): the grounded Luxo's exit transitions took a fifth less time.
-# (derivative_into itself inlined by numba too: a little faster still, but the kernel then
-# took about three times as long to compile cold.)
+# model (``kernels.specialise``): the grounded Luxo's exit transitions took a fifth less time,
+# and loading a model cold no longer (4.4 s against 4.2 s for the full Luxo). Inlining more
+# cost more than it gave: the contact helpers too (called once per contact point) took that
+# load to 11.6 s; derivative_into too, the DP's kernel from 28 s to 87 s to compile cold.
 INLINED = 'inline="always"'
 _PRINTER = PythonCodePrinter({"fully_qualified_modules": True, "standard": "python3"})
 
@@ -344,7 +345,7 @@ def _terrain_helpers(figure: Figure) -> str:
 _TERRAIN_Y = np.array([{ys}])
 
 
-@njit(cache=True, {INLINED})
+@njit(cache=True)
 def _ground_penetration(px, py):
     """How deep (m) the point (px, py) lies inside the ground (solid below the terrain polyline,
     between its first and last x), and the unit normal (nx, ny) from it towards the nearest
@@ -385,7 +386,7 @@ def _ground_penetration(px, py):
     return depth, (nearest_x - px) / depth, (nearest_y - py) / depth
 
 
-@njit(cache=True, {INLINED})
+@njit(cache=True)
 def _contact_force(px, py, vx, vy, stiffness, damping, friction, slip):
     """The ground's force (fx, fy), N, on a contact point at (px, py) moving at (vx, vy):
     normal = stiffness * depth - damping * (normal speed), never pulling; friction opposes the
