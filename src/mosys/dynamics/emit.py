@@ -23,9 +23,10 @@ INDENT = "    "
 # The equations (``_qdd_fill``) are inlined (numba's IR inlining) into their callers,
 # derivative_into among them, which LLVM then inlines into the DP's kernel specialised to the
 # model (``kernels.specialise``): the grounded Luxo's exit transitions took a fifth less time,
-# and loading a model cold no longer (4.4 s against 4.2 s for the full Luxo). Inlining more
-# cost more than it gave: the contact helpers too (called once per contact point) took that
-# load to 11.6 s; derivative_into too, the DP's kernel from 28 s to 87 s to compile cold.
+# and a model's cold load about as long as before (4.4 s against 4.2 s, the full Luxo).
+# Inlining more cost more than it gave: the contact helpers too (called once per contact
+# point) took that load to 11.6 s; derivative_into too, the DP's kernel from 28 s to 87 s to
+# compile cold.
 INLINED = 'inline="always"'
 _PRINTER = PythonCodePrinter({"fully_qualified_modules": True, "standard": "python3"})
 
@@ -138,7 +139,7 @@ class _Body:
         replaced = [
             expr.xreplace(
                 {
-                    f: pairs[f.args[0]][f.func is sp.cos]
+                    f: pairs[f.args[0]][1 if f.func is sp.cos else 0]
                     for f in expr.atoms(sp.sin, sp.cos)
                     if f.args[0] in pairs
                 }
