@@ -549,9 +549,9 @@ def dealt(nodes: np.ndarray) -> np.ndarray:
     """``nodes`` (M,) int64 dealt to numba's threads like cards, for a ``prange`` over them: its
     static schedule gives each of T threads one contiguous share, which now holds every T-th node
     and so a sample of the whole grid rather than one region of it (a node's segments cost more
-    in some regions than others: Luxo's exit transitions took 1.5-1.9 s on two threads in grid
-    order, 1.22-1.46 s dealt). The order of the nodes changes nothing else: each node's
-    transitions are computed on their own and written to its own row."""
+    in some regions than others: Luxo's exit transitions took a median of 1.77 s on two threads
+    in grid order, 1.44 s dealt, 12 runs each). The order of the nodes changes nothing else: each
+    node's transitions are computed on their own and written to its own row."""
     threads = get_num_threads()
     return np.concatenate([nodes[t::threads] for t in range(threads)])
 
