@@ -54,6 +54,22 @@ def test_initial_rules_follow_table_2():
     assert 0.4 < below < 0.6
 
 
+@pytest.mark.parametrize("kind", ["sense", "time"])
+@pytest.mark.parametrize("seed", [0, 1, 12345])
+def test_the_first_rules_drawn_at_once_are_those_drawn_rule_by_rule(kind, seed):
+    """``draw_first_rules`` draws every number in one call; the rules are bit for bit those of
+    ``draw_rule`` called rule after rule from the same generator (a seed's search is unchanged)."""
+    text = SPEC.replace("controller sense rules=6", f"controller {kind} rules=6")
+    at_once = _Population(setup(text), np.random.default_rng(seed))
+    by_rule = _Population(setup(text), np.random.default_rng(0))
+    rng = np.random.default_rng(seed)
+    for k in range(by_rule.tau.shape[0]):
+        for i in range(by_rule.tau.shape[1]):
+            by_rule.draw_rule(k, i, rng, None)
+    for name in ("target", "tau", "center", "side", "segment"):
+        assert np.array_equal(getattr(at_once, name), getattr(by_rule, name)), name
+
+
 def test_a_reinitialised_rule_fires_at_a_corner_on_the_sense_trajectory():
     population = _Population(setup(), np.random.default_rng(1))
     senses = np.random.default_rng(2).uniform(0, 1, (201, len(STARMAN.sense_names)))

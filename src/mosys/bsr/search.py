@@ -283,11 +283,36 @@ class _Population:
         self.center = np.empty((c, r, v))
         self.side = np.empty((c, r, v))
         self.segment = np.ones((c, r))
-        for k in range(c):
-            for i in range(r):
-                self.draw_rule(k, i, rng, None)
+        self.draw_first_rules(rng)
         self.fitness = np.full(c, -np.inf)
         self.senses = np.zeros((c, spec.steps + 1, len(figure.sense_names)))
+
+    def draw_first_rules(self, rng: np.random.Generator) -> None:
+        """Every rule of every controller as ``draw_rule`` without senses draws them, rule after
+        rule, bit for bit, but from one call for all their uniform numbers (a draw is
+        ``low + (high - low) * next_double``, in order), not from five calls a rule: a search
+        with 10,000 rules a controller spent seconds here."""
+        figure = self.setup.figure
+        low, high = self.setup.tau_range
+        c, r, j = self.target.shape
+        v = self.center.shape[2]
+        draws = rng.random((c, r, j + 1 + (2 * v if v else 1)))
+        span = figure.joint_max - figure.joint_min
+        self.target[...] = figure.joint_min + span * draws[:, :, :j]
+        log_low, log_high = math.log(low), math.log(high)
+        self.tau[...] = np.array(
+            [math.exp(log_low + (log_high - log_low) * u) for u in draws[:, :, j].ravel()]
+        ).reshape(c, r)
+        if v:
+            side_low, side_high = math.log(SIDE_MIN), math.log(SIDE_MAX)
+            self.side[...] = np.exp(
+                side_low + (side_high - side_low) * draws[:, :, j + 1 : j + 1 + v]
+            )
+            self.center[...] = CENTER_MIN + (CENTER_MAX - CENTER_MIN) * draws[:, :, j + 1 + v :]
+        else:
+            self.segment[...] = (
+                SEGMENT_WEIGHT_MIN + (SEGMENT_WEIGHT_MAX - SEGMENT_WEIGHT_MIN) * draws[:, :, j + 1]
+            )
 
     def draw_rule(self, k: int, i: int, rng: np.random.Generator, senses: np.ndarray | None):
         """Rule i of controller k from Table 2; with senses (steps + 1, V), its
