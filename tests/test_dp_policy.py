@@ -20,14 +20,15 @@ from mosys.kernels.dp import (
 
 
 def compact_policy_tables(arrays):
-    """``dp.gather_policy``'s tables for a compact copy of one exit per node."""
+    """``dp.gather_policy``'s tables, nothing gathered yet."""
     rows, _, corners = arrays[0].shape
     return (
-        np.zeros((rows, 1, corners), dtype=np.int32),
-        np.zeros((rows, 1, corners), dtype=np.float32),
-        np.zeros(rows, dtype=np.int64),
-        np.empty((rows, 1)),
-        np.zeros((rows, 1), dtype=np.bool_),
+        np.zeros((rows, corners), dtype=np.int32),
+        np.zeros((rows, corners), dtype=np.float32),
+        np.zeros(rows, dtype=np.int32),
+        np.empty(rows),
+        np.empty(rows),
+        np.full(rows, -1, dtype=np.int64),
     )
 
 
@@ -38,13 +39,11 @@ def solve(
     policy_sweeps,
     bound=1e4,
     count=100_000,
-    policy=None,
     blocks=None,
 ):
     """Value iteration from ``bound`` as ``ssc.generate.value_iteration`` runs it: (values,
-    Bellman sweeps, policy sweeps). policy: ``dp.gather_policy``'s tables (default: compact);
-    blocks: ``dp.blocked_gauss_seidel_sweep``'s, each sweep's snapshot a full copy (default:
-    one block, the plain sweeps)."""
+    Bellman sweeps, policy sweeps). blocks: ``dp.blocked_gauss_seidel_sweep``'s, each sweep's
+    snapshot a full copy (default: one block, the plain sweeps)."""
     arrays, is_destination = tables
     row_of = arrays[4]
     value = np.where(is_destination, 0.0, np.where(row_of >= 0, bound, np.inf))
@@ -64,7 +63,7 @@ def solve(
         np.inf,
         False,
         np.zeros(value.size, dtype=np.int64),
-        *(compact_policy_tables(arrays) if policy is None else policy),
+        *compact_policy_tables(arrays),
         policy_sweeps,
     )
     return value, bellman, policy
@@ -80,7 +79,6 @@ def test_a_policy_sweep_is_a_bellman_sweep_over_each_nodes_own_control(axis_coun
     value = np.where(is_destination, 0.0, np.where(row_of >= 0, 1e4, np.inf))
     order = np.empty(nodes, dtype=np.int64)
     control = np.zeros(nodes, dtype=np.int64)
-    rows = exit_index.shape[0]
     policy = compact_policy_tables(arrays)
     for sweep in range(2**counts.size + 3):
         sweep_order(counts, sweep, order)
@@ -97,18 +95,26 @@ def test_a_policy_sweep_is_a_bellman_sweep_over_each_nodes_own_control(axis_coun
         exit_value = np.where(to_destination[held, chosen], 0.0, exit_value)
         promised = cost[held, chosen] + exit_value
         assert np.all(promised[moved] <= value[kept][moved] * (1 + 1e-12))
-        gather_policy(*arrays, control, *policy)
+        gather_policy(*arrays, is_destination, value, control, *policy)
+        corner, weight, count, segment, known, gathered = policy
+        assert np.array_equal(gathered, chosen)  # every row gathered under its control
+        for node, row, u in zip(kept, held, chosen, strict=True):
+            used = exit_weight[row, u] != 0
+            if is_destination[node] or to_destination[row, u] or cost[row, u] == np.inf:
+                assert count[row] == 0
+            else:  # the weighted corners, in order, as node indices (own shapes: all known)
+                assert np.array_equal(corner[row, : count[row]], node + exit_index[row, u][used])
+                assert np.array_equal(weight[row, : count[row]], exit_weight[row, u][used])
+            assert segment[row] == (np.inf if is_destination[node] else cost[row, u])
+            assert known[row] == 1.0
         cut = (
             exit_index[held, chosen][:, None, :].copy(),
             exit_weight[held, chosen][:, None, :].copy(),
             cost[held, chosen][:, None].copy(),
             to_destination[held, chosen][:, None].copy(),
         )
-        assert np.array_equal(policy[2], np.arange(rows))  # compact: each row its own copy
-        for gathered, expected in zip(policy[:2] + policy[3:], cut, strict=True):
-            assert np.array_equal(gathered, expected)
         swept = value.copy()
-        largest = policy_sweep(*policy, None, row_of, is_destination, value, order, np.inf)
+        largest = policy_sweep(*policy[:5], row_of, value, order, np.inf)
         control_after = np.zeros(nodes, dtype=np.int64)
         expected_largest = gauss_seidel_sweep(
             *cut, row_of, None, is_destination, swept, order, np.inf, False, control_after
@@ -181,24 +187,16 @@ def test_policy_sweeps_take_over_the_slow_mode_of_a_returning_chain():
 
 def test_shared_exit_shapes_reach_the_fixed_point_of_each_nodes_own_copy():
     """Where the nodes of a class share their exit shapes (``replay_classes``: shape_row_of an
-    array), the exits' values are renormalised over the known corners as they are read and the
-    policy's exits point into the full shape tables (seen as one control a row) instead of
-    being copied: the same fixed point, to rounding, as each node with a copy of its own."""
+    array), the exits' values are renormalised over the known corners as they are read (and
+    gathered so for the policy sweeps): the same fixed point, to rounding, as each node with a
+    copy of its own."""
     counts = np.array((6, 5, 4), dtype=np.int64)
     (exit_index, exit_weight, cost, to_destination, row_of, _), is_destination = random_tables(
         np.random.default_rng(3), counts, 4
     )
-    corners = exit_index.shape[2]
     shared = (exit_index, exit_weight, cost, to_destination, row_of, row_of)
-    in_place = (
-        exit_index.reshape(-1, 1, corners),
-        exit_weight.reshape(-1, 1, corners),
-        *compact_policy_tables(shared)[2:],
-    )
     own, _, policy_sweeps = solve(((*shared[:5], None), is_destination), counts, 1e-9, 16)
-    value, _, shared_policy_sweeps = solve(
-        (shared, is_destination), counts, 1e-9, 16, policy=in_place
-    )
+    value, _, shared_policy_sweeps = solve((shared, is_destination), counts, 1e-9, 16)
     assert policy_sweeps > 0 and shared_policy_sweeps > 0
     finite = np.isfinite(own)
     assert np.array_equal(np.isfinite(value), finite)

@@ -1077,7 +1077,7 @@ def blocked_gauss_seidel_sweep(
     return largest.max()
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def gather_policy(
     exit_index,
     exit_weight,
@@ -1085,48 +1085,70 @@ def gather_policy(
     to_destination,
     row_of,
     shape_row_of,
+    is_destination,
+    value,
     control,
-    policy_index,
+    policy_corner,
     policy_weight,
-    policy_shape,
+    policy_count,
     policy_cost,
-    policy_to_destination,
+    policy_known,
+    gathered,
 ):
-    """The exit of each node under its control (control: (N,) int64), for ``policy_sweep`` to
-    read in order instead of picking one control's exit out of every row of the full tables:
-    policy_cost and policy_to_destination (R, 1), and policy_shape (R,) int64, the row of the
-    exit's shape in policy_index and policy_weight (S, 1, 2**(d-1)). Where each node has its
-    own shapes, the shape is copied there (S = R, one row per node: compact, in order); where
-    the nodes of a class share theirs (``replay_classes``), policy_index and policy_weight are
-    the full shape tables seen as (E·U, 1, 2**(d-1)), and policy_shape points into them
-    (``shape_of``)."""
-    for node in range(row_of.shape[0]):
+    """The exit of each node under its control (control: (N,) int64), compacted for
+    ``policy_sweep`` to read in order instead of picking one control's exit out of every row
+    of the full tables: for row R, its weighted corners that ``known_value`` reads, in its
+    order, as node indices and weights (policy_corner (R, 2**(d-1)) int32, policy_weight
+    float32, the first policy_count[R] (int32) of them), the segment's cost (policy_cost (R,),
+    inf where the node is never updated: a destination, a discarded segment, an exit none of
+    whose corners is known) and the sum that ``known_value`` divides by (policy_known (R,):
+    the known corners' weight for shared shapes, 1 for a node's own, which are renormalised
+    already; an exit to the destination has no corners). The corners with a known value
+    (finite) are those of the start: value iteration only lowers finite values. Only the rows
+    whose control differs from the one gathered before (gathered (R,) int64, -1: none yet)
+    are rewritten: after the first Bellman sweeps few controls change. A sweep over these
+    tables gives the values ``known_value`` would, bit for bit (the same sums in the same
+    order), and reads about one cache line of them a node instead of the shape tables, the
+    segment costs and the flags."""
+    for node in prange(row_of.shape[0]):
         row = row_of[node]
         if row < 0:
             continue
         u = control[node]
-        shape = shape_of(shape_row_of, row_of, node)
-        policy_cost[row, 0] = segment_cost[row, u]
-        policy_to_destination[row, 0] = to_destination[row, u]
-        if shape_row_of is None:
-            policy_shape[row] = row
+        if gathered[row] == u:
+            continue
+        gathered[row] = u
+        cost = segment_cost[row, u]
+        count = 0
+        known = 0.0
+        if is_destination[node]:
+            cost = np.inf
+        elif cost < np.inf and not to_destination[row, u]:
+            shape = shape_of(shape_row_of, row_of, node)
             for i in range(exit_index.shape[2]):
-                policy_index[row, 0, i] = exit_index[shape, u, i]
-                policy_weight[row, 0, i] = exit_weight[shape, u, i]
-        else:
-            policy_shape[row] = shape * exit_index.shape[1] + u
+                w = exit_weight[shape, u, i]
+                if w != 0.0:
+                    corner = node + exit_index[shape, u, i]
+                    if shape_row_of is None or value[corner] < np.inf:
+                        policy_corner[row, count] = corner
+                        policy_weight[row, count] = w
+                        known += w
+                        count += 1
+            if shape_row_of is not None and count == 0:
+                cost = np.inf  # 0/0: known_value's NaN, which never lowers a value
+        policy_cost[row] = cost
+        policy_count[row] = count
+        policy_known[row] = known if shape_row_of is not None and count > 0 else 1.0
 
 
 @njit(cache=True, inline="always")
 def _policy_block(
-    policy_index,
+    policy_corner,
     policy_weight,
-    policy_shape,
+    policy_count,
     policy_cost,
-    policy_to_destination,
-    shape_row_of,
+    policy_known,
     row_of,
-    is_destination,
     value,
     snapshot,
     order,
@@ -1142,24 +1164,17 @@ def _policy_block(
     for p in range(first, end):
         node = order[p]
         row = row_of[node]
-        if row < 0 or is_destination[node]:
+        if row < 0:
             continue
-        candidate = policy_cost[row, 0]
+        candidate = policy_cost[row]
         if candidate == np.inf:
             continue
-        if not policy_to_destination[row, 0]:
-            candidate += known_value(
-                policy_index,
-                policy_weight,
-                policy_shape[row],
-                0,
-                node,
-                value,
-                shape_row_of,
-                snapshot,
-                low,
-                high,
+        total = 0.0
+        for i in range(policy_count[row]):
+            total += policy_weight[row, i] * block_read(
+                value, snapshot, low, high, policy_corner[row, i]
             )
+        candidate += total / policy_known[row]
         old = value[node]
         if candidate < old:
             value[node] = candidate
@@ -1170,14 +1185,12 @@ def _policy_block(
 
 @njit(cache=True)
 def policy_sweep(
-    policy_index,
+    policy_corner,
     policy_weight,
-    policy_shape,
+    policy_count,
     policy_cost,
-    policy_to_destination,
-    shape_row_of,
+    policy_known,
     row_of,
-    is_destination,
     value,
     order,
     settled_above,
@@ -1190,14 +1203,12 @@ def policy_sweep(
     all of them. Returns the largest decrease, s (decreases to values at or above
     ``settled_above`` not counted, as in ``gauss_seidel_sweep``)."""
     return _policy_block(
-        policy_index,
+        policy_corner,
         policy_weight,
-        policy_shape,
+        policy_count,
         policy_cost,
-        policy_to_destination,
-        shape_row_of,
+        policy_known,
         row_of,
-        is_destination,
         value,
         None,
         order,
@@ -1211,14 +1222,12 @@ def policy_sweep(
 
 @njit(cache=True, parallel=True)
 def blocked_policy_sweep(
-    policy_index,
+    policy_corner,
     policy_weight,
-    policy_shape,
+    policy_count,
     policy_cost,
-    policy_to_destination,
-    shape_row_of,
+    policy_known,
     row_of,
-    is_destination,
     value,
     snapshot,
     order,
@@ -1230,14 +1239,12 @@ def blocked_policy_sweep(
     for k in prange(blocks.shape[0] - 1):
         first, end = block_positions(blocks, k, order)
         largest[k] = _policy_block(
-            policy_index,
+            policy_corner,
             policy_weight,
-            policy_shape,
+            policy_count,
             policy_cost,
-            policy_to_destination,
-            shape_row_of,
+            policy_known,
             row_of,
-            is_destination,
             value,
             snapshot,
             order,
@@ -1280,11 +1287,12 @@ def gauss_seidel_sweeps(
     settled_above,
     prefetching,
     control,
-    policy_index,
+    policy_corner,
     policy_weight,
-    policy_shape,
+    policy_count,
     policy_cost,
-    policy_to_destination,
+    policy_known,
+    gathered,
     policy_sweeps,
 ):
     """Value iteration by modified policy iteration: Bellman sweeps (``gauss_seidel_sweep``),
@@ -1298,8 +1306,9 @@ def gauss_seidel_sweeps(
     of all of them (about a tenth of a Bellman sweep's time). Every sweep takes the next of
     the orders of ``sweep_order``, counting from sweep number ``first``. The exit tables as
     ``gauss_seidel_sweep`` takes them; order: (N,) int64 and control (N,) int64 work space
-    (control: zeros before the first call, kept between calls); policy_*: ``gather_policy``'s
-    tables; settled_above, prefetching: as ``gauss_seidel_sweep``. edges None: one block, each
+    (control: zeros before the first call, kept between calls); policy_* and gathered:
+    ``gather_policy``'s tables (gathered: -1 before the first call, kept between calls as the
+    tables are); settled_above, prefetching: as ``gauss_seidel_sweep``. edges None: one block, each
     sweep ``gauss_seidel_sweep`` or ``policy_sweep`` (snapshot and blocks unread); else the
     blocked sweeps (``blocked_gauss_seidel_sweep``; snapshot, blocks as they take them), each
     from ``copy_block_edges`` (edges). Which it is, is a type: a grid swept in one block
@@ -1356,12 +1365,15 @@ def gauss_seidel_sweeps(
                 to_destination,
                 row_of,
                 shape_row_of,
+                is_destination,
+                value,
                 control,
-                policy_index,
+                policy_corner,
                 policy_weight,
-                policy_shape,
+                policy_count,
                 policy_cost,
-                policy_to_destination,
+                policy_known,
+                gathered,
             )
         for _ in range(policy_sweeps):
             sweep_order(axis_count, sweep, order)
@@ -1369,14 +1381,12 @@ def gauss_seidel_sweeps(
             policy += 1
             if edges is None:
                 change = policy_sweep(
-                    policy_index,
+                    policy_corner,
                     policy_weight,
-                    policy_shape,
+                    policy_count,
                     policy_cost,
-                    policy_to_destination,
-                    shape_row_of,
+                    policy_known,
                     row_of,
-                    is_destination,
                     value,
                     order,
                     settled_above,
@@ -1384,14 +1394,12 @@ def gauss_seidel_sweeps(
             else:
                 copy_block_edges(value, snapshot, edges)
                 change = blocked_policy_sweep(
-                    policy_index,
+                    policy_corner,
                     policy_weight,
-                    policy_shape,
+                    policy_count,
                     policy_cost,
-                    policy_to_destination,
-                    shape_row_of,
+                    policy_known,
                     row_of,
-                    is_destination,
                     value,
                     snapshot,
                     order,

@@ -713,24 +713,18 @@ def value_iteration(
 
 
 def policy_tables(transitions: Transitions) -> tuple[np.ndarray, ...]:
-    """The tables ``dp.gather_policy`` fills for the policy sweeps (policy_index, policy_weight,
-    policy_shape, policy_cost, policy_to_destination): where each node has shapes of its own,
-    a compact copy of one exit per node; where classes share theirs, the full shape tables
-    themselves, which the policy's exits point into."""
+    """The tables ``dp.gather_policy`` fills for the policy sweeps, one row per node that is
+    not removed (policy_corner, policy_weight, policy_count, policy_cost, policy_known, and
+    gathered: -1, nothing gathered yet): each row's exit under its control, compacted."""
     rows = transitions.segment_cost.shape[0]
     corners = transitions.exit_index.shape[2]
-    if transitions.shape_row_of is None:
-        index = np.zeros((rows, 1, corners), dtype=np.int32)
-        weight = np.zeros((rows, 1, corners), dtype=np.float32)
-    else:
-        index = transitions.exit_index.reshape(-1, 1, corners)
-        weight = transitions.exit_weight.reshape(-1, 1, corners)
     return (
-        index,
-        weight,
-        np.zeros(rows, dtype=np.int64),
-        np.empty((rows, 1)),
-        np.zeros((rows, 1), dtype=np.bool_),
+        np.zeros((rows, corners), dtype=np.int32),
+        np.zeros((rows, corners), dtype=np.float32),
+        np.zeros(rows, dtype=np.int32),
+        np.empty(rows),
+        np.empty(rows),
+        np.full(rows, -1, dtype=np.int64),
     )
 
 
