@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 
 from mosys.io.car_scene import CarScene
 from mosys.kernels.geometry import (
+    box_in_polygon,
     first_collision,
     pack_polygons,
     point_in_polygon,
@@ -137,9 +138,46 @@ def test_axis_aligned_boxes_overlap_exactly_when_their_intervals_do(x, y, w, h, 
 
 def test_containment_and_an_l_shaped_obstacle():
     assert polygons_overlap(box(0, 0, 10, 10), box(4, 4, 5, 5))  # one inside the other
-    ell = np.array([[0, 0], [4, 0], [4, 1], [1, 1], [1, 4], [0, 4]], dtype=float)
-    assert not polygons_overlap(ell, box(2, 2, 3, 3))  # in the notch
-    assert point_in_polygon(0.5, 3.0, ell) and not point_in_polygon(2.0, 2.0, ell)
+    assert not polygons_overlap(ELL, box(2, 2, 3, 3))  # in the notch
+    assert point_in_polygon(0.5, 3.0, ELL) and not point_in_polygon(2.0, 2.0, ELL)
+
+
+ELL = np.array([[0, 0], [4, 0], [4, 1], [1, 1], [1, 4], [0, 4]], dtype=float)
+
+
+def test_a_box_is_in_a_polygon_only_with_the_polygons_boundary_outside_it():
+    square = box(0, 0, 10, 10)
+    assert box_in_polygon(2.0, 3.0, 2.0, 3.0, square)
+    assert not box_in_polygon(9.0, 11.0, 2.0, 3.0, square)  # across an edge
+    assert not box_in_polygon(-1.0, 11.0, -1.0, 11.0, square)  # holds the polygon
+    assert not box_in_polygon(2.0, 3.0, 2.0, 3.0, ELL)  # in the notch
+    assert not box_in_polygon(0.5, 1.5, 0.5, 1.5, ELL)  # a corner inside, the notch's corner in it
+    assert box_in_polygon(0.25, 0.75, 0.25, 3.75, ELL)  # the L's upright
+    assert not box_in_polygon(0.0, 0.5, 0.25, 0.75, ELL)  # touching the edge x = 0
+    assert box_in_polygon(1.0, 0.0, 1.0, 0.0, ELL)  # empty: nothing to hold
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.floats(-1.0, 5.0),
+    st.floats(-1.0, 5.0),
+    st.floats(0.0, 4.0),
+    st.floats(0.0, 4.0),
+    st.sampled_from(["ell", "square", "triangle"]),
+)
+def test_every_point_of_a_box_in_a_polygon_is_in_it(x, y, w, h, shape):
+    """What the DP's replay relies on to skip testing each step against the domain: a box that
+    box_in_polygon passes holds no point that point_in_polygon finds outside."""
+    polygon = {
+        "ell": ELL,
+        "square": box(0, 0, 4, 4),
+        "triangle": np.array([[0, 0], [5, 0], [0, 5]], dtype=float),
+    }[shape]
+    if not box_in_polygon(x, x + w, y, y + h, polygon):
+        return
+    for px in np.linspace(x, x + w, 9):
+        for py in np.linspace(y, y + h, 9):
+            assert point_in_polygon(px, py, polygon)
 
 
 def test_first_collision_turns_the_body():

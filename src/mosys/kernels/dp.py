@@ -32,7 +32,7 @@ from numba import njit, prange
 
 from mosys.kernels.arrival import braking_seconds, braking_stop, stops_in_box
 from mosys.kernels.figure_state import load_state
-from mosys.kernels.geometry import box_is_clear, place_outline, pose_is_free
+from mosys.kernels.geometry import box_in_polygon, box_is_clear, place_outline, pose_is_free
 from mosys.kernels.interpolate import (
     corner_weights,
     falls_short,
@@ -48,6 +48,8 @@ UNKNOWN = 1.0e9  # s: cost-to-go of a reachable node whose value is not known ye
 DEAD_END_BOUND = 1.0e4  # s: that bound for a spec with known_weight, whose dead ends keep it (far
 # above any path's seconds, and low enough that values resting partly on it settle in fewer sweeps)
 DEAD_END_SECONDS = 1.0e3  # s: a cost-to-go this long rests on a dead end
+DOMAIN_ROOM = 1e-9  # m: a node whose segments' reference points stay inside the domain polygon
+# with this much room to spare on every side (``replay_classes``) is not tested step by step
 PREFETCH_AHEAD = 2  # nodes: a sweep asks the cache for the exits of the node this far ahead in
 # its order, for the segment costs of the one twice as far, and for the cost-to-go at the next
 # node's corners (``kernels.prefetch``)
@@ -534,8 +536,11 @@ def replay_classes(
     hits an obstacle or leaves the domain polygon discards the segment, one whose braking point
     lies in the arrival box ends it at the destination; and a segment whose exit lies beyond
     the axes is discarded. Obstacles are tested only where the box the class's body sweeps
-    (segment_box (C, U, 8), ``segment_boxes``), moved to the node, meets one's bounding box,
-    and the arrival box only where the box of the class's braking points does. Outputs
+    (segment_box (C, U, 12), ``segment_boxes``), moved to the node, meets one's bounding box,
+    and the arrival box only where the box of the class's braking points does; the domain only
+    at nodes where the box of all the class's reference points, moved there and widened by
+    ``DOMAIN_ROOM``, is not inside it (``geometry.box_in_polygon``), and a segment that then
+    has nothing to test is not stepped through at all. Outputs
     segment_cost and to_destination (R, U); the exit's shape (its corners as offsets and their
     weights) is the class's."""
     d = axis_min.shape[0]
@@ -557,6 +562,25 @@ def replay_classes(
         for i in range(size):
             if not relative_slot[i]:
                 shift[i] = 0.0
+        step_domain = domain  # the domain each step's reference point is tested against
+        if pose_slot[0] >= 0 and domain.shape[0] > 0:
+            low_x = low_y = np.inf
+            high_x = high_y = -np.inf
+            for u in range(control_samples.shape[0]):
+                low_x = min(low_x, segment_box[segment_class, u, 8])
+                high_x = max(high_x, segment_box[segment_class, u, 9])
+                low_y = min(low_y, segment_box[segment_class, u, 10])
+                high_y = max(high_y, segment_box[segment_class, u, 11])
+            x = shift[pose_slot[0]]
+            y = shift[pose_slot[1]]
+            if box_in_polygon(
+                low_x + x - DOMAIN_ROOM,
+                high_x + x + DOMAIN_ROOM,
+                low_y + y - DOMAIN_ROOM,
+                high_y + y + DOMAIN_ROOM,
+                domain,
+            ):
+                step_domain = domain[:0]  # every step inside: none to test
         for u in range(control_samples.shape[0]):
             cost = class_cost[segment_class, u]
             to_destination[row, u] = False
@@ -587,13 +611,15 @@ def replay_classes(
                 )
             if not cost < np.inf and not arriving:
                 continue  # discarded, and never stops in the arrival box either
+            if obstacles.shape[0] <= 1 and step_domain.shape[0] == 0 and not arriving:
+                steps = 0  # no step can hit, leave or arrive: straight to the exit's test
             elapsed = 0.0
             for j in range(1, steps + 1):
                 for i in range(size):
                     after[i] = record[first + j, i] + shift[i]
                 elapsed += record[first + j, size]
                 if not pose_is_free(
-                    after, pose_slot, outline, obstacle_vertices, obstacles, domain, body
+                    after, pose_slot, outline, obstacle_vertices, obstacles, step_domain, body
                 ):
                     segment_cost[row, u] = np.inf
                     break
@@ -638,12 +664,13 @@ def segment_boxes(
     state_slot,
     out,
 ):
-    """out (C, U, 8): for each class segment of a recording (``exit_transitions_template``),
+    """out (C, U, 12): for each class segment of a recording (``exit_transitions_template``),
     the box [x low, x high, y low, y high] (m, relative to the start's reference point) that
     holds its body (``pose_slot``, ``outline`` as ``geometry.pose_is_free`` takes them) at the
     end of each of its steps, then the box that holds the points where full braking from them
-    would stop (``arrival.braking_stop``; where ``arrives``). An empty box (low inf, high -inf)
-    where there is nothing to test."""
+    would stop (``arrival.braking_stop``; where ``arrives``), then the box of the reference
+    point itself at the ends of its steps (the point the domain polygon holds). An empty box
+    (low inf, high -inf) where there is nothing to test."""
     size = record.shape[1] - 1
     body = np.empty_like(outline)
     stop = np.empty(state_slot.shape[0])
@@ -651,7 +678,7 @@ def segment_boxes(
     y_axis = axis_of_slot(state_slot, vehicle_slot[1])
     for c in range(out.shape[0]):
         for u in range(out.shape[1]):
-            for i in range(0, 8, 2):
+            for i in range(0, 12, 2):
                 out[c, u, i] = np.inf
                 out[c, u, i + 1] = -np.inf
             for j in range(1, record_count[c, u]):
@@ -665,6 +692,10 @@ def segment_boxes(
                         out[c, u, 1] = max(out[c, u, 1], body[i, 0])
                         out[c, u, 2] = min(out[c, u, 2], body[i, 1])
                         out[c, u, 3] = max(out[c, u, 3], body[i, 1])
+                    out[c, u, 8] = min(out[c, u, 8], state[pose_slot[0]])
+                    out[c, u, 9] = max(out[c, u, 9], state[pose_slot[0]])
+                    out[c, u, 10] = min(out[c, u, 10], state[pose_slot[1]])
+                    out[c, u, 11] = max(out[c, u, 11], state[pose_slot[1]])
                 if arrives:
                     braking_stop(
                         state, vehicle_slot, wheelbase, wheel_radius, brake, state_slot, stop

@@ -55,6 +55,33 @@ def point_in_polygon(px, py, polygon):
 
 
 @njit(cache=True)
+def box_in_polygon(low_x, high_x, low_y, high_y, polygon):
+    """True when the box [low_x, high_x] × [low_y, high_y] (m) lies inside the simple polygon
+    (V, 2): a corner of it inside (``point_in_polygon``) and no edge of the polygon crossing
+    or touching an edge of the box (``segments_cross``), so that the polygon's boundary, which
+    is connected, lies wholly outside the box. True for an empty box (low > high: no point to
+    test). Conservative: a box whose edge touches the polygon's boundary is not inside."""
+    if low_x > high_x or low_y > high_y:
+        return True
+    if not point_in_polygon(low_x, low_y, polygon):
+        return False
+    n = polygon.shape[0]
+    j = n - 1
+    for i in range(n):
+        ax, ay = polygon[j, 0], polygon[j, 1]
+        bx, by = polygon[i, 0], polygon[i, 1]
+        if (
+            segments_cross(ax, ay, bx, by, low_x, low_y, high_x, low_y)
+            or segments_cross(ax, ay, bx, by, high_x, low_y, high_x, high_y)
+            or segments_cross(ax, ay, bx, by, high_x, high_y, low_x, high_y)
+            or segments_cross(ax, ay, bx, by, low_x, high_y, low_x, low_y)
+        ):
+            return False
+        j = i
+    return True
+
+
+@njit(cache=True)
 def polygons_overlap(a, b):
     """True when the simple polygons a (Va, 2) and b (Vb, 2) share any point: an edge of one
     crosses an edge of the other, or one lies inside the other."""

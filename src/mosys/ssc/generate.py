@@ -434,7 +434,7 @@ def load_kernels(
     sweep_order(problem.grid.axis_count, 0, none)
     if classes is not None:
         _, record_start, record_count, record, relative_slot = no_record(size)
-        boxes = np.empty((0, 0, 8))
+        boxes = np.empty((0, 0, 12))
         segment_boxes(
             record,
             record_start,
@@ -590,7 +590,7 @@ def record_classes(
             ends = np.cumsum(record_count.ravel())
             record_start = (ends - record_count.ravel()).reshape(record_count.shape)
             record = np.empty((int(ends[-1]), size + 1))
-    boxes = np.empty(record_count.shape + (8,))
+    boxes = np.empty(record_count.shape + (12,))
     segment_boxes(
         record,
         record_start,
