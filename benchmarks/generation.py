@@ -27,6 +27,8 @@ spec = parse_controller_text(open(sys.argv[2]).read(), sys.argv[2])
 table = generate_controller(spec, dynamics, sys.argv[3], quiet=True)
 dp_seconds = table.attrs["transition_seconds"] + table.attrs["iteration_seconds"]
 print(json.dumps({"dp_seconds": dp_seconds,
+                  "transition_seconds": table.attrs["transition_seconds"],
+                  "iteration_seconds": table.attrs["iteration_seconds"],
                   "kernel_load_seconds": table.attrs["kernel_load_seconds"],
                   "process_seconds": time.perf_counter() - started,
                   "iterations": int(table.attrs["iterations"]),
