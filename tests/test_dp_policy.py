@@ -15,21 +15,9 @@ from mosys.kernels.dp import (
     gauss_seidel_sweep,
     gauss_seidel_sweeps,
     policy_sweep,
+    policy_tables,
     sweep_order,
 )
-
-
-def compact_policy_tables(arrays):
-    """``dp.gather_policy``'s tables, nothing gathered yet."""
-    rows, _, corners = arrays[0].shape
-    return (
-        np.zeros((rows, corners), dtype=np.int32),
-        np.zeros((rows, corners), dtype=np.float32),
-        np.zeros(rows, dtype=np.int32),
-        np.empty(rows),
-        np.empty(rows),
-        np.full(rows, -1, dtype=np.int64),
-    )
 
 
 def solve(
@@ -63,7 +51,7 @@ def solve(
         np.inf,
         False,
         np.zeros(value.size, dtype=np.int64),
-        *compact_policy_tables(arrays),
+        *policy_tables(arrays[2].shape[0], arrays[0].shape[2]),
         policy_sweeps,
     )
     return value, bellman, policy
@@ -79,7 +67,7 @@ def test_a_policy_sweep_is_a_bellman_sweep_over_each_nodes_own_control(axis_coun
     value = np.where(is_destination, 0.0, np.where(row_of >= 0, 1e4, np.inf))
     order = np.empty(nodes, dtype=np.int64)
     control = np.zeros(nodes, dtype=np.int64)
-    policy = compact_policy_tables(arrays)
+    policy = policy_tables(arrays[2].shape[0], arrays[0].shape[2])
     for sweep in range(2**counts.size + 3):
         sweep_order(counts, sweep, order)
         gauss_seidel_sweep(*arrays, is_destination, value, order, np.inf, False, control)

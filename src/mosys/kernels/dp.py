@@ -1108,6 +1108,20 @@ def blocked_gauss_seidel_sweep(
     return largest.max()
 
 
+def policy_tables(rows: int, corners: int) -> tuple[np.ndarray, ...]:
+    """The tables ``gather_policy`` fills for the policy sweeps, for ``rows`` nodes that are not
+    removed and exits of ``corners`` (2**(d-1)) corners: policy_corner, policy_weight,
+    policy_count, policy_cost, policy_known, and gathered (-1: nothing gathered yet)."""
+    return (
+        np.zeros((rows, corners), dtype=np.int32),
+        np.zeros((rows, corners), dtype=np.float32),
+        np.zeros(rows, dtype=np.int32),
+        np.empty(rows),
+        np.empty(rows),
+        np.full(rows, -1, dtype=np.int64),
+    )
+
+
 @njit(cache=True, parallel=True)
 def gather_policy(
     exit_index,

@@ -35,6 +35,7 @@ from mosys.kernels.dp import (
     free_nodes,
     gauss_seidel_sweeps,
     node_coordinates,
+    policy_tables,
     prefetch_pays,
     reach_sweep,
     replay_classes,
@@ -427,7 +428,7 @@ def load_kernels(
         1.0,
         False,  # prefetching: a flag, whose type is all that compiling needs
         none,
-        *policy_tables(empty),
+        *policy_tables(empty.segment_cost.shape[0], empty.exit_index.shape[2]),
         0,
     )
     best_controls(*empty.arrays(), np.empty(0), none)
@@ -678,7 +679,7 @@ def value_iteration(
     snapshot = value.copy() if edges is not None else value  # one block reads value alone
     order = np.empty(grid.node_count, dtype=np.int64)
     control = np.zeros(grid.node_count, dtype=np.int64)
-    policy = policy_tables(transitions)
+    policy = policy_tables(transitions.segment_cost.shape[0], transitions.exit_index.shape[2])
     prefetching = prefetch_pays(transitions.exit_index, transitions.exit_weight)
     progress = Progress("value iteration", max_iterations, "sweeps")
     residual = np.inf
@@ -710,22 +711,6 @@ def value_iteration(
     if not quiet:
         progress.finish(f"largest change {residual:.3g} s")
     return value, iterations, policy_sweeps, float(residual)
-
-
-def policy_tables(transitions: Transitions) -> tuple[np.ndarray, ...]:
-    """The tables ``dp.gather_policy`` fills for the policy sweeps, one row per node that is
-    not removed (policy_corner, policy_weight, policy_count, policy_cost, policy_known, and
-    gathered: -1, nothing gathered yet): each row's exit under its control, compacted."""
-    rows = transitions.segment_cost.shape[0]
-    corners = transitions.exit_index.shape[2]
-    return (
-        np.zeros((rows, corners), dtype=np.int32),
-        np.zeros((rows, corners), dtype=np.float32),
-        np.zeros(rows, dtype=np.int32),
-        np.empty(rows),
-        np.empty(rows),
-        np.full(rows, -1, dtype=np.int64),
-    )
 
 
 def solve(
