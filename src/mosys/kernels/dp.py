@@ -1122,7 +1122,7 @@ def policy_tables(rows: int, corners: int) -> tuple[np.ndarray, ...]:
     )
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
 def gather_policy(
     exit_index,
     exit_weight,
@@ -1154,8 +1154,9 @@ def gather_policy(
     are rewritten: after the first Bellman sweeps few controls change. A sweep over these
     tables gives the values ``known_value`` would, bit for bit (the same sums in the same
     order), and reads about one cache line of them a node instead of the shape tables, the
-    segment costs and the flags."""
-    for node in prange(row_of.shape[0]):
+    segment costs and the flags. One thread, like the sweeps of a grid swept in one block (a
+    parallel loop here would be compiled for every grid)."""
+    for node in range(row_of.shape[0]):
         row = row_of[node]
         if row < 0:
             continue
