@@ -57,12 +57,18 @@ def solve(
     return value, bellman, policy
 
 
+@pytest.mark.parametrize("shared", [False, True])
 @pytest.mark.parametrize("axis_count", [(7, 5), (4, 3, 5, 2, 3)])
-def test_a_policy_sweep_is_a_bellman_sweep_over_each_nodes_own_control(axis_count):
+def test_a_policy_sweep_is_a_bellman_sweep_over_each_nodes_own_control(axis_count, shared):
+    """Bit for bit, with each node's own (renormalised) shapes or with shapes read as a motion
+    class's are (shared: renormalised over the corners whose value is known as they are read;
+    here each row its own class, so that removed nodes leave corners unknown)."""
     rng = np.random.default_rng(7 + len(axis_count))
     counts = np.array(axis_count, dtype=np.int64)
     arrays, is_destination = random_tables(rng, counts, 5)
     exit_index, exit_weight, cost, to_destination, row_of, _ = arrays
+    if shared:
+        arrays = (*arrays[:5], row_of)
     nodes = row_of.size
     value = np.where(is_destination, 0.0, np.where(row_of >= 0, 1e4, np.inf))
     order = np.empty(nodes, dtype=np.int64)
@@ -82,19 +88,26 @@ def test_a_policy_sweep_is_a_bellman_sweep_over_each_nodes_own_control(axis_coun
         exit_value = np.einsum("ij,ij->i", weights, np.where(weights != 0, corner_values, 0.0))
         exit_value = np.where(to_destination[held, chosen], 0.0, exit_value)
         promised = cost[held, chosen] + exit_value
-        assert np.all(promised[moved] <= value[kept][moved] * (1 + 1e-12))
+        if not shared:  # own shapes are renormalised already: Σ w·V is the exit's value
+            assert np.all(promised[moved] <= value[kept][moved] * (1 + 1e-12))
         gather_policy(*arrays, is_destination, value, control, *policy)
         corner, weight, count, segment, known, gathered = policy
         assert np.array_equal(gathered, chosen)  # every row gathered under its control
         for node, row, u in zip(kept, held, chosen, strict=True):
             used = exit_weight[row, u] != 0
-            if is_destination[node] or to_destination[row, u] or cost[row, u] == np.inf:
+            if shared:  # only the corners whose value is known
+                used &= np.isfinite(value[node + exit_index[row, u]])
+            never = is_destination[node] or (shared and not used.any())
+            if never or to_destination[row, u] or cost[row, u] == np.inf:
                 assert count[row] == 0
-            else:  # the weighted corners, in order, as node indices (own shapes: all known)
+            else:  # the weighted corners, in order, as node indices
                 assert np.array_equal(corner[row, : count[row]], node + exit_index[row, u][used])
                 assert np.array_equal(weight[row, : count[row]], exit_weight[row, u][used])
-            assert segment[row] == (np.inf if is_destination[node] else cost[row, u])
-            assert known[row] == 1.0
+            assert segment[row] == (np.inf if never else cost[row, u])
+            if shared and count[row] > 0:  # the known weight, summed in the same order
+                assert known[row] == np.cumsum(exit_weight[row, u][used].astype(np.float64))[-1]
+            else:
+                assert known[row] == 1.0
         cut = (
             exit_index[held, chosen][:, None, :].copy(),
             exit_weight[held, chosen][:, None, :].copy(),
@@ -105,7 +118,15 @@ def test_a_policy_sweep_is_a_bellman_sweep_over_each_nodes_own_control(axis_coun
         largest = policy_sweep(*policy[:5], row_of, value, order, np.inf)
         control_after = np.zeros(nodes, dtype=np.int64)
         expected_largest = gauss_seidel_sweep(
-            *cut, row_of, None, is_destination, swept, order, np.inf, False, control_after
+            *cut,
+            row_of,
+            row_of if shared else None,
+            is_destination,
+            swept,
+            order,
+            np.inf,
+            False,
+            control_after,
         )
         assert np.array_equal(value, swept)
         assert largest == expected_largest
