@@ -48,6 +48,8 @@ UNKNOWN = 1.0e9  # s: cost-to-go of a reachable node whose value is not known ye
 DEAD_END_BOUND = 1.0e4  # s: that bound for a spec with known_weight, whose dead ends keep it (far
 # above any path's seconds, and low enough that values resting partly on it settle in fewer sweeps)
 DEAD_END_SECONDS = 1.0e3  # s: a cost-to-go this long rests on a dead end
+SEGMENT_BOX_COLUMNS = 12  # ``segment_boxes``: the body's, the braking points' and the reference
+# point's boxes, each [x low, x high, y low, y high]
 DOMAIN_ROOM = 1e-9  # m: a node whose segments' reference points stay inside the domain polygon
 # with this much room to spare on every side (``replay_classes``) is not tested step by step
 PREFETCH_AHEAD = 2  # nodes: a sweep asks the cache for the exits of the node this far ahead in
@@ -678,7 +680,7 @@ def segment_boxes(
     y_axis = axis_of_slot(state_slot, vehicle_slot[1])
     for c in range(out.shape[0]):
         for u in range(out.shape[1]):
-            for i in range(0, 12, 2):
+            for i in range(0, SEGMENT_BOX_COLUMNS, 2):
                 out[c, u, i] = np.inf
                 out[c, u, i + 1] = -np.inf
             for j in range(1, record_count[c, u]):

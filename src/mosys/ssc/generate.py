@@ -27,6 +27,7 @@ from mosys.kernels.dp import (
     DEAD_END_SECONDS,
     DESTINATION_MAX_SWEEPS,
     DESTINATION_TOLERANCE,
+    SEGMENT_BOX_COLUMNS,
     UNKNOWN,
     best_controls,
     destination_indices,
@@ -435,7 +436,7 @@ def load_kernels(
     sweep_order(problem.grid.axis_count, 0, none)
     if classes is not None:
         _, record_start, record_count, record, relative_slot = no_record(size)
-        boxes = np.empty((0, 0, 12))
+        boxes = np.empty((0, 0, SEGMENT_BOX_COLUMNS))
         segment_boxes(
             record,
             record_start,
@@ -591,7 +592,7 @@ def record_classes(
             ends = np.cumsum(record_count.ravel())
             record_start = (ends - record_count.ravel()).reshape(record_count.shape)
             record = np.empty((int(ends[-1]), size + 1))
-    boxes = np.empty(record_count.shape + (12,))
+    boxes = np.empty(record_count.shape + (SEGMENT_BOX_COLUMNS,))
     segment_boxes(
         record,
         record_start,
