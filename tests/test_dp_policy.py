@@ -115,7 +115,10 @@ def test_a_policy_sweep_is_a_bellman_sweep_over_each_nodes_own_control(axis_coun
             to_destination[held, chosen][:, None].copy(),
         )
         swept = value.copy()
-        largest = policy_sweep(*policy[:5], row_of, value, order, np.inf)
+        hinted = value.copy()  # the same sweep asking the cache ahead: the same values
+        largest = policy_sweep(*policy[:5], row_of, value, order, np.inf, False)
+        assert policy_sweep(*policy[:5], row_of, hinted, order, np.inf, True) == largest
+        assert np.array_equal(hinted, value)
         control_after = np.zeros(nodes, dtype=np.int64)
         expected_largest = gauss_seidel_sweep(
             *cut,
