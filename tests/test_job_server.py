@@ -109,7 +109,10 @@ def test_a_served_job_runs_in_the_clients_directory_with_its_streams_and_exit_co
         "started: mosys --version",
         "started: mosys dp",
     ]
-    assert [line for _, line in server.jobs() if line.startswith("ended")] == [
+    # the server logs a job's end when it reaps the job, which can be after the client has its
+    # exit code: wait for each line rather than read the log once
+    jobs = [pid for pid, line in server.jobs() if line.startswith("started")]
+    assert [server.wait_for_end(pid) for pid in jobs] == [
         "ended: exit 0",
         "ended: exit 2",
         "ended: exit 0",
