@@ -15,7 +15,14 @@ from exit_tables import random_tables, reference_sweep
 from test_car import SMALL
 from test_dp_policy import solve
 
-from mosys.kernels.dp import blocked_gauss_seidel_sweep, sweep_order
+from mosys.kernels.dp import (
+    blocked_gauss_seidel_sweep,
+    blocked_policy_sweep,
+    gather_policy,
+    gauss_seidel_sweep,
+    policy_tables,
+    sweep_order,
+)
 from mosys.parsing.controller import parse_controller_text
 from mosys.ssc import generate
 
@@ -57,6 +64,43 @@ def test_a_sweep_in_two_blocks_reads_the_other_blocks_values_as_they_stood(axis_
     finally:
         numba.set_num_threads(before)
     assert np.isfinite(value).sum() > is_destination.sum()  # values really moved
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_a_policy_sweep_in_blocks_gives_the_same_values_asking_the_cache_ahead(threads):
+    rng = np.random.default_rng(5)
+    counts = np.array((6, 5, 4), dtype=np.int64)
+    tables, is_destination = random_tables(rng, counts, 4)
+    nodes = int(counts.prod())
+    blocks = np.array([0, 2 * (nodes // counts[0]), nodes], dtype=np.int64)
+    value = np.where(is_destination, 0.0, np.where(tables[4] >= 0, 1e4, np.inf))
+    order = np.empty(nodes, dtype=np.int64)
+    control = np.zeros(nodes, dtype=np.int64)
+    for sweep in range(3):  # a policy to follow
+        sweep_order(counts, sweep, order)
+        gauss_seidel_sweep(*tables, is_destination, value, order, np.inf, False, control)
+    policy = policy_tables(tables[2].shape[0], tables[0].shape[2])
+    gather_policy(*tables, is_destination, value, control, *policy)
+    start = value.copy()
+    before = numba.get_num_threads()
+    numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+    try:
+        for sweep in range(2**counts.size):
+            sweep_order(counts, sweep, order)
+            snapshot = value.copy()
+            hinted = value.copy()
+            largest = np.empty(2)
+            sweeps = [
+                blocked_policy_sweep(
+                    *policy[:5], tables[4], swept, snapshot, order, blocks, largest, np.inf, hint
+                )
+                for swept, hint in ((value, False), (hinted, True))
+            ]
+            assert sweeps[0] == sweeps[1]
+            assert np.array_equal(value, hinted)
+    finally:
+        numba.set_num_threads(before)
+    assert np.any(value < start)  # the policy sweeps moved values
 
 
 @pytest.mark.parametrize("seed", range(3))
