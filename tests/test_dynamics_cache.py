@@ -14,6 +14,7 @@ import pytest
 
 from mosys.dynamics import compile as compiler
 from mosys.dynamics.compile import COMPILER_MODULES, compile_figure, generate_source, source_key
+from mosys.dynamics.load import write_once
 from mosys.parsing.tokens import SpecError
 
 FIGURES = Path(__file__).resolve().parents[1] / "specs" / "figures"
@@ -103,3 +104,11 @@ def test_a_bad_spec_is_neither_compiled_nor_kept(tmp_path, cache):
         compile_figure(spec, tmp_path / "bad.py")
     assert not (tmp_path / "bad.py").exists()
     assert not cache.exists() or not list(cache.iterdir())
+
+
+def test_a_kept_text_is_written_once_and_whole(tmp_path):
+    kept = tmp_path / "sources" / "key.py"
+    write_once(kept, b"first\n")
+    write_once(kept, b"second\n")  # another process was first: its text stays
+    assert kept.read_bytes() == b"first\n"
+    assert [p.name for p in kept.parent.iterdir()] == ["key.py"]  # no partial file left

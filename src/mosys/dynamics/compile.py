@@ -13,6 +13,7 @@ equations. sympy is imported only when a text is derived.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import importlib.metadata
 import importlib.util
@@ -20,7 +21,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import mosys
-from mosys.dynamics.load import cache_directory
+from mosys.dynamics.load import cache_directory, write_once
 from mosys.dynamics.vehicle import vehicle_source
 from mosys.io.atomic import write_text_atomically
 from mosys.parsing.figure import Figure, parse_figure_spec
@@ -77,20 +78,17 @@ def source_key(spec_path: str | Path) -> str:
 
 def cached_source(spec_path: str | Path) -> str:
     """``generate_source``'s text, read from the dynamics cache when it holds the text of this
-    key (``source_key``), else generated and kept there (written atomically; a cache that
-    cannot be written is skipped)."""
+    key (``source_key``), else generated and kept there (``load.write_once``: never a partial
+    text, whatever runs beside it; a cache that cannot be written is skipped)."""
     try:
         kept = cache_directory() / "sources" / f"{source_key(spec_path)}.py"
     except OSError:
         return generate_source(spec_path)  # an unreadable spec: its own error, from the parser
     if kept.is_file():
-        return kept.read_text()
+        return kept.read_text(encoding="utf-8")
     text = generate_source(spec_path)
-    try:
-        kept.parent.mkdir(parents=True, exist_ok=True)
-        write_text_atomically(kept, text)
-    except OSError:
-        pass  # a read-only cache: compile without keeping the text
+    with contextlib.suppress(OSError):  # a read-only cache: compile without keeping the text
+        write_once(kept, text.encode("utf-8"))
     return text
 
 

@@ -55,22 +55,27 @@ def module_name(path: str | Path, source: bytes) -> str:
     return f"mosys_dynamics_{stem}_{hashlib.sha256(source).hexdigest()[:16]}"
 
 
+def write_once(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` if nothing is there, by a hard link of a finished temporary
+    file beside it: concurrent processes never see a partial file, nor rewrite one that another
+    has read (the first one's stays). Raises OSError where the directory cannot be written."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    handle, partial = tempfile.mkstemp(dir=path.parent, suffix=".partial")
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            stream.write(data)
+        with contextlib.suppress(FileExistsError):  # another process was first: keep theirs
+            os.link(partial, path)
+    finally:
+        os.unlink(partial)
+
+
 def content_addressed_copy(path: Path) -> Path:
-    """The copy of ``path`` named by its content, written once if missing (by a hard link of a
-    finished temporary file, so concurrent processes never rewrite a copy another has loaded)."""
+    """The copy of ``path`` named by its content, written once if missing (``write_once``)."""
     source = path.read_bytes()
-    directory = cache_directory()
-    copy = directory / f"{module_name(path, source)}.py"
+    copy = cache_directory() / f"{module_name(path, source)}.py"
     if not copy.exists():
-        directory.mkdir(parents=True, exist_ok=True)
-        handle, partial = tempfile.mkstemp(dir=directory, suffix=".partial")
-        try:
-            with os.fdopen(handle, "wb") as stream:
-                stream.write(source)
-            with contextlib.suppress(FileExistsError):  # another process was first: keep theirs
-                os.link(partial, copy)
-        finally:
-            os.unlink(partial)
+        write_once(copy, source)
     return copy
 
 
