@@ -47,7 +47,7 @@ def reference_sweep(tables, is_destination, value, order, blocks=None):
     for low, high in zip(bounds[:-1], bounds[1:], strict=True):
         for node in order[(order >= low) & (order < high)]:  # the block's part, in order
             row = row_of[node]
-            if row < 0 or is_destination[node]:
+            if row < 0 or is_destination[node] or value[node] == np.inf:
                 continue
             shape = row if shape_row_of is None else shape_row_of[node]
             best = np.inf

@@ -717,9 +717,11 @@ def sweep_order(axis_count, sweep, out):
     """The grid's nodes in the order of sweep number ``sweep`` (out: (N,) int64): C order with
     the axes whose bit is set in ``sweep mod 2**d`` run backwards. Successive sweeps take the
     2**d orders in turn (the fast sweeping method), so that what is known spreads along every
-    direction of the grid within a few sweeps, each running through memory in order. The node
-    index is carried from one node to the next (a step along the last axis that moves, back
-    to the start of the axes after it) rather than recomputed from the position."""
+    direction of the grid within a few sweeps, each running through memory in order. The first
+    layer of the first axis is walked with the node index carried from one node to the next (a
+    step along the last axis that moves, back to the start of the axes after it); every other
+    layer is that one shifted by its steps along the first axis, a plain add that the compiler
+    vectorises (the car's 1.6 million nodes in 0.4 ms against 1.2–1.6 ms walked node by node)."""
     d = axis_count.shape[0]
     backwards = sweep % (1 << d)
     strides = np.empty(d, np.int64)
@@ -732,11 +734,14 @@ def sweep_order(axis_count, sweep, out):
             node += (axis_count[k] - 1) * strides[k]
         else:
             step[k] = strides[k]
+    n = out.shape[0]  # N; fewer: the order's first n nodes (0: none, to compile the kernel)
+    layer = min(strides[0], n)
+    first = np.empty(layer, np.int64)  # apart from ``out``, so that the adds below vectorise
     position = np.zeros(d, np.int64)
-    for p in range(out.shape[0]):
-        out[p] = node
+    for p in range(layer):
+        first[p] = node
         k = d - 1
-        while k >= 0:
+        while k >= 1:
             position[k] += 1
             if position[k] < axis_count[k]:
                 node += step[k]
@@ -744,6 +749,13 @@ def sweep_order(axis_count, sweep, out):
             position[k] = 0
             node -= (axis_count[k] - 1) * step[k]
             k -= 1
+    for i in range(axis_count[0]):
+        start = i * strides[0]
+        shift = i * step[0]
+        count = min(layer, n - start)
+        destination = out[start : start + count]  # a view from 0: the loop below vectorises
+        for j in range(count):
+            destination[j] = first[j] + shift
 
 
 @njit(cache=True, inline="always")
@@ -983,6 +995,8 @@ def _bellman_block(
         if row < 0 or is_destination[node]:
             continue
         old = value[node]
+        if old == np.inf:  # unreachable: every exit reads only unknown corners (NaN or inf)
+            continue
         best, choice = _bellman(
             exit_index,
             exit_weight,
@@ -1034,7 +1048,8 @@ def gauss_seidel_sweep(
     Value iteration starts from an upper bound (0 at the destination nodes, a large finite
     ``UNKNOWN`` at the other reachable nodes: the paper's "values not yet known"; inf at
     unreachable nodes, which ``known_value`` leaves out), so values only decrease, as the paper
-    describes. is_destination: (N,) bool, held at 0. A decrease to a value still at or above
+    describes; a node at inf is not swept (the car's unreachable 8 %). is_destination: (N,)
+    bool, held at 0. A decrease to a value still at or above
     ``settled_above`` (s; inf: none) does not count in the largest decrease: such a node is a
     dead end (``known_weight``), whatever its exact bound. One thread, in a fixed order: the
     same result on any machine whatever the thread count (``blocked_gauss_seidel_sweep``: two
@@ -1508,12 +1523,13 @@ def best_controls(
     exit_index, exit_weight, segment_cost, to_destination, row_of, shape_row_of, value, best_control
 ):
     """The minimising control sample index of every node (the first on ties; 0 where every
-    sample costs inf or the node is removed). best_control: (N,) int64 out."""
+    sample costs inf, the node is removed or its value is inf: unreachable, where every sample's
+    exit reads only unknown corners). best_control: (N,) int64 out."""
     for node in range(value.shape[0]):
         row = row_of[node]
         best_control[node] = (
             0
-            if row < 0
+            if row < 0 or value[node] == np.inf
             else _bellman(
                 exit_index,
                 exit_weight,
