@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import secrets
 from collections.abc import Callable
 from pathlib import Path
 
@@ -11,11 +12,13 @@ def write_atomically(path: str | Path, write: Callable[[Path], None]) -> None:
     """Call ``write(partial)`` on a hidden sibling path, then rename it onto ``path``.
 
     The rename is atomic on POSIX file systems; on any exception the partial file is removed and
-    ``path`` is left as it was.
+    ``path`` is left as it was. The partial path is this call's own (``.NAME.PID.RANDOM.partial``),
+    so that two writers of one path at once (parallel jobs, tests) never rename a file the other
+    is still writing: the last rename wins, whole.
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    partial = path.with_name(f".{path.name}.partial")
+    partial = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.partial")
     try:
         write(partial)
         os.replace(partial, path)
