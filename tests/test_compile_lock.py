@@ -1,5 +1,6 @@
 """Cold compilation once per machine: two processes that start together on a cold numba cache
-compile a kernel once between them (``mosys.kernels.compile_lock``)."""
+compile a kernel once between them, and within ``deferring`` a process leaves a kernel that
+another is compiling for last (``mosys.kernels.compile_lock``)."""
 
 from __future__ import annotations
 
@@ -46,7 +47,7 @@ def test_two_cold_processes_compile_a_kernel_once(tmp_path):
     # one compiled; the other missed the cache, waited for the lock, and loaded that code (its
     # hit); without the lock both would compile (no hit)
     assert [hits for _, hits in outcomes] == [0, 1] or [hits for _, hits in outcomes] == [1, 0]
-    assert (tmp_path / "cache" / "mosys-compile-cold_kernel.lock").exists()
+    assert (tmp_path / "cache" / "mosys-compile-cold_kernel.kernel.lock").exists()
 
 
 # with a signature: compiled (or loaded from the cache) at import, not at its first call
@@ -83,3 +84,47 @@ def test_within_cache_only_a_kernel_not_in_the_cache_is_refused_not_compiled(tmp
     assert not list((tmp_path / "cache").rglob("*.nbc"))  # nothing was compiled
     run(f"import sys; sys.path.insert(0, {str(tmp_path)!r}); import mosys.kernels, eager_kernel")
     assert run(IMPORT_CACHE_ONLY) == f"loaded {sum(i**0.5 for i in range(4))!r}"
+
+
+TWO_KERNELS = KERNEL + KERNEL.replace("def kernel", "def other")
+
+LOAD_DEFERRING = """
+import sys
+from mosys.kernels.compile_lock import CompilationBusyError, deferring
+sys.path.insert(0, sys.argv[1])
+from two_kernels import kernel, other
+busy = []
+with deferring():
+    for load in (kernel, other):
+        try:
+            load(10)
+            print("loaded", load.__name__, flush=True)
+        except CompilationBusyError as error:
+            print("busy", error, flush=True)
+            busy.append(load)
+for load in busy:
+    load(10)  # waits for the lock, then compiles
+    print("loaded", load.__name__, flush=True)
+"""
+
+
+def test_a_kernel_another_process_compiles_is_left_for_last_within_deferring(tmp_path, monkeypatch):
+    """What ``mosys dp`` does when it loads its kernels: the one whose lock another process
+    holds (here, the test) is skipped, the next compiled meanwhile, then the first waited for."""
+    from mosys.kernels.compile_lock import machine_lock
+
+    (tmp_path / "two_kernels.py").write_text(TWO_KERNELS)
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(cache))  # the child's cache, and its locks
+    with machine_lock("two_kernels.kernel"):
+        child = subprocess.Popen(
+            [sys.executable, "-c", LOAD_DEFERRING, str(tmp_path)],
+            stdout=subprocess.PIPE,
+            text=True,
+        )
+        lines = [child.stdout.readline().strip() for _ in range(2)]
+        assert lines == ["busy two_kernels.kernel", "loaded other"]
+        assert not list(cache.rglob("two_kernels.kernel-*.nbi"))  # it waits, compiling none
+    assert child.stdout.readline().strip() == "loaded kernel"  # once the lock was released
+    assert child.wait(timeout=60) == 0
+    assert list(cache.rglob("two_kernels.kernel-*.nbi"))

@@ -4,16 +4,22 @@ numba compiles a ``cache=True`` function on its first call (or at import, given 
 unless its machine code is in the cache. Two jobs that start together with a cold cache — the
 pipeline's first two ``mosys dp`` jobs, say — would both compile the same kernels, each for
 seconds, and both write the same cache entries. So every top-level compilation that misses the
-cache (in memory and on disk) runs under a machine-wide file lock, one per Python module (so that
-two jobs compiling different modules' kernels still run side by side), and looks at the cache
-again once it holds the lock: a job that waited loads what the other compiled. Cache hits take no
-lock (numba reports a compilation only after a miss: the ``numba:compile`` event), nor do the
-compilations of callees within one (which therefore never wait: no deadlock), nor functions
-without a cache.
+cache (in memory and on disk) runs under a machine-wide file lock, one per function (numba
+caches each function in files of its own, so that two jobs compiling different kernels still
+run side by side), and looks at the cache again once it holds the lock: a job that waited loads
+what the other compiled. Cache hits take no lock (numba reports a compilation only after a miss:
+the ``numba:compile`` event), nor do the compilations of callees within one (which therefore
+never wait: no deadlock), nor functions without a cache.
 
-The lock of module M is ``mosys-compile-M.lock`` in ``$NUMBA_CACHE_DIR`` if set (the cache it
-guards), else in ``$XDG_CACHE_HOME/mosys`` (``~/.cache/mosys``); without ``fcntl`` (Windows), or
-if the file cannot be opened or locked, compilation goes unguarded, as numba alone does it.
+The lock of function F of module M is ``mosys-compile-M.F.lock`` in ``$NUMBA_CACHE_DIR`` if set
+(the cache it guards), else in ``$XDG_CACHE_HOME/mosys`` (``~/.cache/mosys``); without ``fcntl``
+(Windows), or if the file cannot be opened or locked, compilation goes unguarded, as numba alone
+does it.
+
+Within ``deferring()`` a top-level compilation whose lock another process holds raises
+``CompilationBusyError`` instead of waiting, so that a job loading many kernels (``mosys dp``) can
+compile others first and come back to it: two such jobs started together on a cold cache then
+compile different kernels side by side rather than one after the other.
 
 Within ``cache_only()`` a top-level compilation that misses the cache raises
 ``ColdCompilationError`` instead (the job server imports kernel modules ahead of its jobs, and
@@ -29,10 +35,29 @@ from pathlib import Path
 
 _installed = False
 _cache_only = False
+_deferring = False
 
 
 class ColdCompilationError(Exception):
     """A compilation that missed numba's cache within ``cache_only()``."""
+
+
+class CompilationBusyError(Exception):
+    """A compilation that missed numba's cache within ``deferring()`` while another process
+    compiles the same function."""
+
+
+@contextlib.contextmanager
+def deferring() -> Iterator[None]:
+    """Within: a compilation that would wait for another process's lock raises
+    ``CompilationBusyError`` (naming the function) instead; nothing has been compiled then."""
+    global _deferring
+    serialize_cold_compilation()
+    before, _deferring = _deferring, True
+    try:
+        yield
+    finally:
+        _deferring = before
 
 
 @contextlib.contextmanager
@@ -48,10 +73,10 @@ def cache_only() -> Iterator[None]:
         _cache_only = before
 
 
-def lock_path(module: str) -> Path:
-    """The machine-wide lock file of compilations of the Python module ``module``'s functions
-    (see the module docstring)."""
-    name = f"mosys-compile-{module}.lock"
+def lock_path(function: str) -> Path:
+    """The machine-wide lock file of compilations of ``function`` (``module.name``; see the
+    module docstring)."""
+    name = f"mosys-compile-{function}.lock"
     if os.environ.get("NUMBA_CACHE_DIR"):
         return Path(os.environ["NUMBA_CACHE_DIR"]) / name
     base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
@@ -59,13 +84,14 @@ def lock_path(module: str) -> Path:
 
 
 @contextlib.contextmanager
-def machine_lock(module: str) -> Iterator[None]:
-    """Hold the compilation lock of ``module`` (an exclusive ``flock``; released when the process
-    ends, too)."""
+def machine_lock(function: str, wait: bool = True) -> Iterator[None]:
+    """Hold the compilation lock of ``function`` (an exclusive ``flock``; released when the
+    process ends, too); ``wait`` False: raise ``CompilationBusyError`` if another process holds
+    it."""
     try:
         import fcntl
 
-        path = lock_path(module)
+        path = lock_path(function)
         path.parent.mkdir(parents=True, exist_ok=True)
         handle = open(path, "a")  # noqa: SIM115 (closed below, after the lock is released)
     except (ImportError, OSError):
@@ -73,7 +99,9 @@ def machine_lock(module: str) -> Iterator[None]:
         return
     with handle:
         try:
-            fcntl.flock(handle, fcntl.LOCK_EX)
+            fcntl.flock(handle, fcntl.LOCK_EX | (0 if wait else fcntl.LOCK_NB))
+        except BlockingIOError:
+            raise CompilationBusyError(function) from None
         except OSError:  # a file system without locks
             yield
             return
@@ -130,7 +158,8 @@ def serialize_cold_compilation() -> None:
                     raise ColdCompilationError(name) from None
             finally:
                 probe.armed = armed
-            with machine_lock(self.py_func.__module__ or ""):
+            function = f"{self.py_func.__module__}.{self.py_func.__qualname__}"
+            with machine_lock(function, wait=not _deferring):
                 depth += 1
                 try:  # loads it if another process compiled it while this one waited
                     return compile_signature(self, sig)

@@ -22,6 +22,7 @@ from mosys import __version__
 from mosys.errors import SimulationError
 from mosys.io.controller_table import ControllerTable, write_controller_table
 from mosys.io.progress import Progress
+from mosys.kernels.compile_lock import CompilationBusyError, deferring
 from mosys.kernels.dp import (
     DEAD_END_BOUND,
     DEAD_END_SECONDS,
@@ -401,7 +402,9 @@ def load_kernels(
 ) -> float:
     """Load (or compile, on a cold cache) every kernel of ``solve`` and start numba's threads,
     by calling each on no nodes, so that the DP's timings are the DP's; returns the seconds.
-    arguments: ``exit_transition_arguments``."""
+    A kernel that another process is compiling is left for last (``compile_lock.deferring``):
+    two jobs started together on a cold cache compile different kernels side by side, then each
+    loads what the other compiled. arguments: ``exit_transition_arguments``."""
     started = time.perf_counter()
     none = np.empty(0, dtype=np.int64)
     before, obstacles, arrival = arguments
@@ -410,79 +413,98 @@ def load_kernels(
     if classes is not None:  # the sweeps' variant for shared shapes (``dp.shape_of``)
         empty = replace(empty, shape_row_of=empty.row_of)
     size = problem.base_state.shape[0]
-    exit_transitions(*before, none, none, *obstacles, *arrival, *empty.outputs(), *no_record(size))
-    reach_sweep(*empty.arrays(), flags, none)
-    discard_poorly_known_exits(*empty.arrays(), flags, 1.0)
-    gauss_seidel_sweeps(
-        *empty.arrays(),
-        flags,
-        np.empty(0),
-        np.empty(0),
-        np.zeros(2, dtype=np.int64),
-        # edges: the variant that ``sweep_blocks`` is likely to choose (one block: None)
-        None if problem.grid.node_count < BLOCKED_SWEEP_NODES else np.empty((0, 2), np.int64),
-        problem.grid.axis_count,
-        0,
-        0,
-        1.0,
-        none,
-        1.0,
-        False,  # prefetching: a flag, whose type is all that compiling needs
-        none,
-        *policy_tables(empty.segment_cost.shape[0], empty.exit_index.shape[2]),
-        0,
-    )
-    best_controls(*empty.arrays(), np.empty(0), none)
-    sweep_order(problem.grid.axis_count, 0, none)
+    loads = [
+        lambda: exit_transitions(
+            *before, none, none, *obstacles, *arrival, *empty.outputs(), *no_record(size)
+        ),
+        lambda: reach_sweep(*empty.arrays(), flags, none),
+        lambda: discard_poorly_known_exits(*empty.arrays(), flags, 1.0),
+        lambda: gauss_seidel_sweeps(
+            *empty.arrays(),
+            flags,
+            np.empty(0),
+            np.empty(0),
+            np.zeros(2, dtype=np.int64),
+            # edges: the variant that ``sweep_blocks`` is likely to choose (one block: None)
+            None if problem.grid.node_count < BLOCKED_SWEEP_NODES else np.empty((0, 2), np.int64),
+            problem.grid.axis_count,
+            0,
+            0,
+            1.0,
+            none,
+            1.0,
+            False,  # prefetching: a flag, whose type is all that compiling needs
+            none,
+            *policy_tables(empty.segment_cost.shape[0], empty.exit_index.shape[2]),
+            0,
+        ),
+        lambda: best_controls(*empty.arrays(), np.empty(0), none),
+        lambda: sweep_order(problem.grid.axis_count, 0, none),
+    ]
     if classes is not None:
         _, record_start, record_count, record, relative_slot = no_record(size)
         boxes = np.empty((0, 0, SEGMENT_BOX_COLUMNS))
-        segment_boxes(
-            record,
-            record_start,
-            record_count,
-            *obstacles[:2],
-            arrival[0],
-            *arrival[2:],
-            before[4],
-            boxes,
+        loads.append(
+            lambda: segment_boxes(
+                record,
+                record_start,
+                record_count,
+                *obstacles[:2],
+                arrival[0],
+                *arrival[2:],
+                before[4],
+                boxes,
+            )
         )
-        replay_classes(
-            *before[:7],
-            before[9],
-            none,
-            none,
-            none,
-            *obstacles,
-            *arrival,
-            empty.segment_cost,
-            record_start,
-            record_count,
-            record,
-            relative_slot,
-            boxes,
-            empty.segment_cost,
-            empty.to_destination,
+        loads.append(
+            lambda: replay_classes(
+                *before[:7],
+                before[9],
+                none,
+                none,
+                none,
+                *obstacles,
+                *arrival,
+                empty.segment_cost,
+                record_start,
+                record_count,
+                record,
+                relative_slot,
+                boxes,
+                empty.segment_cost,
+                empty.to_destination,
+            )
         )
     if len(problem.spec.destinations) > 1:
-        destination_indices(
-            empty.exit_index,
-            empty.exit_weight,
-            empty.to_destination,
-            none,
-            empty.shape_row_of,
-            none,
-            flags,
-            0,
-            np.empty(0),
-            none,
-            problem.grid.axis_count,
-            DESTINATION_TOLERANCE,
-            1,
-            none,
-            np.empty((0, 2)),
-            none,
+        loads.append(
+            lambda: destination_indices(
+                empty.exit_index,
+                empty.exit_weight,
+                empty.to_destination,
+                none,
+                empty.shape_row_of,
+                none,
+                flags,
+                0,
+                np.empty(0),
+                none,
+                problem.grid.axis_count,
+                DESTINATION_TOLERANCE,
+                1,
+                none,
+                np.empty((0, 2)),
+                none,
+            )
         )
+    busy = []
+    with deferring():
+        for load in loads:
+            try:
+                load()
+            except CompilationBusyError:
+                busy.append(load)
+    for load in busy:
+        load()  # waits for the other process's compilation, then loads it
     return time.perf_counter() - started
 
 
