@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from matplotlib import patheffects
 from matplotlib.text import Text
 from PIL import Image
 
@@ -91,10 +92,15 @@ def test_an_empty_or_hidden_text_draws_nothing():
         assert np.array_equal(background, by_pil)
 
 
-def test_rotated_and_mathtext_texts_are_left_to_matplotlib():
+def test_rotated_mathtext_outlined_and_wrapped_texts_are_left_to_matplotlib():
     with plot_style():
         figure = new_figure(2.0, 2.0)
         ax = figure.add_subplot()
         assert not drawable(ax.text(0.5, 0.5, "up", rotation=90))
         assert not drawable(ax.text(0.5, 0.5, r"$\omega$"))
         assert not drawable(ax.text(0.5, 0.5, "sawtooth", bbox={"boxstyle": "sawtooth"}))
+        assert not drawable(ax.text(0.5, 0.5, "wrapped", wrap=True))
+        outlined = ax.text(0.5, 0.5, "outlined")
+        outlined.set_path_effects([patheffects.withStroke(linewidth=3, foreground="white")])
+        assert not drawable(outlined)
+        assert drawable(ax.text(0.5, 0.5, "plain"))

@@ -56,12 +56,14 @@ def _rgba(color) -> tuple[int, int, int, int]:
 
 def drawable(text: Text) -> bool:
     """Whether ``draw_text`` draws ``text`` as matplotlib would: unrotated, no mathtext or TeX,
-    and a square or round box if any."""
+    no path effects or wrapping, and a square or round box if any."""
     patch = text.get_bbox_patch()
     return (
         text.get_rotation() == 0
         and not text.get_usetex()
         and "$" not in text.get_text()
+        and not text.get_path_effects()
+        and not text.get_wrap()
         and (patch is None or isinstance(patch.get_boxstyle(), BOX_STYLES))
     )
 
