@@ -10,7 +10,7 @@ import sys
 import numpy as np
 import pytest
 from conftest import SPECS
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from mosys.io.controller_table import read_controller_table
@@ -23,6 +23,8 @@ finite = st.floats(-10.0, 10.0, allow_nan=False)
 
 @settings(max_examples=300, deadline=None)
 @given(finite, finite, finite, finite, st.floats(0.01, 5.0), st.floats(0.01, 5.0))
+# ending on the bound, tangent to it: the chord's first guess rounded to an ulp past s = 1
+@example(0.0, 2.377056175564622, -0.9734591014168164, 0.0, 1.0, 2.377056175564622)
 def test_first_crossing_is_the_first_time_the_cubic_reaches_a_bound(x0, x1, d0, d1, below, above):
     """From x0 inside (low, high): the cubic stays strictly inside before the returned s and is
     on a bound at it; 2.0 only when it never leaves [low, high] on [0, 1]."""

@@ -141,6 +141,7 @@ def _level_in_piece(x0, x1, d0, d1, start, end, level):
     high_value = hermite(x0, x1, d0, d1, end) - level
     rising = high_value > low_value
     s = start + (end - start) * (-low_value) / (high_value - low_value)
+    s = min(max(s, start), end)  # rounding can put the chord's guess an ulp past an end
     width = end - start
     for _ in range(60):
         value = hermite(x0, x1, d0, d1, s) - level
