@@ -1,5 +1,4 @@
-"""Value iteration in blocks (``kernels.dp``, ``ssc.generate.sweep_blocks``): the sweep orders
-are C order with the axes of the sweep number's bits reversed (hypothesis); a sweep in two
+"""Value iteration in blocks (``kernels.dp``, ``ssc.generate.sweep_blocks``): a sweep in two
 blocks (``blocked_gauss_seidel_sweep``) is, bit for bit, each block's part of the order swept
 with its own values as it leaves them and the other block's as they stood at the sweep's start,
 in every sweep order and on one thread or two; sweeps in blocks reach the fixed point that one
@@ -9,14 +8,10 @@ two."""
 
 from __future__ import annotations
 
-import itertools
-
 import numba
 import numpy as np
 import pytest
 from exit_tables import random_tables, reference_sweep
-from hypothesis import given, settings
-from hypothesis import strategies as st
 from test_car import SMALL
 from test_dp_policy import solve
 
@@ -30,29 +25,6 @@ from mosys.kernels.dp import (
 )
 from mosys.parsing.controller import parse_controller_text
 from mosys.ssc import generate
-
-
-@settings(max_examples=200, deadline=None)
-@given(
-    axis_count=st.lists(st.integers(1, 5), min_size=1, max_size=5),
-    sweep=st.integers(0, 100),
-    data=st.data(),
-)
-def test_a_sweep_order_is_c_order_with_the_sweeps_axes_reversed(axis_count, sweep, data):
-    """Axis k runs backwards where bit k of sweep mod 2**d is set; an ``out`` shorter than the
-    grid gets the order's first nodes and nothing is written past it."""
-    nodes = int(np.prod(axis_count))
-    d = len(axis_count)
-    ranges = [
-        range(count - 1, -1, -1) if (sweep % (1 << d) >> k) & 1 else range(count)
-        for k, count in enumerate(axis_count)
-    ]
-    expected = [np.ravel_multi_index(at, axis_count) for at in itertools.product(*ranges)]
-    length = data.draw(st.integers(0, nodes), label="length")
-    buffer = np.full(nodes + 3, -7, dtype=np.int64)
-    sweep_order(np.array(axis_count, dtype=np.int64), sweep, buffer[:length])
-    assert buffer[:length].tolist() == expected[:length]
-    assert (buffer[length:] == -7).all()
 
 
 @pytest.mark.parametrize("threads", [1, 2])

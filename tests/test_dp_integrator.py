@@ -61,15 +61,37 @@ def test_first_crossing_looks_past_control_points_that_reach_a_bound():
 def test_each_sweep_order_visits_every_node_once_in_its_directions(counts):
     """Sweep k runs the grid in C order with the axes of bit set in k mod 2**d reversed."""
     counts = np.array(counts, dtype=np.int64)
-    nodes = np.arange(np.prod(counts)).reshape(counts)
-    order = np.empty(nodes.size, dtype=np.int64)
+    order = np.empty(np.prod(counts), dtype=np.int64)
     for sweep in range(2 * (1 << len(counts))):
         sweep_order(counts, sweep, order)
-        flipped = nodes
-        for axis in range(len(counts)):
-            if (sweep % (1 << len(counts))) >> axis & 1:
-                flipped = np.flip(flipped, axis)
-        assert np.array_equal(order, flipped.ravel())
+        assert np.array_equal(order, expected_order(counts, sweep))
+
+
+def expected_order(counts, sweep: int) -> np.ndarray:
+    """The nodes of a grid of ``counts`` in C order with the axes of bit set in sweep mod 2**d
+    reversed."""
+    flipped = np.arange(np.prod(counts)).reshape(counts)
+    for axis in range(len(counts)):
+        if (sweep % (1 << len(counts))) >> axis & 1:
+            flipped = np.flip(flipped, axis)
+    return flipped.ravel()
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    counts=st.lists(st.integers(1, 5), min_size=1, max_size=5),
+    sweep=st.integers(0, 100),
+    data=st.data(),
+)
+def test_a_sweep_order_shorter_than_the_grid_gets_its_first_nodes_and_no_more(counts, sweep, data):
+    """Any grid and sweep (hypothesis); an ``out`` shorter than the grid (``load_kernels`` passes
+    an empty one to compile the kernel) gets the order's first nodes, nothing past it."""
+    expected = expected_order(counts, sweep)
+    length = data.draw(st.integers(0, expected.size), label="length")
+    buffer = np.full(expected.size + 3, -7, dtype=np.int64)
+    sweep_order(np.array(counts, dtype=np.int64), sweep, buffer[:length])
+    assert np.array_equal(buffer[:length], expected[:length])
+    assert (buffer[length:] == -7).all()
 
 
 def test_a_segment_too_stiff_to_follow_stops_trying(tmp_path):

@@ -50,8 +50,9 @@ def _least_line(path: str, pixels: float) -> tuple[float, float, float]:
     return 0.0, 0.0, 0.0
 
 
-def _rgba(color) -> tuple[int, int, int, int]:
-    return tuple(round(255 * channel) for channel in to_rgba(color))
+def _rgba(color, alpha: float | None = None) -> tuple[int, int, int, int]:
+    """``color`` (with ``alpha``, if given) as PIL's 0–255 RGBA."""
+    return tuple(round(255 * channel) for channel in to_rgba(color, alpha))
 
 
 def drawable(text: Text) -> bool:
@@ -119,7 +120,7 @@ def draw_text(image: Image.Image, text: Text, dpi: float) -> None:
             draw.rounded_rectangle(corners, radius, face, outline, edge_width)
         else:
             draw.rectangle(corners, face, outline, edge_width)
-    fill = _rgba(to_rgba(text.get_color(), text.get_alpha()))
+    fill = _rgba(text.get_color(), text.get_alpha())
     align = text.get_horizontalalignment()  # each line as the whole (no ``multialignment``)
     for line, line_width, depth in zip(lines, widths, depths, strict=True):
         offset = {"left": 0.0, "center": (width - line_width) / 2}.get(align, width - line_width)
