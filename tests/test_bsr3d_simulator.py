@@ -366,11 +366,12 @@ def contact_case(u, r, inverse_mass=1 / 42.1, spin_inertia=(3.0, 4.0, 2.5)):
         world_inverse,
         impulse,
         responses,
-        np.zeros((m + 3, m + 4)),
+        np.zeros((m + 4, m + 4)),
         np.zeros((3, m, m)),
         np.zeros((3, m)),
         np.arange(m),
         np.zeros(m),
+        np.zeros((m, m, 9)),
     )
     after = uu[:count].copy()
     for i in range(count):
@@ -452,7 +453,7 @@ def plain_shares(u, r, responses, compliance, twisting, iterations):
 
 
 def test_the_shared_friction_solve_finds_the_fixed_point_of_the_dense_plain_iteration():
-    """The kernel factors the system's normal block once and mixes the shares of three or more
+    """The kernel inverts the system's normal block once and mixes the shares of three or more
     contacts (Anderson): where the plain iteration of a dense solve settles with every normal
     impulse pushing, the kernel ends at the same impulses; and for two contacts (iterated
     plainly, as the 2-D rule is) it agrees on whether they push."""
@@ -494,12 +495,13 @@ def test_the_shared_friction_solve_finds_the_fixed_point_of_the_dense_plain_iter
             count,
             responses,
             impulse,
-            np.zeros((m + 3, m + 4)),
+            np.zeros((m + 4, m + 4)),
             np.zeros((3, m, m)),
             np.zeros(m),
             compliance,
             np.zeros(m),
             True,
+            np.zeros((m, m, 9)),
         )
         # two iterate plainly in the kernel too, and as often; more settle more slowly plainly
         iterations = sim.FIXED_POINT_ITERATIONS if count == 2 else 500

@@ -6,7 +6,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from mosys.kernels import _forget_stale_machine_code
+import pytest
+from numba.core import config
+
+from mosys.kernels import _forget_stale_machine_code, machine_code_directories
 
 
 def cached(directory: Path) -> set[str]:
@@ -27,3 +30,24 @@ def test_editing_any_kernel_file_forgets_every_cached_compilation(tmp_path: Path
     (tmp_path / "simulate.py").write_text("def step(): return 2\n")  # the callee's file only
     _forget_stale_machine_code(tmp_path)
     assert cached(tmp_path) == set()
+
+
+def test_a_cache_under_numba_cache_dir_is_forgotten_too(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+):
+    """With NUMBA_CACHE_DIR set numba keeps the machine code there, in a directory named after
+    the sources' one: that copy goes stale the same way and is removed the same way."""
+    sources = tmp_path / "kernels"
+    sources.mkdir()
+    (sources / "simulate.py").write_text("def step(): return 1\n")
+    monkeypatch.setattr(config, "CACHE_DIR", str(tmp_path / "numba"))
+    beside, elsewhere = machine_code_directories(sources)
+    assert beside == sources / "__pycache__"
+    assert elsewhere.parent == tmp_path / "numba" and elsewhere.name.startswith("kernels_")
+    _forget_stale_machine_code(sources)
+    (elsewhere / "controller.run-1.py311.nbi").write_text("built with step() = 1")
+    _forget_stale_machine_code(sources)  # nothing changed: kept
+    assert (elsewhere / "controller.run-1.py311.nbi").exists()
+    (sources / "simulate.py").write_text("def step(): return 2\n")
+    _forget_stale_machine_code(sources)
+    assert not (elsewhere / "controller.run-1.py311.nbi").exists()

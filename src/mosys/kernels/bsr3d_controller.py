@@ -39,6 +39,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, prange
 
+from mosys.kernels.borrowed import borrowed
 from mosys.kernels.bsr3d_simulate import (
     CX,
     CY,
@@ -148,18 +149,23 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
     steps of dt seconds from the state ``start`` (S,), measuring as ``task`` (a Task) says,
     filling ``record`` (a RunRecord). start_force (E,): the endpoints' normal forces at the
     start, N; carry_over: start with the rule the senses pick (a controller continuing another)
-    instead of rule 0. Long on purpose, as the 2-D run_controller.
+    instead of rule 0. Long on purpose, as the 2-D run_controller; its arrays are borrowed
+    (``kernels.borrowed``), so that the step loop raises and lowers no reference count.
     Returns ``steps``, or ``blown_up(n)`` (< 0) if the state is not sound (``state_is_sound``)
     before step n (n = steps: after the last), as the 2-D run_controller: the samples 0 to n
     recorded, terms_out NaN, final_state the unsound state."""
+    figure = borrowed(figure)
+    task = borrowed(task)
     parent, hinge, rest, length, mass, com, inertia, joint, endpoints = figure[:9]
     joint_min, joint_max, gravity, floor, _ = figure[9:]
-    time_based, target, tau, center, side, segment_end, period = controller
-    senses_out, rule_out, terms_out, ends_out, com_out, final_state, final_force = record
-    state = start.copy()
+    time_based, target, tau, center, side, segment_end, period = borrowed(controller)
+    senses_out, rule_out, terms_out, ends_out, com_out, final_state, final_force = borrowed(record)
+    own_state = start.copy()
+    state = borrowed(own_state)
     n_rods = parent.shape[0]
     n_ends = endpoints.shape[0]
-    work = new_step_work(n_rods, n_ends)
+    own_work = new_step_work(n_rods, n_ends)
+    work = borrowed(own_work)
     rod_ends, end_offset, _, end_force, frames = work[1:6]
     matrices, vectors = work[7:9]
     end_force[:] = start_force
@@ -323,8 +329,8 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
     conjugate(rotation, matrices[2], world_inverse)
     wx, wy, wz = rigid_rate(state, rotation, world_inverse, vectors[0, :3])
     terms_out[FINAL_SPIN] = math.degrees(math.sqrt(wx * wx + wy * wy + wz * wz))
-    final_state[:] = state
-    final_force[:] = end_force
+    final_state[:] = own_state  # (its last use: the borrowed state's memory is kept to here)
+    final_force[:] = own_work.end_force  # (as own_work's, the borrowed work's)
     return steps
 
 

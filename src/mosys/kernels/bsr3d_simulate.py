@@ -21,7 +21,7 @@ step on the floor (up to ``MAX_CONTACTS``, the lowest first), with the paper's f
 to 3-D: a lone contact does not slide; several take horizontal impulses in the ratio of their
 normal impulses, sized so that their normal-impulse-weighted horizontal velocity is zero (a
 fixed point over the weights: each iteration a symmetric positive definite solve, its normal
-block factored once; Anderson mixing of the weights for three or more contacts, where the plain
+block inverted once; Anderson mixing of the weights for three or more contacts, where the plain
 iteration would take twice as many). Contacts whose normal impulse would pull are dropped one at a
 time. An endpoint that still ends the step below the floor lifts the figure out of it, and an
 endpoint alone on the floor is stopped and held where it stood, as in 2-D.
@@ -50,6 +50,9 @@ FIXED_POINT_ITERATIONS = 50  # of the shared-friction shares
 # a twist whose horizontal impulse at some contact exceeds its normal impulse this many times is
 # not used (the shares of a contact that barely touches cannot stop a spin): slide only then
 TWIST_RATIO = 1.0
+# m: the margin by which an endpoint must clear the contact tolerance, however fast it falls, to
+# be passed over without computing its motion (rounding there is far smaller)
+REACH_MARGIN = 1e-9
 
 
 class FigureArrays3D(NamedTuple):
@@ -336,16 +339,17 @@ def invert_symmetric(matrix, out):
 
 @njit(cache=True, error_model="numpy")
 def conjugate(rotation, matrix, out):
-    """out = rotation @ matrix @ rotation.T, all (3, 3)."""
-    for a in range(3):
-        for b in range(3):
-            total = 0.0
-            for c in range(3):
-                inner = 0.0
-                for d in range(3):
-                    inner += matrix[c, d] * rotation[b, d]
-                total += rotation[a, c] * inner
-            out[a, b] = total
+    """out = rotation @ matrix @ rotation.T, all (3, 3): rotation @ (matrix @ rotation.T)."""
+    for b in range(3):
+        inner0 = matrix[0, 0] * rotation[b, 0]
+        inner1 = matrix[1, 0] * rotation[b, 0]
+        inner2 = matrix[2, 0] * rotation[b, 0]
+        for d in range(1, 3):
+            inner0 += matrix[0, d] * rotation[b, d]
+            inner1 += matrix[1, d] * rotation[b, d]
+            inner2 += matrix[2, d] * rotation[b, d]
+        for a in range(3):
+            out[a, b] = rotation[a, 0] * inner0 + rotation[a, 1] * inner1 + rotation[a, 2] * inner2
 
 
 @njit(cache=True, error_model="numpy")
@@ -472,7 +476,19 @@ def _mix_shares(weight, active, count, mixing, stored):
 
 @njit(cache=True, error_model="numpy")
 def _shared_friction(
-    u, r, active, count, responses, impulse, system, mixing, weight, compliance, share, twisting
+    u,
+    r,
+    active,
+    count,
+    responses,
+    impulse,
+    system,
+    mixing,
+    weight,
+    compliance,
+    share,
+    twisting,
+    pairs,
 ):
     """Impulses at the active contacts (at least two), the paper's friction carried to 3-D: no
     active point sinks; each point's horizontal impulse is its share (its normal impulse over
@@ -494,11 +510,18 @@ def _shared_friction(
     How it is solved: the system in the n normal impulses and the m = 3 (2 without the twist)
     tangential unknowns is symmetric positive semi-definite, [[A, B], [Bᵀ, D]] (the body's
     response restricted to those impulses, plus the compliance on A's diagonal). A does not
-    depend on the shares, so its Cholesky factor L is made once a call; each share iteration
-    factors only the Schur complement S = D - Wᵀ W, W = L⁻¹ B (m × m). A pivot at most 1e-12 of
-    the system's largest entry is singular. system (M + 3, M + 4) holds, M = MAX_CONTACTS: L
-    and W in rows :n (columns :n and M:M + m), S in rows M:M + m, the right-hand sides and
-    solutions in column M + 3, and the normal impulses in row M + 2, columns :n."""
+    depend on the shares, so it is inverted once a call (by its Cholesky factor; a pivot at most
+    1e-12 of its largest entry is singular), and so is N0 = A⁻¹ (-u_y); B is linear in the
+    shares and D bilinear, so the terms they sum (``pairs`` (M, M, 9): for each pair of points,
+    the normal response at the first to the slides and twist at the second, and the slide and
+    twist response at the first to them) are made once a call too. Each share iteration sums
+    them, forms the Schur complement S = D - Bᵀ Y, Y = A⁻¹ B (m × m), and solves S x = b - Bᵀ N0
+    by S's adjugate, one division (singular where a pivot of S's Cholesky factor, the ratio of
+    two leading minors, is at most 1e-12 of the system's largest entry); the normal impulses are
+    N0 - Y x: no chain of divisions and square roots an iteration. system (M + 4, M + 4) holds,
+    M = MAX_CONTACTS: A⁻¹ in rows :n, columns :n; B in rows :n, columns M:M + m; Yᵀ in rows M:M
+    + m, columns :n, and S beside it; the right-hand sides and solutions (N0, then b and x) in
+    column M + 3; the normal impulses in row M + 3, columns :n."""
     n = 0
     known = 0.0
     for i in range(count):
@@ -515,8 +538,8 @@ def _shared_friction(
     m = 3 if twisting else 2
     t = MAX_CONTACTS  # the tangential block's first row and column
     rhs = MAX_CONTACTS + 3  # the right-hand sides' and solutions' column
-    normal = MAX_CONTACTS + 2  # the row that keeps the normal impulses
-    # A and -u_y; then L in place of A, and h = L⁻¹ (-u_y) in place of -u_y
+    normal = MAX_CONTACTS + 3  # the row that keeps the normal impulses
+    # A; then L in place of A, then A⁻¹ (both triangles) in place of L, and N0 = A⁻¹ (-u_y)
     scale_a = 0.0
     row = 0
     for i in range(count):
@@ -529,7 +552,21 @@ def _shared_friction(
                 system[row, column] = value
                 scale_a = max(scale_a, abs(value))
                 column += 1
-        system[row, rhs] = -u[i, 1]
+                # B's and D's terms of the pair: the normal (y) response at i and the slide
+                # (x, z) and twist response at i (the twist's velocity r_z v_x - r_x v_z) to a
+                # slide x, a slide z and a twist at j (a twist's impulse (r_z, 0, -r_x))
+                k = responses[i, j]
+                twist_x = r[j, 2] * k[0, 0] - r[j, 0] * k[0, 2]
+                twist_z = r[j, 2] * k[2, 0] - r[j, 0] * k[2, 2]
+                pairs[i, j, 0] = k[1, 0]
+                pairs[i, j, 1] = k[1, 2]
+                pairs[i, j, 2] = r[j, 2] * k[1, 0] - r[j, 0] * k[1, 2]
+                pairs[i, j, 3] = k[0, 0]
+                pairs[i, j, 4] = k[2, 0]
+                pairs[i, j, 5] = k[2, 2]
+                pairs[i, j, 6] = r[i, 2] * k[0, 0] - r[i, 0] * k[2, 0]
+                pairs[i, j, 7] = r[i, 2] * k[0, 2] - r[i, 0] * k[2, 2]
+                pairs[i, j, 8] = r[i, 2] * twist_x - r[i, 0] * twist_z
         row += 1
     for k in range(n):
         for c in range(k):
@@ -543,111 +580,136 @@ def _shared_friction(
         if not total > 1e-12 * scale_a:
             return -2
         system[k, k] = math.sqrt(total)
-        total = system[k, rhs]
-        for p in range(k):
-            total -= system[k, p] * system[p, rhs]
-        system[k, rhs] = total / system[k, k]
+    for k in range(n):  # L⁻¹, row by row (a row's entries of L are used left to right)
+        diagonal = 1.0 / system[k, k]
+        for c in range(k):
+            total = 0.0
+            for p in range(c, k):
+                total -= system[k, p] * system[p, c]
+            system[k, c] = total * diagonal
+        system[k, k] = diagonal
+    for i in range(n):  # A⁻¹ = L⁻ᵀ L⁻¹, rows in order (row i of L⁻¹ is not used after it)
+        for j in range(i + 1):
+            total = 0.0
+            for p in range(i, n):
+                total += system[p, i] * system[p, j]
+            system[i, j] = total
+            system[j, i] = total
+    row = 0
+    for i in range(count):
+        if active[i]:
+            total = 0.0
+            column = 0
+            for j in range(count):
+                if active[j]:
+                    total -= system[row, column] * u[j, 1]
+                    column += 1
+            system[row, rhs] = total
+            row += 1
     converged = False
     last = MAX_CONTACTS - 1  # mixing's row of the last update and residual
     for iteration in range(FIXED_POINT_ITERATIONS):
-        # B, D and the tangential right-hand side at the present shares
-        for p in range(m):
-            for q in range(m):
-                system[t + p, t + q] = 0.0
-            system[t + p, rhs] = 0.0
+        # B, D (lower triangle) and the tangential right-hand side b at the present shares
+        b_x = b_z = b_twist = 0.0
+        d_xx = d_zx = d_zz = d_tx = d_tz = d_tt = 0.0
         scale = scale_a
         row = 0
         for i in range(count):
             if not active[i]:
                 continue
-            # the velocity change at point i along x, y, z per unit slide x (sx), slide z (sz)
-            # and twist (tw), each point taking its share
-            sx0 = sx1 = sx2 = sz0 = sz1 = sz2 = tw0 = tw1 = tw2 = 0.0
+            s0 = s1 = s2 = s3 = s4 = s5 = s6 = s7 = s8 = 0.0
             for j in range(count):
                 if not active[j]:
                     continue
                 wj = weight[j]
-                lever_x = wj * r[j, 2]
-                lever_z = -wj * r[j, 0]
-                k00 = responses[i, j, 0, 0]
-                k10 = responses[i, j, 1, 0]
-                k20 = responses[i, j, 2, 0]
-                k02 = responses[i, j, 0, 2]
-                k12 = responses[i, j, 1, 2]
-                k22 = responses[i, j, 2, 2]
-                sx0 += wj * k00
-                sx1 += wj * k10
-                sx2 += wj * k20
-                sz0 += wj * k02
-                sz1 += wj * k12
-                sz2 += wj * k22
-                tw0 += lever_x * k00 + lever_z * k02
-                tw1 += lever_x * k10 + lever_z * k12
-                tw2 += lever_x * k20 + lever_z * k22
+                s0 += wj * pairs[i, j, 0]
+                s1 += wj * pairs[i, j, 1]
+                s2 += wj * pairs[i, j, 2]
+                s3 += wj * pairs[i, j, 3]
+                s4 += wj * pairs[i, j, 4]
+                s5 += wj * pairs[i, j, 5]
+                s6 += wj * pairs[i, j, 6]
+                s7 += wj * pairs[i, j, 7]
+                s8 += wj * pairs[i, j, 8]
             wi = weight[i]
-            system[row, t] = sx1
-            system[row, t + 1] = sz1
-            system[t, t] += wi * sx0
-            system[t + 1, t] += wi * sx2
-            system[t + 1, t + 1] += wi * sz2
-            system[t, rhs] -= wi * u[i, 0]
-            system[t + 1, rhs] -= wi * u[i, 2]
+            system[row, t] = s0
+            system[row, t + 1] = s1
+            scale = max(scale, abs(s0), abs(s1))
+            d_xx += wi * s3
+            d_zx += wi * s4
+            d_zz += wi * s5
+            b_x -= wi * u[i, 0]
+            b_z -= wi * u[i, 2]
             if twisting:
-                lever_x = wi * r[i, 2]
-                lever_z = -wi * r[i, 0]
-                system[row, t + 2] = tw1
-                system[t + 2, t] += lever_x * sx0 + lever_z * sx2
-                system[t + 2, t + 1] += lever_x * sz0 + lever_z * sz2
-                system[t + 2, t + 2] += lever_x * tw0 + lever_z * tw2
-                system[t + 2, rhs] -= lever_x * u[i, 0] + lever_z * u[i, 2]
-            for q in range(m):
-                scale = max(scale, abs(system[row, t + q]))
+                system[row, t + 2] = s2
+                scale = max(scale, abs(s2))
+                d_tx += wi * s6
+                d_tz += wi * s7
+                d_tt += wi * s8
+                b_twist -= wi * (r[i, 2] * u[i, 0] - r[i, 0] * u[i, 2])
             row += 1
-        for p in range(m):
-            for q in range(p + 1):
-                scale = max(scale, abs(system[t + p, t + q]))
-        # W = L⁻¹ B in place of B; S = D - Wᵀ W and b - Wᵀ h (lower triangle)
+        system[t, t] = d_xx
+        system[t + 1, t] = d_zx
+        system[t + 1, t + 1] = d_zz
+        system[t, rhs] = b_x
+        system[t + 1, rhs] = b_z
+        scale = max(scale, abs(d_xx), abs(d_zx), abs(d_zz))
+        if twisting:
+            system[t + 2, t] = d_tx
+            system[t + 2, t + 1] = d_tz
+            system[t + 2, t + 2] = d_tt
+            system[t + 2, rhs] = b_twist
+            scale = max(scale, abs(d_tx), abs(d_tz), abs(d_tt))
+        # Y = A⁻¹ B (its transpose in rows M:M + m, columns :n); S = D - Bᵀ Y and b - Bᵀ N0
         for q in range(m):
             for k in range(n):
-                total = system[k, t + q]
-                for p in range(k):
-                    total -= system[k, p] * system[p, t + q]
-                system[k, t + q] = total / system[k, k]
+                total = 0.0
+                for p in range(n):
+                    total += system[k, p] * system[p, t + q]
+                system[t + q, k] = total
         for p in range(m):
             for k in range(n):
-                system[t + p, rhs] -= system[k, t + p] * system[k, rhs]
+                b_kp = system[k, t + p]
+                system[t + p, rhs] -= b_kp * system[k, rhs]
                 for q in range(p + 1):
-                    system[t + p, t + q] -= system[k, t + p] * system[k, t + q]
-        # S's Cholesky factor in place and its forward solve, then the back solves: the
-        # tangential unknowns, then the normal impulses L⁻ᵀ (h - W x)
-        for p in range(m):
-            for q in range(p):
-                total = system[t + p, t + q]
-                for s in range(q):
-                    total -= system[t + p, t + s] * system[t + q, t + s]
-                system[t + p, t + q] = total / system[t + q, t + q]
-            total = system[t + p, t + p]
-            for s in range(p):
-                total -= system[t + p, t + s] * system[t + p, t + s]
-            if not total > 1e-12 * scale:
+                    system[t + p, t + q] -= b_kp * system[t + q, k]
+        # S x = b - Bᵀ N0 by S's adjugate; a pivot of S's Cholesky factor (the ratio of its
+        # leading minors) at most 1e-12 of the system's largest entry is singular
+        s00 = system[t, t]
+        s10 = system[t + 1, t]
+        s11 = system[t + 1, t + 1]
+        minor = s00 * s11 - s10 * s10
+        if not (s00 > 1e-12 * scale and minor > 1e-12 * scale * s00):
+            return -2
+        r0 = system[t, rhs]
+        r1 = system[t + 1, rhs]
+        if twisting:
+            s20 = system[t + 2, t]
+            s21 = system[t + 2, t + 1]
+            s22 = system[t + 2, t + 2]
+            c00 = s11 * s22 - s21 * s21
+            c10 = s20 * s21 - s10 * s22
+            c20 = s10 * s21 - s11 * s20
+            determinant = s00 * c00 + s10 * c10 + s20 * c20
+            if not determinant > 1e-12 * scale * minor:
                 return -2
-            system[t + p, t + p] = math.sqrt(total)
-            total = system[t + p, rhs]
-            for s in range(p):
-                total -= system[t + p, t + s] * system[t + s, rhs]
-            system[t + p, rhs] = total / system[t + p, t + p]
-        for p in range(m - 1, -1, -1):
-            total = system[t + p, rhs]
-            for s in range(p + 1, m):
-                total -= system[t + s, t + p] * system[t + s, rhs]
-            system[t + p, rhs] = total / system[t + p, t + p]
-        for k in range(n - 1, -1, -1):
+            inverse = 1.0 / determinant
+            r2 = system[t + 2, rhs]
+            system[t, rhs] = (c00 * r0 + c10 * r1 + c20 * r2) * inverse
+            system[t + 1, rhs] = (
+                c10 * r0 + (s00 * s22 - s20 * s20) * r1 + (s10 * s20 - s00 * s21) * r2
+            ) * inverse
+            system[t + 2, rhs] = (c20 * r0 + (s10 * s20 - s00 * s21) * r1 + minor * r2) * inverse
+        else:
+            inverse = 1.0 / minor
+            system[t, rhs] = (s11 * r0 - s10 * r1) * inverse
+            system[t + 1, rhs] = (s00 * r1 - s10 * r0) * inverse
+        # the normal impulses N0 - Y x
+        for k in range(n):
             total = system[k, rhs]
             for q in range(m):
-                total -= system[k, t + q] * system[t + q, rhs]
-            for p in range(k + 1, n):
-                total -= system[p, k] * system[normal, p]
-            system[normal, k] = total / system[k, k]
+                total -= system[t + q, k] * system[t + q, rhs]
+            system[normal, k] = total
         total = 0.0
         worst = -1
         worst_value = 0.0
@@ -763,6 +825,7 @@ def contact_impulses(
     shares,
     chosen,
     end_share,
+    pairs,
 ):
     """The ground's impulses (count, 3) N s on ``count`` touching endpoints: u (count, 3) their
     velocities m/s, r (count, 3) their offsets from the centre of mass m. First the sinking ones
@@ -770,7 +833,8 @@ def contact_impulses(
     trying again while two or more are left; then each sinking one alone, the fastest first,
     stopped dead. The first set whose normal impulses push and after which no other touching
     point sinks is kept; none, no impulse (the 2-D rule for two, carried to any number).
-    responses (M, M, 3, 3), system (M + 3, M + 4), mixing (3, M, M), shares (3, M): work space.
+    responses (M, M, 3, 3), system (M + 4, M + 4), mixing (3, M, M), shares (3, M), pairs (M, M,
+    9): work space.
     chosen (count,): the points' endpoint numbers; end_share (E,): each endpoint's share of the
     horizontal impulse the step before, updated (the shared-friction iteration starts from
     it)."""
@@ -796,10 +860,10 @@ def contact_impulses(
     # shared friction compiled four times over, 40 s of a cold start)
     points = (u, r, active, np.int64(count), responses, impulse, system, mixing, weight)
     while n >= 2:
-        worst = _shared_friction(*points, compliance, share, np.bool_(True))
+        worst = _shared_friction(*points, compliance, share, np.bool_(True), pairs)
         if worst == -1 and _twist_too_strong(impulse, active, count) or worst == -3:
             # slide only: the paper's rule as it is
-            worst = _shared_friction(*points, compliance, share, np.bool_(False))
+            worst = _shared_friction(*points, compliance, share, np.bool_(False), pairs)
         if worst == -2 and compliance == 0.0:
             # the rigid body leaves the split undecided: a little compliance decides it
             compliance = COMPLIANCE * (responses[0, 0, 0, 0] + responses[0, 0, 1, 1])
@@ -857,12 +921,13 @@ class StepWork(NamedTuple):
     vectors: np.ndarray  # (3, 4) spin, body rate, half-step quaternion
     contact: np.ndarray  # (3, M, 3) the contacts' velocities, offsets and impulses
     responses: np.ndarray  # (M, M, 3, 3) the contacts' responses
-    system: np.ndarray  # (M + 3, M + 4) the shared-friction system
+    system: np.ndarray  # (M + 4, M + 4) the shared-friction system
     mixing: np.ndarray  # (3, M, M) the shared-friction shares' memory (Anderson mixing)
     shares: np.ndarray  # (3, M) active flags, weights and last shares of the contacts
     chosen: np.ndarray  # (M,) int64 the contacts' endpoints
     entry: np.ndarray  # (E, 3) each endpoint in the world before the step, m
     end_share: np.ndarray  # (E,) each endpoint's share of the horizontal impulse last step
+    pairs: np.ndarray  # (M, M, 9) the shared-friction solve's terms of each pair of contacts
 
 
 @njit(cache=True)
@@ -882,12 +947,13 @@ def new_step_work(n_rods, n_ends):
         np.zeros((3, 4)),
         np.empty((3, m, 3)),
         np.empty((m, m, 3, 3)),
-        np.empty((m + 3, m + 4)),
+        np.empty((m + 4, m + 4)),
         np.empty((3, m, m)),
         np.empty((3, m)),
         np.empty(m, np.int64),
         np.empty((n_ends, 3)),
         np.zeros(n_ends),
+        np.empty((m, m, 9)),
     )
 
 
@@ -946,11 +1012,12 @@ def step(figure, state, target, tau, dt, work, place_rods):
     is called, so that no array crosses a call each step.
     """
     parent, hinge, rest, length, mass, com, inertia, joint, endpoints = figure[:9]
-    joint_min, joint_max, gravity, floor, _ = figure[9:]
+    joint_min, joint_max, gravity, floor, reach = figure[9:]
     previous, rod_ends, end_offset, end_velocity, end_force, frames, scratch = work[:7]
     matrices, vectors, contact, responses, system, mixing, shares, chosen, entry, end_share = work[
-        7:
+        7:17
     ]
+    pairs = work.pairs
     rotation = matrices[0]
     tensor = matrices[1]
     tensor_inverse = matrices[2]
@@ -1013,7 +1080,28 @@ def step(figure, state, target, tau, dt, work, place_rods):
         # tolerance of the floor (speculative contacts, as in 2-D)
         lowest = shares[1]
         count = 0
+        # how far any endpoint can fall in the step at most: the centre of mass's fall, the
+        # body's spin at the figure's reach and the fastest deformation velocity; an endpoint
+        # higher than that over the tolerance is passed over unread
+        fastest = 0.0
         for e in range(n_ends):
+            fastest = max(
+                fastest, end_velocity[e, 0] ** 2 + end_velocity[e, 1] ** 2 + end_velocity[e, 2] ** 2
+            )
+        turning = math.sqrt(body_rate[0] ** 2 + body_rate[1] ** 2 + body_rate[2] ** 2)
+        fall = max(0.0, -state[VY] + turning * reach + math.sqrt(fastest)) * dt
+        for e in range(n_ends):
+            height = (
+                state[CY]
+                - floor
+                + (
+                    rotation[1, 0] * end_offset[e, 0]
+                    + rotation[1, 1] * end_offset[e, 1]
+                    + rotation[1, 2] * end_offset[e, 2]
+                )
+            )
+            if height - fall > CONTACT_TOLERANCE + REACH_MARGIN:
+                continue
             _, ry, _, _, uy, _ = endpoint_motion(
                 state, rotation, body_rate, end_offset, end_velocity, e
             )
@@ -1057,6 +1145,7 @@ def step(figure, state, target, tau, dt, work, place_rods):
             shares,
             chosen,
             end_share,
+            pairs,
         )
         for i in range(count):
             if impulse[i, 1] > 0.0:

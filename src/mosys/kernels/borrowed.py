@@ -1,0 +1,42 @@
+"""Borrowed views: arrays (and tuples of them) that numba's runtime does not count references of.
+
+Every array numba binds to a new variable, slices, or unpacks from a tuple has its reference count
+raised and lowered, each an atomic instruction; numba's reference-count pruning removes the pairs
+it can prove redundant, but not those of a long loop body with many branches, such as a
+simulator's step inlined in its run (in a 3-D BSR run they were 9 % of the time). A borrowed view
+is the same array with no owner: its counts are never touched. It is valid only while the array
+it was made from is alive, which its maker must see to (an argument of the function that made
+it, or a local used again after the view's last use).
+"""
+
+from __future__ import annotations
+
+from numba import types
+from numba.core import cgutils
+from numba.extending import intrinsic
+
+
+def _borrow(context, builder, typ, value):
+    if isinstance(typ, types.Array):
+        array = context.make_array(typ)(context, builder, value)
+        array.meminfo = cgutils.get_null_value(array.meminfo.type)
+        return array._getvalue()
+    if isinstance(typ, types.BaseTuple):
+        out = value
+        for index, member in enumerate(typ):
+            item = builder.extract_value(value, index)
+            out = builder.insert_value(out, _borrow(context, builder, member, item), index)
+        return out
+    return value
+
+
+@intrinsic
+def borrowed(typingctx, value):
+    """``value`` (an array, a tuple or named tuple of arrays and scalars, nested) with every array
+    replaced by a view of the same data that no reference count covers (the module's docstring
+    says when that is safe)."""
+
+    def codegen(context, builder, signature, args):
+        return _borrow(context, builder, signature.args[0], args[0])
+
+    return value(value), codegen
