@@ -32,3 +32,9 @@ def test_borrowed_views_read_and_write_the_arrays_they_were_made_from():
     np.testing.assert_array_equal(values, [0.0, 3.0, 6.0, 9.0])
     assert matrix[1, 0] == -1.0
     assert total == 7 + 18.0
+
+
+def test_called_from_python_a_borrowed_value_is_the_value_itself():
+    """(So kernels that borrow also run with ``NUMBA_DISABLE_JIT``.)"""
+    pair = Pair(np.arange(3.0), 2.0)
+    assert borrowed(pair) is pair

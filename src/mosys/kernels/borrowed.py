@@ -11,9 +11,21 @@ it, or a local used again after the view's last use).
 
 from __future__ import annotations
 
+from typing import TypeVar
+
 from numba import types
 from numba.core import cgutils
-from numba.extending import intrinsic
+from numba.extending import intrinsic, overload
+
+Value = TypeVar("Value")
+
+
+def borrowed(value: Value) -> Value:
+    """``value`` (an array, a tuple or named tuple of arrays and scalars, nested) with every array
+    replaced by a view of the same data that no reference count covers (the module's docstring
+    says when that is safe). In Python (``NUMBA_DISABLE_JIT``, or called from Python) it is
+    ``value`` itself."""
+    return value
 
 
 def _borrow(context, builder, typ, value):
@@ -31,12 +43,13 @@ def _borrow(context, builder, typ, value):
 
 
 @intrinsic
-def borrowed(typingctx, value):
-    """``value`` (an array, a tuple or named tuple of arrays and scalars, nested) with every array
-    replaced by a view of the same data that no reference count covers (the module's docstring
-    says when that is safe)."""
-
+def _borrowed(typingctx, value):
     def codegen(context, builder, signature, args):
         return _borrow(context, builder, signature.args[0], args[0])
 
     return value(value), codegen
+
+
+@overload(borrowed)
+def _borrowed_in_numba(value):
+    return lambda value: _borrowed(value)
