@@ -50,6 +50,8 @@ def _borrowed(typingctx, value):
     return value(value), codegen
 
 
+# (not inline="always": numba then compiles writes through arrays in the borrowed tuple wrongly,
+# numba/numba#10037; called, the function is inlined by LLVM anyway)
 @overload(borrowed)
 def _borrowed_in_numba(value):
     return lambda value: _borrowed(value)
