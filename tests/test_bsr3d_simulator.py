@@ -9,6 +9,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from mosys.bsr.figure import load_bsr_figure
 from mosys.bsr.start import standing_state as standing_state_2d
@@ -258,6 +260,45 @@ def test_a_dropped_figure_comes_to_rest_on_the_floor_without_sinking():
     assert speed < 1e-3
     assert np.abs(stepper.world_ends() - before).max() < 1e-3
     assert stepper.world_ends()[:, :, 1].min() == pytest.approx(0.0, abs=1e-6)
+
+
+@settings(max_examples=90, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from(["fall", "spin", "deformation", "all"]))
+def test_no_endpoint_falls_further_in_a_step_than_the_largest_fall(seed: int, moving: str):
+    """The step passes over endpoints higher than ``largest_fall`` (plus the contact tolerance)
+    without computing their motion: that bound must hold for every endpoint of any pose, fall,
+    spin and deformation rate, each alone (so that each term is needed) and all together (the
+    dog, its joints moving up to tens of rad/s)."""
+    rng = np.random.default_rng(seed)
+    figure = figure_arrays(DOG)
+    j = figure.joint_min.shape[0]
+    state = state_of(
+        figure,
+        angles=rng.uniform(figure.joint_min, figure.joint_max),
+        quaternion=rng.normal(size=4),
+        velocity=(0.0, -abs(rng.normal(0.0, 3.0)), 0.0) if moving in ("fall", "all") else (0, 0, 0),
+    )
+    if moving in ("deformation", "all"):
+        state[sim.JOINTS + j :] = rng.normal(0.0, 20.0, j)
+    body_rate = rng.normal(0.0, 5.0, 3) if moving in ("spin", "all") else np.zeros(3)
+    stepper = Stepper(figure, state)
+    stepper.body()
+    w = stepper.work
+    rotation = stepper.rotation()
+    dt = 0.01
+    fall = sim.largest_fall(stepper.state, body_rate, w.end_velocity, figure.reach, dt)
+    falls = [
+        -min(
+            sim.endpoint_motion(
+                stepper.state, rotation, body_rate, w.end_offset, w.end_velocity, e
+            )[4],
+            0.0,
+        )
+        * dt
+        for e in range(figure.endpoints.shape[0])
+    ]
+    assert max(falls) <= fall * (1.0 + 1e-12)
+    assert max(falls) > 0.0 or moving == "deformation"  # (every endpoint can rise then)
 
 
 def planar_copy(figure2d) -> sim.FigureArrays3D:

@@ -391,6 +391,22 @@ def endpoint_motion(state, rotation, body_rate, end_offset, end_velocity, e):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def largest_fall(state, body_rate, end_velocity, reach, dt):
+    """How far any endpoint can fall in a step of dt s at most, m (>= 0): an endpoint's vertical
+    velocity is the centre of mass's (the state's (S,)) plus the body's spin (body_rate (3,)
+    rad/s, world) across its offset from the centre of mass, which is at most the figure's reach
+    (m: the sum of its rods' lengths), plus its deformation velocity (end_velocity (E, 3) m/s,
+    any frame: only the fastest's length counts)."""
+    fastest = 0.0
+    for e in range(end_velocity.shape[0]):
+        fastest = max(
+            fastest, end_velocity[e, 0] ** 2 + end_velocity[e, 1] ** 2 + end_velocity[e, 2] ** 2
+        )
+    turning = math.sqrt(body_rate[0] ** 2 + body_rate[1] ** 2 + body_rate[2] ** 2)
+    return max(0.0, -state[VY] + turning * reach + math.sqrt(fastest)) * dt
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def response(r, i, j, inverse_mass, world_inverse, responses):
     """responses[i, j] (3, 3): the velocity change at a point with offset r[i] (3,) from the
     centre of mass per unit impulse at a point with offset r[j], for a rigid body of inverse
@@ -1080,16 +1096,9 @@ def step(figure, state, target, tau, dt, work, place_rods):
         # tolerance of the floor (speculative contacts, as in 2-D)
         lowest = shares[1]
         count = 0
-        # how far any endpoint can fall in the step at most: the centre of mass's fall, the
-        # body's spin at the figure's reach and the fastest deformation velocity; an endpoint
-        # higher than that over the tolerance is passed over unread
-        fastest = 0.0
-        for e in range(n_ends):
-            fastest = max(
-                fastest, end_velocity[e, 0] ** 2 + end_velocity[e, 1] ** 2 + end_velocity[e, 2] ** 2
-            )
-        turning = math.sqrt(body_rate[0] ** 2 + body_rate[1] ** 2 + body_rate[2] ** 2)
-        fall = max(0.0, -state[VY] + turning * reach + math.sqrt(fastest)) * dt
+        # an endpoint higher over the floor than any endpoint can fall in the step (and the
+        # tolerance) is passed over unread
+        fall = largest_fall(state, body_rate, end_velocity, reach, dt)
         for e in range(n_ends):
             height = (
                 state[CY]
