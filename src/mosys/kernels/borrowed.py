@@ -6,7 +6,8 @@ it can prove redundant, but not those of a long loop body with many branches, su
 simulator's step inlined in its run (in a 3-D BSR run they were 9 % of the time). A borrowed view
 is the same array with no owner: its counts are never touched. It is valid only while the array
 it was made from is alive, which its maker must see to (an argument of the function that made
-it, or a local used again after the view's last use).
+it, or a local used again after the view's last use), and it must not leave the kernels: returned
+to Python, an array that numba allocated would have no owner at all.
 """
 
 from __future__ import annotations
