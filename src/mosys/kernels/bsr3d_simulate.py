@@ -52,7 +52,7 @@ FIXED_POINT_ITERATIONS = 50  # of the shared-friction shares
 TWIST_RATIO = 1.0
 # m: the margin by which an endpoint must clear the contact tolerance, however fast it falls, to
 # be passed over without computing its motion (rounding there is far smaller)
-REACH_MARGIN = 1e-9
+PASS_OVER_MARGIN = 1e-9
 
 
 class FigureArrays3D(NamedTuple):
@@ -1030,10 +1030,19 @@ def step(figure, state, target, tau, dt, work, place_rods):
     parent, hinge, rest, length, mass, com, inertia, joint, endpoints = figure[:9]
     joint_min, joint_max, gravity, floor, reach = figure[9:]
     previous, rod_ends, end_offset, end_velocity, end_force, frames, scratch = work[:7]
-    matrices, vectors, contact, responses, system, mixing, shares, chosen, entry, end_share = work[
-        7:17
-    ]
-    pairs = work.pairs
+    (
+        matrices,
+        vectors,
+        contact,
+        responses,
+        system,
+        mixing,
+        shares,
+        chosen,
+        entry,
+        end_share,
+        pairs,
+    ) = work[7:]
     rotation = matrices[0]
     tensor = matrices[1]
     tensor_inverse = matrices[2]
@@ -1100,16 +1109,8 @@ def step(figure, state, target, tau, dt, work, place_rods):
         # tolerance) is passed over unread
         fall = largest_fall(state, body_rate, end_velocity, reach, dt)
         for e in range(n_ends):
-            height = (
-                state[CY]
-                - floor
-                + (
-                    rotation[1, 0] * end_offset[e, 0]
-                    + rotation[1, 1] * end_offset[e, 1]
-                    + rotation[1, 2] * end_offset[e, 2]
-                )
-            )
-            if height - fall > CONTACT_TOLERANCE + REACH_MARGIN:
+            height = endpoint_position(state, rotation, end_offset, e)[1] - floor
+            if height - fall > CONTACT_TOLERANCE + PASS_OVER_MARGIN:
                 continue
             _, ry, _, _, uy, _ = endpoint_motion(
                 state, rotation, body_rate, end_offset, end_velocity, e
