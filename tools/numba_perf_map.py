@@ -18,6 +18,7 @@ from __future__ import annotations
 import os
 import re
 import runpy
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -82,8 +83,17 @@ def write_map() -> None:
 
 
 def main() -> None:
-    if len(sys.argv) < 2:
-        sys.exit("usage: python tools/numba_perf_map.py SCRIPT [ARGS...]")
+    if len(sys.argv) < 2 or not Path(sys.argv[1]).is_file():
+        found = f"{sys.argv[1]!r}, not a file" if len(sys.argv) > 1 else "nothing"
+        print(
+            f"usage: python tools/numba_perf_map.py SCRIPT [ARGS...]: expected a Python script, "
+            f"found {found}",
+            file=sys.stderr,
+        )
+        sys.exit(2)
+    if shutil.which("nm") is None:
+        print("numba_perf_map: needs binutils' nm (to read the functions' sizes)", file=sys.stderr)
+        sys.exit(2)
     os.environ["NUMBA_CACHE_DIR"] = tempfile.mkdtemp(prefix="numba-perf-map-")
     script = sys.argv[1]
     sys.argv = sys.argv[1:]
