@@ -21,9 +21,9 @@ user + system time of the process and everything it ran (for a build, Snakemake 
 jobs); ``target_s`` and ``meets_target`` (the best wall time against it); ``heavy_imports``
 the numerical libraries a verb's ``--help`` imported (numpy, h5py, sympy, numba, matplotlib,
 pandas, scipy: there should be none); ``detail`` for a build the sum of its jobs' wall times
-(their ``benchmark:`` files), for the two cold jobs how many kernels each compiled and how many
-both did (none: each kernel compiles once per machine; the two compile different ones side by
-side).
+(their ``benchmark:`` files), for the two cold jobs how many kernel signatures each compiled
+(numba's machine-code files, one per kernel and signature) and how many both did (none: each
+compiles once per machine; the two compile different ones side by side).
 """
 
 from __future__ import annotations
@@ -144,7 +144,8 @@ def build(work: Path, env: dict[str, str]) -> tuple[float, float, float]:
 
 def cold_pair(work: Path, tmp: Path) -> dict:
     """Two ``mosys dp`` jobs (controllers A and B) started at once with an empty numba cache,
-    as Snakemake starts them: wall and CPU seconds, and the kernels each compiled and both did."""
+    as Snakemake starts them: wall and CPU seconds, and the kernel signatures each compiled and
+    both did."""
     cache = tmp / "pair_cache"
     env = environment(
         NUMBA_CACHE_DIR=str(cache / "numba"),
@@ -179,11 +180,13 @@ def cold_pair(work: Path, tmp: Path) -> dict:
     if any(job.returncode for job in jobs):
         raise RuntimeError("a cold mosys dp failed:\n" + "\n".join(outputs))
     cpu = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
-    saved = [  # the cache entries (kernels) each process compiled and wrote
+    saved = [  # the machine code each process compiled and wrote: a file per kernel and
+        # signature (a kernel's index file is written again for each of its signatures: two
+        # jobs that compiled different signatures of one kernel both write it)
         {
-            line.split("index saved to", 1)[1].strip()
+            line.split("data saved to", 1)[1].strip()
             for line in output.splitlines()
-            if "index saved to" in line
+            if "data saved to" in line
         }
         for output in outputs
     ]
@@ -192,7 +195,7 @@ def cold_pair(work: Path, tmp: Path) -> dict:
         "two mosys dp (A, B) at once, cold numba cache",
         [(wall, cpu)],
         None,
-        detail=f"kernels compiled: {len(saved[0])} and {len(saved[1])}, "
+        detail=f"kernel signatures compiled: {len(saved[0])} and {len(saved[1])}, "
         f"{len(saved[0] & saved[1])} by both",
     )
 
