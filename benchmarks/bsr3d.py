@@ -111,7 +111,8 @@ def time_population(
     rules (C, steps + 1)."""
     import numba
 
-    from mosys.kernels.bsr3d_controller import TERM_COUNT, run_population
+    from mosys.kernels.bsr3d_controller import TERM_COUNT
+    from mosys.kernels.bsr3d_population import run_population
 
     numba.set_num_threads(threads)
     spec, simulation = setup.spec, setup.simulation

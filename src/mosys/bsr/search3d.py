@@ -32,7 +32,8 @@ from mosys.bsr.search import (
 from mosys.bsr.start3d import standing_state
 from mosys.errors import InputError
 from mosys.io.bsr_result import BsrController
-from mosys.kernels.bsr3d_controller import Task, run_controller, run_population
+from mosys.kernels.bsr3d_controller import Task, run_controller
+from mosys.kernels.bsr3d_population import run_population
 from mosys.kernels.bsr3d_simulate import CX, CY, JOINTS, LX, QW, VX
 from mosys.parsing.bsr import FITNESS_TERMS_3D, BsrSpec
 from mosys.parsing.tokens import SpecError

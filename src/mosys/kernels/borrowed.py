@@ -56,3 +56,21 @@ def _borrowed(typingctx, value):
 @overload(borrowed)
 def _borrowed_in_numba(value):
     return lambda value: _borrowed(value)
+
+
+def keep_alive(value: object) -> None:
+    """Nothing: a use of ``value`` (an array or a tuple of them) at this point, so that numba
+    keeps it, and the memory of the borrowed views made from it, alive to here."""
+
+
+@intrinsic
+def _keep_alive(typingctx, value):
+    def codegen(context, builder, signature, args):
+        return context.get_dummy_value()
+
+    return types.none(value), codegen
+
+
+@overload(keep_alive)
+def _keep_alive_in_numba(value):
+    return lambda value: _keep_alive(value)

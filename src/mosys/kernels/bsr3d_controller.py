@@ -37,7 +37,7 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from mosys.kernels.borrowed import borrowed
 from mosys.kernels.bsr3d_simulate import (
@@ -54,8 +54,6 @@ from mosys.kernels.bsr3d_simulate import (
     step,
 )
 from mosys.kernels.bsr_controller import (
-    ControllerArrays,
-    RunRecord,
     active_rule,
     rule_weights,
     segment_rule,
@@ -143,6 +141,192 @@ def measure_senses(
         out[PHYSICAL_SENSES + n_ends + f] = min(max(value, 0.0), 1.0)
 
 
+class Tally(NamedTuple):
+    """What a 3-D run keeps between steps toward its fitness terms (``new_tallies``; K feet, E
+    endpoints): ``touching`` (E,) bool each endpoint within the contact tolerance of the floor
+    after the last step, ``foot_lift`` (K,) m each foot's highest point over the floor since it
+    left it, ``foot_start`` (K, 3) m each foot at the start (x and z), ``sums`` (SUMS,) the
+    running numbers indexed by HEADING_START ... DEVIATION, ``counts`` (3,) int64 the fallen
+    steps, the foot steps and the foot that made the last one (-1: none yet)."""
+
+    touching: np.ndarray
+    foot_lift: np.ndarray
+    foot_start: np.ndarray
+    sums: np.ndarray
+    counts: np.ndarray
+
+
+# Tally.sums: headings rad, the forward direction's x and z, the start's x and z m, the com's
+# highest and lowest height m, the sum over steps of |heading - heading at the start| rad
+(HEADING_START, HEADING, FORWARD_X, FORWARD_Z, START_X, START_Z, HIGHEST, LOWEST, DEVIATION) = (
+    range(9)
+)
+# Tally.counts
+FALLEN_STEPS, STEPS_TAKEN, LAST_FOOT = range(3)
+
+
+@njit(cache=True)
+def new_tallies(lanes, n_ends, n_feet):
+    """Empty Tallies for ``lanes`` runs of a figure of E = n_ends endpoints and K = n_feet feet:
+    one Tally whose arrays have a leading axis ``lanes`` (``lane_tally``; ``start_tally`` fills
+    each)."""
+    return Tally(
+        np.zeros((lanes, n_ends), np.bool_),
+        np.zeros((lanes, n_feet)),
+        np.zeros((lanes, n_feet, 3)),
+        np.zeros((lanes, 9)),
+        np.zeros((lanes, 3), np.int64),
+    )
+
+
+@njit(cache=True, inline="always")
+def lane_tally(tallies, lane):
+    """Lane ``lane``'s Tally of ``tallies`` (``new_tallies``)."""
+    return Tally(
+        tallies.touching[lane],
+        tallies.foot_lift[lane],
+        tallies.foot_start[lane],
+        tallies.sums[lane],
+        tallies.counts[lane],
+    )
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def start_tally(state, work, floor, task, tally):
+    """Fill the Tally ``tally`` for a run starting at the state (S,) with the StepWork ``work``
+    (its rotation, endpoints and the heading rod's frame; ``start_step_work``)."""
+    rotation = work.matrices[0]
+    end_offset = work.end_offset
+    frames = work.frames
+    touching, _, foot_start, sums, counts = tally
+    for e in range(end_offset.shape[0]):
+        y = apply(rotation, end_offset[e, 0], end_offset[e, 1], end_offset[e, 2])[1]
+        touching[e] = not math.isnan(floor) and state[CY] + y <= floor + CONTACT_TOLERANCE
+    for f in range(task.feet.shape[0]):
+        e = task.feet[f]
+        x, _, z = apply(rotation, end_offset[e, 0], end_offset[e, 1], end_offset[e, 2])
+        foot_start[f, 0] = state[CX] + x
+        foot_start[f, 2] = state[CZ] + z
+    heading_start = heading_of(frames, rotation, task.heading_rod, task.heading_offset)
+    sums[HEADING_START] = heading_start
+    sums[HEADING] = heading_start
+    sums[FORWARD_X] = math.cos(heading_start)
+    sums[FORWARD_Z] = -math.sin(heading_start)
+    sums[START_X] = state[CX]
+    sums[START_Z] = state[CZ]
+    sums[HIGHEST] = state[CY]
+    sums[LOWEST] = state[CY]
+    counts[LAST_FOOT] = -1
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def tally_step(state, work, floor, task, tally):
+    """Count a step that ended at the state (S,) (``work`` as ``start_tally`` reads it) into
+    ``tally``: touch-downs, falls, heights, heading."""
+    rotation = work.matrices[0]
+    end_offset = work.end_offset
+    frames = work.frames
+    touching, foot_lift, _, sums, counts = tally
+    n_feet = task.feet.shape[0]
+    fallen = state[CY] < task.fall_height
+    for e in range(end_offset.shape[0]):
+        y = state[CY] + (
+            rotation[1, 0] * end_offset[e, 0]
+            + rotation[1, 1] * end_offset[e, 1]
+            + rotation[1, 2] * end_offset[e, 2]
+        )
+        now_touching = not math.isnan(floor) and y <= floor + CONTACT_TOLERANCE
+        for f in range(n_feet):
+            if task.feet[f] != e:
+                continue
+            if not now_touching:
+                foot_lift[f] = max(foot_lift[f], y - floor)
+                continue
+            if not touching[e] and foot_lift[f] >= STEP_LIFT:
+                # a touch-down after a lift: a step if another foot made the last one
+                if f != counts[LAST_FOOT]:
+                    counts[STEPS_TAKEN] += 1
+                counts[LAST_FOOT] = f
+            foot_lift[f] = 0.0
+        touching[e] = now_touching
+    for f in range(task.falls.shape[0]):
+        if touching[task.falls[f]]:
+            fallen = True
+    if fallen:
+        counts[FALLEN_STEPS] += 1
+    sums[HIGHEST] = max(sums[HIGHEST], state[CY])
+    sums[LOWEST] = min(sums[LOWEST], state[CY])
+    now = heading_of(frames, rotation, task.heading_rod, task.heading_offset)
+    turned = now - sums[HEADING]
+    turned -= 2.0 * math.pi * math.floor((turned + math.pi) / (2.0 * math.pi))
+    sums[HEADING] += turned
+    sums[DEVIATION] += abs(sums[HEADING] - sums[HEADING_START])
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def tally_terms(state, work, task, tally, steps, terms_out):
+    """Fill terms_out (TERM_COUNT,) from the tally of a run of ``steps`` steps that ended at
+    the state (S,) with the StepWork ``work`` (its rotation, inverse inertia and spin)."""
+    _, _, foot_start, sums, counts = tally
+    forward_x = sums[FORWARD_X]
+    forward_z = sums[FORWARD_Z]
+    dx = state[CX] - sums[START_X]
+    dz = state[CZ] - sums[START_Z]
+    turned = sums[HEADING] - sums[HEADING_START]
+    terms_out[DISTANCE] = dx * forward_x + dz * forward_z
+    terms_out[SIDEWAYS] = abs(dx * forward_z - dz * forward_x)
+    terms_out[HEADING_CHANGE] = math.degrees(turned)
+    terms_out[MAX_HEIGHT] = sums[HIGHEST]
+    terms_out[FALL] = counts[FALLEN_STEPS] / steps
+    terms_out[HEADING_DEVIATION] = math.degrees(sums[DEVIATION] / steps)
+    feet_distance = 0.0
+    rotation = work.matrices[0]
+    end_offset = work.end_offset
+    n_feet = task.feet.shape[0]
+    for f in range(n_feet):
+        e = task.feet[f]
+        x, _, z = apply(rotation, end_offset[e, 0], end_offset[e, 1], end_offset[e, 2])
+        feet_distance += (state[CX] + x - foot_start[f, 0]) * forward_x
+        feet_distance += (state[CZ] + z - foot_start[f, 2]) * forward_z
+    terms_out[FEET_DISTANCE] = feet_distance / n_feet if n_feet > 0 else 0.0
+    terms_out[FOOT_STEPS] = counts[STEPS_TAKEN]
+    terms_out[MIN_HEIGHT] = sums[LOWEST]
+    terms_out[HEADING_SINE] = math.sin(turned)
+    # the body's rate at the end: I⁻¹ (L - h) in the world (the deformation's own spin h)
+    world_inverse = work.matrices[3]
+    conjugate(rotation, work.matrices[2], world_inverse)
+    wx, wy, wz = rigid_rate(state, rotation, world_inverse, work.vectors[0, :3])
+    terms_out[FINAL_SPIN] = math.degrees(math.sqrt(wx * wx + wy * wy + wz * wz))
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def sense_step(state, work, weight, task, figure, smoothing, raw, filtered):
+    """Measure the senses after a step into raw (V,) and low-pass them into filtered (V,) (the
+    physical ones with the factor ``smoothing``; the joint angles as measured); weight = M g N."""
+    end_force = work.end_force
+    rotation = work.matrices[0]
+    world_inverse = work.matrices[3]
+    conjugate(rotation, work.matrices[2], world_inverse)
+    measure_senses(
+        state,
+        rotation,
+        world_inverse,
+        work.vectors[0, :3],
+        end_force,
+        weight,
+        figure.floor,
+        task,
+        figure.joint_min,
+        figure.joint_max,
+        raw,
+    )
+    physical = PHYSICAL_SENSES + end_force.shape[0]
+    for v in range(physical):
+        filtered[v] += smoothing * (raw[v] - filtered[v])
+    for v in range(physical, raw.shape[0]):
+        filtered[v] = raw[v]
+
+
 @njit(cache=True, error_model="numpy")
 def run_controller(figure, controller, task, start, start_force, carry_over, steps, dt, record):
     """Run a controller (a ControllerArrays) of the 3-D figure (a FigureArrays3D) for ``steps``
@@ -153,45 +337,34 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
     (``kernels.borrowed``), so that the step loop raises and lowers no reference count.
     Returns ``steps``, or ``blown_up(n)`` (< 0) if the state is not sound (``state_is_sound``)
     before step n (n = steps: after the last), as the 2-D run_controller: the samples 0 to n
-    recorded, terms_out NaN, final_state the unsound state."""
+    recorded, terms_out NaN, final_state the unsound state. ``bsr3d_population.run_lockstep``
+    runs four at once, with the same numbers."""
     figure = borrowed(figure)
     task = borrowed(task)
-    parent, hinge, rest, length, mass, com, inertia, joint, endpoints = figure[:9]
-    joint_min, joint_max, gravity, floor, _ = figure[9:]
+    floor = figure.floor
     time_based, target, tau, center, side, segment_end, period = borrowed(controller)
     senses_out, rule_out, terms_out, ends_out, com_out, final_state, final_force = borrowed(record)
     own_state = start.copy()
     state = borrowed(own_state)
-    n_rods = parent.shape[0]
-    n_ends = endpoints.shape[0]
+    n_rods = figure.parent.shape[0]
+    n_ends = figure.endpoints.shape[0]
     own_work = new_step_work(n_rods, n_ends)
     work = borrowed(own_work)
+    own_tally = lane_tally(new_tallies(1, n_ends, task.feet.shape[0]), 0)
+    tally = borrowed(own_tally)
     rod_ends, end_offset, _, end_force, frames = work[1:6]
-    matrices, vectors = work[7:9]
+    matrices = work.matrices
     end_force[:] = start_force
-    world_inverse = np.empty((3, 3))
     sensing = senses_out.shape[1] > 0
     raw = np.empty(senses_out.shape[1])
     filtered = np.empty(senses_out.shape[1])
-    weight = mass.sum() * gravity
+    weight = figure.mass.sum() * figure.gravity
     recording = ends_out.shape[0] == steps + 1
     weights = rule_weights(side)
     start_step_work(figure, state, work)
-    rotation = matrices[0]
-    conjugate(rotation, matrices[2], world_inverse)
-    # the start
-    n_feet = task.feet.shape[0]
-    foot_start = np.empty((n_feet, 3))
-    touching = np.zeros(n_ends, np.bool_)
-    for e in range(n_ends):
-        x, y, z = apply(rotation, end_offset[e, 0], end_offset[e, 1], end_offset[e, 2])
-        touching[e] = not math.isnan(floor) and state[CY] + y <= floor + CONTACT_TOLERANCE
-    for f in range(n_feet):
-        e = task.feet[f]
-        x, y, z = apply(rotation, end_offset[e, 0], end_offset[e, 1], end_offset[e, 2])
-        foot_start[f, 0] = state[CX] + x
-        foot_start[f, 2] = state[CZ] + z
+    start_tally(state, work, floor, task, tally)
     if recording:
+        rotation = matrices[0]
         for k in range(n_rods):
             for end in range(2):
                 x, y, z = apply(
@@ -204,17 +377,18 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
         com_out[0, 1] = state[CY]
         com_out[0, 2] = state[CZ]
     if sensing:
+        conjugate(matrices[0], matrices[2], matrices[3])
         measure_senses(
             state,
-            rotation,
-            world_inverse,
-            vectors[0, :3],
+            matrices[0],
+            matrices[3],
+            work.vectors[0, :3],
             end_force,
             weight,
             floor,
             task,
-            joint_min,
-            joint_max,
+            figure.joint_min,
+            figure.joint_max,
             filtered,
         )
         senses_out[0] = filtered
@@ -223,76 +397,13 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
     if carry_over and not time_based:
         rule = active_rule(senses_out[0], center, side, weights, 0)
     rule_out[0] = rule
-    heading_start = heading_of(frames, rotation, task.heading_rod, task.heading_offset)
-    heading = heading_start
-    forward_x = math.cos(heading_start)
-    forward_z = -math.sin(heading_start)
-    start_x = state[CX]
-    start_z = state[CZ]
-    max_height = state[CY]
-    min_height = state[CY]
-    deviation = 0.0
-    fallen_steps = 0
-    foot_steps = 0
-    last_foot = -1
-    foot_lift = np.zeros(n_feet)  # each foot's highest point since it left the floor, m
     for n in range(steps):
         if not state_is_sound(state):
             return stop_unsound(n, state, end_force, terms_out, final_state, final_force)
         step(figure, state, target[rule], tau[rule], dt, work, recording)
-        rotation = matrices[0]
-        fallen = state[CY] < task.fall_height
-        for e in range(n_ends):
-            y = state[CY] + (
-                rotation[1, 0] * end_offset[e, 0]
-                + rotation[1, 1] * end_offset[e, 1]
-                + rotation[1, 2] * end_offset[e, 2]
-            )
-            now_touching = not math.isnan(floor) and y <= floor + CONTACT_TOLERANCE
-            for f in range(n_feet):
-                if task.feet[f] != e:
-                    continue
-                if not now_touching:
-                    foot_lift[f] = max(foot_lift[f], y - floor)
-                    continue
-                if not touching[e] and foot_lift[f] >= STEP_LIFT:
-                    # a touch-down after a lift: a step if another foot made the last one
-                    if f != last_foot:
-                        foot_steps += 1
-                    last_foot = f
-                foot_lift[f] = 0.0
-            touching[e] = now_touching
-        for f in range(task.falls.shape[0]):
-            if touching[task.falls[f]]:
-                fallen = True
-        if fallen:
-            fallen_steps += 1
-        max_height = max(max_height, state[CY])
-        min_height = min(min_height, state[CY])
-        now = heading_of(frames, rotation, task.heading_rod, task.heading_offset)
-        turned = now - heading
-        turned -= 2.0 * math.pi * math.floor((turned + math.pi) / (2.0 * math.pi))
-        heading += turned
-        deviation += abs(heading - heading_start)
+        tally_step(state, work, floor, task, tally)
         if sensing:
-            conjugate(rotation, matrices[2], world_inverse)
-            measure_senses(
-                state,
-                rotation,
-                world_inverse,
-                vectors[0, :3],
-                end_force,
-                weight,
-                floor,
-                task,
-                joint_min,
-                joint_max,
-                raw,
-            )
-            for v in range(PHYSICAL_SENSES + n_ends):
-                filtered[v] += smoothing * (raw[v] - filtered[v])
-            for v in range(PHYSICAL_SENSES + n_ends, raw.shape[0]):
-                filtered[v] = raw[v]
+            sense_step(state, work, weight, task, figure, smoothing, raw, filtered)
             senses_out[n + 1] = filtered
         if time_based:
             rule = segment_rule((n + 1) * dt, segment_end, period)
@@ -306,83 +417,8 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
             com_out[n + 1, 2] = state[CZ]
     if not state_is_sound(state):
         return stop_unsound(steps, state, end_force, terms_out, final_state, final_force)
-    dx = state[CX] - start_x
-    dz = state[CZ] - start_z
-    terms_out[DISTANCE] = dx * forward_x + dz * forward_z
-    terms_out[SIDEWAYS] = abs(dx * forward_z - dz * forward_x)
-    terms_out[HEADING_CHANGE] = math.degrees(heading - heading_start)
-    terms_out[MAX_HEIGHT] = max_height
-    terms_out[FALL] = fallen_steps / steps
-    terms_out[HEADING_DEVIATION] = math.degrees(deviation / steps)
-    feet_distance = 0.0
-    rotation = matrices[0]
-    for f in range(n_feet):
-        e = task.feet[f]
-        x, _, z = apply(rotation, end_offset[e, 0], end_offset[e, 1], end_offset[e, 2])
-        feet_distance += (state[CX] + x - foot_start[f, 0]) * forward_x
-        feet_distance += (state[CZ] + z - foot_start[f, 2]) * forward_z
-    terms_out[FEET_DISTANCE] = feet_distance / n_feet if n_feet > 0 else 0.0
-    terms_out[FOOT_STEPS] = foot_steps
-    terms_out[MIN_HEIGHT] = min_height
-    terms_out[HEADING_SINE] = math.sin(heading - heading_start)
-    # the body's rate at the end: I⁻¹ (L - h) in the world (the deformation's own spin h)
-    conjugate(rotation, matrices[2], world_inverse)
-    wx, wy, wz = rigid_rate(state, rotation, world_inverse, vectors[0, :3])
-    terms_out[FINAL_SPIN] = math.degrees(math.sqrt(wx * wx + wy * wy + wz * wz))
-    final_state[:] = own_state  # (its last use: the borrowed state's memory is kept to here)
-    final_force[:] = own_work.end_force  # (as own_work's, the borrowed work's)
+    # own_tally's, own_state's and own_work's last uses: the borrowed views' memory is kept to here
+    tally_terms(state, work, task, own_tally, steps, terms_out)
+    final_state[:] = own_state
+    final_force[:] = own_work.end_force
     return steps
-
-
-@njit(cache=True, parallel=True)
-def run_population(
-    figure,
-    controllers,
-    task,
-    starts,
-    steps,
-    dt,
-    senses_out,
-    rule_out,
-    terms_out,
-    taken_out,
-    final_out,
-):
-    """``run_controller`` for C controllers at once, in parallel (each run is independent, so
-    the results do not depend on the number of threads): controllers a ControllerArrays whose
-    arrays have a leading axis C, starts (C, S); fills senses_out (C, steps + 1, V), rule_out
-    (C, steps + 1), terms_out (C, TERM_COUNT), taken_out (C,) int64 what each run returned
-    (steps, or ``blown_up(n)`` < 0: its terms are NaN) and final_out (C, S) each run's last
-    state (the unsound one where it stopped)."""
-    n_rods = figure.parent.shape[0]
-    n_ends = figure.endpoints.shape[0]
-    for c in prange(starts.shape[0]):
-        controller = ControllerArrays(
-            controllers.time_based,
-            controllers.target[c],
-            controllers.tau[c],
-            controllers.center[c],
-            controllers.side[c],
-            controllers.segment_end[c],
-            controllers.period,
-        )
-        record = RunRecord(
-            senses_out[c],
-            rule_out[c],
-            terms_out[c],
-            np.empty((0, n_rods, 2, 3)),
-            np.empty((0, 3)),
-            final_out[c],
-            np.empty(n_ends),
-        )
-        taken_out[c] = run_controller(
-            figure,
-            controller,
-            task,
-            starts[c],
-            np.zeros(n_ends),
-            np.bool_(False),  # a bool, not the literal False: the run_controller a call
-            steps,  # from Python compiles (a literal is a signature of its own)
-            dt,
-            record,
-        )

@@ -89,6 +89,25 @@ def _cross(ax, ay, az, bx, by, bz):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def joint_trig(parent, joint, theta, scratch):
+    """Keep each rod's joint angles' cosines and sines in the last two rows of ``scratch`` (N,
+    7, 3; ``new_scratch``): row 5 (θ, cos θ, sin θ), row 6 (ψ, cos ψ, sin ψ), recomputed only for
+    angles that moved since the last call (fixed ones never do). theta (J,) rad."""
+    for k in range(parent.shape[0]):
+        if parent[k] < 0:
+            continue
+        j = joint[k]
+        if theta[j] != scratch[k, 5, 0]:
+            scratch[k, 5, 0] = theta[j]
+            scratch[k, 5, 1] = math.cos(theta[j])
+            scratch[k, 5, 2] = math.sin(theta[j])
+        if theta[j + 1] != scratch[k, 6, 0]:
+            scratch[k, 6, 0] = theta[j + 1]
+            scratch[k, 6, 1] = math.cos(theta[j + 1])
+            scratch[k, 6, 2] = math.sin(theta[j + 1])
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def body_frame(
     parent,
     hinge,
@@ -121,6 +140,7 @@ def body_frame(
     Returns the total mass, kg. theta, theta_rate (J,): rad, rad/s.
     """
     n = parent.shape[0]
+    joint_trig(parent, joint, theta, scratch)
     omega = scratch[:, 0]
     proximal = scratch[:, 1]
     proximal_velocity = scratch[:, 2]
@@ -142,15 +162,6 @@ def body_frame(
                 proximal_velocity[k, a] = 0.0
         else:
             j = joint[k]
-            # cosines and sines only of angles that moved (fixed ones never do)
-            if theta[j] != trig_theta[k, 0]:
-                trig_theta[k, 0] = theta[j]
-                trig_theta[k, 1] = math.cos(theta[j])
-                trig_theta[k, 2] = math.sin(theta[j])
-            if theta[j + 1] != trig_psi[k, 0]:
-                trig_psi[k, 0] = theta[j + 1]
-                trig_psi[k, 1] = math.cos(theta[j + 1])
-                trig_psi[k, 2] = math.sin(theta[j + 1])
             ct = trig_theta[k, 1]
             st = trig_theta[k, 2]
             cp = trig_psi[k, 1]
@@ -947,29 +958,67 @@ class StepWork(NamedTuple):
 
 
 @njit(cache=True)
-def new_step_work(n_rods, n_ends):
-    """A StepWork for N = n_rods rods and E = n_ends endpoints, at rest: no spin, no contact
-    before, no force; its ``end_offset`` must then be filled (``body_frame``) before a step."""
+def new_step_works(lanes, n_rods, n_ends):
+    """StepWorks for ``lanes`` runs of a figure of N = n_rods rods and E = n_ends endpoints, at
+    rest (no spin, no contact before, no force): one StepWork whose arrays have a leading axis
+    ``lanes``, lane ``i``'s work ``lane_work(works, i, ...)``. Each lane's ``end_offset`` must
+    be filled (``body_frame``) before its first step."""
     m = MAX_CONTACTS
     return StepWork(
-        np.zeros(3),
-        np.empty((n_rods, 2, 3)),
-        np.empty((n_ends, 3)),
-        np.empty((n_ends, 3)),
-        np.zeros(n_ends),
-        np.empty((n_rods, 3, 3)),
-        new_scratch(n_rods),
-        np.empty((5, 3, 3)),
-        np.zeros((3, 4)),
-        np.empty((3, m, 3)),
-        np.empty((m, m, 3, 3)),
-        np.empty((m + 4, m + 4)),
-        np.empty((3, m, m)),
-        np.empty((3, m)),
-        np.empty(m, np.int64),
-        np.empty((n_ends, 3)),
-        np.zeros(n_ends),
-        np.empty((m, m, 9)),
+        np.zeros((lanes, 3)),
+        np.empty((lanes, n_rods, 2, 3)),
+        np.empty((lanes, n_ends, 3)),
+        np.empty((lanes, n_ends, 3)),
+        np.zeros((lanes, n_ends)),
+        np.empty((lanes, n_rods, 3, 3)),
+        np.full((lanes, n_rods, 7, 3), np.nan),  # new_scratch's, for each lane
+        np.empty((lanes, 5, 3, 3)),
+        np.zeros((lanes, 3, 4)),
+        np.empty((lanes, 3, m, 3)),
+        np.empty((lanes, m, m, 3, 3)),
+        np.empty((lanes, m + 4, m + 4)),
+        np.empty((lanes, 3, m, m)),
+        np.empty((lanes, 3, m)),
+        np.empty((lanes, m), np.int64),
+        np.empty((lanes, n_ends, 3)),
+        np.zeros((lanes, n_ends)),
+        np.empty((lanes, m, m, 9)),
+    )
+
+
+@njit(cache=True, inline="always")
+def lane_work(works, lane, rod_ends, end_offset, end_velocity, frames):
+    """Lane ``lane``'s StepWork of ``works`` (``new_step_works``), with the arrays given for the
+    four that the body frame fills (``works``' own lane of them, or the lane's views of arrays
+    that hold several lanes, as ``bsr3d_lanes.body_frame_lanes`` fills them)."""
+    return StepWork(
+        works.previous[lane],
+        rod_ends,
+        end_offset,
+        end_velocity,
+        works.end_force[lane],
+        frames,
+        works.scratch[lane],
+        works.matrices[lane],
+        works.vectors[lane],
+        works.contact[lane],
+        works.responses[lane],
+        works.system[lane],
+        works.mixing[lane],
+        works.shares[lane],
+        works.chosen[lane],
+        works.entry[lane],
+        works.end_share[lane],
+        works.pairs[lane],
+    )
+
+
+@njit(cache=True)
+def new_step_work(n_rods, n_ends):
+    """A StepWork for N = n_rods rods and E = n_ends endpoints (``new_step_works``' one lane)."""
+    works = new_step_works(1, n_rods, n_ends)
+    return lane_work(
+        works, 0, works.rod_ends[0], works.end_offset[0], works.end_velocity[0], works.frames[0]
     )
 
 
@@ -1027,22 +1076,60 @@ def step(figure, state, target, tau, dt, work, place_rods):
     One piece on purpose, as the 2-D step (that module's docstring says why); inlined where it
     is called, so that no array crosses a call each step.
     """
-    parent, hinge, rest, length, mass, com, inertia, joint, endpoints = figure[:9]
-    joint_min, joint_max, gravity, floor, reach = figure[9:]
-    previous, rod_ends, end_offset, end_velocity, end_force, frames, scratch = work[:7]
-    (
-        matrices,
-        vectors,
-        contact,
-        responses,
-        system,
-        mixing,
-        shares,
-        chosen,
-        entry,
-        end_share,
-        pairs,
-    ) = work[7:]
+    step_deform(figure, state, target, tau, dt, work)
+    n_joints = target.shape[0]
+    total_mass = body_frame(
+        figure.parent,
+        figure.hinge,
+        figure.rest,
+        figure.length,
+        figure.mass,
+        figure.com,
+        figure.inertia,
+        figure.joint,
+        figure.endpoints,
+        state[JOINTS : JOINTS + n_joints],
+        state[JOINTS + n_joints : JOINTS + 2 * n_joints],
+        work.rod_ends,
+        work.end_offset,
+        work.end_velocity,
+        work.frames,
+        work.scratch,
+        work.matrices[1],
+        work.vectors[0, :3],
+    )
+    step_motion(figure, state, dt, work, total_mass, place_rods)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def step_deform(figure, state, target, tau, dt, work):
+    """``step``'s first part: the endpoints' world positions before the step (work.entry) and
+    the joints advanced toward the target pose (J,) rad (``deform_joints``). The body frame of
+    the new pose comes next (``body_frame``, or ``bsr3d_lanes.body_frame_lanes`` for several
+    controllers at once), then ``step_motion``."""
+    rotation = work.matrices[0]
+    quaternion = state[QW : QW + 4]
+    end_offset = work.end_offset
+    entry = work.entry
+    rotation_of(quaternion, rotation)
+    for e in range(figure.endpoints.shape[0]):
+        entry[e, 0], entry[e, 1], entry[e, 2] = endpoint_position(state, rotation, end_offset, e)
+    n_joints = target.shape[0]
+    theta = state[JOINTS : JOINTS + n_joints]
+    theta_rate = state[JOINTS + n_joints : JOINTS + 2 * n_joints]
+    deform_joints(theta, theta_rate, target, tau, figure.joint_min, figure.joint_max, dt)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def step_motion(figure, state, dt, work, total_mass, place_rods):
+    """``step``'s last part, after the body frame of the deformed pose is in ``work`` (its
+    end_offset, end_velocity, inertia tensor work.matrices[1], spin work.vectors[0, :3];
+    total_mass kg): the orientation correction, gravity, the contacts and the rigid motion."""
+    endpoints = figure.endpoints
+    gravity, floor, reach = figure[11:]
+    previous, rod_ends, end_offset, end_velocity, end_force = work[:5]
+    matrices, vectors, contact, responses, system, mixing, shares, chosen, entry = work[7:16]
+    end_share, pairs = work[16:]
     rotation = matrices[0]
     tensor = matrices[1]
     tensor_inverse = matrices[2]
@@ -1052,34 +1139,7 @@ def step(figure, state, target, tau, dt, work, place_rods):
     body_rate = vectors[1, :3]
     quaternion = state[QW : QW + 4]
     half = vectors[2]
-    rotation_of(quaternion, rotation)
     n_ends = endpoints.shape[0]
-    for e in range(n_ends):
-        entry[e, 0], entry[e, 1], entry[e, 2] = endpoint_position(state, rotation, end_offset, e)
-    n_joints = target.shape[0]
-    theta = state[JOINTS : JOINTS + n_joints]
-    theta_rate = state[JOINTS + n_joints : JOINTS + 2 * n_joints]
-    deform_joints(theta, theta_rate, target, tau, joint_min, joint_max, dt)
-    total_mass = body_frame(
-        parent,
-        hinge,
-        rest,
-        length,
-        mass,
-        com,
-        inertia,
-        joint,
-        endpoints,
-        theta,
-        theta_rate,
-        rod_ends,
-        end_offset,
-        end_velocity,
-        frames,
-        scratch,
-        tensor,
-        spin,
-    )
     invert_symmetric(tensor, tensor_inverse)
     # orientation correction: the deformation leaves the angular momentum unchanged
     sx, sy, sz = apply(tensor_inverse, spin[0], spin[1], spin[2])
