@@ -11,7 +11,7 @@ import pytest
 from mosys.bsr.figure3d import load_bsr_figure3d
 from mosys.bsr.search3d import bind_search3d
 from mosys.kernels.bsr3d_controller import TERM_COUNT, run_controller
-from mosys.kernels.bsr3d_population import run_population
+from mosys.kernels.bsr3d_population import lockstep_groups, run_population
 from mosys.kernels.bsr3d_simulate import VX
 from mosys.kernels.bsr_controller import (
     CENTER_MAX,
@@ -21,6 +21,7 @@ from mosys.kernels.bsr_controller import (
     ControllerArrays,
     RunRecord,
 )
+from mosys.kernels.lanes import LANES
 from mosys.kernels.soundness import blown_up
 from mosys.parsing.bsr import parse_bsr_spec
 
@@ -89,3 +90,20 @@ def test_each_controller_of_a_population_runs_as_it_does_alone_bit_for_bit(searc
         np.testing.assert_array_equal(alone.final_state, final[c])
     # the runs differ from each other (a test of something)
     assert len({tuple(row) for row in terms[[0, 2, 3, 4, 5]]}) == POPULATION - 1
+
+
+@pytest.mark.parametrize("threads", [1, 2, 3])
+@pytest.mark.parametrize("population", [1, 3, 4, 5, 9, 10, 40, 41])
+def test_the_groups_hold_every_controller_once_and_give_each_thread_an_even_share(
+    population, threads
+):
+    groups = lockstep_groups(population, threads)
+    members = groups[groups >= 0]
+    assert sorted(members.tolist()) == list(range(population))
+    assert groups.shape[1] == LANES and groups.shape[0] % threads == 0
+    # each group's members fill its first lanes; each thread's block of groups runs about
+    # the same number of controllers, in as few groups as the largest share needs
+    assert all((row >= 0).tolist() == sorted((row >= 0).tolist(), reverse=True) for row in groups)
+    per_thread = (groups >= 0).reshape(threads, -1, LANES).sum(axis=(1, 2))
+    assert per_thread.max() - per_thread.min() <= 1
+    assert groups.shape[0] // threads == -(-per_thread.max() // LANES)

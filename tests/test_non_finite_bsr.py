@@ -29,7 +29,7 @@ from mosys.bsr.search3d import ChainStart, bind_search3d
 from mosys.bsr.start import standing_state
 from mosys.composite.session import CompositeSession
 from mosys.errors import NonFiniteStateError
-from mosys.kernels import bsr3d_controller, bsr_controller
+from mosys.kernels import bsr3d_controller, bsr3d_population, bsr_controller
 from mosys.kernels.bsr3d_simulate import VY as VY_3D
 from mosys.kernels.bsr_simulate import VY
 from mosys.kernels.soundness import STATE_LIMIT, blown_up, state_is_sound, steps_before_blow_up
@@ -180,7 +180,7 @@ def test_one_unsound_start_in_a_population_leaves_the_others_bit_for_bit(family)
             terms, taken, final,
         )  # fmt: skip
     else:
-        bsr3d_controller.run_population(
+        bsr3d_population.run_population(
             CUJO.arrays, arrays, setup.simulation.task, starts, steps, DT, senses, rules, terms,
             taken, final,
         )  # fmt: skip

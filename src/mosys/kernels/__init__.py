@@ -1,7 +1,7 @@
 """The numeric kernels (numba, ``cache=True``).
 
 numba checks a cached function against its own source file only: a kernel that calls a kernel of
-another file (``bsr3d_controller.run_population`` steps ``bsr3d_simulate.step``) would keep
+another file (``bsr3d_controller.run_lockstep`` calls ``bsr3d_simulate.step_motion``) would keep
 running the callee as it was compiled. So the cache stands for the whole package: importing it
 compares a digest of every kernel source file with the one the cache was built from and, if they
 differ, removes the package's cached machine code (numba's ``.nbi``/``.nbc`` files, beside the

@@ -1,6 +1,7 @@
-"""Running a BSR controller of a 3-D figure (the 1995 paper's §4): the simulator steps, the
-senses of §4.2, rule selection (shared with 2-D), and the 3-D fitness terms; a population at
-once in parallel.
+"""Running BSR controllers of a 3-D figure (the 1995 paper's §4): the simulator steps, the
+senses of §4.2, rule selection (shared with 2-D), and the 3-D fitness terms; four runs at once
+in lockstep (``run_lockstep``: their body frames in vector lanes), one run as a lockstep of one
+(``run_controller``); a population in groups of four is ``kernels.bsr3d_population``'s.
 
 Senses (V = 10 + E + F, each normalised to [0, 1] and clipped), in this order: the centre of
 mass's height over the floor ``y / (2 h0)``; its velocity, the body's angular velocity and the
@@ -28,7 +29,8 @@ angular speed at the end, deg/s (a run that ends toppling or spinning pays for i
 search of a chain starts there).
 
 A run stops where the state is not sound (``kernels.soundness.state_is_sound``), as the 2-D
-one does: checked before every step and after the last, it returns ``blown_up(step)`` (< 0).
+one does: checked before every step and after the last, it returns ``blown_up(step)`` (< 0);
+the other runs of its lockstep go on.
 """
 
 from __future__ import annotations
@@ -39,7 +41,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from mosys.kernels.borrowed import borrowed
+from mosys.kernels.borrowed import borrowed, keep_alive
+from mosys.kernels.bsr3d_lanes import body_frame_lanes
 from mosys.kernels.bsr3d_simulate import (
     CX,
     CY,
@@ -48,18 +51,23 @@ from mosys.kernels.bsr3d_simulate import (
     VX,
     apply,
     conjugate,
-    new_step_work,
+    joint_trig,
+    lane_work,
+    new_step_works,
     rigid_rate,
     start_step_work,
-    step,
+    step_deform,
+    step_motion,
 )
 from mosys.kernels.bsr_controller import (
+    ControllerArrays,
     active_rule,
     rule_weights,
     segment_rule,
     stop_unsound,
 )
 from mosys.kernels.bsr_simulate import CONTACT_TOLERANCE
+from mosys.kernels.lanes import LANES
 from mosys.kernels.soundness import state_is_sound
 
 # the columns of terms_out (``parsing.bsr.FITNESS_TERMS_3D`` names them in this order)
@@ -328,97 +336,332 @@ def sense_step(state, work, weight, task, figure, smoothing, raw, filtered):
 
 
 @njit(cache=True, error_model="numpy")
+def run_lockstep(
+    figure, controllers, task, members, starts, start_forces, carry_over, steps, dt, records
+):
+    """Run the controllers ``members`` (LANES,) int64 (-1: an empty lane) of ``controllers`` (a
+    ControllerArrays whose arrays have a leading axis C) of the 3-D figure (a FigureArrays3D)
+    for ``steps`` steps of dt seconds at once, in lockstep: lane i runs controller c =
+    members[i] from the state starts[c] (C, S) with the endpoints' normal forces
+    start_forces[c] (C, E) N, measuring as ``task`` (a Task) says, filling lane c of
+    ``records`` (a RunRecord whose arrays have a leading axis C, and ``taken_out`` (C,) int64
+    as its last member: what the run of c returns). carry_over: start with the rule the senses
+    pick (a controller continuing another) instead of rule 0.
+
+    Each step deforms every lane's figure, computes the lanes' body frames at once in vector
+    lanes (``bsr3d_lanes.body_frame_lanes``, bit for bit the scalar ``body_frame``), then moves
+    and measures each lane's figure. A lane's numbers do not depend on the others (tested): a
+    run is the same alone (``run_controller``) as in a population (``bsr3d_population``). A run
+    returns ``steps``, or ``blown_up(n)`` (< 0) if the state is not sound (``state_is_sound``)
+    before step n (n = steps: after the last), as the 2-D run_controller: the samples 0 to n
+    recorded, its terms NaN, its final state the unsound one; the other lanes go on. Its arrays
+    are borrowed (``kernels.borrowed``), so that the step loop raises and lowers no reference
+    count."""
+    figure = borrowed(figure)
+    task = borrowed(task)
+    controllers = borrowed(controllers)
+    records = borrowed(records)
+    parent, hinge, rest, length, mass, com, inertia, joint, endpoints = figure[:9]
+    senses_out, rule_out, terms_out, ends_out, com_out, final_out, final_force = records[:7]
+    taken_out = records[7]
+    floor = figure.floor
+    time_based = controllers.time_based
+    n_rods = parent.shape[0]
+    n_ends = endpoints.shape[0]
+    n_joints = figure.joint_min.shape[0]
+    n_senses = senses_out.shape[2]
+    sensing = n_senses > 0
+    recording = ends_out.shape[1] == steps + 1
+    # the body frames' inputs and outputs, lanes last (``body_frame_lanes``): each lane's work
+    # reads and writes its rods' and endpoints' frames, ends and velocities there
+    own_trig = np.ones((4, n_rods, LANES))
+    own_rates = np.zeros((n_joints, LANES))
+    own_rod_ends = np.empty((n_rods, 2, 3, LANES))
+    own_end_offset = np.empty((n_ends, 3, LANES))
+    own_end_velocity = np.empty((n_ends, 3, LANES))
+    own_frames = np.empty((n_rods, 3, 3, LANES))
+    own_rod_work = np.empty((5, n_rods, 3, LANES))
+    own_tensor = np.empty((3, 3, LANES))
+    own_spin = np.empty((3, LANES))
+    own_states = np.empty((LANES, starts.shape[1]))
+    own_works = new_step_works(LANES, n_rods, n_ends)
+    own_tallies = new_tallies(LANES, n_ends, task.feet.shape[0])
+    own_weights = np.empty((LANES, controllers.side.shape[1]))
+    own_raw = np.empty((LANES, n_senses))
+    own_filtered = np.empty((LANES, n_senses))
+    own_moving = np.zeros(n_rods, np.bool_)  # rods with an angle that is not fixed
+    own_rules = np.zeros(LANES, np.int64)
+    own_live = members >= 0
+    trig = borrowed(own_trig)
+    rates = borrowed(own_rates)
+    rod_ends = borrowed(own_rod_ends)
+    end_offset = borrowed(own_end_offset)
+    end_velocity = borrowed(own_end_velocity)
+    frames = borrowed(own_frames)
+    rod_work = borrowed(own_rod_work)
+    tensor = borrowed(own_tensor)
+    spin = borrowed(own_spin)
+    states = borrowed(own_states)
+    works = borrowed(own_works)
+    tallies = borrowed(own_tallies)
+    weights = borrowed(own_weights)
+    raw = borrowed(own_raw)
+    filtered = borrowed(own_filtered)
+    moving = borrowed(own_moving)
+    rules = borrowed(own_rules)
+    live = borrowed(own_live)
+    for k in range(n_rods):
+        j = joint[k]
+        if j >= 0:
+            for a in range(j, j + 2):
+                moving[k] |= figure.joint_min[a] != figure.joint_max[a]
+    weight = mass.sum() * figure.gravity
+    smoothing = 1.0 - math.exp(-dt / task.filter_time) if task.filter_time > 0.0 else 1.0
+    for lane in range(LANES):
+        if not live[lane]:
+            continue
+        c = members[lane]
+        state = states[lane]
+        work = lane_work(
+            works,
+            lane,
+            rod_ends[:, :, :, lane],
+            end_offset[:, :, lane],
+            end_velocity[:, :, lane],
+            frames[:, :, :, lane],
+        )
+        state[:] = starts[c]
+        work.end_force[:] = start_forces[c]
+        weights[lane] = rule_weights(controllers.side[c])
+        start_step_work(figure, state, work)
+        start_tally(state, work, floor, task, lane_tally(tallies, lane))
+        if recording:
+            _place(state, work, ends_out[c, 0], com_out[c, 0])
+        if sensing:
+            matrices = work.matrices
+            conjugate(matrices[0], matrices[2], matrices[3])
+            measure_senses(
+                state,
+                matrices[0],
+                matrices[3],
+                work.vectors[0, :3],
+                work.end_force,
+                weight,
+                floor,
+                task,
+                figure.joint_min,
+                figure.joint_max,
+                filtered[lane],
+            )
+            senses_out[c, 0] = filtered[lane]
+        if carry_over and not time_based:
+            rules[lane] = active_rule(
+                senses_out[c, 0], controllers.center[c], controllers.side[c], weights[lane], 0
+            )
+        rule_out[c, 0] = rules[lane]
+    for n in range(steps):
+        running = 0
+        for lane in range(LANES):
+            if not live[lane]:
+                continue
+            c = members[lane]
+            state = states[lane]
+            work = lane_work(
+                works,
+                lane,
+                rod_ends[:, :, :, lane],
+                end_offset[:, :, lane],
+                end_velocity[:, :, lane],
+                frames[:, :, :, lane],
+            )
+            if not state_is_sound(state):
+                taken_out[c] = stop_unsound(
+                    n, state, work.end_force, terms_out[c], final_out[c], final_force[c]
+                )
+                live[lane] = False
+                continue
+            running += 1
+            rule = rules[lane]
+            target = controllers.target[c, rule]
+            step_deform(figure, state, target, controllers.tau[c, rule], dt, work)
+            joint_trig(parent, joint, state[JOINTS : JOINTS + n_joints], work.scratch)
+            for k in range(n_rods):
+                if n == 0 or moving[k]:
+                    for t in range(4):
+                        trig[t, k, lane] = work.scratch[k, 5 + t // 2, 1 + t % 2]
+            for j in range(n_joints):
+                rates[j, lane] = state[JOINTS + n_joints + j]
+        if running == 0:
+            break
+        total_mass = body_frame_lanes(
+            parent,
+            hinge,
+            rest,
+            length,
+            mass,
+            com,
+            inertia,
+            joint,
+            endpoints,
+            trig[0],
+            trig[1],
+            trig[2],
+            trig[3],
+            rates,
+            rod_ends,
+            end_offset,
+            end_velocity,
+            frames,
+            rod_work[0],
+            rod_work[1],
+            rod_work[2],
+            rod_work[3],
+            rod_work[4],
+            tensor,
+            spin,
+        )
+        for lane in range(LANES):
+            if not live[lane]:
+                continue
+            c = members[lane]
+            state = states[lane]
+            work = lane_work(
+                works,
+                lane,
+                rod_ends[:, :, :, lane],
+                end_offset[:, :, lane],
+                end_velocity[:, :, lane],
+                frames[:, :, :, lane],
+            )
+            for a in range(3):
+                for b in range(3):
+                    work.matrices[1, a, b] = tensor[a, b, lane]
+                work.vectors[0, a] = spin[a, lane]
+            step_motion(figure, state, dt, work, total_mass, recording)
+            tally_step(state, work, floor, task, lane_tally(tallies, lane))
+            if sensing:
+                sense_step(state, work, weight, task, figure, smoothing, raw[lane], filtered[lane])
+                senses_out[c, n + 1] = filtered[lane]
+            if time_based:
+                rule = segment_rule((n + 1) * dt, controllers.segment_end[c], controllers.period)
+            else:
+                rule = active_rule(
+                    senses_out[c, n + 1],
+                    controllers.center[c],
+                    controllers.side[c],
+                    weights[lane],
+                    rules[lane],
+                )
+            rules[lane] = rule
+            rule_out[c, n + 1] = rule
+            if recording:
+                ends_out[c, n + 1] = work.rod_ends
+                for a in range(3):
+                    com_out[c, n + 1, a] = state[CX + a]
+    for lane in range(LANES):
+        if not live[lane]:
+            continue
+        c = members[lane]
+        state = states[lane]
+        work = lane_work(
+            works,
+            lane,
+            rod_ends[:, :, :, lane],
+            end_offset[:, :, lane],
+            end_velocity[:, :, lane],
+            frames[:, :, :, lane],
+        )
+        if not state_is_sound(state):
+            taken_out[c] = stop_unsound(
+                steps, state, work.end_force, terms_out[c], final_out[c], final_force[c]
+            )
+            continue
+        tally_terms(state, work, task, lane_tally(tallies, lane), steps, terms_out[c])
+        final_out[c] = state
+        final_force[c] = work.end_force
+        taken_out[c] = steps
+    # the owned arrays' last uses: their borrowed views' memory is kept to here
+    keep_alive((own_trig, own_rates, own_rod_ends, own_end_offset, own_end_velocity, own_frames))
+    keep_alive((own_rod_work, own_tensor, own_spin, own_states, own_weights, own_raw))
+    keep_alive((own_filtered, own_moving, own_rules, own_live))
+    keep_alive(own_works)
+    keep_alive(own_tallies)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _place(state, work, ends_out, com_out):
+    """Record the rods' ends (N, 2, 3) and the centre of mass (3,) in the world, m, of the state
+    (S,) whose body frame ``work`` holds (its rod_ends from the centre of mass, body frame)."""
+    rotation = work.matrices[0]
+    rod_ends = work.rod_ends
+    for k in range(rod_ends.shape[0]):
+        for end in range(2):
+            x, y, z = apply(rotation, rod_ends[k, end, 0], rod_ends[k, end, 1], rod_ends[k, end, 2])
+            ends_out[k, end, 0] = state[CX] + x
+            ends_out[k, end, 1] = state[CY] + y
+            ends_out[k, end, 2] = state[CZ] + z
+    for a in range(3):
+        com_out[a] = state[CX + a]
+
+
+class LockstepRecords(NamedTuple):
+    """What ``run_lockstep`` fills, for C controllers: a RunRecord's arrays with a leading axis
+    C, and taken_out (C,) int64 what each run returns."""
+
+    senses_out: np.ndarray
+    rule_out: np.ndarray
+    terms_out: np.ndarray
+    ends_out: np.ndarray
+    com_out: np.ndarray
+    final_state: np.ndarray
+    final_force: np.ndarray
+    taken_out: np.ndarray
+
+
+@njit(cache=True, inline="always")
+def _one(array):
+    """``array`` as the only row of an array with a leading axis of 1 (a view)."""
+    return array.reshape((1,) + array.shape)
+
+
+@njit(cache=True, error_model="numpy")
 def run_controller(figure, controller, task, start, start_force, carry_over, steps, dt, record):
     """Run a controller (a ControllerArrays) of the 3-D figure (a FigureArrays3D) for ``steps``
     steps of dt seconds from the state ``start`` (S,), measuring as ``task`` (a Task) says,
     filling ``record`` (a RunRecord). start_force (E,): the endpoints' normal forces at the
     start, N; carry_over: start with the rule the senses pick (a controller continuing another)
-    instead of rule 0. Long on purpose, as the 2-D run_controller; its arrays are borrowed
-    (``kernels.borrowed``), so that the step loop raises and lowers no reference count.
-    Returns ``steps``, or ``blown_up(n)`` (< 0) if the state is not sound (``state_is_sound``)
-    before step n (n = steps: after the last), as the 2-D run_controller: the samples 0 to n
-    recorded, terms_out NaN, final_state the unsound state. ``bsr3d_population.run_lockstep``
-    runs four at once, with the same numbers."""
-    figure = borrowed(figure)
-    task = borrowed(task)
-    floor = figure.floor
-    time_based, target, tau, center, side, segment_end, period = borrowed(controller)
-    senses_out, rule_out, terms_out, ends_out, com_out, final_state, final_force = borrowed(record)
-    own_state = start.copy()
-    state = borrowed(own_state)
-    n_rods = figure.parent.shape[0]
-    n_ends = figure.endpoints.shape[0]
-    own_work = new_step_work(n_rods, n_ends)
-    work = borrowed(own_work)
-    own_tally = lane_tally(new_tallies(1, n_ends, task.feet.shape[0]), 0)
-    tally = borrowed(own_tally)
-    rod_ends, end_offset, _, end_force, frames = work[1:6]
-    matrices = work.matrices
-    end_force[:] = start_force
-    sensing = senses_out.shape[1] > 0
-    raw = np.empty(senses_out.shape[1])
-    filtered = np.empty(senses_out.shape[1])
-    weight = figure.mass.sum() * figure.gravity
-    recording = ends_out.shape[0] == steps + 1
-    weights = rule_weights(side)
-    start_step_work(figure, state, work)
-    start_tally(state, work, floor, task, tally)
-    if recording:
-        rotation = matrices[0]
-        for k in range(n_rods):
-            for end in range(2):
-                x, y, z = apply(
-                    rotation, rod_ends[k, end, 0], rod_ends[k, end, 1], rod_ends[k, end, 2]
-                )
-                ends_out[0, k, end, 0] = state[CX] + x
-                ends_out[0, k, end, 1] = state[CY] + y
-                ends_out[0, k, end, 2] = state[CZ] + z
-        com_out[0, 0] = state[CX]
-        com_out[0, 1] = state[CY]
-        com_out[0, 2] = state[CZ]
-    if sensing:
-        conjugate(matrices[0], matrices[2], matrices[3])
-        measure_senses(
-            state,
-            matrices[0],
-            matrices[3],
-            work.vectors[0, :3],
-            end_force,
-            weight,
-            floor,
-            task,
-            figure.joint_min,
-            figure.joint_max,
-            filtered,
-        )
-        senses_out[0] = filtered
-    smoothing = 1.0 - math.exp(-dt / task.filter_time) if task.filter_time > 0.0 else 1.0
-    rule = 0
-    if carry_over and not time_based:
-        rule = active_rule(senses_out[0], center, side, weights, 0)
-    rule_out[0] = rule
-    for n in range(steps):
-        if not state_is_sound(state):
-            return stop_unsound(n, state, end_force, terms_out, final_state, final_force)
-        step(figure, state, target[rule], tau[rule], dt, work, recording)
-        tally_step(state, work, floor, task, tally)
-        if sensing:
-            sense_step(state, work, weight, task, figure, smoothing, raw, filtered)
-            senses_out[n + 1] = filtered
-        if time_based:
-            rule = segment_rule((n + 1) * dt, segment_end, period)
-        else:
-            rule = active_rule(senses_out[n + 1], center, side, weights, rule)
-        rule_out[n + 1] = rule
-        if recording:
-            ends_out[n + 1] = rod_ends
-            com_out[n + 1, 0] = state[CX]
-            com_out[n + 1, 1] = state[CY]
-            com_out[n + 1, 2] = state[CZ]
-    if not state_is_sound(state):
-        return stop_unsound(steps, state, end_force, terms_out, final_state, final_force)
-    # own_tally's, own_state's and own_work's last uses: the borrowed views' memory is kept to here
-    tally_terms(state, work, task, own_tally, steps, terms_out)
-    final_state[:] = own_state
-    final_force[:] = own_work.end_force
-    return steps
+    instead of rule 0. ``run_lockstep`` with this run in one lane: returns ``steps``, or
+    ``blown_up(n)`` (< 0) if the state is not sound before step n, as that says."""
+    members = np.full(LANES, -1, np.int64)
+    members[0] = 0
+    taken = np.zeros(1, np.int64)
+    run_lockstep(
+        figure,
+        ControllerArrays(
+            controller.time_based,
+            _one(controller.target),
+            _one(controller.tau),
+            _one(controller.center),
+            _one(controller.side),
+            _one(controller.segment_end),
+            controller.period,
+        ),
+        task,
+        members,
+        _one(start),
+        _one(start_force),
+        carry_over,
+        steps,
+        dt,
+        LockstepRecords(
+            _one(record.senses_out),
+            _one(record.rule_out),
+            _one(record.terms_out),
+            _one(record.ends_out),
+            _one(record.com_out),
+            _one(record.final_state),
+            _one(record.final_force),
+            taken,
+        ),
+    )
+    return taken[0]

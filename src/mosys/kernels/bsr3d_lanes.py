@@ -1,6 +1,6 @@
-"""The 3-D BSR simulator's pieces for LANES controllers in lockstep (``kernels.lanes``): work in
-progress towards evaluating a population four controllers at a time (README, "3-D figures",
-Measured). So far the body frame.
+"""The 3-D BSR simulator's pieces for LANES controllers in lockstep (``kernels.lanes``;
+``bsr3d_controller.run_lockstep`` runs them): so far the body frame, the rest of a step is
+computed lane by lane.
 
 Arrays hold lanes last and contiguous, flattened: a quantity of shape S per controller is an
 array of prod(S) * LANES float64, element (index, lane) at ``index * LANES + lane``.

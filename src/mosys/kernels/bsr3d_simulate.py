@@ -382,7 +382,7 @@ def rigid_rate(state, rotation, world_inverse, spin):
     return apply(world_inverse, state[LX] - hx, state[LX + 1] - hy, state[LX + 2] - hz)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def endpoint_position(state, rotation, end_offset, e):
     """World (x, y, z) of endpoint e, m, from its offset from the centre of mass in the body
     frame (end_offset (E, 3)) and the body's orientation (rotation (3, 3))."""
@@ -390,7 +390,7 @@ def endpoint_position(state, rotation, end_offset, e):
     return state[CX] + x, state[CY] + y, state[CZ] + z
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def endpoint_motion(state, rotation, body_rate, end_offset, end_velocity, e):
     """Endpoint e's offset (rx, ry, rz) from the centre of mass in the world, m, and its
     velocity (ux, uy, uz), m/s: the body's motion (velocity of the centre of mass, rotation at
@@ -1073,8 +1073,10 @@ def step(figure, state, target, tau, dt, work, place_rods):
     must be sound (``kernels.soundness.state_is_sound``): the runs of
     ``kernels.bsr3d_controller`` check it before every step and stop where it is not.
 
-    One piece on purpose, as the 2-D step (that module's docstring says why); inlined where it
-    is called, so that no array crosses a call each step.
+    ``step_deform``, ``body_frame`` and ``step_motion`` in turn, each inlined where it is
+    called, so that no array crosses a call each step. The runs of ``kernels.bsr3d_controller``
+    step four figures at once with the same parts and ``bsr3d_lanes.body_frame_lanes`` (this
+    body frame, bit for bit) between them; this scalar step is what the simulator's tests drive.
     """
     step_deform(figure, state, target, tau, dt, work)
     n_joints = target.shape[0]

@@ -1,5 +1,5 @@
-"""Four-lane float64 vectors for numba kernels: the first piece of evaluating several BSR
-controllers in lockstep (README, "3-D figures", Measured: the lead for Rex's 1 ms target).
+"""Four-lane float64 vectors for numba kernels: what the 3-D BSR runs compute for four
+controllers at once in lockstep (``bsr3d_lanes``; README, "3-D figures", Measured).
 
 numba's LLVM does not vectorise a loop over controllers by itself (the arrays may alias, and
 numba ships LLVM's SLP vectoriser switched off), so these functions write the vector operations
@@ -16,7 +16,6 @@ from __future__ import annotations
 import numpy as np
 from llvmlite import ir
 from numba import types
-from numba.core import cgutils
 from numba.extending import intrinsic, overload
 
 LANES = 4
@@ -60,39 +59,6 @@ def _binary(instruction):
 _add, _subtract, _multiply, _divide = (_binary(name) for name in ("fadd", "fsub", "fmul", "fdiv"))
 
 
-def _llvm_unary(name):
-    @intrinsic
-    def operation(typingctx, a):
-        if a != _LANES_TYPE:
-            return None
-
-        def codegen(context, builder, signature, args):
-            function = cgutils.get_or_insert_function(
-                builder.module, ir.FunctionType(_VECTOR, [_VECTOR]), f"{name}.v{LANES}f64"
-            )
-            return _lanes(context, builder, builder.call(function, [_vector(builder, args[0])]))
-
-        return _LANES_TYPE(_LANES_TYPE), codegen
-
-    return operation
-
-
-_nearest, _floor = _llvm_unary("llvm.rint"), _llvm_unary("llvm.floor")
-
-
-@intrinsic
-def _where_positive(typingctx, condition, a, b):
-    if condition != _LANES_TYPE or a != _LANES_TYPE or b != _LANES_TYPE:
-        return None
-
-    def codegen(context, builder, signature, args):
-        c, x, y = (_vector(builder, value) for value in args)
-        mask = builder.fcmp_ordered(">", c, ir.Constant(_VECTOR, [0.0] * LANES))
-        return _lanes(context, builder, builder.select(mask, x, y))
-
-    return _LANES_TYPE(_LANES_TYPE, _LANES_TYPE, _LANES_TYPE), codegen
-
-
 def add(a: Lanes, b: Lanes) -> Lanes:
     """a + b, lane by lane."""
     return tuple(x + y for x, y in zip(a, b, strict=True))
@@ -112,21 +78,6 @@ def divide(a: Lanes, b: Lanes) -> Lanes:
     """a / b, lane by lane (IEEE: inf or NaN on a zero, no exception)."""
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         return tuple(float(np.float64(x) / np.float64(y)) for x, y in zip(a, b, strict=True))
-
-
-def nearest(a: Lanes) -> Lanes:
-    """Each lane rounded to the nearest whole number, ties to even."""
-    return tuple(float(np.rint(x)) for x in a)
-
-
-def floor(a: Lanes) -> Lanes:
-    """Each lane rounded down to a whole number."""
-    return tuple(float(np.floor(x)) for x in a)
-
-
-def where_positive(condition: Lanes, a: Lanes, b: Lanes) -> Lanes:
-    """a's lane where condition's lane is > 0, else b's (NaN: b)."""
-    return tuple(x if c > 0.0 else y for c, x, y in zip(condition, a, b, strict=True))
 
 
 def splat(x: float) -> Lanes:
@@ -227,18 +178,3 @@ def _load_in_numba(array, offset):
 @overload(store)
 def _store_in_numba(array, offset, value):
     return lambda array, offset, value: _store(array, offset, value)
-
-
-@overload(nearest, inline="always")
-def _nearest_in_numba(a):
-    return lambda a: _nearest(a)
-
-
-@overload(floor, inline="always")
-def _floor_in_numba(a):
-    return lambda a: _floor(a)
-
-
-@overload(where_positive, inline="always")
-def _where_positive_in_numba(condition, a, b):
-    return lambda condition, a, b: _where_positive(condition, a, b)
