@@ -78,23 +78,11 @@ def test_the_body_frame_of_four_controllers_is_body_frame_of_each_bit_for_bit(na
         if figure.joint[k] >= 0:
             angle, psi = theta[:, figure.joint[k]], theta[:, figure.joint[k] + 1]
             trig[:, k] = np.cos(angle), np.sin(angle), np.cos(psi), np.sin(psi)
-    shapes = (
-        (n, 2, 3),
-        (e, 3),
-        (e, 3),
-        (n, 3, 3),
-        (n, 3),
-        (n, 3),
-        (n, 3),
-        (n, 3),
-        (n, 3),
-        (3, 3),
-        (3,),
-    )
+    shapes = ((n, 2, 3), (e, 3), (e, 3), (n, 3, 3), (5, n, 3), (3, 3), (3,))
     work = tuple(np.zeros((*shape, LANES)) for shape in shapes)
-    total = body_frame_lanes(*figure[:9], *trig, np.ascontiguousarray(rate.T), *work)
+    total = body_frame_lanes(figure, trig, np.ascontiguousarray(rate.T), *work)
     rod_ends, end_offset, end_velocity, frames = work[:4]
-    tensor, spin = work[9], work[10]
+    tensor, spin = work[5], work[6]
     for lane in range(LANES):
         expected = (np.zeros((n, 2, 3)), np.zeros((e, 3)), np.zeros((e, 3)), np.zeros((n, 3, 3)))
         expected_tensor, expected_spin = np.zeros((3, 3)), np.zeros(3)

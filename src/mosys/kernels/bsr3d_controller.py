@@ -61,6 +61,7 @@ from mosys.kernels.bsr3d_simulate import (
 )
 from mosys.kernels.bsr_controller import (
     ControllerArrays,
+    RunRecord,
     active_rule,
     rule_weights,
     segment_rule,
@@ -335,18 +336,60 @@ def sense_step(state, work, weight, task, figure, smoothing, raw, filtered):
         filtered[v] = raw[v]
 
 
+@njit(cache=True, inline="always")
+def _lane_work(works, lane, rod_ends, end_offset, end_velocity, frames):
+    """Lane ``lane``'s StepWork of ``works`` (``new_step_works``), its body frame's arrays the
+    lane's views of the lanes-last ones (``body_frame_lanes``)."""
+    return lane_work(
+        works,
+        lane,
+        rod_ends[:, :, :, lane],
+        end_offset[:, :, lane],
+        end_velocity[:, :, lane],
+        frames[:, :, :, lane],
+    )
+
+
+@njit(cache=True, inline="always")
+def _stopped_unsound(step, c, state, work, records, taken_out):
+    """If the state (S,) of run c is not sound before step ``step`` (``state_is_sound``), stop
+    the run there (``stop_unsound``: its terms NaN, its final state and forces the unsound
+    ones, taken_out[c] ``blown_up(step)``) and return True; else False."""
+    if state_is_sound(state):
+        return False
+    taken_out[c] = stop_unsound(
+        step,
+        state,
+        work.end_force,
+        records.terms_out[c],
+        records.final_state[c],
+        records.final_force[c],
+    )
+    return True
+
+
 @njit(cache=True, error_model="numpy")
 def run_lockstep(
-    figure, controllers, task, members, starts, start_forces, carry_over, steps, dt, records
+    figure,
+    controllers,
+    task,
+    members,
+    starts,
+    start_forces,
+    carry_over,
+    steps,
+    dt,
+    records,
+    taken_out,
 ):
     """Run the controllers ``members`` (LANES,) int64 (-1: an empty lane) of ``controllers`` (a
     ControllerArrays whose arrays have a leading axis C) of the 3-D figure (a FigureArrays3D)
     for ``steps`` steps of dt seconds at once, in lockstep: lane i runs controller c =
     members[i] from the state starts[c] (C, S) with the endpoints' normal forces
     start_forces[c] (C, E) N, measuring as ``task`` (a Task) says, filling lane c of
-    ``records`` (a RunRecord whose arrays have a leading axis C, and ``taken_out`` (C,) int64
-    as its last member: what the run of c returns). carry_over: start with the rule the senses
-    pick (a controller continuing another) instead of rule 0.
+    ``records`` (a RunRecord whose arrays have a leading axis C) and taken_out[c] (taken_out
+    (C,) int64: what the run of c returns). carry_over: start with the rule the senses pick (a
+    controller continuing another) instead of rule 0.
 
     Each step deforms every lane's figure, computes the lanes' body frames at once in vector
     lanes (``bsr3d_lanes.body_frame_lanes``, bit for bit the scalar ``body_frame``), then moves
@@ -361,9 +404,8 @@ def run_lockstep(
     task = borrowed(task)
     controllers = borrowed(controllers)
     records = borrowed(records)
-    parent, hinge, rest, length, mass, com, inertia, joint, endpoints = figure[:9]
-    senses_out, rule_out, terms_out, ends_out, com_out, final_out, final_force = records[:7]
-    taken_out = records[7]
+    parent, joint, endpoints = figure.parent, figure.joint, figure.endpoints
+    senses_out, rule_out, terms_out, ends_out, com_out, final_out, final_force = records
     floor = figure.floor
     time_based = controllers.time_based
     n_rods = parent.shape[0]
@@ -415,21 +457,14 @@ def run_lockstep(
         if j >= 0:
             for a in range(j, j + 2):
                 moving[k] |= figure.joint_min[a] != figure.joint_max[a]
-    weight = mass.sum() * figure.gravity
+    weight = figure.mass.sum() * figure.gravity
     smoothing = 1.0 - math.exp(-dt / task.filter_time) if task.filter_time > 0.0 else 1.0
     for lane in range(LANES):
         if not live[lane]:
             continue
         c = members[lane]
         state = states[lane]
-        work = lane_work(
-            works,
-            lane,
-            rod_ends[:, :, :, lane],
-            end_offset[:, :, lane],
-            end_velocity[:, :, lane],
-            frames[:, :, :, lane],
-        )
+        work = _lane_work(works, lane, rod_ends, end_offset, end_velocity, frames)
         state[:] = starts[c]
         work.end_force[:] = start_forces[c]
         weights[lane] = rule_weights(controllers.side[c])
@@ -466,18 +501,8 @@ def run_lockstep(
                 continue
             c = members[lane]
             state = states[lane]
-            work = lane_work(
-                works,
-                lane,
-                rod_ends[:, :, :, lane],
-                end_offset[:, :, lane],
-                end_velocity[:, :, lane],
-                frames[:, :, :, lane],
-            )
-            if not state_is_sound(state):
-                taken_out[c] = stop_unsound(
-                    n, state, work.end_force, terms_out[c], final_out[c], final_force[c]
-                )
+            work = _lane_work(works, lane, rod_ends, end_offset, end_velocity, frames)
+            if _stopped_unsound(n, c, state, work, records, taken_out):
                 live[lane] = False
                 continue
             running += 1
@@ -494,45 +519,14 @@ def run_lockstep(
         if running == 0:
             break
         total_mass = body_frame_lanes(
-            parent,
-            hinge,
-            rest,
-            length,
-            mass,
-            com,
-            inertia,
-            joint,
-            endpoints,
-            trig[0],
-            trig[1],
-            trig[2],
-            trig[3],
-            rates,
-            rod_ends,
-            end_offset,
-            end_velocity,
-            frames,
-            rod_work[0],
-            rod_work[1],
-            rod_work[2],
-            rod_work[3],
-            rod_work[4],
-            tensor,
-            spin,
+            figure, trig, rates, rod_ends, end_offset, end_velocity, frames, rod_work, tensor, spin
         )
         for lane in range(LANES):
             if not live[lane]:
                 continue
             c = members[lane]
             state = states[lane]
-            work = lane_work(
-                works,
-                lane,
-                rod_ends[:, :, :, lane],
-                end_offset[:, :, lane],
-                end_velocity[:, :, lane],
-                frames[:, :, :, lane],
-            )
+            work = _lane_work(works, lane, rod_ends, end_offset, end_velocity, frames)
             for a in range(3):
                 for b in range(3):
                     work.matrices[1, a, b] = tensor[a, b, lane]
@@ -563,18 +557,8 @@ def run_lockstep(
             continue
         c = members[lane]
         state = states[lane]
-        work = lane_work(
-            works,
-            lane,
-            rod_ends[:, :, :, lane],
-            end_offset[:, :, lane],
-            end_velocity[:, :, lane],
-            frames[:, :, :, lane],
-        )
-        if not state_is_sound(state):
-            taken_out[c] = stop_unsound(
-                steps, state, work.end_force, terms_out[c], final_out[c], final_force[c]
-            )
+        work = _lane_work(works, lane, rod_ends, end_offset, end_velocity, frames)
+        if _stopped_unsound(steps, c, state, work, records, taken_out):
             continue
         tally_terms(state, work, task, lane_tally(tallies, lane), steps, terms_out[c])
         final_out[c] = state
@@ -602,20 +586,6 @@ def _place(state, work, ends_out, com_out):
             ends_out[k, end, 2] = state[CZ] + z
     for a in range(3):
         com_out[a] = state[CX + a]
-
-
-class LockstepRecords(NamedTuple):
-    """What ``run_lockstep`` fills, for C controllers: a RunRecord's arrays with a leading axis
-    C, and taken_out (C,) int64 what each run returns."""
-
-    senses_out: np.ndarray
-    rule_out: np.ndarray
-    terms_out: np.ndarray
-    ends_out: np.ndarray
-    com_out: np.ndarray
-    final_state: np.ndarray
-    final_force: np.ndarray
-    taken_out: np.ndarray
 
 
 @njit(cache=True, inline="always")
@@ -653,7 +623,7 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
         carry_over,
         steps,
         dt,
-        LockstepRecords(
+        RunRecord(
             _one(record.senses_out),
             _one(record.rule_out),
             _one(record.terms_out),
@@ -661,7 +631,7 @@ def run_controller(figure, controller, task, start, start_force, carry_over, ste
             _one(record.com_out),
             _one(record.final_state),
             _one(record.final_force),
-            taken,
         ),
+        taken,
     )
     return taken[0]

@@ -30,41 +30,22 @@ def _at(index):
 
 @njit(cache=True)
 def body_frame_lanes(
-    parent,
-    hinge,
-    rest,
-    length,
-    mass,
-    com,
-    inertia,
-    joint,
-    endpoints,
-    cosine_theta,
-    sine_theta,
-    cosine_psi,
-    sine_psi,
-    theta_rate,
-    rod_ends,
-    end_offset,
-    end_velocity,
-    frames,
-    omega,
-    proximal,
-    proximal_velocity,
-    centre,
-    centre_velocity,
-    tensor,
-    spin,
+    figure, trig, theta_rate, rod_ends, end_offset, end_velocity, frames, rod_work, tensor, spin
 ):
-    """``bsr3d_simulate.body_frame`` for LANES controllers of one figure at once, lanes last.
+    """``bsr3d_simulate.body_frame`` for LANES controllers of one figure (a FigureArrays3D) at
+    once, lanes last.
 
-    The figure's arrays as ``body_frame`` takes them; per controller (each flattened, lanes
-    last): cosine_theta, sine_theta, cosine_psi, sine_psi (N): each rod's joint angles' cosines
-    and sines (the root's unread); theta_rate (J) rad/s. Fills rod_ends (N, 2, 3), end_offset,
-    end_velocity (E, 3), frames (N, 3, 3), tensor (3, 3), spin (3) as ``body_frame`` does, and
-    works in omega, proximal, proximal_velocity, centre, centre_velocity (N, 3). Returns the
-    total mass, kg. The same numbers as ``body_frame`` lane by lane, to rounding (its sums in
-    the same order): bit for bit (tested)."""
+    Per controller (each flattened, lanes last): trig (4, N): each rod's joint angles' cosine
+    and sine of θ, then of ψ (the root's unread); theta_rate (J) rad/s. Fills rod_ends (N, 2,
+    3), end_offset, end_velocity (E, 3), frames (N, 3, 3), tensor (3, 3), spin (3) as
+    ``body_frame`` does, and works in rod_work (5, N, 3): each rod's angular velocity, proximal
+    end and its velocity, centre of mass and its velocity. Returns the total mass, kg. The same
+    numbers as ``body_frame`` lane by lane, to rounding (its sums in the same order): bit for
+    bit (tested)."""
+    parent, hinge, rest, length, mass, com, inertia, joint, endpoints = figure[:9]
+    cosine_theta, sine_theta, cosine_psi, sine_psi = trig[0], trig[1], trig[2], trig[3]
+    omega, proximal, proximal_velocity = rod_work[0], rod_work[1], rod_work[2]
+    centre, centre_velocity = rod_work[3], rod_work[4]
     n = parent.shape[0]
     zero = splat(0.0)
     mass_x = mass_y = mass_z = momentum_x = momentum_y = momentum_z = zero

@@ -12,7 +12,8 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-from mosys.kernels.bsr3d_controller import LockstepRecords, run_lockstep
+from mosys.kernels.bsr3d_controller import run_lockstep
+from mosys.kernels.bsr_controller import RunRecord
 from mosys.kernels.lanes import LANES
 
 
@@ -60,7 +61,7 @@ def run_population(
     population = starts.shape[0]
     n_rods = figure.parent.shape[0]
     n_ends = figure.endpoints.shape[0]
-    records = LockstepRecords(
+    records = RunRecord(
         senses_out,
         rule_out,
         terms_out,
@@ -68,24 +69,14 @@ def run_population(
         np.empty((population, 0, 3)),
         final_out,
         np.empty((population, n_ends)),
-        taken_out,
     )
     groups = lockstep_groups(population, numba.get_num_threads())
-    _run_groups(
-        figure,
-        controllers,
-        task,
-        groups,
-        starts,
-        np.zeros((population, n_ends)),
-        steps,
-        dt,
-        records,
-    )
+    forces = np.zeros((population, n_ends))
+    _run_groups(figure, controllers, task, groups, starts, forces, steps, dt, records, taken_out)
 
 
 @njit(cache=True, parallel=True)
-def _run_groups(figure, controllers, task, groups, starts, start_forces, steps, dt, records):
+def _run_groups(figure, controllers, task, groups, starts, start_forces, steps, dt, records, taken):
     """``run_lockstep`` for each group (G, LANES) of controllers, in parallel, from rule 0."""
     for g in prange(groups.shape[0]):
         run_lockstep(
@@ -99,4 +90,5 @@ def _run_groups(figure, controllers, task, groups, starts, start_forces, steps, 
             steps,  # run_controller calls (a literal is a signature of its own)
             dt,
             records,
+            taken,
         )

@@ -1022,6 +1022,34 @@ def new_step_work(n_rods, n_ends):
     )
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def work_body_frame(figure, state, work):
+    """``body_frame`` of the state's (S,) pose into the StepWork ``work`` (its rod_ends,
+    end_offset, end_velocity, frames, scratch; the inertia tensor in work.matrices[1], the
+    deformation's spin in work.vectors[0, :3]). Returns the total mass, kg."""
+    n_joints = figure.joint_min.shape[0]
+    return body_frame(
+        figure.parent,
+        figure.hinge,
+        figure.rest,
+        figure.length,
+        figure.mass,
+        figure.com,
+        figure.inertia,
+        figure.joint,
+        figure.endpoints,
+        state[JOINTS : JOINTS + n_joints],
+        state[JOINTS + n_joints : JOINTS + 2 * n_joints],
+        work.rod_ends,
+        work.end_offset,
+        work.end_velocity,
+        work.frames,
+        work.scratch,
+        work.matrices[1],
+        work.vectors[0, :3],
+    )
+
+
 @njit(cache=True, error_model="numpy")
 def start_step_work(figure, state, work):
     """Make the StepWork ``work`` ready for a first step from the state (S,): the body-frame
@@ -1030,30 +1058,9 @@ def start_step_work(figure, state, work):
     work.vectors[0, :3]), the body's rotation in work.matrices[0], and the deformation's own
     spin I⁻¹ h in the world in work.previous. Kept out of ``step``'s callers' code (a call, not
     inlined): one copy of ``body_frame`` inlined there is enough to compile."""
-    parent, hinge, rest, length, mass, com, inertia, joint, endpoints = figure[:9]
-    n_joints = figure.joint_min.shape[0]
     matrices = work.matrices
     vectors = work.vectors
-    body_frame(
-        parent,
-        hinge,
-        rest,
-        length,
-        mass,
-        com,
-        inertia,
-        joint,
-        endpoints,
-        state[JOINTS : JOINTS + n_joints],
-        state[JOINTS + n_joints : JOINTS + 2 * n_joints],
-        work.rod_ends,
-        work.end_offset,
-        work.end_velocity,
-        work.frames,
-        work.scratch,
-        matrices[1],
-        vectors[0, :3],
-    )
+    work_body_frame(figure, state, work)
     invert_symmetric(matrices[1], matrices[2])
     rotation_of(state[QW : QW + 4], matrices[0])
     sx, sy, sz = apply(matrices[2], vectors[0, 0], vectors[0, 1], vectors[0, 2])
@@ -1079,27 +1086,7 @@ def step(figure, state, target, tau, dt, work, place_rods):
     body frame, bit for bit) between them; this scalar step is what the simulator's tests drive.
     """
     step_deform(figure, state, target, tau, dt, work)
-    n_joints = target.shape[0]
-    total_mass = body_frame(
-        figure.parent,
-        figure.hinge,
-        figure.rest,
-        figure.length,
-        figure.mass,
-        figure.com,
-        figure.inertia,
-        figure.joint,
-        figure.endpoints,
-        state[JOINTS : JOINTS + n_joints],
-        state[JOINTS + n_joints : JOINTS + 2 * n_joints],
-        work.rod_ends,
-        work.end_offset,
-        work.end_velocity,
-        work.frames,
-        work.scratch,
-        work.matrices[1],
-        work.vectors[0, :3],
-    )
+    total_mass = work_body_frame(figure, state, work)
     step_motion(figure, state, dt, work, total_mass, place_rods)
 
 

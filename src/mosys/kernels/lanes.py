@@ -145,26 +145,6 @@ def _store(typingctx, array, offset, value):
     return types.void(array, types.intp, _LANES_TYPE), codegen
 
 
-@overload(add, inline="always")
-def _add_in_numba(a, b):
-    return lambda a, b: _add(a, b)
-
-
-@overload(subtract, inline="always")
-def _subtract_in_numba(a, b):
-    return lambda a, b: _subtract(a, b)
-
-
-@overload(multiply, inline="always")
-def _multiply_in_numba(a, b):
-    return lambda a, b: _multiply(a, b)
-
-
-@overload(divide, inline="always")
-def _divide_in_numba(a, b):
-    return lambda a, b: _divide(a, b)
-
-
 @overload(splat, inline="always")
 def _splat_in_numba(x):
     return lambda x: _splat(np.float64(x))
@@ -178,3 +158,19 @@ def _load_in_numba(array, offset):
 @overload(store)
 def _store_in_numba(array, offset, value):
     return lambda array, offset, value: _store(array, offset, value)
+
+
+def _binary_overload(intrinsic_function):
+    def typer(a, b):
+        return lambda a, b: intrinsic_function(a, b)
+
+    return typer
+
+
+for _function, _intrinsic in (
+    (add, _add),
+    (subtract, _subtract),
+    (multiply, _multiply),
+    (divide, _divide),
+):
+    overload(_function, inline="always")(_binary_overload(_intrinsic))
