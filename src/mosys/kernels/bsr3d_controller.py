@@ -54,6 +54,7 @@ from mosys.kernels.bsr3d_simulate import (
     joint_trig,
     lane_work,
     new_step_works,
+    place_in_world,
     rigid_rate,
     start_step_work,
     step_deform,
@@ -471,7 +472,8 @@ def run_lockstep(
         start_step_work(figure, state, work)
         start_tally(state, work, floor, task, lane_tally(tallies, lane))
         if recording:
-            _place(state, work, ends_out[c, 0], com_out[c, 0])
+            place_in_world(state, work.matrices[0], work.rod_ends, ends_out[c, 0])
+            com_out[c, 0] = state[CX : CX + 3]
         if sensing:
             matrices = work.matrices
             conjugate(matrices[0], matrices[2], matrices[3])
@@ -550,8 +552,7 @@ def run_lockstep(
             rule_out[c, n + 1] = rule
             if recording:
                 ends_out[c, n + 1] = work.rod_ends
-                for a in range(3):
-                    com_out[c, n + 1, a] = state[CX + a]
+                com_out[c, n + 1] = state[CX : CX + 3]
     for lane in range(LANES):
         if not live[lane]:
             continue
@@ -570,22 +571,6 @@ def run_lockstep(
     keep_alive((own_filtered, own_moving, own_rules, own_live))
     keep_alive(own_works)
     keep_alive(own_tallies)
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def _place(state, work, ends_out, com_out):
-    """Record the rods' ends (N, 2, 3) and the centre of mass (3,) in the world, m, of the state
-    (S,) whose body frame ``work`` holds (its rod_ends from the centre of mass, body frame)."""
-    rotation = work.matrices[0]
-    rod_ends = work.rod_ends
-    for k in range(rod_ends.shape[0]):
-        for end in range(2):
-            x, y, z = apply(rotation, rod_ends[k, end, 0], rod_ends[k, end, 1], rod_ends[k, end, 2])
-            ends_out[k, end, 0] = state[CX] + x
-            ends_out[k, end, 1] = state[CY] + y
-            ends_out[k, end, 2] = state[CZ] + z
-    for a in range(3):
-        com_out[a] = state[CX + a]
 
 
 @njit(cache=True, inline="always")

@@ -402,6 +402,22 @@ def endpoint_motion(state, rotation, body_rate, end_offset, end_velocity, e):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def place_in_world(state, rotation, body_ends, out):
+    """Every rod's ends in the world, m: body_ends (N, 2, 3) relative to the centre of mass in
+    the body frame, turned by the body's orientation rotation (3, 3) and moved to the state's
+    centre of mass; written to out (N, 2, 3), which may be body_ends itself (as the 2-D
+    ``bsr_simulate.place_in_world``)."""
+    for k in range(body_ends.shape[0]):
+        for end in range(2):
+            x, y, z = apply(
+                rotation, body_ends[k, end, 0], body_ends[k, end, 1], body_ends[k, end, 2]
+            )
+            out[k, end, 0] = state[CX] + x
+            out[k, end, 1] = state[CY] + y
+            out[k, end, 2] = state[CZ] + z
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def largest_fall(state, body_rate, end_velocity, reach, dt):
     """How far any endpoint can fall in a step of dt s at most, m (>= 0): an endpoint's vertical
     velocity is the centre of mass's (the state's (S,)) plus the body's spin (body_rate (3,)
@@ -1297,11 +1313,5 @@ def step_motion(figure, state, dt, work, total_mass, place_rods):
             if entry[bottom, 1] - floor <= CONTACT_TOLERANCE:
                 state[CX] = entry[bottom, 0] - rx
                 state[CZ] = entry[bottom, 2] - rz
-    if not place_rods:
-        return
-    for k in range(rod_ends.shape[0]):
-        for end in range(2):
-            x, y, z = apply(rotation, rod_ends[k, end, 0], rod_ends[k, end, 1], rod_ends[k, end, 2])
-            rod_ends[k, end, 0] = state[CX] + x
-            rod_ends[k, end, 1] = state[CY] + y
-            rod_ends[k, end, 2] = state[CZ] + z
+    if place_rods:
+        place_in_world(state, rotation, rod_ends, rod_ends)
