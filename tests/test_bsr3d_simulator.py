@@ -413,6 +413,7 @@ def contact_case(u, r, inverse_mass=1 / 42.1, spin_inertia=(3.0, 4.0, 2.5)):
         np.arange(m),
         np.zeros(m),
         np.zeros((m, m, 9)),
+        np.zeros((m, 3, 3)),
     )
     after = uu[:count].copy()
     for i in range(count):
@@ -445,6 +446,34 @@ def test_a_contact_that_barely_touches_does_not_make_friction_explode():
     impulse, after = contact_case(u, r)
     assert np.abs(impulse).max() < 10.0
     assert np.abs(after).max() < 0.2
+
+
+def skew(v: np.ndarray) -> np.ndarray:
+    """[v]x: the matrix of the cross product v x ."""
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_a_contacts_response_is_the_rigid_bodys(seed):
+    """responses[i, j] (from the spin per impulse made once per point) is the rigid body's
+    velocity change at r_i per unit impulse at r_j, E/M - [r_i]x I⁻¹ [r_j]x, written out
+    independently here."""
+    rng = np.random.default_rng(seed)
+    m = sim.MAX_CONTACTS
+    r = rng.normal(0.0, 0.5, (m, 3))
+    a = rng.normal(size=(3, 3))
+    world_inverse = np.linalg.inv(a @ a.T + np.eye(3))
+    world_inverse = 0.5 * (world_inverse + world_inverse.T)
+    inverse_mass = 1.0 / rng.uniform(1.0, 60.0)
+    responses, spins = np.zeros((m, m, 3, 3)), np.zeros((m, 3, 3))
+    for j in range(m):
+        sim.spin_per_impulse(r, j, world_inverse, spins)
+    for i in range(m):
+        for j in range(m):
+            sim.response(r, i, j, inverse_mass, spins, responses)
+            expected = inverse_mass * np.eye(3) - skew(r[i]) @ world_inverse @ skew(r[j])
+            np.testing.assert_allclose(responses[i, j], expected, rtol=0, atol=1e-12)
 
 
 def plain_shares(u, r, responses, compliance, twisting, iterations):
@@ -522,10 +551,12 @@ def test_the_shared_friction_solve_finds_the_fixed_point_of_the_dense_plain_iter
         inverse_mass = 1.0 / rng.uniform(5.0, 60.0)
         uu, rr = np.zeros((m, 3)), np.zeros((m, 3))
         uu[:count], rr[:count] = u, r
-        responses = np.zeros((m, m, 3, 3))
+        responses, spins = np.zeros((m, m, 3, 3)), np.zeros((m, 3, 3))
+        for j in range(count):
+            sim.spin_per_impulse(rr, j, world_inverse, spins)
         for i in range(count):
             for j in range(count):
-                sim.response(rr, i, j, inverse_mass, world_inverse, responses)
+                sim.response(rr, i, j, inverse_mass, spins, responses)
         compliance = sim.COMPLIANCE * (responses[0, 0, 0, 0] + responses[0, 0, 1, 1])
         compliance = 0.0 if count < 3 else compliance
         impulse = np.zeros((m, 3))

@@ -434,18 +434,31 @@ def largest_fall(state, body_rate, end_velocity, reach, dt):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def response(r, i, j, inverse_mass, world_inverse, responses):
-    """responses[i, j] (3, 3): the velocity change at a point with offset r[i] (3,) from the
-    centre of mass per unit impulse at a point with offset r[j], for a rigid body of inverse
-    mass inverse_mass and inverse inertia world_inverse (3, 3): E/M - [r_i]x I⁻¹ [r_j]x."""
+def spin_per_impulse(r, j, world_inverse, spins):
+    """spins[j] (3, 3): column b the body's change of spin (rad/s, world) per unit impulse along
+    axis b at a point with offset r[j] (3,) from the centre of mass, for a rigid body of inverse
+    inertia world_inverse (3, 3): I⁻¹ [r_j]x (the part of ``response`` that does not depend on
+    the point that moves, made once for every point it is paired with)."""
     for b in range(3):
-        # column b: impulse along axis b at r_j -> angular impulse r_j x e_b
         ex = 1.0 if b == 0 else 0.0
         ey = 1.0 if b == 1 else 0.0
         ez = 1.0 if b == 2 else 0.0
         tx, ty, tz = _cross(r[j, 0], r[j, 1], r[j, 2], ex, ey, ez)
-        wx, wy, wz = apply(world_inverse, tx, ty, tz)
-        vx, vy, vz = _cross(wx, wy, wz, r[i, 0], r[i, 1], r[i, 2])
+        spins[j, 0, b], spins[j, 1, b], spins[j, 2, b] = apply(world_inverse, tx, ty, tz)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def response(r, i, j, inverse_mass, spins, responses):
+    """responses[i, j] (3, 3): the velocity change at a point with offset r[i] (3,) from the
+    centre of mass per unit impulse at a point with offset r[j], for a rigid body of inverse
+    mass inverse_mass whose spin per impulse at r[j] is spins[j] (``spin_per_impulse``):
+    E/M - [r_i]x I⁻¹ [r_j]x."""
+    for b in range(3):
+        ex = 1.0 if b == 0 else 0.0
+        ey = 1.0 if b == 1 else 0.0
+        ez = 1.0 if b == 2 else 0.0
+        sx, sy, sz = spins[j, 0, b], spins[j, 1, b], spins[j, 2, b]
+        vx, vy, vz = _cross(sx, sy, sz, r[i, 0], r[i, 1], r[i, 2])
         responses[i, j, 0, b] = vx + inverse_mass * ex
         responses[i, j, 1, b] = vy + inverse_mass * ey
         responses[i, j, 2, b] = vz + inverse_mass * ez
@@ -869,6 +882,7 @@ def contact_impulses(
     chosen,
     end_share,
     pairs,
+    spins,
 ):
     """The ground's impulses (count, 3) N s on ``count`` touching endpoints: u (count, 3) their
     velocities m/s, r (count, 3) their offsets from the centre of mass m. First the sinking ones
@@ -877,7 +891,7 @@ def contact_impulses(
     stopped dead. The first set whose normal impulses push and after which no other touching
     point sinks is kept; none, no impulse (the 2-D rule for two, carried to any number).
     responses (M, M, 3, 3), system (M + 4, M + 4), mixing (3, M, M), shares (3, M), pairs (M, M,
-    9): work space.
+    9), spins (M, 3, 3): work space.
     chosen (count,): the points' endpoint numbers; end_share (E,): each endpoint's share of the
     horizontal impulse the step before, updated (the shared-friction iteration starts from
     it)."""
@@ -894,9 +908,11 @@ def contact_impulses(
         n += int(active[i])
     if n == 0:
         return
+    for j in range(count):
+        spin_per_impulse(r, j, world_inverse, spins)
     for i in range(count):
         for j in range(count):
-            response(r, i, j, inverse_mass, world_inverse, responses)
+            response(r, i, j, inverse_mass, spins, responses)
     # three or more points: a rigid body often leaves their split undecided
     compliance = 0.0 if n < 3 else COMPLIANCE * (responses[0, 0, 0, 0] + responses[0, 0, 1, 1])
     # np.int64 and np.bool_: types, not literals (each literal a signature of its own: the
@@ -971,6 +987,7 @@ class StepWork(NamedTuple):
     entry: np.ndarray  # (E, 3) each endpoint in the world before the step, m
     end_share: np.ndarray  # (E,) each endpoint's share of the horizontal impulse last step
     pairs: np.ndarray  # (M, M, 9) the shared-friction solve's terms of each pair of contacts
+    spins: np.ndarray  # (M, 3, 3) each contact's spin per impulse (``spin_per_impulse``)
 
 
 @njit(cache=True)
@@ -999,6 +1016,7 @@ def new_step_works(lanes, n_rods, n_ends):
         np.empty((lanes, n_ends, 3)),
         np.zeros((lanes, n_ends)),
         np.empty((lanes, m, m, 9)),
+        np.empty((lanes, m, 3, 3)),
     )
 
 
@@ -1026,6 +1044,7 @@ def lane_work(works, lane, rod_ends, end_offset, end_velocity, frames):
         works.entry[lane],
         works.end_share[lane],
         works.pairs[lane],
+        works.spins[lane],
     )
 
 
@@ -1134,7 +1153,7 @@ def step_motion(figure, state, dt, work, total_mass, place_rods):
     gravity, floor, reach = figure[11:]
     previous, rod_ends, end_offset, end_velocity, end_force = work[:5]
     matrices, vectors, contact, responses, system, mixing, shares, chosen, entry = work[7:16]
-    end_share, pairs = work[16:]
+    end_share, pairs, spins = work[16:]
     rotation = matrices[0]
     tensor = matrices[1]
     tensor_inverse = matrices[2]
@@ -1221,6 +1240,7 @@ def step_motion(figure, state, dt, work, total_mass, place_rods):
             chosen,
             end_share,
             pairs,
+            spins,
         )
         for i in range(count):
             if impulse[i, 1] > 0.0:
@@ -1293,7 +1313,8 @@ def step_motion(figure, state, dt, work, total_mass, place_rods):
             u[0, 1] = uy
             u[0, 2] = uz
             inverse_mass = 1.0 / total_mass
-            response(r, 0, 0, inverse_mass, world_inverse, responses)
+            spin_per_impulse(r, 0, world_inverse, spins)
+            response(r, 0, 0, inverse_mass, spins, responses)
             px, py, pz = stop_dead(u, responses, 0)
             if py <= 0.0:
                 # horizontal only: solve the x-z block for zero horizontal velocity
