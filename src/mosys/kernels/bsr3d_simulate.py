@@ -21,8 +21,9 @@ step on the floor (up to ``MAX_CONTACTS``, the lowest first), with the paper's f
 to 3-D: a lone contact does not slide; several take horizontal impulses in the ratio of their
 normal impulses, sized so that their normal-impulse-weighted horizontal velocity is zero (a
 fixed point over the weights: each iteration a symmetric positive definite solve, its normal
-block inverted once; Anderson mixing of the weights for three or more contacts, where the plain
-iteration would take twice as many). Contacts whose normal impulse would pull are dropped one at a
+block inverted once; Anderson mixing of the weights, where the plain iteration would take two to
+five times as many, except for two contacts in the plane z = 0, which iterate plainly as the 2-D
+rule does). Contacts whose normal impulse would pull are dropped one at a
 time. An endpoint that still ends the step below the floor lifts the figure out of it, and an
 endpoint alone on the floor is stopped and held where it stood, as in 2-D.
 
@@ -559,9 +560,11 @@ def _shared_friction(
     the index of the contact whose normal impulse pulls most (-1: none pulls; -2: the system is
     singular; -3: the shares of a twisting solve did not settle; slide only keeps its last
     iterate, as the 2-D rule does). ``share`` (count,): the shares the points had the step
-    before (0: not in contact then), where the iteration starts if every active point had one
-    and there are three or more (which the 2-D rule never has: two start at even shares, as in
-    2-D, since where the iteration starts can decide whether a normal impulse pulls).
+    before (0: not in contact then), where the iteration starts if every active point had one,
+    the shares then mixed (``_mix_shares``), unless there are two in the plane z = 0 with their
+    velocities: those start at even shares and iterate plainly, as the 2-D rule does (where the
+    iteration starts can decide whether a normal impulse pulls, and a figure in that plane moves
+    as the 2-D simulator moves it).
 
     How it is solved: the system in the n normal impulses and the m = 3 (2 without the twist)
     tangential unknowns is symmetric positive semi-definite, [[A, B], [Bᵀ, D]] (the body's
@@ -580,14 +583,17 @@ def _shared_friction(
     column M + 3; the normal impulses in row M + 3, columns :n."""
     n = 0
     known = 0.0
+    planar = True  # every active point and its velocity in the plane z = 0: the 2-D rule's case
     for i in range(count):
         if active[i]:
             n += 1
             known = known + share[i] if share[i] > 0.0 and known >= 0.0 else -1.0
+            planar = planar and r[i, 2] == 0.0 and u[i, 2] == 0.0
+    accelerated = n >= 3 or not planar  # two in the plane iterate plainly, as the 2-D rule does
     for i in range(count):
         if not active[i]:
             weight[i] = 0.0
-        elif known > 0.0 and n >= 3:  # two start even, as the 2-D rule does
+        elif known > 0.0 and accelerated:  # two in the plane start even, as the 2-D rule does
             weight[i] = share[i] / known
         else:
             weight[i] = 1.0 / n
@@ -803,7 +809,7 @@ def _shared_friction(
         if change <= 1e-12:
             converged = True
             break
-        if n >= 3:  # two iterate plainly, as the 2-D rule does
+        if accelerated:
             _mix_shares(weight, active, count, mixing, min(iteration, depth))
     if twisting and not converged:
         return -3
