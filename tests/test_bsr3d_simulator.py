@@ -453,6 +453,18 @@ def skew(v: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
+def responses_of(r, count, inverse_mass, world_inverse):
+    """The kernel's responses (M, M, 3, 3) among the first ``count`` points of r (M, 3)."""
+    m = sim.MAX_CONTACTS
+    responses, spins = np.zeros((m, m, 3, 3)), np.zeros((m, 3, 3))
+    for j in range(count):
+        sim.spin_per_impulse(r, j, world_inverse, spins)
+    for i in range(count):
+        for j in range(count):
+            sim.response(r, i, j, inverse_mass, spins, responses)
+    return responses
+
+
 @settings(max_examples=25, deadline=None)
 @given(st.integers(0, 2**32 - 1))
 def test_a_contacts_response_is_the_rigid_bodys(seed):
@@ -466,12 +478,9 @@ def test_a_contacts_response_is_the_rigid_bodys(seed):
     world_inverse = np.linalg.inv(a @ a.T + np.eye(3))
     world_inverse = 0.5 * (world_inverse + world_inverse.T)
     inverse_mass = 1.0 / rng.uniform(1.0, 60.0)
-    responses, spins = np.zeros((m, m, 3, 3)), np.zeros((m, 3, 3))
-    for j in range(m):
-        sim.spin_per_impulse(r, j, world_inverse, spins)
+    responses = responses_of(r, m, inverse_mass, world_inverse)
     for i in range(m):
         for j in range(m):
-            sim.response(r, i, j, inverse_mass, spins, responses)
             expected = inverse_mass * np.eye(3) - skew(r[i]) @ world_inverse @ skew(r[j])
             np.testing.assert_allclose(responses[i, j], expected, rtol=0, atol=1e-12)
 
@@ -557,12 +566,7 @@ def test_the_shared_friction_solve_finds_the_fixed_point_of_the_dense_plain_iter
         inverse_mass = 1.0 / rng.uniform(5.0, 60.0)
         uu, rr = np.zeros((m, 3)), np.zeros((m, 3))
         uu[:count], rr[:count] = u, r
-        responses, spins = np.zeros((m, m, 3, 3)), np.zeros((m, 3, 3))
-        for j in range(count):
-            sim.spin_per_impulse(rr, j, world_inverse, spins)
-        for i in range(count):
-            for j in range(count):
-                sim.response(rr, i, j, inverse_mass, spins, responses)
+        responses = responses_of(rr, count, inverse_mass, world_inverse)
         compliance = sim.COMPLIANCE * (responses[0, 0, 0, 0] + responses[0, 0, 1, 1])
         compliance = 0.0 if count < 3 else compliance
         impulse = np.zeros((m, 3))
