@@ -534,7 +534,7 @@ def plain_shares(u, r, responses, compliance, twisting, iterations):
 def test_the_shared_friction_solve_finds_the_fixed_point_of_the_dense_plain_iteration():
     """The kernel inverts the system's normal block once and mixes the shares (Anderson): where
     the plain iteration of a dense solve settles with every normal impulse pushing, the kernel
-    ends at the same impulses; and for two contacts in the plane z = 0 (iterated plainly, as
+    ends at the same impulses; and for two contacts with no z in r or u (iterated plainly, as
     the 2-D rule is) it agrees on whether they push."""
     rng = np.random.default_rng(7)
     m = sim.MAX_CONTACTS

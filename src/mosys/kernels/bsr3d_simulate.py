@@ -22,10 +22,11 @@ to 3-D: a lone contact does not slide; several take horizontal impulses in the r
 normal impulses, sized so that their normal-impulse-weighted horizontal velocity is zero (a
 fixed point over the weights: each iteration a symmetric positive definite solve, its normal
 block inverted once; Anderson mixing of the weights, where the plain iteration would take two to
-five times as many, except for two contacts in the plane z = 0, which iterate plainly as the 2-D
-rule does). Contacts whose normal impulse would pull are dropped one at a
-time. An endpoint that still ends the step below the floor lifts the figure out of it, and an
-endpoint alone on the floor is stopped and held where it stood, as in 2-D.
+five times as many, except for two contacts with no z in their offsets from the centre of mass
+or their velocities, which iterate plainly as the 2-D rule does). Contacts whose normal impulse
+would pull are dropped one at a time. An endpoint that still ends the step below the floor lifts
+the figure out of it, and an endpoint alone on the floor is stopped and held where it stood, as
+in 2-D.
 
 State vector (S = 13 + 2J): ``c`` (3, m), ``v`` (3, m/s), the orientation quaternion ``q`` (w,
 x, y, z), ``L`` (3, kg m²/s, world), ``θ`` (J, rad), ``θ'`` (J, rad/s).
@@ -561,10 +562,10 @@ def _shared_friction(
     singular; -3: the shares of a twisting solve did not settle; slide only keeps its last
     iterate, as the 2-D rule does). ``share`` (count,): the shares the points had the step
     before (0: not in contact then), where the iteration starts if every active point had one,
-    the shares then mixed (``_mix_shares``), unless there are two in the plane z = 0 with their
-    velocities: those start at even shares and iterate plainly, as the 2-D rule does (where the
-    iteration starts can decide whether a normal impulse pulls, and a figure in that plane moves
-    as the 2-D simulator moves it).
+    the shares then mixed (``_mix_shares``), unless there are two with no z in their offsets r or
+    velocities u (a figure moving in its x-y plane): those start at even shares and iterate
+    plainly, as the 2-D rule does (where the iteration starts can decide whether a normal
+    impulse pulls, and a figure in that plane moves as the 2-D simulator moves it).
 
     How it is solved: the system in the n normal impulses and the m = 3 (2 without the twist)
     tangential unknowns is symmetric positive semi-definite, [[A, B], [Bᵀ, D]] (the body's
@@ -583,7 +584,7 @@ def _shared_friction(
     column M + 3; the normal impulses in row M + 3, columns :n."""
     n = 0
     known = 0.0
-    planar = True  # every active point and its velocity in the plane z = 0: the 2-D rule's case
+    planar = True  # no z in any active point's offset or velocity: the 2-D rule's case
     for i in range(count):
         if active[i]:
             n += 1
