@@ -4,15 +4,26 @@ the arrival box."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from test_car import SMALL
 
 from mosys.errors import InputError
+from mosys.io.car_scene import controller_table_scene
+from mosys.io.controller_table import write_controller_table
 from mosys.io.start_grid import read_start_grid, write_start_grid
-from mosys.kernels.geometry import first_colliding_sample, pack_polygons, point_in_polygon
+from mosys.kernels.geometry import (
+    first_colliding_sample,
+    grown_polygon,
+    pack_polygons,
+    point_in_polygon,
+)
+from mosys.kernels.lookahead import CLEARANCE, _swept_free
 from mosys.parsing.controller import parse_controller_text
 from mosys.parsing.tokens import SpecError
 from mosys.ssc.controller import Controller
@@ -63,6 +74,7 @@ def test_it_never_touches_an_obstacle_or_leaves_the_domain(small, seed):
     run stays within them too."""
     rng = np.random.default_rng(seed)
     obstacles = small.lookahead
+    body = controller_table_scene(small.table).body_outline  # the real one, not the grown
     while True:
         start = np.array(
             [
@@ -76,7 +88,7 @@ def test_it_never_touches_an_obstacle_or_leaves_the_domain(small, seed):
         state = small.figure_state(start)
         collision, _ = first_colliding_sample(
             poses(small, state[None, :]),
-            obstacles.outline,
+            body,
             obstacles.obstacle_vertices,
             obstacles.obstacle_start,
         )
@@ -85,7 +97,7 @@ def test_it_never_touches_an_obstacle_or_leaves_the_domain(small, seed):
     run = small.simulate(state, 8.0, DT)
     sample, _ = first_colliding_sample(
         poses(small, run.states),
-        obstacles.outline,
+        body,
         obstacles.obstacle_vertices,
         obstacles.obstacle_start,
     )
@@ -258,8 +270,6 @@ def test_a_step_that_clips_an_obstacle_between_its_ends_is_not_free():
     """A thin wall 5 cm wide at x 2..2.05: a 4 m body stepping 4.7 m along +x starts clear of
     it (its nose at 1.8 m) and ends past it (its tail at 2.5 m) — both ends free, the step not
     (``_swept_free`` tests every 5 mm of travel); a step that stops short of the wall is free."""
-    from mosys.kernels.lookahead import _swept_free
-
     outline = np.array([[0.8, -0.85], [0.8, 0.85], [-3.2, 0.85], [-3.2, -0.85]])
     wall = [np.array([[2.0, -5.0], [2.05, -5.0], [2.05, 5.0], [2.0, 5.0]])]
     vertices, start = pack_polygons(wall)
@@ -271,6 +281,117 @@ def test_a_step_that_clips_an_obstacle_between_its_ends_is_not_free():
         assert first_colliding_sample(pose[None, :], outline, vertices, start)[0] == -1
     assert not _swept_free(before, past, slots, outline, vertices, start, domain, body)
     assert _swept_free(before, short, slots, outline, vertices, start, domain, body)
+
+
+CAR_BODY = np.array([[0.8, -0.85], [0.8, 0.85], [-3.2, 0.85], [-3.2, -0.85]])  # m
+POSE_SLOTS = np.arange(3, dtype=np.int64)
+NO_DOMAIN = np.zeros((0, 2))
+
+
+def test_a_polygon_grows_by_its_margin_on_every_side():
+    """A rectangle grows by the margin on each side, whichever way round its vertices run; a
+    right triangle's corners move along their bisectors; a polygon that is not convex is
+    refused."""
+    for outline in (CAR_BODY, CAR_BODY[::-1]):
+        grown = grown_polygon(outline, 0.005)
+        np.testing.assert_allclose(grown, outline + 0.005 * np.sign(outline))
+    triangle = grown_polygon(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]), 0.1)
+    np.testing.assert_allclose(
+        triangle, [[-0.1, -0.1], [1.1 + 0.1 * 2**0.5, -0.1], [-0.1, 1.1 + 0.1 * 2**0.5]]
+    )
+    with pytest.raises(ValueError, match="not convex"):
+        grown_polygon(np.array([[0.0, 0.0], [2.0, 0.0], [1.0, 0.2], [1.0, 2.0]]), 0.1)
+
+
+def test_the_runtime_tests_the_body_grown_by_its_clearance(small, tmp_path):
+    """The lookahead's outline is the table's body grown by CLEARANCE; a table whose body is not
+    convex is refused by name (an InputError: exit 2 at the command line)."""
+    body = controller_table_scene(small.table).body_outline
+    np.testing.assert_allclose(small.lookahead.outline, grown_polygon(body, CLEARANCE))
+    dent = [[0, -0.85], [0.8, 0], [0, 0.85], [-3.2, 0.85], [-3.2, -0.85], [-0.1, 0]]
+    attrs = {**small.table.attrs, "body_outline": json.dumps(dent)}
+    path = tmp_path / "dented.h5"
+    write_controller_table(path, dataclasses.replace(small.table, attrs=attrs))
+    with pytest.raises(InputError, match="the lookahead runtime needs a convex body_outline"):
+        Controller.load(path, small.dynamics)
+
+
+def test_a_corner_clipped_between_two_tests_is_caught():
+    """A step of 4.95 mm (one test, at its end) carries the body's front-left corner 0.25 mm
+    into a wall's corner halfway and out again: both ends are free, and the real body, tested
+    every 5 mm, misses it; the grown body (CLEARANCE) does not."""
+    nose = CAR_BODY[1]  # (0.8, 0.85): the body's front-left corner at the pose (0, 0, 0)
+    wall = [np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]) + nose]
+    vertices, start = pack_polygons(wall)
+    before, after = np.array([-0.0015, 0.002, 0.0]), np.array([0.002, -0.0015, 0.0])
+    middle = (0.5 * (before + after))[None, :]
+    body = np.empty_like(CAR_BODY)
+    assert first_colliding_sample(middle, CAR_BODY, vertices, start)[0] == 0
+    args = (POSE_SLOTS, CAR_BODY, vertices, start, NO_DOMAIN, body)
+    assert _swept_free(before, after, *args)  # the gap CLEARANCE closes
+    grown = grown_polygon(CAR_BODY, CLEARANCE)
+    assert not _swept_free(before, after, POSE_SLOTS, grown, vertices, start, NO_DOMAIN, body)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    corner=st.tuples(st.floats(-0.02, 0.02), st.floats(-0.02, 0.02)),
+    heading=st.floats(-0.3, 0.3),
+    move=st.tuples(st.floats(-0.05, 0.05), st.floats(-0.05, 0.05), st.floats(-0.03, 0.03)),
+)
+def test_a_step_free_for_the_grown_body_is_free_all_along(corner, heading, move):
+    """A square obstacle with a corner within 2 cm of the body's front-left corner, the body
+    stepping up to 5 cm and 1.7 degrees, as a DP step does: if ``_swept_free`` passes the step
+    with the grown body, the real body is free at 2,000 poses along it."""
+    nose = CAR_BODY[1]
+    square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]) + nose + np.array(corner)
+    vertices, start = pack_polygons([square])
+    before = np.array([0.0, 0.0, heading])
+    after = before + np.array(move)
+    grown, body = grown_polygon(CAR_BODY, CLEARANCE), np.empty_like(CAR_BODY)
+    if first_colliding_sample(before[None, :], grown, vertices, start)[0] >= 0:
+        return  # the run only steps from poses the grown body tested free
+    if not _swept_free(before, after, POSE_SLOTS, grown, vertices, start, NO_DOMAIN, body):
+        return
+    along = before + np.linspace(0.0, 1.0, 2001)[:, None] * (after - before)
+    assert first_colliding_sample(along, CAR_BODY, vertices, start)[0] == -1
+
+
+def test_with_nothing_admissible_it_brakes_to_rest_and_stays(small):
+    """The car rolling at 2 cm/s with its nose 3 mm from the front car (closer than CLEARANCE):
+    no sample is admissible, so it brakes, choosing again every step, and comes to rest within
+    two steps without rolling back (the braking input was once held for a whole DP step,
+    overshooting rest: the car rocked to and fro and crept into the car behind it)."""
+    state = small.figure_state(np.array([3.0 - 0.8 - 0.003, 1.0, 0.0, 0.0, 0.02]))
+    run = small.simulate(state, 1.0, DT)
+    speed = small.controller_states(run.states)[:, small.state_order.index("speed")]
+    assert np.all(speed >= 0.0)
+    assert np.all(speed[2:] == 0.0)
+    x = small.controller_states(run.states)[:, small.state_order.index("x")]
+    assert x.max() - x[0] < 0.2e-3  # v²/2a: 0.19 mm
+
+
+def test_where_no_exit_is_trusted_it_chooses_by_any_known_corner(small, car):
+    """A runtime that trusts no exit (a known weight above 1, which no exit carries) does not
+    brake and stand where the trusted values end: it chooses among its admissible samples by
+    the paper's rule (any known corner, renormalised), so its first segment is the one the
+    table's own runtime (known weight 0) takes, and it drives on, touching nothing."""
+    start = small.figure_state(np.array([1.5, 2.0, 5.0, 0.0, 0.0]))
+    wary = Controller("wary", small.table, car)
+    wary.lookahead = dataclasses.replace(small.lookahead, minimum_known_weight=1.5)
+    assert small.lookahead.minimum_known_weight == 0.0
+    ordinary, run = small.simulate(start, 8.0, DT), wary.simulate(start, 8.0, DT)
+    first = np.flatnonzero(np.any(ordinary.controls != ordinary.controls[0], axis=1))[0]
+    np.testing.assert_array_equal(run.controls[:first], ordinary.controls[:first])
+    assert np.any(run.controls[:, 1] != 0.0)  # it drives
+    path = poses(wary, run.states)
+    assert np.sum(np.hypot(*np.diff(path[:, :2], axis=0).T)) > 0.5
+    body = controller_table_scene(small.table).body_outline
+    lookahead = wary.lookahead
+    hit, _ = first_colliding_sample(
+        path, body, lookahead.obstacle_vertices, lookahead.obstacle_start
+    )
+    assert hit == -1
 
 
 def test_a_start_grid_whose_pose_search_would_not_fit_in_memory_is_refused(car, tmp_path):

@@ -174,6 +174,24 @@ def pose_is_free(state, pose_slot, outline, obstacle_vertices, obstacle_start, d
     return first_collision(outline, x, y, heading, obstacle_vertices, obstacle_start, body) < 0
 
 
+def grown_polygon(vertices: np.ndarray, margin: float) -> np.ndarray:
+    """A convex polygon (V, 2), m, with every edge moved ``margin`` m outward (V, 2): it holds
+    every point within ``margin`` of the original (each corner moves along its bisector to where
+    the two moved edges meet, so a rectangle grows by ``margin`` on each side)."""
+    vertices = np.asarray(vertices, dtype=np.float64)
+    edges = np.roll(vertices, -1, axis=0) - vertices  # edge k runs from vertex k to k + 1
+    following = np.roll(edges, -1, axis=0)
+    turns = edges[:, 0] * following[:, 1] - edges[:, 1] * following[:, 0]
+    if not (np.all(turns > 0.0) or np.all(turns < 0.0)):
+        raise ValueError("grown_polygon: the polygon is not convex")
+    sense = 1.0 if turns[0] > 0.0 else -1.0  # counter-clockwise: the outward normal is right
+    normals = sense * np.column_stack([edges[:, 1], -edges[:, 0]])
+    normals /= np.hypot(normals[:, 0], normals[:, 1])[:, None]
+    before = np.roll(normals, 1, axis=0)  # the normal of the edge ending at each vertex
+    bisector = (before + normals) / (1.0 + np.sum(before * normals, axis=1))[:, None]
+    return np.ascontiguousarray(vertices + margin * bisector)
+
+
 def pack_polygons(polygons: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     """Polygons (each (V_k, 2)) as one (M, 2) float64 vertex array and (K+1,) int64 offsets."""
     starts = np.zeros(len(polygons) + 1, dtype=np.int64)

@@ -6,14 +6,17 @@ asks the DP's own question at the vehicle's actual state instead: for every cont
 it until the state leaves the box of ±1 grid step around the state where the choice is made (the
 DP's cell), and cost that segment as the DP does (its seconds plus the interpolated cost-to-go
 where it leaves). It takes the cheapest sample and holds it to that exit, as the DP's transition
-assumes, then chooses again; where the cheapest choice costs more than the interpolated
+assumes, then chooses again (where no admissible sample's exit is trusted, ``known_weight``, it
+takes the cheapest by any known corner, the paper's rule; where none is admissible at all, it
+brakes, choosing again every step); where the cheapest choice costs more than the interpolated
 cost-to-go at the state promised, the run raises its own copy of the table there (``_learn``), so
 that a spot where interpolation promises too much does not hold the vehicle dithering in it.
-A segment is admissible only if no step of it touches an obstacle or
-leaves the domain polygon, and if braking to rest from its exit, steering held, touches nothing
-either; so the vehicle can always stop. Once the point where full braking would bring the
-vehicle to rest lies in the arrival box around the destination, it brakes to rest there and
-holds.
+A segment is admissible only if no step of it touches an obstacle or leaves the domain polygon,
+and if braking to rest from its exit, steering held, touches nothing either; so the vehicle can
+always stop. The body tested is the vehicle's grown by CLEARANCE (``ssc.lookahead``), so that the
+poses between two tests, and the run's own steps, which trace the segment with a smaller step
+than the DP's, are free too. Once the point where full braking would bring the vehicle to rest
+lies in the arrival box around the destination, it brakes to rest there and holds.
 
 SI units throughout; grids as in ``kernels.interpolate``; obstacles as ``geometry.pose_is_free``.
 """
@@ -48,6 +51,12 @@ from mosys.kernels.soundness import blown_up, state_is_sound
 
 OUTSIDE_PENALTY = 100.0  # s per grid step beyond the table's axes, added to the cost-to-go
 SWEEP_STEP = 0.005  # m: the collision tests along a lookahead step are this far apart
+# m: the body the lookahead tests is grown by this. Between two tests no point of the body moves
+# more than SWEEP_STEP, so a pose between them lies within SWEEP_STEP / 2 of a tested one; the
+# other half allows for the run, whose step (its dt) traces a segment a little differently from
+# the DP's step it was planned with. Without it a corner clipped an obstacle's corner between
+# two tests (a start grid with 7 steering rates, 2026-12-05).
+CLEARANCE = SWEEP_STEP
 _POSE = np.arange(3, dtype=np.int64)  # the slots of x, y and heading in a pose (3,)
 
 LOOKAHEAD_SIGNATURE = types.int64(
@@ -598,34 +607,39 @@ def simulate_lookahead(
         if arrived:
             _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs)
         elif step >= held_until:
-            sample, steps, cost = _choose(
-                derivative_into,
-                axis_min,
-                axis_step,
-                axis_count,
-                wrap,
-                value,
-                known,
-                minimum_known_weight,
-                control_samples,
-                control_slot,
-                input_size,
-                state_slot,
-                pose_slot,
-                outline,
-                obstacle_vertices,
-                obstacle_start,
-                domain,
-                vehicle_slot,
-                wheelbase,
-                wheel_radius,
-                brake,
-                limits,
-                arrival_box,
-                max_segment_steps,
-                segment_dt,
-                state,
-            )
+            # the cheapest sample whose exit is trusted; if none is, whose exit has any known
+            # corner (the paper's rule), rather than braking where the trusted values end
+            for trust in (minimum_known_weight, 0.0):
+                sample, steps, cost = _choose(
+                    derivative_into,
+                    axis_min,
+                    axis_step,
+                    axis_count,
+                    wrap,
+                    value,
+                    known,
+                    trust,
+                    control_samples,
+                    control_slot,
+                    input_size,
+                    state_slot,
+                    pose_slot,
+                    outline,
+                    obstacle_vertices,
+                    obstacle_start,
+                    domain,
+                    vehicle_slot,
+                    wheelbase,
+                    wheel_radius,
+                    brake,
+                    limits,
+                    arrival_box,
+                    max_segment_steps,
+                    segment_dt,
+                    state,
+                )
+                if sample >= 0 or trust == 0.0:
+                    break
             read_state(state, state_slot, here)  # stops_in_box used it for the braking point
             _learn(
                 axis_min,
@@ -642,11 +656,14 @@ def simulate_lookahead(
                 clamped,
                 out,
             )
-            if sample < 0:  # nothing admissible: brake, and choose again next step
+            if sample < 0:  # nothing admissible: brake, and choose again next step (held
+                # longer, a braking input made for one step overshoots rest and rocks the
+                # vehicle to and fro, creeping)
                 _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs)
+                held_until = step + 1
             else:
                 _sample_inputs(control_samples, control_slot, sample, inputs)
-            held_until = step + max(1, round(steps * segment_dt / dt))
+                held_until = step + max(1, round(steps * segment_dt / dt))
         _limit_inputs(state, vehicle_slot, limits, wheel_radius, dt, inputs, limited)
         for j in range(control_slot.shape[0]):
             record_control[step, j] = limited[control_slot[j]]

@@ -10,10 +10,11 @@ from types import ModuleType
 
 import numpy as np
 
+from mosys.errors import InputError
 from mosys.io.car_scene import controller_table_scene, has_car_scene
 from mosys.io.controller_table import ControllerTable
 from mosys.kernels.dp import DEAD_END_BOUND
-from mosys.kernels.geometry import pack_polygons
+from mosys.kernels.geometry import grown_polygon, pack_polygons
 from mosys.ssc.grid import FigureGrid, control_scale, figure_state_names
 
 MAX_SEGMENT_SECONDS = 2.0  # a held sample still in its cell after this long is chosen again
@@ -28,7 +29,8 @@ class Lookahead:
     value: (N, 1) cost-to-go, s (a dead end's: ``dp.DEAD_END_BOUND``); known: (N,) finite
     values; minimum_known_weight: the table's ``known_weight`` (0: any); control_samples:
     (U, m) every combination of the table's control samples; pose_slot, outline, obstacle_vertices,
-    obstacle_start, domain: the obstacles (``geometry.pose_is_free``; pose_slot -1: none);
+    obstacle_start, domain: the obstacles (``geometry.pose_is_free``; pose_slot -1: none; the
+    outline is the body grown by ``kernels.lookahead.CLEARANCE``);
     vehicle_slot: (7,) the state slots of x, y, heading, steer and speed, the input slots of
     steer_rate and wheel_accel; wheelbase and wheel_radius, m; brake: the largest wheel
     deceleration, rad/s²; arrival_box: (3, d) lower, upper and period (> 0: an angle) over the
@@ -102,6 +104,8 @@ def vehicle_arrival(
 
 def lookahead_runtime(table: ControllerTable, dynamics: ModuleType, grid: FigureGrid) -> Lookahead:
     """The lookahead arrays of a table whose attrs say ``policy`` = ``lookahead``."""
+    from mosys.kernels.lookahead import CLEARANCE  # here: importing it compiles the runtime
+
     attrs = table.attrs
     names = figure_state_names(dynamics)
     counts = np.atleast_1d(np.asarray(attrs["control_samples"], dtype=np.int64))
@@ -114,7 +118,14 @@ def lookahead_runtime(table: ControllerTable, dynamics: ModuleType, grid: Figure
     pose_slot = np.array([names.index(n) for n in ("x", "y", "heading")], dtype=np.int64)
     if has_car_scene(attrs):
         scene = controller_table_scene(table)
-        outline, domain = scene.body_outline, scene.domain
+        try:
+            outline = grown_polygon(scene.body_outline, CLEARANCE)
+        except ValueError:
+            raise InputError(
+                f"controller table of {table.figure}: the lookahead runtime needs a convex"
+                f" body_outline, got {scene.body_outline.tolist()}"
+            ) from None
+        domain = scene.domain
         vertices, start = pack_polygons(list(scene.obstacles))
     else:  # no obstacles and no domain polygon: every pose is free
         pose_slot[:] = -1
