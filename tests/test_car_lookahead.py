@@ -32,6 +32,9 @@ from mosys.ssc.parking import NOT_FREE, evaluate_starts
 
 ARRIVAL = "policy lookahead x=0.1 y=0.1 heading=4\n"
 DT = 0.01
+CAR_BODY = np.array([[0.8, -0.85], [0.8, 0.85], [-3.2, 0.85], [-3.2, -0.85]])  # the car's, m
+POSE_SLOTS = np.arange(3, dtype=np.int64)  # x, y, heading in a pose (3,)
+NO_DOMAIN = np.zeros((0, 2))
 
 
 @pytest.fixture(scope="module")
@@ -270,7 +273,7 @@ def test_a_step_that_clips_an_obstacle_between_its_ends_is_not_free():
     """A thin wall 5 cm wide at x 2..2.05: a 4 m body stepping 4.7 m along +x starts clear of
     it (its nose at 1.8 m) and ends past it (its tail at 2.5 m) — both ends free, the step not
     (``_swept_free`` tests every 5 mm of travel); a step that stops short of the wall is free."""
-    outline = np.array([[0.8, -0.85], [0.8, 0.85], [-3.2, 0.85], [-3.2, -0.85]])
+    outline = CAR_BODY
     wall = [np.array([[2.0, -5.0], [2.05, -5.0], [2.05, 5.0], [2.0, 5.0]])]
     vertices, start = pack_polygons(wall)
     slots = np.arange(3, dtype=np.int64)
@@ -281,11 +284,6 @@ def test_a_step_that_clips_an_obstacle_between_its_ends_is_not_free():
         assert first_colliding_sample(pose[None, :], outline, vertices, start)[0] == -1
     assert not _swept_free(before, past, slots, outline, vertices, start, domain, body)
     assert _swept_free(before, short, slots, outline, vertices, start, domain, body)
-
-
-CAR_BODY = np.array([[0.8, -0.85], [0.8, 0.85], [-3.2, 0.85], [-3.2, -0.85]])  # m
-POSE_SLOTS = np.arange(3, dtype=np.int64)
-NO_DOMAIN = np.zeros((0, 2))
 
 
 def test_a_polygon_grows_by_its_margin_on_every_side():
