@@ -630,6 +630,30 @@ def test_consistency_figure(tmp_path):
     assert_png(out)
 
 
+def test_consistency_figure_against_the_whole_arrival_box_too(tmp_path):
+    """A grid with ``arrival_cost_to_go`` (here 10 s where the cost-to-go is 8 s: ratios 0.8,
+    1.0 and 1.2, all within 25 %) adds a title line and an outlined histogram beside the
+    ratios against ``/value``, both in the legend."""
+    path = write_start_grid(tmp_path / "grid.h5", steers=(-30.0, 0.0))
+    with h5py.File(path, "a") as h5:
+        h5["arrival_cost_to_go"] = np.where(h5["cost_to_go"][()] == 8.0, 10.0, 11.0)
+    figure = consistency_figure(path)
+    assert figure.get_suptitle().endswith(
+        "within ±25 %: 2 of 3 (66.7 %); median 1.25, 90th percentile 1.45\n"
+        "against the cost-to-go to the whole arrival box: within ±25 %: 3 (100.0 %); median 1.00"
+    )
+    ax = figure.axes[0]
+    (filled,) = ax.containers
+    assert [round(bar.get_x(), 9) for bar in filled if bar.get_height() > 0] == [1.0, 1.25, 1.5]
+    (step,) = [patch for patch in ax.patches if not patch.get_fill()]  # the outline: one polygon
+    xy = step.get_xy()
+    assert sorted({round(x, 9) for x, y in xy if y > 0}) == [0.8, 0.85, 1.0, 1.05, 1.2, 1.25]
+    assert legend_labels(figure)[1:3] == [
+        "against the cost-to-go (/value)",
+        "against the cost-to-go to the whole arrival box",
+    ]
+
+
 def test_consistency_figure_without_a_parked_start(tmp_path):
     path = write_start_grid(tmp_path / "grid.h5")
     with h5py.File(path, "a") as h5:

@@ -4,6 +4,7 @@ controller table, start grid and two Figure 19 trajectories."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -56,10 +57,32 @@ GRID_COLUMNS = {
     "consistency_p90": 1.45,  # 1.25 + 0.8 × (1.5 - 1.25)
     "consistency_within_25pct": 0.5,  # 1 and 1.25 (the band's edge) of the four
 }
+NO_ARRIVAL = dict.fromkeys(
+    ("arrival_consistency_median", "arrival_consistency_p90", "arrival_consistency_within_25pct"),
+    "nan",
+)
 
 
 def test_start_grid_columns():
-    assert start_grid_columns(start_grid()) == GRID_COLUMNS
+    columns = start_grid_columns(start_grid())
+    assert {k: "nan" if k in NO_ARRIVAL and math.isnan(v) else v for k, v in columns.items()} == (
+        GRID_COLUMNS | NO_ARRIVAL
+    )
+
+
+def test_start_grid_columns_against_the_whole_arrival_box():
+    """The ratios against ``arrival_cost_to_go`` (10, 8, 12 s and unknown: 0.8, 1.25, 1.0 and
+    NaN) beside those against the cost-to-go."""
+    grid = dataclasses.replace(
+        start_grid(), arrival_cost_to_go=np.array([10.0, 8.0, 12.0, math.inf] + [9.0] * 6)
+    )
+    columns = start_grid_columns(grid)
+    assert {k: columns[k] for k in GRID_COLUMNS} == GRID_COLUMNS
+    assert {k: columns[k] for k in NO_ARRIVAL} == {
+        "arrival_consistency_median": 1.0,
+        "arrival_consistency_p90": 1.2,  # 1.0 + 0.8 × (1.25 - 1.0)
+        "arrival_consistency_within_25pct": 0.75,  # 0.8, 1.25 and 1.0 of the four
+    }
 
 
 def test_start_grid_columns_when_no_start_parks():
@@ -149,4 +172,6 @@ def test_write_car_table(tmp_path):
         "start that parked; its median, 90th percentile and the share within 25 % "
         "(|ratio - 1| <= 0.25)"
     ) in text
-    assert "| consistency_within_25pct |" in text
+    assert "arrival_consistency: the same against the table's cost-to-go to the whole" in text
+    rows = {line.split("|")[1].strip() for line in text.splitlines() if line.startswith("|")}
+    assert {"consistency_within_25pct", "arrival_consistency_within_25pct"} <= rows

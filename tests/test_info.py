@@ -212,7 +212,8 @@ def test_a_trajectory_told_its_units_writes_them_per_column(made, tmp_path):
 
 def test_the_axes_are_dimension_scales_of_every_per_node_dataset(pendulum_tables, tmp_path):
     """``/axes/<name>`` is a dimension scale named <name>, attached along its state dimension
-    to ``/value``, ``/torque``, ``/dead_end`` and ``/destination_index`` (labelled <name>);
+    to ``/value``, ``/torque``, ``/dead_end``, ``/destination_index`` and ``/arrival_value``
+    (labelled <name>);
     ``/torque``'s last dimension is labelled ``control``. The reader is not confused by the
     scales' attributes."""
     table = read_controller_table(pendulum_tables / "A.h5")
@@ -221,6 +222,7 @@ def test_the_axes_are_dimension_scales_of_every_per_node_dataset(pendulum_tables
         dead_end=np.zeros(table.value.shape, dtype=bool),
         destinations=(table.dest, {"angle": 90.0, "omega": 0.0}),
         destination_index=np.zeros(table.value.shape, dtype=np.int64),
+        arrival_value=table.value / 2,
     )
     write_controller_table(tmp_path / "several.h5", several)
     names = table.state_order
@@ -228,7 +230,7 @@ def test_the_axes_are_dimension_scales_of_every_per_node_dataset(pendulum_tables
         for name in names:
             assert h5py.h5ds.is_scale(h5["axes"][name].id)
             assert h5py.h5ds.get_scale_name(h5["axes"][name].id) == name.encode()
-        for dataset in ("value", "torque", "dead_end", "destination_index"):
+        for dataset in ("value", "torque", "dead_end", "destination_index", "arrival_value"):
             dims = h5[dataset].dims
             assert [dims[k].label for k in range(len(names))] == list(names), dataset
             assert [dims[k][0].name for k in range(len(names))] == [f"/axes/{n}" for n in names]
@@ -238,6 +240,7 @@ def test_the_axes_are_dimension_scales_of_every_per_node_dataset(pendulum_tables
             INDEX,
             INDEX,
         )
+        assert h5["arrival_value"].attrs["unit"] == "s"
     back = read_controller_table(tmp_path / "several.h5")
     assert back.state_order == names and back.axis_units == ("deg", "deg/s")
     assert back.wrap == table.wrap and back.control_units == ("N*m",)
@@ -246,6 +249,8 @@ def test_the_axes_are_dimension_scales_of_every_per_node_dataset(pendulum_tables
     np.testing.assert_array_equal(back.value, table.value)
     np.testing.assert_array_equal(back.destination_index, several.destination_index)
     assert back.destinations == several.destinations
+    np.testing.assert_array_equal(back.arrival_value, several.arrival_value)
+    assert table.arrival_value is None  # an interpolate table has none
 
 
 def car_table(**changes) -> ControllerTable:

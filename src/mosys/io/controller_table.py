@@ -2,9 +2,9 @@
 
 Beyond the contract (docs/formats/controller_table.md): every dataset has a ``unit``
 (``/torque`` also ``units``, one per control); each ``/axes/<name>`` is an HDF5 dimension scale
-named ``<name>``, attached to ``/value``, ``/torque``, ``/dead_end`` and ``/destination_index``
-along its state dimension (labelled ``<name>``; ``/torque``'s last dimension is labelled
-``control``); the root carries the provenance attrs (``io.provenance``)."""
+named ``<name>``, attached to ``/value``, ``/torque``, ``/dead_end``, ``/destination_index``
+and ``/arrival_value`` along its state dimension (labelled ``<name>``; ``/torque``'s last
+dimension is labelled ``control``); the root carries the provenance attrs (``io.provenance``)."""
 
 from __future__ import annotations
 
@@ -49,6 +49,12 @@ class ControllerTable:
     ``destinations`` of the destination the node's optimal path ends at, -1 where the value is
     inf (``kernels.dp.destination_indices`` says how it is found).
 
+    arrival_value: (n_1, ..., n_d) s, dataset ``/arrival_value``, for a ``policy lookahead``
+    table (None otherwise, and a file without it reads as None): the cost-to-go to the whole
+    arrival box, the arrival the lookahead runtime brakes into, inf where unreachable or a dead
+    end; ``value`` is the DP's to that box scaled by root attr ``arrival_aim`` (the same where
+    the aim is 1), which the runtime descends (README, "The self-parking car").
+
     control_units: the spec unit of each control ('N*m' for a hinge actuator, 'deg/s' and
     'deg/s^2' for the car's), written as ``/torque``'s ``units``; None: the writer infers them
     (``torque_units``), and a file without them reads as None.
@@ -71,6 +77,7 @@ class ControllerTable:
     destinations: tuple[dict[str, float], ...] | None = None
     destination_index: np.ndarray | None = None
     control_units: tuple[str, ...] | None = None
+    arrival_value: np.ndarray | None = None
 
     @property
     def all_destinations(self) -> tuple[dict[str, float], ...]:
@@ -106,6 +113,9 @@ def write_controller_table(path: str | Path, table: ControllerTable) -> None:
             if table.destination_index is not None:
                 index = np.asarray(table.destination_index, dtype=np.int64)
                 per_node.append(create_with_unit(h5, "destination_index", index, INDEX))
+            if table.arrival_value is not None:
+                arrival = np.asarray(table.arrival_value, dtype=np.float64)
+                per_node.append(create_with_unit(h5, "arrival_value", arrival, "s"))
             for dataset in per_node:
                 for k, name in enumerate(table.state_order):
                     dataset.dims[k].attach_scale(axes[name])
@@ -180,4 +190,7 @@ def read_controller_table(path: str | Path) -> ControllerTable:
             if "destination_index" in h5
             else None,
             control_units=column_units(h5["torque"]),
+            arrival_value=np.asarray(h5["arrival_value"][()], dtype=np.float64)
+            if "arrival_value" in h5
+            else None,
         )

@@ -23,6 +23,8 @@ from mosys.io.provenance import PROVENANCE_KEYS
 
 BLOCK_ELEMENTS = 1 << 20  # values read at a time
 ATTR_WIDTH = 76  # a shown attribute value is cut to this many characters
+# a controller table's datasets with the axes attached as dimension scales
+PER_NODE = ("value", "torque", "dead_end", "destination_index", "arrival_value")
 # attributes HDF5 dimension scales keep for themselves (shown as the axes section instead)
 SCALE_ATTRS = {"CLASS", "NAME", "REFERENCE_LIST", "DIMENSION_LIST", "DIMENSION_LABELS"}
 
@@ -158,7 +160,7 @@ def _table_sections(h5: h5py.File, summaries: dict) -> list[tuple[str, list[str]
     axes = _table(rows)
     scaled = [
         (dataset.name, ", ".join(d.label or "?" for d in dataset.dims))
-        for dataset in (h5.get(n) for n in ("value", "torque", "dead_end", "destination_index"))
+        for dataset in (h5.get(n) for n in PER_NODE)
         if isinstance(dataset, h5py.Dataset) and any(len(d) for d in dataset.dims)
     ]
     scales = _table([("dataset", "dimensions"), *scaled]) if scaled else ["  none attached"]

@@ -3,8 +3,10 @@ park. Datasets ``start`` (n, d) spec units (columns: root attr ``state_order``),
 bool, ``collided`` (n,) bool, ``parking_seconds`` (n,) float64 (nan: not parked), ``excluded``
 (n,) str (why the start cannot park at all, computed; "" for the starts that count and were
 run), ``cost_to_go`` (n,) float64 s (the table's, interpolated at the start as the runtime does;
-inf: unknown) and ``path_length`` (n,) float64 m (the shortest collision-free path the pose
-search found; inf: none, nan: the start is not free); root attrs ``controller``,
+inf: unknown), ``path_length`` (n,) float64 m (the shortest collision-free path the pose search
+found; inf: none, nan: the start is not free) and, optionally, ``arrival_cost_to_go`` (n,)
+float64 s (the table's cost-to-go to its whole arrival box, ``Controller.arrival_cost_to_go``;
+inf: unknown); root attrs ``controller``,
 ``simulated_seconds``, ``dt`` and the scene (``io.car_scene``). The success rate counts the
 starts that are not excluded.
 
@@ -75,6 +77,7 @@ class StartGrid:
     path_length: np.ndarray
     attrs: dict
     state_units: tuple[str, ...] | None = None
+    arrival_cost_to_go: np.ndarray | None = None
 
     @property
     def counted(self) -> np.ndarray:
@@ -93,6 +96,15 @@ class StartGrid:
         parked = self.parked & self.counted
         return consistency_ratios(self.parking_seconds[parked], self.cost_to_go[parked])
 
+    @property
+    def arrival_consistency(self) -> np.ndarray | None:
+        """``consistency`` against the cost-to-go to the whole arrival box; None for a grid
+        without ``arrival_cost_to_go``."""
+        if self.arrival_cost_to_go is None:
+            return None
+        parked = self.parked & self.counted
+        return consistency_ratios(self.parking_seconds[parked], self.arrival_cost_to_go[parked])
+
 
 def write_start_grid(path: str | Path, grid: StartGrid) -> None:
     """Write a start grid atomically."""
@@ -108,6 +120,9 @@ def write_start_grid(path: str | Path, grid: StartGrid) -> None:
             create_with_unit(h5, "excluded", excluded, TEXT, dtype=STRING)
             create_with_unit(h5, "cost_to_go", np.asarray(grid.cost_to_go, float), "s")
             create_with_unit(h5, "path_length", np.asarray(grid.path_length, float), "m")
+            if grid.arrival_cost_to_go is not None:
+                arrival = np.asarray(grid.arrival_cost_to_go, float)
+                create_with_unit(h5, "arrival_cost_to_go", arrival, "s")
             h5.attrs["state_order"] = list(grid.state_order)
             for key, value in grid.attrs.items():
                 h5.attrs[key] = value
@@ -160,4 +175,5 @@ def read_start_grid(path: str | Path) -> StartGrid:
             path_length=h5["path_length"][()],
             attrs={k: h5.attrs[k] for k in h5.attrs if k != "state_order"},
             state_units=column_units(h5["start"]),
+            arrival_cost_to_go=h5["arrival_cost_to_go"][()] if "arrival_cost_to_go" in h5 else None,
         )

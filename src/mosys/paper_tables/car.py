@@ -30,22 +30,11 @@ def start_grid_columns(grid: StartGrid) -> dict:
     success rate over the counted starts, the collisions, the mean parking time (s) of the
     parked starts and the consistency of the table (``StartGrid.consistency``: parking time /
     cost-to-go at the start): its median, its 90th percentile (linear interpolation) and the
-    share of parked starts within CONSISTENCY_BAND of 1. NaN where no start parked."""
+    share of parked starts within CONSISTENCY_BAND of 1; the same against the cost-to-go to the
+    whole arrival box (``arrival_consistency_*``, ``StartGrid.arrival_consistency``). NaN where
+    no start parked or the grid has no such cost-to-go."""
     parked = grid.parked & grid.counted
-    ratios = grid.consistency
-    if parked.any():
-        median, p90, within = consistency_summary(ratios)
-        consistency = {
-            "mean_parking_s": round(float(grid.parking_seconds[parked].mean()), 2),
-            "consistency_median": round(median, 3),
-            "consistency_p90": round(p90, 3),
-            "consistency_within_25pct": round(within, 3),
-        }
-    else:
-        consistency = dict.fromkeys(
-            ("mean_parking_s", "consistency_median", "consistency_p90", "consistency_within_25pct"),
-            np.nan,
-        )
+    arrival = grid.arrival_consistency
     return {
         "grid_starts": int(grid.start.shape[0]),
         "grid_counted": int(grid.counted.sum()),
@@ -54,8 +43,21 @@ def start_grid_columns(grid: StartGrid) -> dict:
         "grid_parked": int(parked.sum()),
         "grid_success_rate": round(grid.success_rate, 3),
         "grid_collisions": int(grid.collided.sum()),
-        **consistency,
+        "mean_parking_s": round(float(grid.parking_seconds[parked].mean()), 2)
+        if parked.any()
+        else np.nan,
+        **consistency_columns("consistency", grid.consistency if parked.any() else None),
+        **consistency_columns("arrival_consistency", arrival if parked.any() else None),
     }
+
+
+def consistency_columns(prefix: str, ratios: np.ndarray | None) -> dict:
+    """``prefix``_median, _p90 and _within_25pct of consistency ratios (p,)
+    (``consistency_summary``), rounded; NaN for None."""
+    names = (f"{prefix}_median", f"{prefix}_p90", f"{prefix}_within_25pct")
+    if ratios is None:
+        return dict.fromkeys(names, np.nan)
+    return dict(zip(names, (round(v, 3) for v in consistency_summary(ratios)), strict=True))
 
 
 def car_row(
@@ -116,8 +118,10 @@ def write_car_table(
         "over poses (the steer's largest angle, forward and back) finds no collision-free path "
         "to the destination. Consistency: parking time / the table's cost-to-go at the start, "
         "for each counted start that parked; its median, 90th percentile and the share within "
-        f"{100 * CONSISTENCY_BAND:.0f} % (|ratio - 1| <= {CONSISTENCY_BAND}); mean_parking_s "
-        "over the same starts; NaN where no start parked.\n\n"
+        f"{100 * CONSISTENCY_BAND:.0f} % (|ratio - 1| <= {CONSISTENCY_BAND}); "
+        "arrival_consistency: the same against the table's cost-to-go to the whole arrival box "
+        "(/arrival_value: the runtime descends the cost-to-go to the box scaled by the table's "
+        "aim); mean_parking_s over the same starts; NaN where no start parked.\n\n"
     )
     write_text_atomically(md_path, caption + frame.T.to_markdown(headers=["", "value"]) + "\n")
     return frame

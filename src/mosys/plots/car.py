@@ -95,6 +95,7 @@ OBSTACLE_FACE, OBSTACLE_EDGE = "0.72", "0.45"
 FAILURE_COLOR = "#d62728"  # the collision outline, the FAILED titles, the collision markers
 TIMEOUT_COLOR = "#ff7f0e"
 PATH_COLOR = "0.2"
+ARRIVAL_COLOR = "#1f4e9c"  # the consistency against the whole arrival box (outline)
 TIME_SHADES = matplotlib.colormaps["Blues"]  # outlines, light (start) to dark (end)
 SHADE_RANGE = (0.3, 0.95)  # the part of TIME_SHADES used
 PARKING_TIMES = LinearSegmentedColormap.from_list(
@@ -213,7 +214,8 @@ class StartGrid:
     str, why the start cannot park at all (``NOT_FREE`` or ``NO_WAY``; "" for the starts that
     count and were run); cost_to_go: (n,) s, the controller table's at the start (inf: unknown);
     path_length: (n,) m, the shortest collision-free path the pose search found (inf: none, NaN:
-    the start is not free)."""
+    the start is not free); arrival_cost_to_go: (n,) s, the table's cost-to-go to its whole
+    arrival box at the start (inf: unknown; None: the file has none)."""
 
     start: np.ndarray
     state_order: tuple[str, ...]
@@ -226,6 +228,7 @@ class StartGrid:
     scene: CarScene
     controller: str
     simulated_seconds: float
+    arrival_cost_to_go: np.ndarray | None = None
 
     @property
     def counted(self) -> np.ndarray:
@@ -244,6 +247,16 @@ class StartGrid:
         knows no cost-to-go there."""
         succeeded = self.succeeded
         return consistency_ratios(self.parking_seconds[succeeded], self.cost_to_go[succeeded])
+
+    @property
+    def arrival_consistency(self) -> np.ndarray | None:
+        """``consistency`` against ``arrival_cost_to_go``; None where there is none."""
+        if self.arrival_cost_to_go is None:
+            return None
+        succeeded = self.succeeded
+        return consistency_ratios(
+            self.parking_seconds[succeeded], self.arrival_cost_to_go[succeeded]
+        )
 
 
 def _missing(path, kind: str, names: Sequence[str], present) -> None:
@@ -344,6 +357,8 @@ def read_start_grid(path: str | Path) -> StartGrid:
     _missing(path, "start grid (root attributes)", GRID_ATTRS, attrs)
     start = np.asarray(grid.start, dtype=np.float64)
     per_start = {name: np.asarray(getattr(grid, name)) for name in DATASETS[1:]}
+    if grid.arrival_cost_to_go is not None:
+        per_start["arrival_cost_to_go"] = np.asarray(grid.arrival_cost_to_go)
     state_order = grid.state_order
     _columns(path, state_order, ("x", "y"))
     if start.ndim != 2 or start.shape[1] != len(state_order) or len(start) == 0:
@@ -392,6 +407,9 @@ def read_start_grid(path: str | Path) -> StartGrid:
         scene=_read_scene(path, attrs),
         controller=string_attr(attrs["controller"]),
         simulated_seconds=float(attrs["simulated_seconds"]),
+        arrival_cost_to_go=per_start["arrival_cost_to_go"].astype(np.float64)
+        if "arrival_cost_to_go" in per_start
+        else None,
     )
 
 
@@ -1075,11 +1093,16 @@ def consistency_figure(start_grid_path: str | Path) -> Figure:
     and the 90th percentile (linear interpolation) of the ratio (``consistency_summary``), both
     also drawn; ratios that are not finite (no cost-to-go known at the start) count as outside
     the band and are left off the histogram, as are ratios above CONSISTENCY_CLIP; the title
-    says how many. Reads the start grid as ``success_map_figure`` does."""
+    says how many. A grid with the cost-to-go to the whole arrival box
+    (``StartGrid.arrival_consistency``) adds the ratios against it as an outlined histogram
+    and a title line (share within the band and median). Reads the start grid as
+    ``success_map_figure`` does."""
     grid = read_start_grid(start_grid_path)
     ratios = grid.consistency
     median, p90, within = consistency_summary(ratios)
     finite = ratios[np.isfinite(ratios)]
+    arrival = grid.arrival_consistency if len(ratios) else None
+    arrival_finite = np.zeros(0) if arrival is None else arrival[np.isfinite(arrival)]
     headline = (
         f"Controller {grid.controller}: parking time / cost-to-go at the start, "
         f"{len(ratios)} starts that parked"
@@ -1095,12 +1118,25 @@ def consistency_figure(start_grid_path: str | Path) -> Figure:
             left_off.append(f"{len(ratios) - len(finite)} with no cost-to-go at the start")
         if np.any(finite > CONSISTENCY_CLIP):
             left_off.append(f"{int(np.sum(finite > CONSISTENCY_CLIP))} above {CONSISTENCY_CLIP:g}")
+        if arrival is not None:
+            arrival_median, _, arrival_within = consistency_summary(arrival)
+            arrival_inside = int(np.sum(np.abs(arrival - 1.0) <= CONSISTENCY_BAND))
+            details += (
+                f"\nagainst the cost-to-go to the whole arrival box: within "
+                f"±{100 * CONSISTENCY_BAND:.0f} %: {arrival_inside} "
+                f"({100 * arrival_within:.1f} %); median {arrival_median:.2f}"
+            )
+            if np.any(arrival_finite > CONSISTENCY_CLIP):
+                above = int(np.sum(arrival_finite > CONSISTENCY_CLIP))
+                left_off.append(f"{above} above {CONSISTENCY_CLIP:g} against the whole box")
         if left_off:
             details += f"\nnot drawn: {', '.join(left_off)}"
         finite = finite[finite <= CONSISTENCY_CLIP]
+        arrival_finite = arrival_finite[arrival_finite <= CONSISTENCY_CLIP]
     else:
         details = "no start parked: nothing to compare"
-    upper = max(1.0 + 2 * CONSISTENCY_BAND, float(finite.max()) if len(finite) else 0.0)
+    drawn = np.concatenate([finite, arrival_finite])
+    upper = max(1.0 + 2 * CONSISTENCY_BAND, float(drawn.max()) if len(drawn) else 0.0)
     bins = np.round(CONSISTENCY_BIN * np.arange(math.floor(upper / CONSISTENCY_BIN) + 2), 9)
     with plot_style():
         figure = new_figure(CONSISTENCY_WIDTH, CONSISTENCY_HEIGHT)
@@ -1114,8 +1150,25 @@ def consistency_figure(start_grid_path: str | Path) -> Figure:
             label=f"within ±{100 * CONSISTENCY_BAND:.0f} % of the cost-to-go",
         )
         counts, _, _ = ax.hist(
-            finite, bins=bins, color=PARKING_TIMES(0.7), edgecolor="black", linewidth=0.5, zorder=2
+            finite,
+            bins=bins,
+            color=PARKING_TIMES(0.7),
+            edgecolor="black",
+            linewidth=0.5,
+            zorder=2,
+            **({} if arrival is None else {"label": "against the cost-to-go (/value)"}),
         )
+        if arrival is not None:
+            arrival_counts, _, _ = ax.hist(
+                arrival_finite,
+                bins=bins,
+                histtype="step",
+                color=ARRIVAL_COLOR,
+                linewidth=1.6,
+                zorder=5,
+                label="against the cost-to-go to the whole arrival box",
+            )
+            counts = np.maximum(counts, arrival_counts)
         for edge in (1 - CONSISTENCY_BAND, 1 + CONSISTENCY_BAND):
             ax.axvline(edge, color="black", linestyle="--", linewidth=1.0, zorder=3)
         ax.axvline(1.0, color="black", linewidth=0.8, zorder=3, label="as the table predicts")

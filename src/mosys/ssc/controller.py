@@ -137,9 +137,24 @@ class Controller:
         DP's bound ``dp.DEAD_END_BOUND``), inf where those carry less than the table's
         ``minimum_known_weight`` (0 when absent) of the weight (up to rounding,
         ``interpolate.falls_short``); beyond the axes, at the nearest covered state."""
+        return self._interpolated_cost(*self._known_values, state)
+
+    def arrival_cost_to_go(self, state: np.ndarray) -> float:
+        """The table's cost-to-go (s) to its whole arrival box (``/arrival_value``) at a
+        controller state (d,) in spec units, interpolated over the corners where it is finite,
+        inf where those carry less than the table's ``minimum_known_weight``; ``cost_to_go``
+        for a table without one (its aim is 1, or it has no arrival box)."""
+        if self._arrival_values is None:
+            return self.cost_to_go(state)
+        return self._interpolated_cost(*self._arrival_values, state)
+
+    def _interpolated_cost(
+        self, known_values: np.ndarray, known: np.ndarray, state: np.ndarray
+    ) -> float:
+        """Node costs (N, 1) s, 0 where not ``known`` (N,) bool, interpolated at a controller
+        state (d,) in spec units (``cost_to_go``)."""
         grid = self.grid
         clamped, _ = self._clamped(state)
-        known_values, known = self._known_values
         out = np.empty(1)
         known_weight = interpolate_into(
             grid.axis_min,
@@ -176,6 +191,16 @@ class Controller:
         else:
             value = self.table.value.reshape(-1, 1)
             known = np.isfinite(value[:, 0])
+        return np.ascontiguousarray(np.where(known[:, None], value, 0.0)), known
+
+    @cached_property
+    def _arrival_values(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """(N, 1) cost-to-go to the whole arrival box, s, 0 where not finite, and (N,) bool
+        finite; None for a table without ``/arrival_value``."""
+        if self.table.arrival_value is None:
+            return None
+        value = self.table.arrival_value.reshape(-1, 1)
+        known = np.isfinite(value[:, 0])
         return np.ascontiguousarray(np.where(known[:, None], value, 0.0)), known
 
     def figure_state(self, state: np.ndarray) -> np.ndarray:

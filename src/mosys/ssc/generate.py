@@ -9,6 +9,7 @@ from __future__ import annotations
 import itertools
 import json
 import resource
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -293,10 +294,10 @@ class Transitions:
 
 
 def exit_transition_arguments(
-    problem: Problem, dynamics: ModuleType, dt: float
+    problem: Problem, dynamics: ModuleType, dt: float, aim: float | None = None
 ) -> tuple[tuple, tuple, tuple]:
     """The exit-transition kernel's arguments (``dp.exit_transitions_template``) before
-    ``nodes``, its obstacles and its arrival box (``arrival_arguments``), SI."""
+    ``nodes``, its obstacles and its arrival box (``arrival_arguments``, scaled by ``aim``), SI."""
     grid = problem.grid
     # the kernels take SI controls; K stays per spec unit: K |u_spec| = (K / scale) |u_SI|
     samples_si = np.ascontiguousarray(problem.control_samples * problem.control_scale)
@@ -314,22 +315,24 @@ def exit_transition_arguments(
         effort,
         float(dt),
     )
-    return before, problem.obstacles.kernel_arguments(), arrival_arguments(problem, dynamics)
+    arrival = arrival_arguments(problem, dynamics, aim)
+    return before, problem.obstacles.kernel_arguments(), arrival
 
 
-def arrival_arguments(problem: Problem, dynamics: ModuleType) -> tuple:
+def arrival_arguments(problem: Problem, dynamics: ModuleType, aim: float | None = None) -> tuple:
     """The exit kernel's arrival arguments (``dp.exit_transitions_template``): a lookahead
-    table's arrival box scaled by its ``aim`` (README, "The self-parking car") and braking, else
-    a disabled placeholder."""
+    table's arrival box scaled by ``aim`` (None: the spec's ``aim``; README, "The self-parking
+    car") and braking, else a disabled placeholder."""
     spec, grid = problem.spec, problem.grid
     if spec.policy is None or spec.policy.kind != "lookahead":
         return no_arrival(len(grid.names))
+    scale = spec.policy.aim if aim is None else aim
     control = next(c for c in spec.controls if c.name == "wheel_accel")
     arrival = vehicle_arrival(
         dynamics,
         grid,
         spec.destination_values(),
-        {name: spec.policy.aim * tolerance for name, tolerance in spec.policy.arrival},
+        {name: scale * tolerance for name, tolerance in spec.policy.arrival},
         min(abs(control.minimum), abs(control.maximum)),
     )
     return (
@@ -744,10 +747,12 @@ def solve(
     dt: float,
     node_valid: np.ndarray | None = None,
     quiet: bool = False,
+    aim: float | None = None,
 ) -> Solution:
     """Exit transitions once (integrator steps of at most ``dt`` s), then Bellman sweeps until the
     largest decrease < tolerance (s) or ``max_iterations`` sweeps. ``node_valid``: (N,) bool,
-    False for further nodes to remove (on top of ``problem.node_valid``). The kernels are
+    False for further nodes to remove (on top of ``problem.node_valid``); ``aim``: the scale of
+    a lookahead table's arrival box the segments end in (None: the spec's). The kernels are
     loaded first, outside the DP's timings (``kernel_load_seconds``). With the spec's
     ``known_weight``, exits resting on less of it than that cost inf, values start from
     DEAD_END_BOUND, and the nodes left at DEAD_END_SECONDS or more are dead ends (inf).
@@ -755,7 +760,7 @@ def solve(
     grid = problem.grid
     valid = problem.node_valid if node_valid is None else problem.node_valid & node_valid
     exit_transitions = specialise(exit_transitions_template, dynamics, parallel=True)
-    arguments = exit_transition_arguments(problem, dynamics, dt)
+    arguments = exit_transition_arguments(problem, dynamics, dt, aim)
     classes = MotionClasses.of(problem, dynamics)
     kernel_load_seconds = load_kernels(exit_transitions, arguments, problem, classes)
     started = time.perf_counter()
@@ -804,6 +809,30 @@ def solve(
         iteration_seconds,
         kernel_load_seconds,
         destination_index,
+    )
+
+
+def arrival_solution(
+    problem: Problem,
+    dynamics: ModuleType,
+    solution: Solution,
+    tolerance: float,
+    max_iterations: int,
+    quiet: bool,
+) -> Solution | None:
+    """For a lookahead table, the DP whose segments end in the whole arrival box (aim 1): the
+    cost-to-go to the arrival the runtime brakes into, where the table's own (``solution``)
+    is to the box scaled by its ``aim`` (README, "The self-parking car"); ``solution`` itself
+    where the aim is 1 already. None for any other table."""
+    policy = problem.spec.policy
+    if policy is None or policy.kind != "lookahead":
+        return None
+    if policy.aim == 1.0:
+        return solution
+    if not quiet:
+        print("the DP again, aiming at the whole arrival box:", file=sys.stderr, flush=True)
+    return solve(
+        problem, dynamics, tolerance, max_iterations, problem.spec.dt, quiet=quiet, aim=1.0
     )
 
 
@@ -912,15 +941,14 @@ def generate_controller(
         memory_bytes=dp_memory_bytes(spec),
     )
     problem = build_problem(spec, dynamics)
-    solution = solve(
-        problem,
-        dynamics,
-        spec.tolerance if tolerance is None else tolerance,
-        spec.max_iterations if max_iterations is None else max_iterations,
-        spec.dt,
-        quiet=quiet,
-    )
-    generation_seconds = time.perf_counter() - started - solution.kernel_load_seconds
+    tolerance = spec.tolerance if tolerance is None else tolerance
+    max_iterations = spec.max_iterations if max_iterations is None else max_iterations
+    solution = solve(problem, dynamics, tolerance, max_iterations, spec.dt, quiet=quiet)
+    arrival = arrival_solution(problem, dynamics, solution, tolerance, max_iterations, quiet)
+    kernel_load_seconds = solution.kernel_load_seconds
+    if arrival is not None and arrival is not solution:
+        kernel_load_seconds += arrival.kernel_load_seconds
+    generation_seconds = time.perf_counter() - started - kernel_load_seconds
     grid = problem.grid
     lower = np.array([c.minimum for c in spec.controls])
     upper = np.array([c.maximum for c in spec.controls])
@@ -950,6 +978,7 @@ def generate_controller(
         destination_index=None
         if solution.destination_index is None
         else solution.destination_index.reshape(grid.shape),
+        arrival_value=None if arrival is None else arrival.value.reshape(grid.shape),
         attrs={
             "spec_sha256": spec.spec_sha256,
             "generation_seconds": generation_seconds,
@@ -959,10 +988,8 @@ def generate_controller(
             "iterations": solution.iterations,
             "policy_sweeps": solution.policy_sweeps,
             "residual": solution.residual,
-            "converged": bool(
-                solution.residual < (spec.tolerance if tolerance is None else tolerance)
-            ),
-            "tolerance": spec.tolerance if tolerance is None else tolerance,
+            "converged": bool(solution.residual < tolerance),
+            "tolerance": tolerance,
             "dt": spec.dt,
             "control_samples": np.array([c.samples for c in spec.controls], dtype=np.int64),
             "unreachable_nodes": int((unreachable & ~solution.dead_end).sum()),

@@ -146,6 +146,7 @@ def evaluate_starts(
         excluded=excluded,
         cost_to_go=np.array([controller.cost_to_go(start) for start in starts]),
         path_length=path_length,
+        arrival_cost_to_go=np.array([controller.arrival_cost_to_go(start) for start in starts]),
         attrs={
             "controller": controller.name,
             "simulated_seconds": float(seconds),
