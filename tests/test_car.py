@@ -351,6 +351,18 @@ def test_specs_that_do_not_fit_the_car_name_the_line(car, old, new, message):
             "x.ssc:15:32: expected 'aim=' only once, found 'aim=0.6'",
         ),
         (
+            "policy lookahead x=0.1 arrival_value aim=0.5 arrival_value",
+            "x.ssc:15:46: expected 'arrival_value' only once, found 'arrival_value'",
+        ),
+        (
+            "policy lookahead x=0.1 arrival_values",
+            "x.ssc:15:24: expected a 'name=tolerance' arrival tolerance, found 'arrival_values'",
+        ),
+        (
+            "policy interpolate arrival_value",
+            "x.ssc:15:20: expected the end of the line after 'interpolate', found 'arrival_value'",
+        ),
+        (
             "policy lookahead aim=0.5",
             "x.ssc:15:25: expected a 'name=tolerance' arrival tolerance of a dest dimension "
             "after 'lookahead', found end of line",
@@ -382,6 +394,15 @@ def test_a_policy_line_round_trips_and_lookahead_needs_a_vehicle(link1):
     assert (aimed.policy.arrival, aimed.policy.aim) == (spec.policy.arrival, 0.25)
     again = parse_controller_text(render_controller_spec(aimed), "x.ssc")
     assert again.policy == aimed.policy
+    assert not aimed.policy.arrival_value
+    both = parse_controller_text(SMALL + "policy lookahead arrival_value x=0.1 aim=0.5\n", "x.ssc")
+    assert (both.policy.arrival, both.policy.aim, both.policy.arrival_value) == (
+        (("x", 0.1),),
+        0.5,
+        True,
+    )
+    again = parse_controller_text(render_controller_spec(both), "x.ssc")
+    assert again.policy == both.policy
     pendulum = parse_controller_text(
         "dyn link1\nssd angle -180 170 36 wrap\nssd omega -500 500 21\n"
         "torq torque -10 10 11 0.1\ndest angle=0 omega=0\npolicy lookahead angle=5\n",

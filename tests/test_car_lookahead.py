@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 
 import numpy as np
 import pytest
@@ -208,8 +209,8 @@ def test_a_car_without_obstacles_parks_in_the_open(car, tmp_path):
 def test_a_start_grid_runs_the_starts_that_can_park_and_excludes_the_others(small, tmp_path):
     """Starts whose pose overlaps the curb or lies outside the domain are excluded (not run),
     with the reason; every start records the table's cost-to-go there; the rate counts only
-    the starts that are not excluded; two threads give the same file as one. The table aims at
-    its whole arrival box, so the cost-to-go to that box is the same."""
+    the starts that are not excluded; two threads give the same file as one. The table keeps
+    no cost-to-go to the whole arrival box (``arrival_value``), so the grid has none."""
     starts = np.array(
         [
             [1.5, 2.0, 0.0, 0.0, 0.0],
@@ -234,8 +235,7 @@ def test_a_start_grid_runs_the_starts_that_can_park_and_excludes_the_others(smal
     assert back.excluded.tolist() == one.excluded.tolist()
     np.testing.assert_array_equal(back.cost_to_go, one.cost_to_go)
     np.testing.assert_array_equal(back.consistency, one.consistency)
-    np.testing.assert_array_equal(back.arrival_cost_to_go, one.cost_to_go)
-    np.testing.assert_array_equal(back.arrival_consistency, one.consistency)
+    assert one.arrival_cost_to_go is None and back.arrival_cost_to_go is None
 
 
 def test_the_dp_ends_a_segment_where_the_runtime_would_brake_into_the_arrival_box(
@@ -410,16 +410,18 @@ def test_a_start_grid_whose_pose_search_would_not_fit_in_memory_is_refused(car, 
 def test_an_aim_shrinks_the_dps_arrival_box_so_values_only_grow(small, car, tmp_path):
     """aim=0.5: the DP ends its segments in half the arrival box, a smaller target, so no node's
     cost-to-go falls below the same table's aiming at the whole box (within the sweeps'
-    tolerance), some rise, and the runtime still brakes in the whole box. The table keeps the
-    cost-to-go to the whole box too (``/arrival_value``): the very values of the table aiming
-    at it, which keeps them as its own ``/value``."""
-    spec = parse_controller_text(SMALL + ARRIVAL.replace("\n", " aim=0.5\n"), "aimed.ssc")
+    tolerance), some rise, and the runtime still brakes in the whole box. Asked for
+    (``arrival_value``), the table keeps the cost-to-go to the whole box too
+    (``/arrival_value``): the very values of the table aiming at it, which keeps them as its
+    own ``/value``; not asked for, it keeps none."""
+    spec = parse_controller_text(SMALL + ARRIVAL.replace("\n", " aim=0.5 arrival_value\n"), "a")
     generate_controller(spec, car, tmp_path / "a.h5", quiet=True)
     aimed = Controller.load(tmp_path / "a.h5", car)
     np.testing.assert_array_equal(aimed.table.arrival_value, small.table.value)
-    np.testing.assert_array_equal(small.table.arrival_value, small.table.value)
+    assert small.table.arrival_value is None
     state = np.array([0.3, 1.1, 7.0, 5.0, 0.1])  # between nodes, near the destination
     assert aimed.arrival_cost_to_go(state) == small.cost_to_go(state) < aimed.cost_to_go(state)
+    assert small.arrival_cost_to_go(state) == math.inf  # no /arrival_value: none known
     assert (aimed.table.attrs["arrival_aim"], small.table.attrs["arrival_aim"]) == (0.5, 1.0)
     np.testing.assert_array_equal(aimed.lookahead.arrival_box, small.lookahead.arrival_box)
     both = np.isfinite(aimed.table.value) & np.isfinite(small.table.value)

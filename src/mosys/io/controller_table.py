@@ -50,10 +50,11 @@ class ControllerTable:
     inf (``kernels.dp.destination_indices`` says how it is found).
 
     arrival_value: (n_1, ..., n_d) s, dataset ``/arrival_value``, for a ``policy lookahead``
-    table (None otherwise, and a file without it reads as None): the cost-to-go to the whole
-    arrival box, the arrival the lookahead runtime brakes into, inf where unreachable or a dead
-    end; ``value`` is the DP's to that box scaled by root attr ``arrival_aim`` (the same where
-    the aim is 1), which the runtime descends (README, "The self-parking car").
+    table whose policy line has ``arrival_value`` (None otherwise, and a file without it reads
+    as None): the cost-to-go to the whole arrival box, the arrival the lookahead runtime brakes
+    into, inf where unreachable or a dead end; ``value`` is the DP's to that box scaled by root
+    attr ``arrival_aim`` (the same where the aim is 1), which the runtime descends (README, "The
+    self-parking car").
 
     control_units: the spec unit of each control ('N*m' for a hinge actuator, 'deg/s' and
     'deg/s^2' for the car's), written as ``/torque``'s ``units``; None: the writer infers them

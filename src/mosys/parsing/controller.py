@@ -74,6 +74,7 @@ KEYWORDS = (
     "policy",
 )
 POLICIES = ("interpolate", "lookahead")
+ARRIVAL_VALUE = "arrival_value"  # the policy line's flag: keep the cost-to-go to the whole box
 DEFAULT_TOLERANCE = (
     1e-6  # s: largest change of the cost-to-go in one sweep that counts as converged
 )
@@ -172,12 +173,15 @@ class Policy:
     ``name=tolerance`` pairs (spec units, > 0, names from ``dest``) of ``lookahead``: where the
     vehicle's braking point lies within them of the destination, it brakes to rest and holds.
     ``aim`` (in (0, 1], from ``aim=``): the DP's segments end in the arrival box scaled by it
-    about the destination. ``token`` is the kind's token."""
+    about the destination. ``arrival_value`` (the bare word): the table also keeps the
+    cost-to-go to the whole arrival box (a second DP where the aim is below 1). ``token`` is the
+    kind's token."""
 
     kind: str
     arrival: tuple[tuple[str, float], ...]
     token: Token
     aim: float = 1.0
+    arrival_value: bool = False
 
 
 @dataclass(frozen=True)
@@ -634,7 +638,17 @@ class _Parser:
                 line.tokens[2], "the end of the line after 'interpolate'", line.tokens[2].text
             )
         arrival: list[tuple[str, float]] = []
-        aim, pairs = 1.0, [token for token in line.tokens[2:] if token.text[:4] != "aim="]
+        flags = [token for token in line.tokens[2:] if token.text == ARRIVAL_VALUE]
+        if len(flags) > 1:
+            raise self.error(flags[1], f"'{ARRIVAL_VALUE}' only once", flags[1].text)
+        aim, pairs = (
+            1.0,
+            [
+                token
+                for token in line.tokens[2:]
+                if token.text[:4] != "aim=" and token.text != ARRIVAL_VALUE
+            ],
+        )
         for number, token in enumerate(t for t in line.tokens[2:] if t.text[:4] == "aim="):
             if number:
                 raise self.error(token, "'aim=' only once", token.text)
@@ -660,7 +674,7 @@ class _Parser:
                 "a 'name=tolerance' arrival tolerance of a dest dimension after 'lookahead'",
                 None,
             )
-        return Policy(kind.text, tuple(arrival), kind, aim)
+        return Policy(kind.text, tuple(arrival), kind, aim, bool(flags))
 
     def line_maxiter(self, line: Line) -> None:
         reader = line.reader()
@@ -751,5 +765,6 @@ def render_controller_spec(spec: ControllerSpec) -> str:
     if spec.policy is not None:
         arrival = "".join(f" {name}={number(value)}" for name, value in spec.policy.arrival)
         aim = f" aim={number(spec.policy.aim)}" if spec.policy.aim != 1.0 else ""
-        lines.append(f"policy {spec.policy.kind}{arrival}{aim}")
+        flag = f" {ARRIVAL_VALUE}" if spec.policy.arrival_value else ""
+        lines.append(f"policy {spec.policy.kind}{arrival}{aim}{flag}")
     return "\n".join(lines) + "\n"

@@ -142,10 +142,10 @@ class Controller:
     def arrival_cost_to_go(self, state: np.ndarray) -> float:
         """The table's cost-to-go (s) to its whole arrival box (``/arrival_value``) at a
         controller state (d,) in spec units, interpolated over the corners where it is finite,
-        inf where those carry less than the table's ``minimum_known_weight``; ``cost_to_go``
-        for a table without one (its aim is 1, or it has no arrival box)."""
+        inf where those carry less than the table's ``minimum_known_weight``, and for a table
+        without one (its policy line does not ask for ``arrival_value``)."""
         if self._arrival_values is None:
-            return self.cost_to_go(state)
+            return math.inf
         return self._interpolated_cost(*self._arrival_values, state)
 
     def _interpolated_cost(

@@ -820,12 +820,13 @@ def arrival_solution(
     max_iterations: int,
     quiet: bool,
 ) -> Solution | None:
-    """For a lookahead table, the DP whose segments end in the whole arrival box (aim 1): the
-    cost-to-go to the arrival the runtime brakes into, where the table's own (``solution``)
-    is to the box scaled by its ``aim`` (README, "The self-parking car"); ``solution`` itself
-    where the aim is 1 already. None for any other table."""
+    """For a lookahead table whose policy line asks for ``arrival_value``, the DP whose segments
+    end in the whole arrival box (aim 1): the cost-to-go to the arrival the runtime brakes
+    into, where the table's own (``solution``) is to the box scaled by its ``aim`` (README,
+    "The self-parking car"); ``solution`` itself where the aim is 1 already. None for any other
+    table."""
     policy = problem.spec.policy
-    if policy is None or policy.kind != "lookahead":
+    if policy is None or policy.kind != "lookahead" or not policy.arrival_value:
         return None
     if policy.aim == 1.0:
         return solution

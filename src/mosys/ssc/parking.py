@@ -146,7 +146,9 @@ def evaluate_starts(
         excluded=excluded,
         cost_to_go=np.array([controller.cost_to_go(start) for start in starts]),
         path_length=path_length,
-        arrival_cost_to_go=np.array([controller.arrival_cost_to_go(start) for start in starts]),
+        arrival_cost_to_go=None
+        if controller.table.arrival_value is None
+        else np.array([controller.arrival_cost_to_go(start) for start in starts]),
         attrs={
             "controller": controller.name,
             "simulated_seconds": float(seconds),
