@@ -55,6 +55,12 @@ def values(spec: ControllerSpec) -> tuple:
         spec.max_iterations,
         spec.dt,
         spec.known_weight,
+        tuple((o.name, o.vertices) for o in spec.obstacles),
+        None if spec.domain is None else spec.domain.vertices,
+        spec.hold is not None,
+        None
+        if spec.policy is None
+        else (spec.policy.kind, spec.policy.arrival, spec.policy.aim, spec.policy.arrival_value),
     )
 
 
@@ -411,10 +417,16 @@ def test_file_errors_and_path(tmp_path):
 
 # --- hypothesis -----------------------------------------------------------------------------
 
-SPECS = [(PENDULUM / f"{name}.ssc").read_text() for name in [*sorted(FIGURE_13), "G"]]
+PARK = (ROOT / "specs" / "controllers" / "car" / "park.ssc").read_text()
+SPECS = [
+    *((PENDULUM / f"{name}.ssc").read_text() for name in [*sorted(FIGURE_13), "G"]),
+    PARK,
+    PARK.replace("heading=4.9 aim=0.7", "heading=4.9 aim=0.7 arrival_value"),
+]
 WORDS = [
     *("dyn", "ssd", "torq", "dest", "tol", "maxiter", "dt", "wrap", "angle", "omega"),
     *("angle=0", "omega=50", "=", "=1", "#", ",", "1e999", "nan", "inf", "-0", "0", "1", "2"),
+    *("policy", "lookahead", "interpolate", "aim=0.5", "arrival_value", "x=0.1", "hold"),
 ]
 garbage = st.one_of(
     st.sampled_from(WORDS),
