@@ -6,9 +6,8 @@ run), ``cost_to_go`` (n,) float64 s (the table's, interpolated at the start as t
 inf: unknown), ``path_length`` (n,) float64 m (the shortest collision-free path the pose search
 found; inf: none, nan: the start is not free) and, optionally, ``arrival_cost_to_go`` (n,)
 float64 s (the table's cost-to-go to its whole arrival box, ``Controller.arrival_cost_to_go``;
-inf: unknown); root attrs ``controller``,
-``simulated_seconds``, ``dt`` and the scene (``io.car_scene``). The success rate counts the
-starts that are not excluded.
+inf: unknown); root attrs ``controller``, ``simulated_seconds``, ``dt`` and the scene
+(``io.car_scene``). The success rate counts the starts that are not excluded.
 
 Every dataset also has a ``unit`` (``start`` also ``units``, one per column; booleans ``index``,
 ``excluded`` ``text``) and the root the provenance attrs (``io.provenance``);
