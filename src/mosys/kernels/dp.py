@@ -53,11 +53,10 @@ SEGMENT_BOX_COLUMNS = 12  # ``segment_boxes``: the body's, the braking points' a
 DOMAIN_ROOM = 1e-9  # m: a node whose segments' reference points stay inside the domain polygon
 # with this much room to spare on every side (``replay_classes``) is not tested step by step
 PREFETCH_AHEAD = 2  # nodes: a sweep asks the cache for the exits of the node this far ahead in
-# its order, for the segment costs of the one twice as far, and for the cost-to-go at the next
-# node's corners (``kernels.prefetch``)
+# its order and for the segment costs of the one twice as far (``kernels.prefetch``)
 CACHE_LINE = 64  # bytes
 POLICY_PREFETCH_AHEAD = 16  # nodes: a policy sweep asks the cache for the compact row of the
-# node this far ahead in its order (``_prefetch_policy``)
+# node this far ahead in its order (``_policy_block``)
 PREFETCH_ABOVE_BYTES = 64 * 2**20  # tables of corners larger than this are swept with cache
 # hints: on smaller ones (in or near the processor's caches) the hints cost more than they save
 
@@ -917,40 +916,6 @@ def _bellman(
 
 
 @njit(cache=True, inline="always")
-def _prefetch_exits(exit_index, exit_weight, segment_cost, row_of, shape_row_of, value, order, p):
-    """Ask the cache for what the sweep at position p of ``order`` reads soon, each a step
-    before the next needs it: the segment costs of the node 2·PREFETCH_AHEAD places ahead, the
-    exit shapes (corners and weights) of the finite-cost controls of the node PREFETCH_AHEAD
-    ahead, and the cost-to-go of the next node's corners."""
-    n = order.shape[0]
-    if p + 2 * PREFETCH_AHEAD < n:
-        far = row_of[order[p + 2 * PREFETCH_AHEAD]]
-        if far >= 0:
-            for u in range(0, segment_cost.shape[1], CACHE_LINE // segment_cost.itemsize):
-                prefetch(segment_cost, (far, u))
-    if p + PREFETCH_AHEAD < n:
-        node = order[p + PREFETCH_AHEAD]
-        ahead = row_of[node]
-        if ahead >= 0:
-            shape = shape_of(shape_row_of, row_of, node)
-            per_line = CACHE_LINE // exit_index.itemsize
-            for u in range(segment_cost.shape[1]):
-                if segment_cost[ahead, u] != np.inf:
-                    for i in range(0, exit_index.shape[2], per_line):
-                        prefetch(exit_index, (shape, u, i))
-                        prefetch(exit_weight, (shape, u, i))
-    if p + 1 < n:
-        node = order[p + 1]
-        following = row_of[node]
-        if following >= 0:
-            shape = shape_of(shape_row_of, row_of, node)
-            for u in range(segment_cost.shape[1]):
-                if segment_cost[following, u] != np.inf:
-                    for i in range(exit_index.shape[2]):
-                        prefetch(value, (node + exit_index[shape, u, i],))
-
-
-@njit(cache=True, inline="always")
 def block_positions(blocks, k, order):
     """(first, end): the positions in ``order`` (``sweep_order``) of sweep block k, the nodes
     [blocks[k], blocks[k + 1]) (blocks: (K + 1,) int64, node indices at boundaries between
@@ -984,13 +949,35 @@ def _bellman_block(
     control,
 ):
     """``gauss_seidel_sweep`` over the positions [first, end) of ``order``, reading values as
-    the block of nodes [low, high) sees them (``block_read``); returns the largest decrease."""
+    the block of nodes [low, high) sees them (``block_read``); returns the largest decrease.
+    ``prefetching``: ask the cache, a step before the sweep needs them, for the segment costs
+    of the node 2·PREFETCH_AHEAD places ahead and the exit shapes (corners and weights) of the
+    finite-cost controls of the node PREFETCH_AHEAD ahead. Written out in the loop: as an
+    inlined function taking the tables, the hints took and dropped a reference to each table at
+    every node (numba's reference counts). Measured on a car grid with exits of its own at every
+    node (840,840 nodes, 1.2 GB of exit shapes; mean over the 2**5 orders): a blocked sweep 111
+    ms without hints, 114 ms with the inlined function, 104 ms written out; the hints for the
+    cost-to-go at the next node's corners (400 a node) cost more than they saved (117 ms) and
+    are gone."""
     largest = 0.0
     for p in range(first, end):
         if prefetching:
-            _prefetch_exits(
-                exit_index, exit_weight, segment_cost, row_of, shape_row_of, value, order, p
-            )
+            if p + 2 * PREFETCH_AHEAD < end:  # the segment costs, two steps ahead
+                far = row_of[order[p + 2 * PREFETCH_AHEAD]]
+                if far >= 0:
+                    for u in range(0, segment_cost.shape[1], CACHE_LINE // segment_cost.itemsize):
+                        prefetch(segment_cost, (far, u))
+            if p + PREFETCH_AHEAD < end:  # the exit shapes of the finite-cost controls
+                ahead_node = order[p + PREFETCH_AHEAD]
+                ahead = row_of[ahead_node]
+                if ahead >= 0:
+                    ahead_shape = shape_of(shape_row_of, row_of, ahead_node)
+                    per_line = CACHE_LINE // exit_index.itemsize
+                    for u in range(segment_cost.shape[1]):
+                        if segment_cost[ahead, u] != np.inf:
+                            for i in range(0, exit_index.shape[2], per_line):
+                                prefetch(exit_index, (ahead_shape, u, i))
+                                prefetch(exit_weight, (ahead_shape, u, i))
         node = order[p]
         row = row_of[node]
         if row < 0 or is_destination[node]:
@@ -1055,7 +1042,7 @@ def gauss_seidel_sweep(
     dead end (``known_weight``), whatever its exact bound. One thread, in a fixed order: the
     same result on any machine whatever the thread count (``blocked_gauss_seidel_sweep``: two
     threads, the same). ``prefetching``: ask the cache for the rows a few nodes ahead
-    (``_prefetch_exits``; ``prefetch_pays``): half the orders run backwards through memory,
+    (``_bellman_block``; ``prefetch_pays``): half the orders run backwards through memory,
     where the processor's own prefetch falls behind on tables larger than its caches. The hint
     changes no value.
     """
@@ -1210,24 +1197,6 @@ def gather_policy(
 
 
 @njit(cache=True, inline="always")
-def _prefetch_policy(
-    policy_corner, policy_weight, policy_count, policy_cost, policy_known, row_of, node
-):
-    """Ask the cache for the compact row of ``node`` (``gather_policy``) that a policy sweep
-    reads POLICY_PREFETCH_AHEAD nodes later: in the orders that run some of the grid's inner
-    axes backwards and others forwards the processor's own prefetcher falls behind on the
-    car's tables (a policy sweep 8 ms in memory order, up to 21 ms in those; 16 ms on average
-    over the 2**5 orders, 12 ms with the hint)."""
-    row = row_of[node]
-    if row >= 0:
-        prefetch(policy_corner, (row,))
-        prefetch(policy_weight, (row,))
-        prefetch(policy_count, (row,))
-        prefetch(policy_cost, (row,))
-        prefetch(policy_known, (row,))
-
-
-@njit(cache=True, inline="always")
 def _policy_block(
     policy_corner,
     policy_weight,
@@ -1247,19 +1216,23 @@ def _policy_block(
 ):
     """``policy_sweep`` over the positions [first, end) of ``order``, reading values as the
     block of nodes [low, high) sees them (``block_read``), asking the cache ahead where
-    ``prefetching`` (``_prefetch_policy``); returns the largest decrease."""
+    ``prefetching``: the compact row of the node POLICY_PREFETCH_AHEAD places ahead, which in
+    the orders that run some inner axes backwards and others forwards the processor's own
+    prefetcher does not fetch in time (the car's policy sweep 12.5 ms on two threads without
+    the hint, 10 ms with it, over the 2**5 orders). Written out in the loop: as an inlined
+    function taking the tables, the hint took and dropped a reference to each table at every
+    node (numba's reference counts), which made a one-block sweep of the car's tables 85 ms
+    instead of 12. Returns the largest decrease."""
     largest = 0.0
     for p in range(first, end):
         if prefetching and p + POLICY_PREFETCH_AHEAD < end:
-            _prefetch_policy(
-                policy_corner,
-                policy_weight,
-                policy_count,
-                policy_cost,
-                policy_known,
-                row_of,
-                order[p + POLICY_PREFETCH_AHEAD],
-            )
+            ahead = row_of[order[p + POLICY_PREFETCH_AHEAD]]
+            if ahead >= 0:
+                prefetch(policy_corner, (ahead,))
+                prefetch(policy_weight, (ahead,))
+                prefetch(policy_count, (ahead,))
+                prefetch(policy_cost, (ahead,))
+                prefetch(policy_known, (ahead,))
         node = order[p]
         row = row_of[node]
         if row < 0:
@@ -1301,7 +1274,7 @@ def policy_sweep(
     cost-to-go and still only decrease; a sweep reads one control's exit per node instead of
     all of them. Returns the largest decrease, s (decreases to values at or above
     ``settled_above`` not counted, as in ``gauss_seidel_sweep``). ``prefetching``: ask the
-    cache for the rows a few nodes ahead (``_prefetch_policy``; ``prefetch_pays`` of the
+    cache for the rows a few nodes ahead (``_policy_block``; ``prefetch_pays`` of the
     compact tables). The hint changes no value."""
     return _policy_block(
         policy_corner,
