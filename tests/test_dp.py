@@ -7,7 +7,7 @@ import pytest
 
 from mosys.io.controller_table import read_controller_table
 from mosys.parsing.controller import parse_controller_text
-from mosys.ssc.generate import generate_controller
+from mosys.ssc.generate import build_problem, generate_controller, solve
 
 DOUBLE_INTEGRATOR_SPEC = """
 dyn double_integrator
@@ -161,3 +161,45 @@ def test_dp_is_general_in_state_dimensions_and_controls(tmp_path):
     assert table.value[1, 2, 2, 2] == 0.0  # shoulder -90, elbow 0, at rest
     assert np.isfinite(table.value).sum() > table.value.size // 2
     assert np.all(np.abs(table.torque[..., 0]) <= 40) and np.all(np.abs(table.torque[..., 1]) <= 20)
+
+
+def solve_double_integrator(double_integrator, quiet=True, warm=None):
+    """The double integrator's DP to the origin (``ssc.generate.solve``): (spec, solution)."""
+    spec = parse_controller_text(DOUBLE_INTEGRATOR_SPEC, "double_integrator.ssc")
+    problem = build_problem(spec, double_integrator)
+    return spec, solve(
+        problem,
+        double_integrator,
+        spec.tolerance,
+        spec.max_iterations,
+        spec.dt,
+        quiet=quiet,
+        warm=warm,
+    )
+
+
+def test_sweeps_from_a_warm_start_above_the_cost_to_go_end_at_the_cold_values(double_integrator):
+    """Values 1 s above the cost-to-go everywhere: the sweeps end at the nodes the DP from the
+    bound reaches, within its tolerance of its values, with the same controls nearly
+    everywhere; started from the DP's own values, one Bellman sweep finds nothing to lower."""
+    spec, cold = solve_double_integrator(double_integrator)
+    _, warm = solve_double_integrator(double_integrator, warm=cold.value + 1.0)
+    finite = np.isfinite(cold.value)
+    assert np.array_equal(np.isfinite(warm.value), finite)
+    assert np.max(np.abs(warm.value[finite] - cold.value[finite])) <= 2 * spec.tolerance
+    assert np.mean(warm.best_control[finite] == cold.best_control[finite]) > 0.95
+    _, settled = solve_double_integrator(double_integrator, warm=cold.value)
+    assert settled.iterations == 1 < cold.iterations  # started where the DP ended
+
+
+def test_a_warm_start_below_the_cost_to_go_is_caught_and_the_sweeps_start_again(
+    double_integrator, capsys
+):
+    """Values at half the cost-to-go: some node is left below what its best control gives
+    (``dp.best_controls``'s excess), so the sweeps run again from the bound: the DP's own values,
+    bit for bit, and a line on stderr saying so."""
+    _, cold = solve_double_integrator(double_integrator)
+    _, again = solve_double_integrator(double_integrator, quiet=False, warm=0.5 * cold.value)
+    np.testing.assert_array_equal(again.value, cold.value)
+    np.testing.assert_array_equal(again.best_control, cold.best_control)
+    assert "the warm start lay below the cost-to-go (by up to " in capsys.readouterr().err

@@ -1494,31 +1494,49 @@ def gauss_seidel_sweeps(
 
 @njit(cache=True)
 def best_controls(
-    exit_index, exit_weight, segment_cost, to_destination, row_of, shape_row_of, value, best_control
+    exit_index,
+    exit_weight,
+    segment_cost,
+    to_destination,
+    row_of,
+    shape_row_of,
+    value,
+    settled_above,
+    best_control,
 ):
     """The minimising control sample index of every node (the first on ties; 0 where every
     sample costs inf, the node is removed or its value is inf: unreachable, where every sample's
-    exit reads only unknown corners). best_control: (N,) int64 out."""
+    exit reads only unknown corners). best_control: (N,) int64 out. Returns the largest excess,
+    s, of a node's Bellman update over its value, over the nodes whose value is above 0 (not a
+    destination) and below ``settled_above`` (0 where there are none): at most 0 for values
+    reached from an upper
+    bound (each update only lowers a value that its own update does not exceed), above 0 where
+    a value lies below what its best control gives, which no value iteration from above leaves
+    (``ssc.generate.solve`` checks a warm start by it)."""
+    excess = 0.0
     for node in range(value.shape[0]):
         row = row_of[node]
-        best_control[node] = (
-            0
-            if row < 0 or value[node] == np.inf
-            else _bellman(
-                exit_index,
-                exit_weight,
-                segment_cost,
-                to_destination,
-                value,
-                row,
-                shape_of(shape_row_of, row_of, node),
-                node,
-                shape_row_of,
-                None,
-                0,
-                value.shape[0],
-            )[1]
+        if row < 0 or value[node] == np.inf:
+            best_control[node] = 0
+            continue
+        best, choice = _bellman(
+            exit_index,
+            exit_weight,
+            segment_cost,
+            to_destination,
+            value,
+            row,
+            shape_of(shape_row_of, row_of, node),
+            node,
+            shape_row_of,
+            None,
+            0,
+            value.shape[0],
         )
+        best_control[node] = choice
+        if 0.0 < value[node] < settled_above and best - value[node] > excess:
+            excess = best - value[node]
+    return excess
 
 
 @njit(parallel=True, cache=True)

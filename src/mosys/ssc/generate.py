@@ -441,7 +441,7 @@ def load_kernels(
             *policy_tables(empty.segment_cost.shape[0], empty.exit_index.shape[2]),
             0,
         ),
-        lambda: best_controls(*empty.arrays(), np.empty(0), none),
+        lambda: best_controls(*empty.arrays(), np.empty(0), 1.0, none),
         lambda: sweep_order(problem.grid.axis_count, 0, none),
     ]
     if classes is not None:
@@ -692,14 +692,18 @@ def value_iteration(
     tolerance: float,
     max_iterations: int,
     quiet: bool,
+    warm: np.ndarray | None = None,
 ) -> tuple[np.ndarray, int, int, float]:
     """Bellman sweeps, each followed by up to POLICY_SWEEPS sweeps of its policy
     (``dp.gauss_seidel_sweeps``), in the orders of ``dp.sweep_order`` until a Bellman sweep's
     largest decrease < tolerance (s) or ``max_iterations`` Bellman sweeps, from the paper's upper
-    bound; returns the cost-to-go (N,) s, the Bellman sweeps, the policy sweeps and the last
-    Bellman sweep's largest decrease."""
+    bound, or where ``warm`` (N,) s is finite at a reachable node, from it (an upper bound of
+    this problem's cost-to-go: ``solve`` checks it); returns the cost-to-go (N,) s, the Bellman
+    sweeps, the policy sweeps and the last Bellman sweep's largest decrease."""
     grid = problem.grid
     bound = DEAD_END_BOUND if problem.spec.known_weight else UNKNOWN
+    if warm is not None:
+        bound = np.where(np.isfinite(warm), warm, bound)
     value = np.where(problem.is_destination, 0.0, np.where(reachable, bound, np.inf))
     blocks, edges = sweep_blocks(grid.axis_count, transitions)
     snapshot = value.copy() if edges is not None else value  # one block reads value alone
@@ -748,6 +752,7 @@ def solve(
     node_valid: np.ndarray | None = None,
     quiet: bool = False,
     aim: float | None = None,
+    warm: np.ndarray | None = None,
 ) -> Solution:
     """Exit transitions once (integrator steps of at most ``dt`` s), then Bellman sweeps until the
     largest decrease < tolerance (s) or ``max_iterations`` sweeps. ``node_valid``: (N,) bool,
@@ -756,6 +761,11 @@ def solve(
     loaded first, outside the DP's timings (``kernel_load_seconds``). With the spec's
     ``known_weight``, exits resting on less of it than that cost inf, values start from
     DEAD_END_BOUND, and the nodes left at DEAD_END_SECONDS or more are dead ends (inf).
+    ``warm`` (N,) s: values believed to bound this problem's cost-to-go from above (a cost-to-go
+    of the same grid to a smaller target), from which the sweeps start where they are finite;
+    where the result leaves some node below what its best control gives by more than the
+    tolerance (``dp.best_controls``), the belief was wrong there, and the sweeps run again
+    from the bound.
     """
     grid = problem.grid
     valid = problem.node_valid if node_valid is None else problem.node_valid & node_valid
@@ -769,11 +779,22 @@ def solve(
     transition_seconds = time.perf_counter() - started
     reachable = reachable_nodes(transitions, problem.is_destination, grid.axis_count)
     discard_poorly_known_exits(*transitions.arrays(), reachable, problem.spec.known_weight)
-    value, iterations, policy_sweeps, residual = value_iteration(
-        problem, transitions, reachable, tolerance, max_iterations, quiet
-    )
+    settled_above = DEAD_END_SECONDS if problem.spec.known_weight else np.inf
     best_control = np.empty(grid.node_count, dtype=np.int64)
-    best_controls(*transitions.arrays(), value, best_control)
+    for start in (warm, None) if warm is not None else (None,):
+        value, iterations, policy_sweeps, residual = value_iteration(
+            problem, transitions, reachable, tolerance, max_iterations, quiet, start
+        )
+        excess = best_controls(*transitions.arrays(), value, settled_above, best_control)
+        if start is None or excess <= tolerance:
+            break
+        if not quiet:
+            print(
+                f"the warm start lay below the cost-to-go (by up to {excess:.3g} s): "
+                "the sweeps again from the bound",
+                file=sys.stderr,
+                flush=True,
+            )
     iteration_seconds = time.perf_counter() - started - transition_seconds
     dead_end = reachable & (value >= DEAD_END_SECONDS) & bool(problem.spec.known_weight)
     value = np.where(reachable & ~dead_end, value, np.inf)
@@ -824,7 +845,9 @@ def arrival_solution(
     end in the whole arrival box (aim 1): the cost-to-go to the arrival the runtime brakes
     into, where the table's own (``solution``) is to the box scaled by its ``aim`` (README,
     "The self-parking car"); ``solution`` itself where the aim is 1 already. None for any other
-    table."""
+    table. Its sweeps start from ``solution``'s cost-to-go: a segment that reaches the aimed
+    box has passed through the whole box, so the whole box is usually nearer (``solve`` checks
+    it, and starts again from the bound where it is not)."""
     policy = problem.spec.policy
     if policy is None or policy.kind != "lookahead" or not policy.arrival_value:
         return None
@@ -833,7 +856,14 @@ def arrival_solution(
     if not quiet:
         print("the DP again, aiming at the whole arrival box:", file=sys.stderr, flush=True)
     return solve(
-        problem, dynamics, tolerance, max_iterations, problem.spec.dt, quiet=quiet, aim=1.0
+        problem,
+        dynamics,
+        tolerance,
+        max_iterations,
+        problem.spec.dt,
+        quiet=quiet,
+        aim=1.0,
+        warm=solution.value,
     )
 
 
