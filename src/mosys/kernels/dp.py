@@ -955,10 +955,10 @@ def _bellman_block(
     finite-cost controls of the node PREFETCH_AHEAD ahead. Written out in the loop: as an
     inlined function taking the tables, the hints took and dropped a reference to each table at
     every node (numba's reference counts). Measured on a car grid with exits of its own at every
-    node (840,840 nodes, 1.2 GB of exit shapes; mean over the 2**5 orders): a blocked sweep 111
-    ms without hints, 114 ms with the inlined function, 104 ms written out; the hints for the
-    cost-to-go at the next node's corners (400 a node) cost more than they saved (117 ms) and
-    are gone."""
+    node (840,840 nodes, 1.2 GB of exit shapes; ``benchmarks/dp_sweeps.py``, mean over the
+    2**5 orders): a blocked sweep 113 ms without hints, 115 ms with the inlined function, 105
+    ms written out; the hints for the cost-to-go at the next node's corners (400 a node) cost
+    more than they saved (117 ms) and are gone."""
     largest = 0.0
     for p in range(first, end):
         if prefetching:
@@ -1509,10 +1509,9 @@ def best_controls(
     exit reads only unknown corners). best_control: (N,) int64 out. Returns the largest excess,
     s, of a node's Bellman update over its value, over the nodes whose value is above 0 (not a
     destination) and below ``settled_above`` (0 where there are none): at most 0 for values
-    reached from an upper
-    bound (each update only lowers a value that its own update does not exceed), above 0 where
-    a value lies below what its best control gives, which no value iteration from above leaves
-    (``ssc.generate.solve`` checks a warm start by it)."""
+    reached from an upper bound (each update only lowers a value that its own update does not
+    exceed), above 0 where a value lies below what its best control gives, which no value
+    iteration from above leaves (``ssc.generate.solve`` checks a warm start by it)."""
     excess = 0.0
     for node in range(value.shape[0]):
         row = row_of[node]
