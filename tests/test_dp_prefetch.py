@@ -69,15 +69,15 @@ def test_only_tables_larger_than_the_caches_are_swept_with_hints():
 
 
 def blocks_taking_references(kernel) -> list[str]:
-    """The labels of the basic blocks of ``kernel``'s compiled code (LLVM) other than a
-    function's entry that take a reference (``NRT_incref``): the entry takes one to each array
-    once a call, the loop's blocks would take them at every node."""
+    """The labels of the basic blocks of ``kernel``'s compiled code (LLVM) that take a
+    reference (``NRT_incref``): a function's entry takes one to each array once a call, the
+    loop's blocks would take them at every node."""
     labels = []
     for code in kernel.inspect_llvm().values():
         for function in re.split(r"\ndefine ", code)[1:]:
             for block in re.split(r"\n(?=[\w.$]+:)", function):
                 label = block.split(":", 1)[0]
-                if "call void @NRT_incref" in block and label != "entry" and "{" not in label:
+                if "call void @NRT_incref" in block and "{" not in label:
                     labels.append(label)
     return labels
 
@@ -99,5 +99,6 @@ def test_the_one_block_sweeps_hints_take_no_reference_at_a_node():
     gather_policy(*arrays, is_destination, value, control, *policy)
     follow = njit(dp.policy_sweep.py_func)
     follow(*policy[:5], row_of, value, order, np.inf, True)
-    assert blocks_taking_references(bellman) == []
-    assert blocks_taking_references(follow) == []
+    assert "entry" in blocks_taking_references(bellman)  # the test sees references at all
+    for kernel in (bellman, follow):
+        assert set(blocks_taking_references(kernel)) <= {"entry"}
