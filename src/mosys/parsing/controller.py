@@ -641,14 +641,8 @@ class _Parser:
         flags = [token for token in line.tokens[2:] if token.text == ARRIVAL_VALUE]
         if len(flags) > 1:
             raise self.error(flags[1], f"'{ARRIVAL_VALUE}' only once", flags[1].text)
-        aim, pairs = (
-            1.0,
-            [
-                token
-                for token in line.tokens[2:]
-                if token.text[:4] != "aim=" and token.text != ARRIVAL_VALUE
-            ],
-        )
+        aim = 1.0
+        pairs = [t for t in line.tokens[2:] if t.text[:4] != "aim=" and t.text != ARRIVAL_VALUE]
         for number, token in enumerate(t for t in line.tokens[2:] if t.text[:4] == "aim="):
             if number:
                 raise self.error(token, "'aim=' only once", token.text)

@@ -47,6 +47,14 @@ def non_finite_message(
     )
 
 
+def node_costs(value: np.ndarray, known: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Node costs (N, 1) s as ``Controller`` interpolates them: C-contiguous, 0 where not
+    ``known`` (N,) bool (None: where finite), and ``known``."""
+    if known is None:
+        known = np.isfinite(value[:, 0])
+    return np.ascontiguousarray(np.where(known[:, None], value, 0.0)), known
+
+
 @dataclass(frozen=True)
 class ClosedLoopRun:
     """One simulated stretch: ``states`` (steps+1, S) the model's state, SI, the first row the
@@ -187,11 +195,8 @@ class Controller:
         ``cost_to_go`` interpolates them (dead ends at the DP's bound, as the runtime sees
         them); built once, not per state."""
         if self.lookahead is not None:
-            value, known = self.lookahead.value, self.lookahead.known
-        else:
-            value = self.table.value.reshape(-1, 1)
-            known = np.isfinite(value[:, 0])
-        return np.ascontiguousarray(np.where(known[:, None], value, 0.0)), known
+            return node_costs(self.lookahead.value, self.lookahead.known)
+        return node_costs(self.table.value.reshape(-1, 1))
 
     @cached_property
     def _arrival_values(self) -> tuple[np.ndarray, np.ndarray] | None:
@@ -199,9 +204,7 @@ class Controller:
         finite; None for a table without ``/arrival_value``."""
         if self.table.arrival_value is None:
             return None
-        value = self.table.arrival_value.reshape(-1, 1)
-        known = np.isfinite(value[:, 0])
-        return np.ascontiguousarray(np.where(known[:, None], value, 0.0)), known
+        return node_costs(self.table.arrival_value.reshape(-1, 1))
 
     def figure_state(self, state: np.ndarray) -> np.ndarray:
         """A full model state (S,), SI, from a controller state (d,) in spec units; model
