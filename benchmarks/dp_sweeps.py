@@ -5,17 +5,19 @@ two (``blocked_gauss_seidel_sweep``, ``blocked_policy_sweep``).
     python benchmarks/dp_sweeps.py            # park.ssc, heading every 5 deg: 840,840 nodes
     python benchmarks/dp_sweeps.py --smoke    # CI: y to 3.15 m, heading every 15 deg
 
-The tables are park.ssc's scene and controls with exit shapes of every node's own (the motion
-classes off, as for a model without ignorable axes): 1.2 GB of shapes on the full grid, where
-``prefetch_pays``. Value iteration runs to the spec's tolerance first (untimed); each timed sweep
-then starts from a copy of those values, once in each of the 2**5 orders of ``sweep_order``, and
-the policy sweeps follow the controls of its last Bellman sweep (``gather_policy``). The sweeps
-are the DP's own kernels, loaded from the install's numba cache.
+The tables are park.ssc's scene and controls, twice: with exit shapes of every node's own (the
+motion classes off, as for a model without ignorable axes: 1.2 GB of shapes on the full grid,
+where ``prefetch_pays``), then with shapes shared by the motion classes, as ``mosys dp`` builds
+the car's (a few MB: the cost tables and values are what the sweeps stream). Value iteration
+runs to the spec's tolerance first (untimed); each timed sweep then starts from a copy of those
+values, once in each of the 2**5 orders of ``sweep_order``, and the policy sweeps follow the
+controls of its last Bellman sweep (``gather_policy``). The sweeps are the DP's own kernels,
+loaded from the install's numba cache.
 
 Writes results/benchmarks/dp_sweeps.{csv,md} (dp_sweeps_smoke.* with --smoke) and prints them.
-Columns: ``sweep`` (bellman or policy), ``blocks`` (1 or 2), ``hints`` (whether the sweep asked
-the cache ahead), ``ms_mean``/``ms_min`` over the orders, and ``hints_speed_up`` (the same sweep
-without hints over with them, by mean).
+Columns: ``shapes`` (own or shared), ``sweep`` (bellman or policy), ``blocks`` (1 or 2),
+``hints`` (whether the sweep asked the cache ahead), ``ms_mean``/``ms_min`` over the orders, and
+``hints_speed_up`` (the same sweep without hints over with them, by mean).
 """
 
 from __future__ import annotations
@@ -46,9 +48,9 @@ def spec_text(smoke: bool) -> str:
     return text
 
 
-def tables(smoke: bool, work: Path) -> tuple:
-    """(problem, transitions, values): the exit tables of every node's own and the converged
-    cost-to-go."""
+def tables(smoke: bool, work: Path, shared: bool) -> tuple:
+    """(problem, transitions, values): the exit tables, each node's own or (``shared``) shared by
+    the motion classes as ``mosys dp`` builds them, and the converged cost-to-go."""
     from mosys.dynamics.load import figure_dynamics
     from mosys.kernels.dp import discard_poorly_known_exits, exit_transitions_template
     from mosys.kernels.specialise import specialise
@@ -64,9 +66,10 @@ def tables(smoke: bool, work: Path) -> tuple:
     problem = generate.build_problem(spec, dynamics)
     exits = specialise(exit_transitions_template, dynamics, parallel=True)
     arguments = generate.exit_transition_arguments(problem, dynamics, spec.dt)
-    generate.load_kernels(exits, arguments, problem, None)
+    classes = generate.MotionClasses.of(problem, dynamics) if shared else None
+    generate.load_kernels(exits, arguments, problem, classes)
     transitions = generate.compute_transitions(
-        exits, arguments, problem, problem.node_valid, None, quiet=False
+        exits, arguments, problem, problem.node_valid, classes, quiet=False
     )
     reachable = generate.reachable_nodes(
         transitions, problem.is_destination, problem.grid.axis_count
@@ -153,6 +156,7 @@ def time_sweeps(problem, transitions, value: np.ndarray) -> pd.DataFrame:
         round(plain[(s, b)] / m, 3)
         for s, b, m in zip(frame.sweep, frame.blocks, frame.ms_mean, strict=True)
     ]
+    frame.insert(0, "shapes", "own" if transitions.shape_row_of is None else "shared")
     frame["nodes"] = grid.node_count
     frame["exit_shapes_mb"] = round(
         (transitions.exit_index.nbytes + transitions.exit_weight.nbytes) / 1e6, 1
@@ -167,9 +171,13 @@ def main() -> None:
     args = parser.parse_args()
     import tempfile
 
-    with tempfile.TemporaryDirectory() as tmp:
-        problem, transitions, value = tables(args.smoke, Path(tmp))
-    write_results(time_sweeps(problem, transitions, value), "dp_sweeps", args.smoke)
+    frames = []
+    for shared in (False, True):
+        with tempfile.TemporaryDirectory() as tmp:
+            problem, transitions, value = tables(args.smoke, Path(tmp), shared)
+        frames.append(time_sweeps(problem, transitions, value))
+        del problem, transitions, value
+    write_results(pd.concat(frames, ignore_index=True), "dp_sweeps", args.smoke)
 
 
 if __name__ == "__main__":
