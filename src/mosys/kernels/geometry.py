@@ -161,16 +161,23 @@ def first_collision(outline, x, y, heading, obstacle_vertices, obstacle_start, b
 @njit(cache=True, inline="always")  # its callers' hot loops: no call (and no reference
 # counts of its seven arrays) where there are no obstacles
 def pose_is_free(state, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body):
-    """True when a model state (S,) is allowed: its reference point (state[pose_slot[0]],
-    state[pose_slot[1]]) lies inside ``domain`` (P, 2; P = 0: no domain polygon) and its body,
-    turned by state[pose_slot[2]], overlaps no obstacle. pose_slot[0] < 0: always True."""
+    """True when a model state (S,) is allowed (``pose_is_free_at`` its pose: x
+    state[pose_slot[0]], y state[pose_slot[1]], heading state[pose_slot[2]]). pose_slot[0] < 0:
+    always True."""
     if pose_slot[0] < 0:
         return True
     x = state[pose_slot[0]]
     y = state[pose_slot[1]]
+    heading = state[pose_slot[2]]
+    return pose_is_free_at(x, y, heading, outline, obstacle_vertices, obstacle_start, domain, body)
+
+
+@njit(cache=True, inline="always")
+def pose_is_free_at(x, y, heading, outline, obstacle_vertices, obstacle_start, domain, body):
+    """True when the reference point (x, y) m lies inside ``domain`` (P, 2; P = 0: no domain
+    polygon) and the body (``outline``), turned by ``heading`` rad, overlaps no obstacle."""
     if domain.shape[0] > 0 and not point_in_polygon(x, y, domain):
         return False
-    heading = state[pose_slot[2]]
     return first_collision(outline, x, y, heading, obstacle_vertices, obstacle_start, body) < 0
 
 

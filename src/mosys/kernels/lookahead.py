@@ -29,8 +29,9 @@ import numpy as np
 from numba import njit, types
 
 from mosys.kernels.arrival import braking_seconds, stops_in_box
+from mosys.kernels.borrowed import borrowed, keep_alive
 from mosys.kernels.figure_state import read_state
-from mosys.kernels.geometry import pose_is_free
+from mosys.kernels.geometry import pose_is_free_at
 from mosys.kernels.integrate import (
     DERIVATIVE_INTO,
     FLAGS,
@@ -57,7 +58,6 @@ SWEEP_STEP = 0.005  # m: the collision tests along a lookahead step are this far
 # the DP's step it was planned with. Without it a corner clipped an obstacle's corner between
 # two tests (a start grid with 7 steering rates, 2026-12-05).
 CLEARANCE = SWEEP_STEP
-_POSE = np.arange(3, dtype=np.int64)  # the slots of x, y and heading in a pose (3,)
 
 LOOKAHEAD_SIGNATURE = types.int64(
     DERIVATIVE_INTO,  # derivative_into
@@ -107,10 +107,10 @@ def _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs):
 
 @njit(cache=True)
 def _swept_free(before, after, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body):
-    """True when the body is free (``pose_is_free``) at every pose of a step from model state
-    ``before`` to ``after`` (S,), tested every SWEEP_STEP m of the farthest outline vertex's
-    travel along the straight line between the two poses (their x, y and heading), the step's
-    end included: a body corner that clips an obstacle between two steps is caught."""
+    """True when the body is free (``geometry.pose_is_free_at``) at every pose of a step from
+    model state ``before`` to ``after`` (S,), tested every SWEEP_STEP m of the farthest outline
+    vertex's travel along the straight line between the two poses (their x, y and heading), the
+    step's end included: a body corner that clips an obstacle between two steps is caught."""
     if pose_slot[0] < 0:
         return True
     reach = 0.0
@@ -120,12 +120,17 @@ def _swept_free(before, after, pose_slot, outline, obstacle_vertices, obstacle_s
     dx, dy = after[pose_slot[0]] - x, after[pose_slot[1]] - y
     turn = after[pose_slot[2]] - heading
     pieces = max(1, math.ceil((math.hypot(dx, dy) + reach * abs(turn)) / SWEEP_STEP))
-    pose = np.empty(3)
     for j in range(1, pieces + 1):
-        pose[0] = x + dx * j / pieces
-        pose[1] = y + dy * j / pieces
-        pose[2] = heading + turn * j / pieces
-        if not pose_is_free(pose, _POSE, outline, obstacle_vertices, obstacle_start, domain, body):
+        if not pose_is_free_at(
+            x + dx * j / pieces,
+            y + dy * j / pieces,
+            heading + turn * j / pieces,
+            outline,
+            obstacle_vertices,
+            obstacle_start,
+            domain,
+            body,
+        ):
             return False
     return True
 
@@ -222,6 +227,7 @@ def _segment(
     stop,
     scratch,
     body,
+    before,
 ):
     """Hold the model's ``inputs`` from ``start`` (S,) until the controller state lies one grid
     step from where it began on some axis, or the point where full braking would stop it lies
@@ -231,13 +237,12 @@ def _segment(
     within the table's axes, lies beyond the end of a (non-wrap) axis. The inputs are cut at
     the ends of the steer and speed axes (``_limit_inputs``: vehicle_slot, limits,
     wheel_radius; limited: a work array like inputs). origin, here, stop: (d,) work arrays;
-    scratch: ``rk4_scratch(S)``; body: like outline."""
+    scratch: ``rk4_scratch(S)``; body: like outline; before: (S,) work array."""
     for i in range(start.shape[0]):
         end[i] = start[i]
     read_state(start, state_slot, origin)
     inside = clamp_to_domain(axis_min, axis_step, axis_count, wrap, origin, stop)
     taken = 0
-    before = np.empty_like(end)
     while taken < max_steps:
         _limit_inputs(end, vehicle_slot, limits, wheel_radius, dt, inputs, limited)
         before[:] = end
@@ -285,12 +290,13 @@ def _can_brake(
     scratch,
     body,
     here,
+    before,
 ):
     """True when braking to rest from ``start``, steering held, keeps every step free and, if
-    ``inside``, within the ends of the table's (non-wrap) axes. here: (d,) work array."""
+    ``inside``, within the ends of the table's (non-wrap) axes. here: (d,), before: (S,) work
+    arrays."""
     for i in range(start.shape[0]):
         state[i] = start[i]
-    before = np.empty_like(state)
     for _ in range(max_steps):
         if abs(state[vehicle_slot[4]]) < 1e-9:
             return True
@@ -352,19 +358,22 @@ def _choose(
     size = state.shape[0]
     d = axis_min.shape[0]
     n = control_samples.shape[0]
-    strides = np.empty(d, np.int64)
-    grid_strides(axis_count, strides)
-    interpolation = interpolation_scratch(d)
-    scratch = rk4_scratch(size)
-    body = np.empty_like(outline)
-    first = np.empty(size)
-    braking = np.empty(size)
-    origin = np.empty(d)
-    here = np.empty(d)
-    clamped = np.empty(d)
-    out = np.empty(1)
-    inputs = np.zeros(input_size)
-    limited = np.zeros(input_size)
+    own_strides = np.empty(d, np.int64)
+    grid_strides(axis_count, own_strides)
+    own_interpolation = interpolation_scratch(d)
+    own_scratch = rk4_scratch(size)
+    own_body = np.empty_like(outline)
+    own_states = np.empty((3, size))  # the segment's exit, the braking's state, a step's start
+    own_points = np.empty((4, d))  # origin, here, clamped; out (one entry)
+    own_inputs = np.zeros((2, input_size))  # the sample's inputs, limited
+    # borrowed views (``kernels.borrowed``), kept alive to the end (keep_alive)
+    strides, interpolation, scratch, body = borrowed(
+        (own_strides, own_interpolation, own_scratch, own_body)
+    )
+    states, points, both_inputs = borrowed((own_states, own_points, own_inputs))
+    first, braking, before = states[0], states[1], states[2]
+    origin, here, clamped, out = points[0], points[1], points[2], points[3, :1]
+    inputs, limited = both_inputs[0], both_inputs[1]
     read_state(state, state_slot, here)
     inside = clamp_to_domain(axis_min, axis_step, axis_count, wrap, here, clamped)
     best = np.inf
@@ -401,6 +410,7 @@ def _choose(
             clamped,
             scratch,
             body,
+            before,
         )
         if taken < 0:
             continue
@@ -449,10 +459,13 @@ def _choose(
             scratch,
             body,
             origin,
+            before,
         ):
             best = cost
             best_sample = u
             best_steps = taken
+    keep_alive((own_strides, own_interpolation, own_scratch, own_body))
+    keep_alive((own_states, own_points, own_inputs))
     return best_sample, best_steps, best
 
 
@@ -570,21 +583,45 @@ def simulate_lookahead(
     """
     size = state.shape[0]
     d = axis_min.shape[0]
-    inputs = np.zeros(input_size)
-    limited = np.zeros(input_size)
-    limits = _axis_limits(axis_min, axis_step, axis_count, state_slot, vehicle_slot)
-    here = np.empty(d)
-    clamped = np.empty(d)
+    own_inputs = np.zeros(input_size)
+    own_limited = np.zeros(input_size)
+    own_limits = _axis_limits(axis_min, axis_step, axis_count, state_slot, vehicle_slot)
+    own_here = np.empty(d)
+    own_clamped = np.empty(d)
     regions = region_lower.shape[0]
-    start_membership = np.empty(regions, np.bool_)
-    membership = np.empty(regions, np.bool_)
-    region_membership(state, region_lower, region_upper, region_period, start_membership)
-    scratch = rk4_scratch(size)
-    value = value.copy()  # this run's own: raised where a choice finds it too low (_learn)
-    strides = np.empty(d, np.int64)
-    grid_strides(axis_count, strides)
-    interpolation = interpolation_scratch(d)
-    out = np.empty(1)
+    own_start_membership = np.empty(regions, np.bool_)
+    own_membership = np.empty(regions, np.bool_)
+    region_membership(state, region_lower, region_upper, region_period, own_start_membership)
+    own_scratch = rk4_scratch(size)
+    own_value = value.copy()  # this run's own: raised where a choice finds it too low (_learn)
+    own_strides = np.empty(d, np.int64)
+    grid_strides(axis_count, own_strides)
+    own_interpolation = interpolation_scratch(d)
+    own_out = np.empty(1)
+    # borrowed views (``kernels.borrowed``): the arguments, and the work arrays above, which
+    # keep_alive keeps to the end
+    axis_min, axis_step, axis_count, wrap, known = borrowed(
+        (axis_min, axis_step, axis_count, wrap, known)
+    )
+    control_samples, control_slot, state_slot, pose_slot, vehicle_slot = borrowed(
+        (control_samples, control_slot, state_slot, pose_slot, vehicle_slot)
+    )
+    outline, obstacle_vertices, obstacle_start, domain, arrival_box = borrowed(
+        (outline, obstacle_vertices, obstacle_start, domain, arrival_box)
+    )
+    state, record_state, record_control, record_outside = borrowed(
+        (state, record_state, record_control, record_outside)
+    )
+    region_lower, region_upper, region_period = borrowed(
+        (region_lower, region_upper, region_period)
+    )
+    inputs, limited, limits, here, clamped, scratch, value, strides, out = borrowed(
+        (own_inputs, own_limited, own_limits, own_here, own_clamped, own_scratch, own_value,
+         own_strides, own_out)
+    )  # fmt: skip
+    start_membership, membership, interpolation = borrowed(
+        (own_start_membership, own_membership, own_interpolation)
+    )
     held_until = 0  # the step at which the held sample's segment ends
     arrived = False
     for step in range(record_state.shape[0]):
@@ -668,6 +705,9 @@ def simulate_lookahead(
         for j in range(control_slot.shape[0]):
             record_control[step, j] = limited[control_slot[j]]
         rk4_step(derivative_into, state, limited, dt, scratch)
+    keep_alive((own_inputs, own_limited, own_limits, own_here, own_clamped, own_scratch))
+    keep_alive((own_value, own_strides, own_out, own_start_membership, own_membership))
+    keep_alive(own_interpolation)
     if not state_is_sound(state):
         return blown_up(record_state.shape[0])
     return record_state.shape[0]
