@@ -443,7 +443,8 @@ def test_a_choice_that_costs_more_than_promised_raises_the_runs_table_there(seed
     best choice costs more than the interpolation promises, the known corners around the state
     rise (only they, none falls) until the interpolation there equals the choice's cost; where
     it costs less, or nothing is admissible (inf), or too little weight is known, nothing
-    changes."""
+    changes. Each node it raises is logged once, with its value before: putting the log back
+    gives the table bit for bit, after any number of raises."""
     from mosys.kernels.interpolate import (
         clamp_to_domain,
         grid_strides,
@@ -469,9 +470,17 @@ def test_a_choice_that_costs_more_than_promised_raises_the_runs_table_there(seed
         )
         return out[0], weight
 
-    def learn(value, state, cost, minimum=0.0):
-        _learn(axis_min, axis_step, axis_count, wrap, strides, value, known, minimum, state,
-               cost, scratch, clamped, out)  # fmt: skip
+    touched = np.zeros(nodes, np.bool_)
+    undo_index, undo_value = np.empty(nodes, np.int64), np.empty(nodes)
+
+    def learn(value, state, cost, minimum=0.0, logged=0):
+        return _learn(axis_min, axis_step, axis_count, wrap, strides, value, known, minimum,
+                      state, cost, scratch, clamped, out, touched, undo_index, undo_value,
+                      logged)  # fmt: skip
+
+    def put_back(value, logged):
+        value[undo_index[:logged], 0] = undo_value[:logged]
+        touched[:] = False
 
     for _ in range(20):
         value = rng.uniform(0, 10, (nodes, 1))
@@ -481,19 +490,32 @@ def test_a_choice_that_costs_more_than_promised_raises_the_runs_table_there(seed
             continue
         for cost, minimum in ((before - 1.0, 0.0), (np.inf, 0.0), (before + 3.0, weight + 0.01)):
             learned = value.copy()
-            learn(learned, state, cost, minimum)
+            assert learn(learned, state, cost, minimum) == 0
             np.testing.assert_array_equal(learned, value)
         learned = value.copy()
-        learn(learned, state, before + 3.0)
+        logged = learn(learned, state, before + 3.0)
         assert promised(learned, state)[0] == pytest.approx(before + 3.0, abs=1e-9)
         rise = (learned - value)[:, 0]
         assert np.all(rise >= 0) and not np.any(rise[~known])
         assert 1 <= np.count_nonzero(rise) <= 8  # the state's corners only
+        # the raised nodes are logged (and perhaps a known corner of zero weight, raised by 0)
+        assert set(np.flatnonzero(rise)) <= set(undo_index[:logged])
+        assert known[undo_index[:logged]].all() and logged <= 8
+        top = axis_min + axis_step * (axis_count - 1)
+        for _ in range(5):  # more raises around it: each node logged once
+            moved = np.clip(state + rng.normal(0, 0.3, 3), axis_min, top)
+            logged = learn(learned, moved, promised(learned, moved)[0] + 1.0, 0.0, logged)
+        assert len(set(undo_index[:logged])) == logged
+        put_back(learned, logged)
+        np.testing.assert_array_equal(learned, value)
 
 
-def test_a_run_learns_on_its_own_copy_so_runs_do_not_depend_on_each_other(small):
+def test_a_run_puts_back_what_it_learned_so_runs_do_not_depend_on_each_other(small):
+    """A run learns on its thread's copy of the table and puts it back before it returns: the
+    table and the copy are as they were, bit for bit, and the run again is the same run."""
     start = small.figure_state(np.array([1.5, 1.8, 10.0, 0.0, 0.0]))
     value = small.lookahead.value.copy()
     first = small.simulate(start, 8.0, DT).states
     np.testing.assert_array_equal(small.lookahead.value, value)
+    np.testing.assert_array_equal(small._learning_values(), value)
     np.testing.assert_array_equal(small.simulate(start, 8.0, DT).states, first)

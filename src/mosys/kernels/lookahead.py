@@ -9,8 +9,9 @@ where it leaves). It takes the cheapest sample and holds it to that exit, as the
 assumes, then chooses again (where no admissible sample's exit is trusted, ``known_weight``, it
 takes the cheapest by any known corner, the paper's rule; where none is admissible at all, it
 brakes, choosing again every step); where the cheapest choice costs more than the interpolated
-cost-to-go at the state promised, the run raises its own copy of the table there (``_learn``), so
-that a spot where interpolation promises too much does not hold the vehicle dithering in it.
+cost-to-go at the state promised, the run raises the table there (``_learn``; every raised value
+is put back when the run ends), so that a spot where interpolation promises too much does not
+hold the vehicle dithering in it.
 A segment is admissible only if no step of it touches an obstacle or leaves the domain polygon,
 and if braking to rest from its exit, steering held, touches nothing either; so the vehicle can
 always stop. The body tested is the vehicle's grown by CLEARANCE (``ssc.lookahead``), so that the
@@ -484,14 +485,21 @@ def _learn(
     scratch,
     clamped,
     out,
+    touched,
+    undo_index,
+    undo_value,
+    logged,
 ):
     """Raise the cost-to-go where a choice found it too low (learning real-time search: Korf's
     LRTA*, 1990). When ``cost`` (s), the cheapest choice at controller state ``state`` (d,),
     exceeds the cost-to-go interpolated there, the known corners around the state rise by the
     least change (least squares) that makes the interpolation there equal ``cost``: each by
-    shortfall · w / Σw², w its renormalised weight. value: (N, 1), the run's own copy; scratch:
-    ``interpolation_scratch(d)``; clamped: (d,), out: (1,) work arrays. Nothing changes where
-    the known corners carry less than ``minimum_known_weight``, nor where ``cost`` is inf."""
+    shortfall · w / Σw², w its renormalised weight. value: (N, 1), raised in place; a node
+    raised for the first time (touched (N,) bool False) is marked and logged with its value
+    before, in undo_index[logged] and undo_value[logged]; returns the entries logged in all.
+    scratch: ``interpolation_scratch(d)``;
+    clamped: (d,), out: (1,) work arrays. Nothing changes where the known corners carry less
+    than ``minimum_known_weight``, nor where ``cost`` is inf."""
     clamp_to_domain(axis_min, axis_step, axis_count, wrap, state, clamped)
     known_weight = interpolate_with(
         axis_min, axis_step, axis_count, wrap, strides, value, known, clamped, scratch, out
@@ -502,7 +510,7 @@ def _learn(
         or known_weight == 0.0
         or not 0.0 < shortfall < np.inf
     ):
-        return
+        return logged
     # the corners of ``clamped`` and their weights, as interpolate_with left them in scratch
     corner_index, corner_weight = scratch[2], scratch[3]
     count = corner_index.shape[0]
@@ -512,8 +520,14 @@ def _learn(
             squares += (corner_weight[c] / known_weight) ** 2
     for c in range(count):
         if known[corner_index[c]]:
-            rise = shortfall * corner_weight[c] / known_weight / squares
-            value[corner_index[c], 0] += rise
+            node = corner_index[c]
+            if not touched[node]:
+                touched[node] = True
+                undo_index[logged] = node
+                undo_value[logged] = value[node, 0]
+                logged += 1
+            value[node, 0] += shortfall * corner_weight[c] / known_weight / squares
+    return logged
 
 
 @njit(LOOKAHEAD_SIGNATURE, cache=True, nogil=True)
@@ -563,8 +577,10 @@ def simulate_lookahead(
     value: (N, 1) cost-to-go at the grid nodes, s; known: (N,) bool, the nodes with a finite
     value (interpolation renormalises over them, as ``interpolate_with``, and an exit whose
     known corners carry less than minimum_known_weight of its weight costs inf, as in the DP);
-    the run works on a copy of it, which ``_learn`` raises where a choice costs more than it
-    promised (``value`` itself is left as it was). Steer and speed stop at the ends of their
+    the run raises it where a choice costs more than it promised (``_learn``), and puts every
+    raised entry back before it returns: ``value`` is as it was, bit for bit, but runs at once
+    need arrays of their own (``ssc.controller.Controller`` keeps one per thread; copying the
+    table for every run took 14 % of a start grid's time). Steer and speed stop at the ends of their
     axes (``_limit_inputs``), and from a state within the table's axes a sample is admissible
     only if its segment, and braking from its exit, stay within them: the run stays on the
     table. control_samples: (U, m) the DP's control samples, SI, driving ``control_slot`` (m,)
@@ -593,7 +609,13 @@ def simulate_lookahead(
     own_membership = np.empty(regions, np.bool_)
     region_membership(state, region_lower, region_upper, region_period, own_start_membership)
     own_scratch = rk4_scratch(size)
-    own_value = value.copy()  # this run's own: raised where a choice finds it too low (_learn)
+    # the nodes _learn raises, each with its value before: put back before the run returns (a
+    # choice at most every step, each raising at most the 2**d corners around it)
+    logged = 0
+    capacity = min(value.shape[0], record_state.shape[0] << d)
+    own_touched = np.zeros(value.shape[0], np.bool_)
+    own_undo_index = np.empty(capacity, np.int64)
+    own_undo_value = np.empty(capacity)
     own_strides = np.empty(d, np.int64)
     grid_strides(axis_count, own_strides)
     own_interpolation = interpolation_scratch(d)
@@ -615,22 +637,28 @@ def simulate_lookahead(
     region_lower, region_upper, region_period = borrowed(
         (region_lower, region_upper, region_period)
     )
-    inputs, limited, limits, here, clamped, scratch, value, strides, out = borrowed(
-        (own_inputs, own_limited, own_limits, own_here, own_clamped, own_scratch, own_value,
-         own_strides, own_out)
+    inputs, limited, limits, here, clamped, scratch, strides, out = borrowed(
+        (own_inputs, own_limited, own_limits, own_here, own_clamped, own_scratch, own_strides,
+         own_out)
     )  # fmt: skip
+    value, touched, undo_index, undo_value = borrowed(
+        (value, own_touched, own_undo_index, own_undo_value)
+    )
     start_membership, membership, interpolation = borrowed(
         (own_start_membership, own_membership, own_interpolation)
     )
     held_until = 0  # the step at which the held sample's segment ends
     arrived = False
+    taken = record_state.shape[0]
     for step in range(record_state.shape[0]):
         if not state_is_sound(state):
-            return blown_up(step)
+            taken = blown_up(step)
+            break
         if crossed_a_region_border(
             state, region_lower, region_upper, region_period, start_membership, membership
         ):
-            return step
+            taken = step
+            break
         for i in range(size):
             record_state[step, i] = state[i]
         read_state(state, state_slot, here)
@@ -678,7 +706,7 @@ def simulate_lookahead(
                 if sample >= 0 or trust == 0.0:
                     break
             read_state(state, state_slot, here)  # stops_in_box used it for the braking point
-            _learn(
+            logged = _learn(
                 axis_min,
                 axis_step,
                 axis_count,
@@ -692,6 +720,10 @@ def simulate_lookahead(
                 interpolation,
                 clamped,
                 out,
+                touched,
+                undo_index,
+                undo_value,
+                logged,
             )
             if sample < 0:  # nothing admissible: brake, and choose again next step (held
                 # longer, a braking input made for one step overshoots rest and rocks the
@@ -705,9 +737,11 @@ def simulate_lookahead(
         for j in range(control_slot.shape[0]):
             record_control[step, j] = limited[control_slot[j]]
         rk4_step(derivative_into, state, limited, dt, scratch)
+    if taken == record_state.shape[0] and not state_is_sound(state):
+        taken = blown_up(record_state.shape[0])
+    for k in range(logged):  # the table as it was
+        value[undo_index[k], 0] = undo_value[k]
     keep_alive((own_inputs, own_limited, own_limits, own_here, own_clamped, own_scratch))
-    keep_alive((own_value, own_strides, own_out, own_start_membership, own_membership))
-    keep_alive(own_interpolation)
-    if not state_is_sound(state):
-        return blown_up(record_state.shape[0])
-    return record_state.shape[0]
+    keep_alive((own_strides, own_out, own_start_membership, own_membership, own_interpolation))
+    keep_alive((own_touched, own_undo_index, own_undo_value))
+    return taken

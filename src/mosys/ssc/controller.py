@@ -8,6 +8,7 @@ modulo their period. Interpolated torques are clamped to the controls' limits.
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -100,6 +101,7 @@ class Controller:
             from mosys.ssc.lookahead import lookahead_runtime
 
             self.lookahead = lookahead_runtime(table, dynamics, self.grid)
+        self._per_thread = threading.local()  # each thread's copy of the lookahead's values
 
     @classmethod
     def load(cls, path: str | Path, dynamics: ModuleType) -> Controller:
@@ -300,6 +302,15 @@ class Controller:
             box[name] = (max(low, -rest), min(high, rest))
         return box
 
+    def _learning_values(self) -> np.ndarray:
+        """This thread's copy of the lookahead's cost-to-go (N, 1) s, made at its first run: a
+        run raises it where it learns and puts it back before it returns
+        (``kernels.lookahead.simulate_lookahead``), so runs at once need one each."""
+        values = getattr(self._per_thread, "value", None)
+        if values is None:
+            values = self._per_thread.value = self.lookahead.value.copy()
+        return values
+
     def simulate(
         self,
         figure_state: np.ndarray,
@@ -354,7 +365,7 @@ class Controller:
                 grid.axis_step,
                 grid.axis_count,
                 grid.wrap,
-                policy.value,
+                self._learning_values(),
                 policy.known,
                 policy.minimum_known_weight,
                 policy.control_samples,
