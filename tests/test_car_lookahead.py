@@ -24,7 +24,7 @@ from mosys.kernels.geometry import (
     pack_polygons,
     point_in_polygon,
 )
-from mosys.kernels.lookahead import CLEARANCE, _swept_free
+from mosys.kernels.lookahead import CLEARANCE, Scene, _swept_free
 from mosys.parsing.controller import parse_controller_text
 from mosys.parsing.tokens import SpecError
 from mosys.ssc.controller import Controller
@@ -285,8 +285,9 @@ def test_a_step_that_clips_an_obstacle_between_its_ends_is_not_free():
     body, domain = np.empty_like(outline), np.zeros((0, 2))
     for pose in (before, past, short):
         assert first_colliding_sample(pose[None, :], outline, vertices, start)[0] == -1
-    assert not _swept_free(before, past, slots, outline, vertices, start, domain, body)
-    assert _swept_free(before, short, slots, outline, vertices, start, domain, body)
+    scene = Scene(slots, outline, vertices, start, domain)
+    assert not _swept_free(before, past, scene, body)
+    assert _swept_free(before, short, scene, body)
 
 
 def test_a_polygon_grows_by_its_margin_on_every_side():
@@ -328,10 +329,10 @@ def test_a_corner_clipped_between_two_tests_is_caught():
     middle = (0.5 * (before + after))[None, :]
     body = np.empty_like(CAR_BODY)
     assert first_colliding_sample(middle, CAR_BODY, vertices, start)[0] == 0
-    args = (POSE_SLOTS, CAR_BODY, vertices, start, NO_DOMAIN, body)
-    assert _swept_free(before, after, *args)  # the gap CLEARANCE closes
+    scene = Scene(POSE_SLOTS, CAR_BODY, vertices, start, NO_DOMAIN)
+    assert _swept_free(before, after, scene, body)  # the gap CLEARANCE closes
     grown = grown_polygon(CAR_BODY, CLEARANCE)
-    assert not _swept_free(before, after, POSE_SLOTS, grown, vertices, start, NO_DOMAIN, body)
+    assert not _swept_free(before, after, scene._replace(outline=grown), body)
 
 
 @settings(max_examples=300, deadline=None)
@@ -352,7 +353,7 @@ def test_a_step_free_for_the_grown_body_is_free_all_along(corner, heading, move)
     grown, body = grown_polygon(CAR_BODY, CLEARANCE), np.empty_like(CAR_BODY)
     if first_colliding_sample(before[None, :], grown, vertices, start)[0] >= 0:
         return  # the run only steps from poses the grown body tested free
-    if not _swept_free(before, after, POSE_SLOTS, grown, vertices, start, NO_DOMAIN, body):
+    if not _swept_free(before, after, Scene(POSE_SLOTS, grown, vertices, start, NO_DOMAIN), body):
         return
     along = before + np.linspace(0.0, 1.0, 2001)[:, None] * (after - before)
     assert first_colliding_sample(along, CAR_BODY, vertices, start)[0] == -1

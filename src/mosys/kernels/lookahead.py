@@ -25,6 +25,7 @@ SI units throughout; grids as in ``kernels.interpolate``; obstacles as ``geometr
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit, types
@@ -96,22 +97,72 @@ LOOKAHEAD_SIGNATURE = types.int64(
 )
 
 
+class TableAxes(NamedTuple):
+    """The table's axes (as ``kernels.interpolate`` takes them) and where they lie in the model's
+    state."""
+
+    axis_min: np.ndarray  # (d,) SI
+    axis_step: np.ndarray  # (d,) SI
+    axis_count: np.ndarray  # (d,) int64
+    wrap: np.ndarray  # (d,) bool
+    state_slot: np.ndarray  # (d,) int64: each axis's slot in the model's state
+
+
+class Scene(NamedTuple):
+    """What every pose must keep clear of (``geometry.pose_is_free``)."""
+
+    pose_slot: np.ndarray  # (3,) int64: x, y, heading in the model's state (-1: no obstacles)
+    outline: np.ndarray  # (V, 2) m: the body, grown by CLEARANCE
+    obstacle_vertices: np.ndarray  # (M, 2) m
+    obstacle_start: np.ndarray  # (K + 1,) int64
+    domain: np.ndarray  # (P, 2) m (P = 0: no domain polygon)
+
+
+class Vehicle(NamedTuple):
+    """How the vehicle is driven and brakes (``kernels.arrival``), and where its steer and speed
+    stop."""
+
+    slot: np.ndarray  # (7,) int64: x, y, heading, steer, speed, then steer_rate, wheel_accel
+    wheelbase: float  # m
+    wheel_radius: float  # m
+    brake: float  # rad/s²: the largest wheel deceleration
+    limits: np.ndarray  # (2, 2): the ends of the table's steer and speed axes (``_axis_limits``)
+
+
 @njit(cache=True)
-def _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs):
+def _braking_inputs(state, vehicle, dt, inputs):
     """inputs (model's) that hold the steering and brake the wheels toward rest within one step,
-    no harder than ``brake`` (rad/s²)."""
+    no harder than ``vehicle.brake`` (rad/s²)."""
     for i in range(inputs.shape[0]):
         inputs[i] = 0.0
-    wanted = -state[vehicle_slot[4]] / (wheel_radius * dt)
-    inputs[vehicle_slot[6]] = min(max(wanted, -brake), brake)
+    wanted = -state[vehicle.slot[4]] / (vehicle.wheel_radius * dt)
+    inputs[vehicle.slot[6]] = min(max(wanted, -vehicle.brake), vehicle.brake)
+
+
+@njit(cache=True, inline="always")
+def _arrives(state, axes, vehicle, arrival_box, point):
+    """True when the point where full braking would bring the vehicle to rest from model state
+    ``state`` lies in ``arrival_box`` (``arrival.stops_in_box``); point: (d,) work array."""
+    return stops_in_box(
+        state,
+        vehicle.slot,
+        vehicle.wheelbase,
+        vehicle.wheel_radius,
+        vehicle.brake,
+        axes.state_slot,
+        arrival_box,
+        point,
+    )
 
 
 @njit(cache=True)
-def _swept_free(before, after, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body):
-    """True when the body is free (``geometry.pose_is_free_at``) at every pose of a step from
-    model state ``before`` to ``after`` (S,), tested every SWEEP_STEP m of the farthest outline
-    vertex's travel along the straight line between the two poses (their x, y and heading), the
-    step's end included: a body corner that clips an obstacle between two steps is caught."""
+def _swept_free(before, after, scene, body):
+    """True when the body is free in ``scene`` (``geometry.pose_is_free_at``) at every pose of a
+    step from model state ``before`` to ``after`` (S,), tested every SWEEP_STEP m of the farthest
+    outline vertex's travel along the straight line between the two poses (their x, y and
+    heading), the step's end included: a body corner that clips an obstacle between two steps is
+    caught. body: like the outline, a work array."""
+    pose_slot, outline, obstacle_vertices, obstacle_start, domain = scene
     if pose_slot[0] < 0:
         return True
     reach = 0.0
@@ -152,16 +203,17 @@ def _axis_limits(axis_min, axis_step, axis_count, state_slot, vehicle_slot):
 
 
 @njit(cache=True)
-def _limit_inputs(state, vehicle_slot, limits, wheel_radius, dt, inputs, out):
+def _limit_inputs(state, vehicle, dt, inputs, out):
     """out: ``inputs`` with the steer rate and the wheel acceleration cut so that a step of dt
-    seconds ends with steer and speed no further out than ``limits`` (2, 2): (steer low, high)
-    rad and (speed low, high) m/s, the table's axis ends. So the vehicle stops at the ends of
-    the axes instead of overshooting them (the model's steer_limit lies further out)."""
+    seconds ends with steer and speed no further out than ``vehicle.limits`` (2, 2): (steer low,
+    high) rad and (speed low, high) m/s, the table's axis ends. So the vehicle stops at the ends
+    of the axes instead of overshooting them (the model's steer_limit lies further out)."""
+    limits = vehicle.limits
     for i in range(inputs.shape[0]):
         out[i] = inputs[i]
-    for k, gain in ((0, 1.0), (1, wheel_radius)):
-        value = state[vehicle_slot[3 + k]]
-        slot = vehicle_slot[5 + k]
+    for k, gain in ((0, 1.0), (1, vehicle.wheel_radius)):
+        value = state[vehicle.slot[3 + k]]
+        slot = vehicle.slot[5 + k]
         out[slot] = min(out[slot], max(0.0, (limits[k, 1] - value) / (gain * dt)))
         out[slot] = max(out[slot], min(0.0, (limits[k, 0] - value) / (gain * dt)))
 
@@ -200,116 +252,62 @@ def _cost_to_go(
 
 @njit(cache=True)
 def _segment(
-    derivative_into,
-    start,
-    inputs,
-    vehicle_slot,
-    limits,
-    wheel_radius,
-    limited,
-    axis_min,
-    axis_step,
-    axis_count,
-    wrap,
-    state_slot,
-    pose_slot,
-    outline,
-    obstacle_vertices,
-    obstacle_start,
-    domain,
-    wheelbase,
-    brake,
-    arrival_box,
-    max_steps,
-    dt,
-    end,
-    origin,
-    here,
-    stop,
-    scratch,
-    body,
-    before,
-):
+    derivative_into, start, inputs, axes, scene, vehicle, arrival_box, max_steps, dt, work
+):  # fmt: skip
     """Hold the model's ``inputs`` from ``start`` (S,) until the controller state lies one grid
     step from where it began on some axis, or the point where full braking would stop it lies
     in ``arrival_box`` (``stops_in_box``: the runtime brakes there, and so does the DP), or for
-    max_steps; the last state goes to ``end``. Returns (the steps taken, whether it arrived);
-    the steps are -1 when some step is not free (obstacle or domain polygon) or, from a start
-    within the table's axes, lies beyond the end of a (non-wrap) axis. The inputs are cut at
-    the ends of the steer and speed axes (``_limit_inputs``: vehicle_slot, limits,
-    wheel_radius; limited: a work array like inputs). origin, here, stop: (d,) work arrays;
-    scratch: ``rk4_scratch(S)``; body: like outline; before: (S,) work array."""
+    max_steps; the last state goes to ``work.exit``. Returns (the steps taken, whether it
+    arrived); the steps are -1 when some step is not free (obstacle or domain polygon) or, from
+    a start within the table's axes, lies beyond the end of a (non-wrap) axis. The inputs are
+    cut at the ends of the steer and speed axes (``_limit_inputs``)."""
+    end, origin, here, stop = work.exit, work.origin, work.here, work.clamped
     for i in range(start.shape[0]):
         end[i] = start[i]
-    read_state(start, state_slot, origin)
-    inside = clamp_to_domain(axis_min, axis_step, axis_count, wrap, origin, stop)
+    read_state(start, axes.state_slot, origin)
+    inside = clamp_to_domain(
+        axes.axis_min, axes.axis_step, axes.axis_count, axes.wrap, origin, stop
+    )
     taken = 0
     while taken < max_steps:
-        _limit_inputs(end, vehicle_slot, limits, wheel_radius, dt, inputs, limited)
-        before[:] = end
-        rk4_step(derivative_into, end, limited, dt, scratch)
+        _limit_inputs(end, vehicle, dt, inputs, work.limited)
+        work.before[:] = end
+        rk4_step(derivative_into, end, work.limited, dt, work.rk4)
         taken += 1
-        if not _swept_free(
-            before, end, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
+        if not _swept_free(work.before, end, scene, work.body):
+            return -1, False
+        read_state(end, axes.state_slot, here)
+        if inside and not clamp_to_domain(
+            axes.axis_min, axes.axis_step, axes.axis_count, axes.wrap, here, here
         ):
             return -1, False
-        read_state(end, state_slot, here)
-        if inside and not clamp_to_domain(axis_min, axis_step, axis_count, wrap, here, here):
-            return -1, False
-        for k in range(axis_step.shape[0]):
-            if abs(here[k] - origin[k]) >= axis_step[k]:
+        for k in range(axes.axis_step.shape[0]):
+            if abs(here[k] - origin[k]) >= axes.axis_step[k]:
                 return taken, False
-        if stops_in_box(
-            end, vehicle_slot, wheelbase, wheel_radius, brake, state_slot, arrival_box, stop
-        ):
+        if _arrives(end, axes, vehicle, arrival_box, stop):
             return taken, True
     return taken, False
 
 
 @njit(cache=True)
-def _can_brake(
-    derivative_into,
-    start,
-    vehicle_slot,
-    wheel_radius,
-    brake,
-    pose_slot,
-    outline,
-    obstacle_vertices,
-    obstacle_start,
-    domain,
-    max_steps,
-    dt,
-    axis_min,
-    axis_step,
-    axis_count,
-    wrap,
-    state_slot,
-    inside,
-    state,
-    inputs,
-    scratch,
-    body,
-    here,
-    before,
-):
+def _can_brake(derivative_into, start, axes, scene, vehicle, inside, max_steps, dt, work):
     """True when braking to rest from ``start``, steering held, keeps every step free and, if
-    ``inside``, within the ends of the table's (non-wrap) axes. here: (d,), before: (S,) work
-    arrays."""
+    ``inside``, within the ends of the table's (non-wrap) axes."""
+    state, here = work.braking, work.here
     for i in range(start.shape[0]):
         state[i] = start[i]
     for _ in range(max_steps):
-        if abs(state[vehicle_slot[4]]) < 1e-9:
+        if abs(state[vehicle.slot[4]]) < 1e-9:
             return True
-        _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs)
-        before[:] = state
-        rk4_step(derivative_into, state, inputs, dt, scratch)
-        if not _swept_free(
-            before, state, pose_slot, outline, obstacle_vertices, obstacle_start, domain, body
-        ):
+        _braking_inputs(state, vehicle, dt, work.inputs)
+        work.before[:] = state
+        rk4_step(derivative_into, state, work.inputs, dt, work.rk4)
+        if not _swept_free(work.before, state, scene, work.body):
             return False
-        read_state(state, state_slot, here)
-        if inside and not clamp_to_domain(axis_min, axis_step, axis_count, wrap, here, here):
+        read_state(state, axes.state_slot, here)
+        if inside and not clamp_to_domain(
+            axes.axis_min, axes.axis_step, axes.axis_count, axes.wrap, here, here
+        ):
             return False
     return True
 
@@ -323,150 +321,116 @@ def _sample_inputs(control_samples, control_slot, sample, inputs):
         inputs[control_slot[j]] += control_samples[sample, j]
 
 
+class ChoiceWork(NamedTuple):
+    """The work arrays of ``_choose`` and the segments it tries (``choice_work``), for a model
+    of S state variables and I inputs and a table of d axes."""
+
+    exit: np.ndarray  # (S,) a segment's last state
+    braking: np.ndarray  # (S,) the state braking from it
+    before: np.ndarray  # (S,) the state before a step
+    origin: np.ndarray  # (d,)
+    here: np.ndarray  # (d,)
+    clamped: np.ndarray  # (d,)
+    out: np.ndarray  # (1,)
+    inputs: np.ndarray  # (I,) a sample's (or braking's) inputs
+    limited: np.ndarray  # (I,) the same cut at the axis ends
+    rk4: np.ndarray  # ``rk4_scratch(S)``
+    body: np.ndarray  # like the outline
+    strides: np.ndarray  # (d,) int64, ``grid_strides``
+    interpolation: tuple  # ``interpolation_scratch(d)``
+
+
+@njit(cache=True)
+def choice_work(axis_count, size, input_size, outline):
+    """A ``ChoiceWork`` for a table of axes ``axis_count`` (d,), a model state of ``size``
+    entries and ``input_size`` inputs, and a body ``outline``."""
+    d = axis_count.shape[0]
+    strides = np.empty(d, np.int64)
+    grid_strides(axis_count, strides)
+    states = np.empty((3, size))
+    points = np.empty((4, d))
+    inputs = np.zeros((2, input_size))
+    return ChoiceWork(
+        states[0],
+        states[1],
+        states[2],
+        points[0],
+        points[1],
+        points[2],
+        points[3, :1],
+        inputs[0],
+        inputs[1],
+        rk4_scratch(size),
+        np.empty_like(outline),
+        strides,
+        interpolation_scratch(d),
+    )
+
+
 @njit(cache=True)
 def _choose(
     derivative_into,
-    axis_min,
-    axis_step,
-    axis_count,
-    wrap,
+    axes,
+    scene,
+    vehicle,
     value,
     known,
     minimum_known_weight,
     control_samples,
     control_slot,
-    input_size,
-    state_slot,
-    pose_slot,
-    outline,
-    obstacle_vertices,
-    obstacle_start,
-    domain,
-    vehicle_slot,
-    wheelbase,
-    wheel_radius,
-    brake,
-    limits,
     arrival_box,
     max_steps,
     dt,
     state,
+    work,
 ):
     """(sample, steps, cost): the cheapest admissible control sample from ``state``, the length
     of its segment and its cost (s: the segment's seconds plus the cost-to-go at its exit, or,
     for a segment that arrives, plus the time to brake to rest); (-1, 1, inf) when none is
-    admissible."""
-    size = state.shape[0]
-    d = axis_min.shape[0]
-    n = control_samples.shape[0]
-    own_strides = np.empty(d, np.int64)
-    grid_strides(axis_count, own_strides)
-    own_interpolation = interpolation_scratch(d)
-    own_scratch = rk4_scratch(size)
-    own_body = np.empty_like(outline)
-    own_states = np.empty((3, size))  # the segment's exit, the braking's state, a step's start
-    own_points = np.empty((4, d))  # origin, here, clamped; out (one entry)
-    own_inputs = np.zeros((2, input_size))  # the sample's inputs, limited
-    # borrowed views (``kernels.borrowed``), kept alive to the end (keep_alive)
-    strides, interpolation, scratch, body = borrowed(
-        (own_strides, own_interpolation, own_scratch, own_body)
+    admissible. work: ``choice_work``'s."""
+    here, clamped = work.here, work.clamped
+    read_state(state, axes.state_slot, here)
+    inside = clamp_to_domain(
+        axes.axis_min, axes.axis_step, axes.axis_count, axes.wrap, here, clamped
     )
-    states, points, both_inputs = borrowed((own_states, own_points, own_inputs))
-    first, braking, before = states[0], states[1], states[2]
-    origin, here, clamped, out = points[0], points[1], points[2], points[3, :1]
-    inputs, limited = both_inputs[0], both_inputs[1]
-    read_state(state, state_slot, here)
-    inside = clamp_to_domain(axis_min, axis_step, axis_count, wrap, here, clamped)
     best = np.inf
     best_sample = -1
     best_steps = 1
-    for u in range(n):
-        _sample_inputs(control_samples, control_slot, u, inputs)
+    for u in range(control_samples.shape[0]):
+        _sample_inputs(control_samples, control_slot, u, work.inputs)
         taken, arrived = _segment(
-            derivative_into,
-            state,
-            inputs,
-            vehicle_slot,
-            limits,
-            wheel_radius,
-            limited,
-            axis_min,
-            axis_step,
-            axis_count,
-            wrap,
-            state_slot,
-            pose_slot,
-            outline,
-            obstacle_vertices,
-            obstacle_start,
-            domain,
-            wheelbase,
-            brake,
-            arrival_box,
-            max_steps,
-            dt,
-            first,
-            origin,
-            here,
-            clamped,
-            scratch,
-            body,
-            before,
-        )
+            derivative_into, state, work.inputs, axes, scene, vehicle, arrival_box, max_steps,
+            dt, work,
+        )  # fmt: skip
         if taken < 0:
             continue
-        read_state(first, state_slot, here)
+        read_state(work.exit, axes.state_slot, here)
         if arrived:  # it brakes to rest from here
-            onward = braking_seconds(first, vehicle_slot, wheel_radius, brake)
+            onward = braking_seconds(work.exit, vehicle.slot, vehicle.wheel_radius, vehicle.brake)
         else:
             onward = _cost_to_go(
-                axis_min,
-                axis_step,
-                axis_count,
-                wrap,
-                strides,
+                axes.axis_min,
+                axes.axis_step,
+                axes.axis_count,
+                axes.wrap,
+                work.strides,
                 value,
                 known,
                 minimum_known_weight,
                 here,
                 clamped,
-                interpolation,
-                out,
+                work.interpolation,
+                work.out,
             )
         cost = taken * dt + onward
         if not cost < best:
             continue
         if _can_brake(
-            derivative_into,
-            first,
-            vehicle_slot,
-            wheel_radius,
-            brake,
-            pose_slot,
-            outline,
-            obstacle_vertices,
-            obstacle_start,
-            domain,
-            max_steps,
-            dt,
-            axis_min,
-            axis_step,
-            axis_count,
-            wrap,
-            state_slot,
-            inside,
-            braking,
-            inputs,
-            scratch,
-            body,
-            origin,
-            before,
+            derivative_into, work.exit, axes, scene, vehicle, inside, max_steps, dt, work
         ):
             best = cost
             best_sample = u
             best_steps = taken
-    keep_alive((own_strides, own_interpolation, own_scratch, own_body))
-    keep_alive((own_states, own_points, own_inputs))
     return best_sample, best_steps, best
 
 
@@ -570,9 +534,9 @@ def simulate_lookahead(
     (< 0) when the state is not sound before step ``step`` or after the last, as
     ``simulate.simulate_controlled``.
 
-    Long because it threads the grid, table, obstacle and vehicle arrays through to ``_choose``
-    one by one. Named tuples for those groups would shorten it, but measure first: passed to a
-    kernel called every step, a named tuple of arrays cost the BSR simulator 10-16% per step.
+    Its arguments are the arrays one by one (its signature is compiled ahead); inside it passes
+    them down in named tuples of borrowed views (``TableAxes``, ``Scene``, ``Vehicle``,
+    ``ChoiceWork``), which take no reference counts.
 
     value: (N, 1) cost-to-go at the grid nodes, s; known: (N,) bool, the nodes with a finite
     value (interpolation renormalises over them, as ``interpolate_with``, and an exit whose
@@ -599,16 +563,11 @@ def simulate_lookahead(
     """
     size = state.shape[0]
     d = axis_min.shape[0]
-    own_inputs = np.zeros(input_size)
-    own_limited = np.zeros(input_size)
+    own_membership = np.empty((2, region_lower.shape[0]), np.bool_)  # at the start, now
+    region_membership(state, region_lower, region_upper, region_period, own_membership[0])
+    own_inputs = np.zeros((2, input_size))  # the held inputs, and the same cut at the axis ends
     own_limits = _axis_limits(axis_min, axis_step, axis_count, state_slot, vehicle_slot)
-    own_here = np.empty(d)
-    own_clamped = np.empty(d)
-    regions = region_lower.shape[0]
-    own_start_membership = np.empty(regions, np.bool_)
-    own_membership = np.empty(regions, np.bool_)
-    region_membership(state, region_lower, region_upper, region_period, own_start_membership)
-    own_scratch = rk4_scratch(size)
+    own_work = choice_work(axis_count, size, input_size, outline)
     # the nodes _learn raises, each with its value before: put back before the run returns (a
     # choice at most every step, each raising at most the 2**d corners around it)
     logged = 0
@@ -616,37 +575,23 @@ def simulate_lookahead(
     own_touched = np.zeros(value.shape[0], np.bool_)
     own_undo_index = np.empty(capacity, np.int64)
     own_undo_value = np.empty(capacity)
-    own_strides = np.empty(d, np.int64)
-    grid_strides(axis_count, own_strides)
-    own_interpolation = interpolation_scratch(d)
-    own_out = np.empty(1)
-    # borrowed views (``kernels.borrowed``): the arguments, and the work arrays above, which
-    # keep_alive keeps to the end
-    axis_min, axis_step, axis_count, wrap, known = borrowed(
-        (axis_min, axis_step, axis_count, wrap, known)
-    )
-    control_samples, control_slot, state_slot, pose_slot, vehicle_slot = borrowed(
-        (control_samples, control_slot, state_slot, pose_slot, vehicle_slot)
-    )
-    outline, obstacle_vertices, obstacle_start, domain, arrival_box = borrowed(
-        (outline, obstacle_vertices, obstacle_start, domain, arrival_box)
+    # borrowed views (``kernels.borrowed``) of the arguments and of the work arrays above (kept
+    # alive to the end by keep_alive): numba's reference counts of the arrays passed down at
+    # every step of every segment tried were two thirds of the run's time
+    axes = borrowed(TableAxes(axis_min, axis_step, axis_count, wrap, state_slot))
+    scene = borrowed(Scene(pose_slot, outline, obstacle_vertices, obstacle_start, domain))
+    vehicle = borrowed(Vehicle(vehicle_slot, wheelbase, wheel_radius, brake, own_limits))
+    value, known, control_samples, control_slot, arrival_box = borrowed(
+        (value, known, control_samples, control_slot, arrival_box)
     )
     state, record_state, record_control, record_outside = borrowed(
         (state, record_state, record_control, record_outside)
     )
-    region_lower, region_upper, region_period = borrowed(
-        (region_lower, region_upper, region_period)
-    )
-    inputs, limited, limits, here, clamped, scratch, strides, out = borrowed(
-        (own_inputs, own_limited, own_limits, own_here, own_clamped, own_scratch, own_strides,
-         own_out)
-    )  # fmt: skip
-    value, touched, undo_index, undo_value = borrowed(
-        (value, own_touched, own_undo_index, own_undo_value)
-    )
-    start_membership, membership, interpolation = borrowed(
-        (own_start_membership, own_membership, own_interpolation)
-    )
+    regions = borrowed((region_lower, region_upper, region_period))
+    work, membership, both_inputs = borrowed((own_work, own_membership, own_inputs))
+    touched, undo_index, undo_value = borrowed((own_touched, own_undo_index, own_undo_value))
+    inputs, limited = both_inputs[0], both_inputs[1]
+    here, clamped = work.here, work.clamped  # read afresh wherever used, as _choose does
     held_until = 0  # the step at which the held sample's segment ends
     arrived = False
     taken = record_state.shape[0]
@@ -654,72 +599,44 @@ def simulate_lookahead(
         if not state_is_sound(state):
             taken = blown_up(step)
             break
-        if crossed_a_region_border(
-            state, region_lower, region_upper, region_period, start_membership, membership
-        ):
+        if crossed_a_region_border(state, *regions, membership[0], membership[1]):
             taken = step
             break
         for i in range(size):
             record_state[step, i] = state[i]
-        read_state(state, state_slot, here)
+        read_state(state, axes.state_slot, here)
         record_outside[step] = not clamp_to_domain(
-            axis_min, axis_step, axis_count, wrap, here, clamped
+            axes.axis_min, axes.axis_step, axes.axis_count, axes.wrap, here, clamped
         )
         if not arrived:
-            arrived = stops_in_box(
-                state, vehicle_slot, wheelbase, wheel_radius, brake, state_slot, arrival_box, here
-            )
+            arrived = _arrives(state, axes, vehicle, arrival_box, here)
         if arrived:
-            _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs)
+            _braking_inputs(state, vehicle, dt, inputs)
         elif step >= held_until:
             # the cheapest sample whose exit is trusted; if none is, whose exit has any known
             # corner (the paper's rule), rather than braking where the trusted values end
             for trust in (minimum_known_weight, 0.0):
                 sample, steps, cost = _choose(
-                    derivative_into,
-                    axis_min,
-                    axis_step,
-                    axis_count,
-                    wrap,
-                    value,
-                    known,
-                    trust,
-                    control_samples,
-                    control_slot,
-                    input_size,
-                    state_slot,
-                    pose_slot,
-                    outline,
-                    obstacle_vertices,
-                    obstacle_start,
-                    domain,
-                    vehicle_slot,
-                    wheelbase,
-                    wheel_radius,
-                    brake,
-                    limits,
-                    arrival_box,
-                    max_segment_steps,
-                    segment_dt,
-                    state,
-                )
+                    derivative_into, axes, scene, vehicle, value, known, trust, control_samples,
+                    control_slot, arrival_box, max_segment_steps, segment_dt, state, work,
+                )  # fmt: skip
                 if sample >= 0 or trust == 0.0:
                     break
-            read_state(state, state_slot, here)  # stops_in_box used it for the braking point
+            read_state(state, axes.state_slot, here)  # the choice used it
             logged = _learn(
-                axis_min,
-                axis_step,
-                axis_count,
-                wrap,
-                strides,
+                axes.axis_min,
+                axes.axis_step,
+                axes.axis_count,
+                axes.wrap,
+                work.strides,
                 value,
                 known,
                 minimum_known_weight,
                 here,
                 cost,
-                interpolation,
+                work.interpolation,
                 clamped,
-                out,
+                work.out,
                 touched,
                 undo_index,
                 undo_value,
@@ -728,20 +645,20 @@ def simulate_lookahead(
             if sample < 0:  # nothing admissible: brake, and choose again next step (held
                 # longer, a braking input made for one step overshoots rest and rocks the
                 # vehicle to and fro, creeping)
-                _braking_inputs(state, vehicle_slot, wheel_radius, brake, dt, inputs)
+                _braking_inputs(state, vehicle, dt, inputs)
                 held_until = step + 1
             else:
                 _sample_inputs(control_samples, control_slot, sample, inputs)
                 held_until = step + max(1, round(steps * segment_dt / dt))
-        _limit_inputs(state, vehicle_slot, limits, wheel_radius, dt, inputs, limited)
+        _limit_inputs(state, vehicle, dt, inputs, limited)
         for j in range(control_slot.shape[0]):
             record_control[step, j] = limited[control_slot[j]]
-        rk4_step(derivative_into, state, limited, dt, scratch)
+        rk4_step(derivative_into, state, limited, dt, work.rk4)
     if taken == record_state.shape[0] and not state_is_sound(state):
         taken = blown_up(record_state.shape[0])
     for k in range(logged):  # the table as it was
         value[undo_index[k], 0] = undo_value[k]
-    keep_alive((own_inputs, own_limited, own_limits, own_here, own_clamped, own_scratch))
-    keep_alive((own_strides, own_out, own_start_membership, own_membership, own_interpolation))
-    keep_alive((own_touched, own_undo_index, own_undo_value))
+    keep_alive((own_membership, own_inputs, own_limits, own_touched, own_undo_index))
+    keep_alive(own_undo_value)
+    keep_alive(own_work)
     return taken
