@@ -10,18 +10,27 @@ size is park.ssc (its scene, controls and destination) on the paper's steps: 0.5
 in y, 15 deg of heading, 15 deg of steer and 0.5 m/s. The 8x grid halves the step of x, y and
 heading over the same ranges (2n - 1 nodes on each of those axes). dp_s_warm is the DP's time,
 split into its exit transitions and its value iteration (transitions_s_warm,
-value_iteration_s_warm), so that the table shows where the time goes.
+value_iteration_s_warm), so that the table shows where the time goes. Each table then runs the
+start grid of the pipeline's config (config/config.yaml's car.start_grid, 1,680 starts; with
+--smoke, config/ci.yaml's), ``mosys starts`` on two threads in a new process as the pipeline runs
+it: start_grid_s_warm is that process's wall time, start_grid_parked how many of the counted
+starts parked.
 """
 
 from __future__ import annotations
 
 import argparse
 import re
+import subprocess
+import sys
 import tempfile
+import time
 from pathlib import Path
 
+import h5py
 import pandas as pd
-from generation import generate, numba_cache, write_results
+import yaml
+from generation import cache_environment, generate, numba_cache, write_results
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = ROOT / "specs/controllers/car/park.ssc"
@@ -54,6 +63,31 @@ def refined_spec(text: str) -> str:
     return re.sub(pattern, refine, text, flags=re.M)
 
 
+def start_grid(table: Path, dynamics: Path, out: Path, cache: Path | None, smoke: bool) -> dict:
+    """Run the config's start grid (ci.yaml's with ``smoke``) from ``table`` as the pipeline's
+    rule does, in a new process; its wall seconds and the counted and parked starts."""
+    config = ROOT / "config" / ("ci.yaml" if smoke else "config.yaml")
+    grid = yaml.safe_load(config.read_text())["car"]["start_grid"]
+    mosys = str(Path(sys.executable).parent / "mosys")  # this environment's
+    command = [mosys, "starts", str(table), "--dynamics", str(dynamics)]
+    for name in ("x", "y", "heading", "steer"):
+        command += [f"--{name}", *(str(v) for v in grid[name])]
+    command += ["--seconds", str(grid["seconds"]), "--dt", str(grid["dt"]), "--threads", "2"]
+    started = time.perf_counter()
+    subprocess.run(
+        [*command, "-o", str(out)],
+        env=cache_environment(cache) | {"NUMBA_NUM_THREADS": "1"},
+        check=True,
+        capture_output=True,
+    )
+    seconds = time.perf_counter() - started
+    with h5py.File(out) as f:
+        counted = int((f["excluded"][()] == b"").sum())
+        parked = int(f["parked"][()].sum())
+    return {"start_grid_s_warm": round(seconds, 2), "start_grid_counted": counted,
+            "start_grid_parked": parked}  # fmt: skip
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--smoke", action="store_true", help="the paper's size only, for CI")
@@ -76,6 +110,8 @@ def main() -> None:
             spec.write_text(text)
             generate(dynamics, spec, tmp / "park.h5", cache)  # fill the numba cache
             warm = generate(dynamics, spec, tmp / "park.h5", cache)
+            if cache is not None and not rows:  # fill it with the start grid's kernels too
+                start_grid(tmp / "park.h5", dynamics, tmp / "grid.h5", cache, smoke=True)
             rows.append(
                 {
                     "case": label,
@@ -90,6 +126,7 @@ def main() -> None:
                     "process_s_warm": round(warm["process_seconds"], 2),
                     "peak_rss_MiB": round(warm["peak_rss_bytes"] / 2**20, 1),
                 }
+                | start_grid(tmp / "park.h5", dynamics, tmp / "grid.h5", cache, args.smoke)
             )
     frame = pd.DataFrame(rows)
     if len(frame) > 1:  # growth against the paper's size

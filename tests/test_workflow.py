@@ -303,8 +303,14 @@ def test_the_built_car_never_drives_into_what_it_could_have_stopped_short_of(wor
     from mosys.dynamics.load import load_dynamics
     from mosys.io.car_scene import controller_table_scene
     from mosys.kernels.geometry import first_colliding_sample, pack_polygons, point_in_polygon
-    from mosys.kernels.integrate import rk4_scratch
-    from mosys.kernels.lookahead import _can_brake
+    from mosys.kernels.lookahead import (
+        Scene,
+        TableAxes,
+        Vehicle,
+        _axis_limits,
+        _can_brake,
+        choice_work,
+    )
     from mosys.ssc.controller import Controller
     from mosys.ssc.parking import parking_outcome
 
@@ -316,6 +322,12 @@ def test_the_built_car_never_drives_into_what_it_could_have_stopped_short_of(wor
     scene, grid, policy = controller_table_scene(car.table), car.grid, car.lookahead
     vertices, start = pack_polygons(list(scene.obstacles))
     body = scene.body_outline
+    axes = TableAxes(grid.axis_min, grid.axis_step, grid.axis_count, grid.wrap, grid.state_slot)
+    limits = _axis_limits(*axes[:3], grid.state_slot, policy.vehicle_slot)
+    vehicle = Vehicle(
+        policy.vehicle_slot, policy.wheelbase, policy.wheel_radius, policy.brake, limits
+    )
+    real_body = Scene(policy.pose_slot, body, vertices, start, policy.domain)
     rng = np.random.default_rng(2026_12_05)
     doomed = 0
     for _ in range(80):
@@ -331,13 +343,10 @@ def test_the_built_car_never_drives_into_what_it_could_have_stopped_short_of(wor
             0.01 * np.arange(len(run.states)), car.controller_states(run.states),
             car.state_order, scene,
         )  # fmt: skip
+        work = choice_work(grid.axis_count, len(state), len(car.dynamics.INPUT_NAMES), body)
         can_stop = _can_brake(
-            car.dynamics.derivative_into, state, policy.vehicle_slot, policy.wheel_radius,
-            policy.brake, policy.pose_slot, body, vertices, start, policy.domain, 1000, 0.01,
-            grid.axis_min, grid.axis_step, grid.axis_count, grid.wrap, grid.state_slot, False,
-            np.empty_like(state), np.zeros(len(car.dynamics.INPUT_NAMES)),
-            rk4_scratch(len(state)), np.empty_like(body), np.empty(len(grid.axis_min)),
-        )  # fmt: skip
+            car.dynamics.derivative_into, state, axes, real_body, vehicle, False, 1000, 0.01, work
+        )
         doomed += not can_stop
         assert outcome.collision_index == -1 or not can_stop, x
     assert doomed < 20  # most starts could stop, so the claim was tested
