@@ -251,16 +251,14 @@ def _cost_to_go(
 
 
 @njit(cache=True)
-def _segment(
-    derivative_into, start, inputs, axes, scene, vehicle, arrival_box, max_steps, dt, work
-):  # fmt: skip
-    """Hold the model's ``inputs`` from ``start`` (S,) until the controller state lies one grid
-    step from where it began on some axis, or the point where full braking would stop it lies
-    in ``arrival_box`` (``stops_in_box``: the runtime brakes there, and so does the DP), or for
-    max_steps; the last state goes to ``work.exit``. Returns (the steps taken, whether it
-    arrived); the steps are -1 when some step is not free (obstacle or domain polygon) or, from
-    a start within the table's axes, lies beyond the end of a (non-wrap) axis. The inputs are
-    cut at the ends of the steer and speed axes (``_limit_inputs``)."""
+def _segment(derivative_into, start, axes, scene, vehicle, arrival_box, max_steps, dt, work):
+    """Hold the model's inputs ``work.inputs`` from ``start`` (S,) until the controller state
+    lies one grid step from where it began on some axis, or the point where full braking would
+    stop it lies in ``arrival_box`` (``stops_in_box``: the runtime brakes there, and so does the
+    DP), or for max_steps; the last state goes to ``work.exit``. Returns (the steps taken,
+    whether it arrived); the steps are -1 when some step is not free (obstacle or domain
+    polygon) or, from a start within the table's axes, lies beyond the end of a (non-wrap)
+    axis. The inputs are cut at the ends of the steer and speed axes (``_limit_inputs``)."""
     end, origin, here, stop = work.exit, work.origin, work.here, work.clamped
     for i in range(start.shape[0]):
         end[i] = start[i]
@@ -270,7 +268,7 @@ def _segment(
     )
     taken = 0
     while taken < max_steps:
-        _limit_inputs(end, vehicle, dt, inputs, work.limited)
+        _limit_inputs(end, vehicle, dt, work.inputs, work.limited)
         work.before[:] = end
         rk4_step(derivative_into, end, work.limited, dt, work.rk4)
         taken += 1
@@ -399,9 +397,8 @@ def _choose(
     for u in range(control_samples.shape[0]):
         _sample_inputs(control_samples, control_slot, u, work.inputs)
         taken, arrived = _segment(
-            derivative_into, state, work.inputs, axes, scene, vehicle, arrival_box, max_steps,
-            dt, work,
-        )  # fmt: skip
+            derivative_into, state, axes, scene, vehicle, arrival_box, max_steps, dt, work
+        )
         if taken < 0:
             continue
         read_state(work.exit, axes.state_slot, here)
@@ -461,9 +458,9 @@ def _learn(
     shortfall · w / Σw², w its renormalised weight. value: (N, 1), raised in place; a node
     raised for the first time (touched (N,) bool False) is marked and logged with its value
     before, in undo_index[logged] and undo_value[logged]; returns the entries logged in all.
-    scratch: ``interpolation_scratch(d)``;
-    clamped: (d,), out: (1,) work arrays. Nothing changes where the known corners carry less
-    than ``minimum_known_weight``, nor where ``cost`` is inf."""
+    scratch: ``interpolation_scratch(d)``; clamped: (d,), out: (1,) work arrays. Nothing changes
+    where the known corners carry less than ``minimum_known_weight``, nor where ``cost`` is
+    inf."""
     clamp_to_domain(axis_min, axis_step, axis_count, wrap, state, clamped)
     known_weight = interpolate_with(
         axis_min, axis_step, axis_count, wrap, strides, value, known, clamped, scratch, out
