@@ -7,6 +7,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import shutil
 
 import numpy as np
 import pytest
@@ -14,6 +15,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_car import SMALL
 
+from mosys.animation.runner import run_row_bytes
+from mosys.cli import main
 from mosys.errors import InputError
 from mosys.io.car_scene import controller_table_scene
 from mosys.io.controller_table import write_controller_table
@@ -25,6 +28,7 @@ from mosys.kernels.geometry import (
     point_in_polygon,
 )
 from mosys.kernels.lookahead import CLEARANCE, Scene, _swept_free
+from mosys.limits import LimitError
 from mosys.parsing.controller import parse_controller_text
 from mosys.parsing.tokens import SpecError
 from mosys.ssc.controller import Controller
@@ -406,6 +410,56 @@ def test_a_start_grid_whose_pose_search_would_not_fit_in_memory_is_refused(car, 
     wide = Controller("wide", generate_controller(spec, car, tmp_path / "wide.h5", quiet=True), car)
     with pytest.raises(InputError, match=r"^controller wide: the pose search: the lattice would"):
         evaluate_starts(wide, np.array([[1.5, 2.0, 0.0, 0.0, 0.0]]), 1.0, DT)
+
+
+def test_a_start_grid_counts_the_lookaheads_own_memory_before_it_runs(small, car, monkeypatch):
+    """A lookahead run allocates more than its records: each thread's copy of the cost-to-go
+    and the run's put-back log (``Controller.run_work_bytes``). With the memory limit between
+    the records alone and the records with that work, the start grid is refused, naming both
+    counts of threads, before any run; the same limit takes one thread's records alone."""
+    starts = np.array([[1.5, 2.0, 0.0, 0.0, 0.0]])
+    seconds, threads = 10.0, 2
+    steps = round(seconds / DT)
+    records = steps * 8.0 * (2 * (len(car.STATE_NAMES) + len(small.state_order)) + 8)
+    work = small.run_work_bytes(steps)
+    nodes = small.lookahead.value.shape[0]
+    assert work == 8 * nodes + nodes + 16 * min(nodes, steps << len(small.grid.names))
+    gib = float(1 << 30)
+    monkeypatch.setenv("MOSYS_MAX_MEMORY_GIB", repr(threads * (records + work / 2) / gib))
+    with pytest.raises(LimitError, match=r"^mosys starts: expected a job that fits in .*2 at once"):
+        evaluate_starts(small, starts, seconds, DT, threads=threads)
+    monkeypatch.setenv("MOSYS_MAX_MEMORY_GIB", repr((records + work) / gib * 1.001))
+    assert evaluate_starts(small, starts, seconds, DT, threads=1).parked.shape == (1,)
+
+
+def test_a_script_counts_the_lookaheads_own_memory_before_it_runs(
+    small, car, tmp_path, monkeypatch, capsys
+):
+    """``mosys run`` counts a lookahead table's work beside the run's records too: with the
+    limit between them it refuses the ``sim`` line (exit 2) and writes nothing."""
+    controllers = tmp_path / "controllers"
+    controllers.mkdir()
+    write_controller_table(controllers / "small.h5", small.table)
+    script = tmp_path / "park.anim"
+    script.write_text("state car 1.5,2,0,0,0\nswapcon car consmall.ctab\nsim 2\n")
+    out = tmp_path / "park.h5"
+    steps = round(2.0 / DT)
+    records = steps * run_row_bytes(car)
+    limit = (records + small.run_work_bytes(steps) / 2) / float(1 << 30)
+    monkeypatch.setenv("MOSYS_MAX_MEMORY_GIB", repr(limit))
+    argv = ["run", str(script), "--controllers", str(controllers), "--dt", str(DT), "-o", str(out)]
+    dynamics = tmp_path / "dynamics"
+    dynamics.mkdir()
+    shutil.copy(car.__file__, dynamics / "car.py")  # the module is a content-addressed copy
+    argv += ["--dynamics-dir", str(dynamics)]
+    assert main(argv) == 2
+    assert (
+        capsys.readouterr()
+        .err.strip()
+        .splitlines()[-1]
+        .startswith(f"{script}:3:1: expected a job that fits in")
+    )
+    assert not out.exists()
 
 
 def test_an_aim_shrinks_the_dps_arrival_box_so_values_only_grow(small, car, tmp_path):

@@ -301,9 +301,12 @@ def run_row_bytes(dynamics: ModuleType) -> int:
 
 def _check_size(script: AnimationScript, sources: ScriptSources, dt: float) -> None:
     """LimitError at the first ``sim`` or ``motor`` line where the run, counted from its start,
-    needs more integration steps or memory than the limits allow (``mosys.limits``)."""
+    needs more integration steps or memory than the limits allow (``mosys.limits``): its
+    records, and what the most demanding of its controllers allocates besides them
+    (``Controller.run_work_bytes``, a lookahead table's)."""
     steps = 0.0
     row_bytes = run_row_bytes(sources.dynamics)
+    controllers = sources.controllers.values()
     for command in script.commands:
         if isinstance(command, Simulate):
             steps += command.seconds / dt
@@ -313,7 +316,10 @@ def _check_size(script: AnimationScript, sources: ScriptSources, dt: float) -> N
             continue
         where = location(script.path, command.token)
         job = f"the run to the end of this line at dt {dt:g} s"
-        check_job(where, job, steps, steps * row_bytes)
+        work = 0.0  # steps that are not finite are refused
+        if math.isfinite(steps):
+            work = max((c.run_work_bytes(round(steps)) for c in controllers), default=0.0)
+        check_job(where, job, steps, steps * row_bytes + work)
 
 
 def _set_slew(

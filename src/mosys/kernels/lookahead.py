@@ -432,6 +432,22 @@ def _choose(
 
 
 @njit(cache=True)
+def undo_capacity(node_count, steps, dimensions):
+    """The entries of a run's put-back log: a choice at most every step, each raising at most
+    the 2**dimensions corners around it, and no node twice (``_learn``)."""
+    return min(node_count, steps << dimensions)
+
+
+def run_work_bytes(node_count: int, steps: int, dimensions: int) -> float:
+    """Bytes a ``simulate_lookahead`` run of ``steps`` steps on a table of ``node_count`` nodes
+    and ``dimensions`` axes allocates besides its records and its table: the put-back log
+    (``touched``, 1 byte a node; ``undo_index`` and ``undo_value``, 16 bytes an entry of
+    ``undo_capacity``)."""
+    # the Python function: exact for any count (the compiled one works in int64)
+    return float(node_count) + 16.0 * float(undo_capacity.py_func(node_count, steps, dimensions))
+
+
+@njit(cache=True)
 def _learn(
     axis_min,
     axis_step,
@@ -565,10 +581,9 @@ def simulate_lookahead(
     own_inputs = np.zeros((2, input_size))  # the held inputs, and the same cut at the axis ends
     own_limits = _axis_limits(axis_min, axis_step, axis_count, state_slot, vehicle_slot)
     own_work = choice_work(axis_count, size, input_size, outline)
-    # the nodes _learn raises, each with its value before: put back before the run returns (a
-    # choice at most every step, each raising at most the 2**d corners around it)
+    # the nodes _learn raises, each with its value before: put back before the run returns
     logged = 0
-    capacity = min(value.shape[0], record_state.shape[0] << d)
+    capacity = undo_capacity(value.shape[0], record_state.shape[0], d)
     own_touched = np.zeros(value.shape[0], np.bool_)
     own_undo_index = np.empty(capacity, np.int64)
     own_undo_value = np.empty(capacity)

@@ -311,6 +311,17 @@ class Controller:
             values = self._per_thread.value = self.lookahead.value.copy()
         return values
 
+    def run_work_bytes(self, steps: int) -> float:
+        """What a run of ``steps`` steps allocates besides its records, bytes: for a lookahead
+        table, this thread's copy of the cost-to-go (8 bytes a node, at its first run) and the
+        run's put-back log (``kernels.lookahead.run_work_bytes``); 0 for any other."""
+        if self.lookahead is None:
+            return 0.0
+        from mosys.kernels.lookahead import run_work_bytes
+
+        nodes = self.lookahead.value.shape[0]
+        return 8.0 * nodes + run_work_bytes(nodes, steps, len(self.grid.names))
+
     def simulate(
         self,
         figure_state: np.ndarray,
