@@ -532,10 +532,10 @@ def plain_shares(u, r, responses, compliance, twisting, iterations):
 
 
 def test_the_shared_friction_solve_finds_the_fixed_point_of_the_dense_plain_iteration():
-    """The kernel inverts the system's normal block once and mixes the shares (Anderson): where
-    the plain iteration of a dense solve settles with every normal impulse pushing, the kernel
-    ends at the same impulses; and for two contacts with no z in r or u (iterated plainly, as
-    the 2-D rule is) it agrees on whether they push."""
+    """The kernel inverts the system's normal block once (``_normal_block``) and mixes the
+    shares (Anderson): where the plain iteration of a dense solve settles with every normal
+    impulse pushing, the kernel ends at the same impulses; and for two contacts with no z in r
+    or u (iterated plainly, as the 2-D rule is) it agrees on whether they push."""
     rng = np.random.default_rng(7)
     m = sim.MAX_CONTACTS
     compared = dict.fromkeys(range(2, m + 1), 0)
@@ -570,20 +570,13 @@ def test_the_shared_friction_solve_finds_the_fixed_point_of_the_dense_plain_iter
         compliance = sim.COMPLIANCE * (responses[0, 0, 0, 0] + responses[0, 0, 1, 1])
         compliance = 0.0 if count < 3 else compliance
         impulse = np.zeros((m, 3))
+        active = np.r_[np.ones(count), np.zeros(m - count)]
+        system, pairs = np.zeros((m + 4, m + 4)), np.zeros((m, m, 9))
+        scale_a = sim._normal_block(uu, rr, active, count, responses, system, compliance, pairs)
+        assert scale_a > 0.0
+        mixing, weight, share = np.zeros((3, m, m)), np.zeros(m), np.zeros(m)
         code = sim._shared_friction(
-            uu,
-            rr,
-            np.r_[np.ones(count), np.zeros(m - count)],
-            count,
-            responses,
-            impulse,
-            np.zeros((m + 4, m + 4)),
-            np.zeros((3, m, m)),
-            np.zeros(m),
-            compliance,
-            np.zeros(m),
-            True,
-            np.zeros((m, m, 9)),
+            uu, rr, active, count, impulse, system, mixing, weight, share, True, pairs, scale_a
         )
         # two in the plane iterate plainly in the kernel too, and as often; others settle more
         # slowly plainly

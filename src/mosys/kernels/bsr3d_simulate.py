@@ -533,75 +533,17 @@ def _mix_shares(weight, active, count, mixing, stored):
 
 
 @njit(cache=True, error_model="numpy")
-def _shared_friction(
-    u,
-    r,
-    active,
-    count,
-    responses,
-    impulse,
-    system,
-    mixing,
-    weight,
-    compliance,
-    share,
-    twisting,
-    pairs,
-):
-    """Impulses at the active contacts (at least two), the paper's friction carried to 3-D: no
-    active point sinks; each point's horizontal impulse is its share (its normal impulse over
-    their sum) of a common one, a slide (T_x, T_z) plus a twist Γ about the vertical (at offset
-    r from the centre of mass: (T_x + Γ r_z, T_z - Γ r_x)); and the normal-weighted horizontal
-    velocity and twist (r_z u_x - r_x u_z) of the points vanish after it, so that together they
-    neither slide nor spin on the floor (in a vertical plane the twist is 0 and this is the 2-D
-    rule). A fixed point over the shares, iterated to 1e-12. ``compliance`` (s/kg, 0: none) is
-    added to each contact's own normal response: it splits the load of contacts that a rigid
-    body leaves undecided (more than three on a plane, several in a line). ``twisting``: False
-    leaves the twist out (Γ = 0: slide only, the 2-D rule as it is). u, r (count, 3). Returns
-    the index of the contact whose normal impulse pulls most (-1: none pulls; -2: the system is
-    singular; -3: the shares of a twisting solve did not settle; slide only keeps its last
-    iterate, as the 2-D rule does). ``share`` (count,): the shares the points had the step
-    before (0: not in contact then), where the iteration starts if every active point had one,
-    the shares then mixed (``_mix_shares``), unless there are two with no z in their offsets r or
-    velocities u (a figure moving in its x-y plane): those start at even shares and iterate
-    plainly, as the 2-D rule does (where the iteration starts can decide whether a normal
-    impulse pulls, and a figure in that plane moves as the 2-D simulator moves it).
-
-    How it is solved: the system in the n normal impulses and the m = 3 (2 without the twist)
-    tangential unknowns is symmetric positive semi-definite, [[A, B], [Bᵀ, D]] (the body's
-    response restricted to those impulses, plus the compliance on A's diagonal). A does not
-    depend on the shares, so it is inverted once a call (by its Cholesky factor; a pivot at most
-    1e-12 of its largest entry is singular), and so is N0 = A⁻¹ (-u_y); B is linear in the
-    shares and D bilinear, so the terms they sum (``pairs`` (M, M, 9): for each pair of points,
-    the normal response at the first to the slides and twist at the second, and the slide and
-    twist response at the first to them) are made once a call too. Each share iteration sums
-    them, forms the Schur complement S = D - Bᵀ Y, Y = A⁻¹ B (m × m), and solves S x = b - Bᵀ N0
-    by S's adjugate, one division (singular where a pivot of S's Cholesky factor, the ratio of
-    two leading minors, is at most 1e-12 of the system's largest entry); the normal impulses are
-    N0 - Y x: no chain of divisions and square roots an iteration. system (M + 4, M + 4) holds,
-    M = MAX_CONTACTS: A⁻¹ in rows :n, columns :n; B in rows :n, columns M:M + m; Yᵀ in rows M:M
-    + m, columns :n, and S beside it; the right-hand sides and solutions (N0, then b and x) in
-    column M + 3; the normal impulses in row M + 3, columns :n."""
+def _normal_block(u, r, active, count, responses, system, compliance, pairs):
+    """The set-up of ``_shared_friction`` at the active contacts: A⁻¹ into system[:n, :n], N0 =
+    A⁻¹ (-u_y) into system[:n, M + 3] and the pairs' terms into ``pairs`` (M = MAX_CONTACTS;
+    the layout and the names are ``_shared_friction``'s; ``compliance`` added to A's diagonal).
+    Returns the largest entry of A, the scale its pivots are judged by, or -1.0 where A is
+    singular."""
     n = 0
-    known = 0.0
-    planar = True  # no z in any active point's offset or velocity: the 2-D rule's case
     for i in range(count):
         if active[i]:
             n += 1
-            known = known + share[i] if share[i] > 0.0 and known >= 0.0 else -1.0
-            planar = planar and r[i, 2] == 0.0 and u[i, 2] == 0.0
-    accelerated = n >= 3 or not planar  # two in the plane iterate plainly, as the 2-D rule does
-    for i in range(count):
-        if not active[i]:
-            weight[i] = 0.0
-        elif known > 0.0 and accelerated:  # two in the plane start even, as the 2-D rule does
-            weight[i] = share[i] / known
-        else:
-            weight[i] = 1.0 / n
-    m = 3 if twisting else 2
-    t = MAX_CONTACTS  # the tangential block's first row and column
     rhs = MAX_CONTACTS + 3  # the right-hand sides' and solutions' column
-    normal = MAX_CONTACTS + 3  # the row that keeps the normal impulses
     # A; then L in place of A, then A⁻¹ (both triangles) in place of L, and N0 = A⁻¹ (-u_y)
     scale_a = 0.0
     row = 0
@@ -641,7 +583,7 @@ def _shared_friction(
         for p in range(k):
             total -= system[k, p] * system[k, p]
         if not total > 1e-12 * scale_a:
-            return -2
+            return -1.0
         system[k, k] = math.sqrt(total)
     for k in range(n):  # L⁻¹, row by row (a row's entries of L are used left to right)
         diagonal = 1.0 / system[k, k]
@@ -669,6 +611,70 @@ def _shared_friction(
                     column += 1
             system[row, rhs] = total
             row += 1
+    return scale_a
+
+
+@njit(cache=True, error_model="numpy")
+def _shared_friction(
+    u, r, active, count, impulse, system, mixing, weight, share, twisting, pairs, scale_a
+):
+    """Impulses at the active contacts (at least two), the paper's friction carried to 3-D: no
+    active point sinks; each point's horizontal impulse is its share (its normal impulse over
+    their sum) of a common one, a slide (T_x, T_z) plus a twist Γ about the vertical (at offset
+    r from the centre of mass: (T_x + Γ r_z, T_z - Γ r_x)); and the normal-weighted horizontal
+    velocity and twist (r_z u_x - r_x u_z) of the points vanish after it, so that together they
+    neither slide nor spin on the floor (in a vertical plane the twist is 0 and this is the 2-D
+    rule). A fixed point over the shares, iterated to 1e-12. The compliance (s/kg, 0: none)
+    that ``_normal_block`` adds to each contact's own normal response splits the load of
+    contacts that a rigid body leaves undecided (more than three on a plane, several in a
+    line). ``twisting``: False
+    leaves the twist out (Γ = 0: slide only, the 2-D rule as it is). u, r (count, 3). Returns
+    the index of the contact whose normal impulse pulls most (-1: none pulls; -2: the system is
+    singular; -3: the shares of a twisting solve did not settle; slide only keeps its last
+    iterate, as the 2-D rule does). ``share`` (count,): the shares the points had the step
+    before (0: not in contact then), where the iteration starts if every active point had one,
+    the shares then mixed (``_mix_shares``), unless there are two with no z in their offsets r or
+    velocities u (a figure moving in its x-y plane): those start at even shares and iterate
+    plainly, as the 2-D rule does (where the iteration starts can decide whether a normal
+    impulse pulls, and a figure in that plane moves as the 2-D simulator moves it).
+
+    How it is solved: the system in the n normal impulses and the m = 3 (2 without the twist)
+    tangential unknowns is symmetric positive semi-definite, [[A, B], [Bᵀ, D]] (the body's
+    response restricted to those impulses, plus the compliance on A's diagonal). A does not
+    depend on the shares, so it is inverted once a call (by its Cholesky factor; a pivot at most
+    1e-12 of its largest entry is singular), and so is N0 = A⁻¹ (-u_y); B is linear in the
+    shares and D bilinear, so the terms they sum (``pairs`` (M, M, 9): for each pair of points,
+    the normal response at the first to the slides and twist at the second, and the slide and
+    twist response at the first to them) are made once a call too. Each share iteration sums
+    them, forms the Schur complement S = D - Bᵀ Y, Y = A⁻¹ B (m × m), and solves S x = b - Bᵀ N0
+    by S's adjugate, one division (singular where a pivot of S's Cholesky factor, the ratio of
+    two leading minors, is at most 1e-12 of the system's largest entry); the normal impulses are
+    N0 - Y x: no chain of divisions and square roots an iteration. system (M + 4, M + 4) holds,
+    M = MAX_CONTACTS: A⁻¹ in rows :n, columns :n; B in rows :n, columns M:M + m; Yᵀ in rows M:M
+    + m, columns :n, and S beside it; the right-hand sides and solutions (N0, then b and x) in
+    column M + 3; the normal impulses in row M + 3, columns :n. A⁻¹, N0 and the pairs' terms
+    depend neither on the shares nor on ``twisting``: ``_normal_block`` makes them (scale_a: the
+    largest entry of A, which it returns), and a retry without the twist reads the same."""
+    n = 0
+    known = 0.0
+    planar = True  # no z in any active point's offset or velocity: the 2-D rule's case
+    for i in range(count):
+        if active[i]:
+            n += 1
+            known = known + share[i] if share[i] > 0.0 and known >= 0.0 else -1.0
+            planar = planar and r[i, 2] == 0.0 and u[i, 2] == 0.0
+    accelerated = n >= 3 or not planar  # two in the plane iterate plainly, as the 2-D rule does
+    for i in range(count):
+        if not active[i]:
+            weight[i] = 0.0
+        elif known > 0.0 and accelerated:  # two in the plane start even, as the 2-D rule does
+            weight[i] = share[i] / known
+        else:
+            weight[i] = 1.0 / n
+    m = 3 if twisting else 2
+    t = MAX_CONTACTS  # the tangential block's first row and column
+    rhs = MAX_CONTACTS + 3  # the right-hand sides' and solutions' column
+    normal = MAX_CONTACTS + 3  # the row that keeps the normal impulses
     converged = False
     last = MAX_CONTACTS - 1  # mixing's row of the last update and residual
     for iteration in range(FIXED_POINT_ITERATIONS):
@@ -924,12 +930,15 @@ def contact_impulses(
     compliance = 0.0 if n < 3 else COMPLIANCE * (responses[0, 0, 0, 0] + responses[0, 0, 1, 1])
     # np.int64 and np.bool_: types, not literals (each literal a signature of its own: the
     # shared friction compiled four times over, 40 s of a cold start)
-    points = (u, r, active, np.int64(count), responses, impulse, system, mixing, weight)
+    points = (u, r, active, np.int64(count), impulse, system, mixing, weight, share)
     while n >= 2:
-        worst = _shared_friction(*points, compliance, share, np.bool_(True), pairs)
+        scale_a = _normal_block(u, r, active, np.int64(count), responses, system, compliance, pairs)
+        worst = -2
+        if scale_a >= 0.0:
+            worst = _shared_friction(*points, np.bool_(True), pairs, scale_a)
         if worst == -1 and _twist_too_strong(impulse, active, count) or worst == -3:
-            # slide only: the paper's rule as it is
-            worst = _shared_friction(*points, compliance, share, np.bool_(False), pairs)
+            # slide only: the paper's rule as it is (on the same normal block)
+            worst = _shared_friction(*points, np.bool_(False), pairs, scale_a)
         if worst == -2 and compliance == 0.0:
             # the rigid body leaves the split undecided: a little compliance decides it
             compliance = COMPLIANCE * (responses[0, 0, 0, 0] + responses[0, 0, 1, 1])
