@@ -627,8 +627,8 @@ def _shared_friction(
     rule). A fixed point over the shares, iterated to 1e-12. The compliance (s/kg, 0: none)
     that ``_normal_block`` adds to each contact's own normal response splits the load of
     contacts that a rigid body leaves undecided (more than three on a plane, several in a
-    line). ``twisting``: False
-    leaves the twist out (Γ = 0: slide only, the 2-D rule as it is). u, r (count, 3). Returns
+    line). ``twisting``: False leaves the twist out (Γ = 0: slide only, the 2-D rule as it
+    is). u, r (count, 3). Returns
     the index of the contact whose normal impulse pulls most (-1: none pulls; -2: the system is
     singular; -3: the shares of a twisting solve did not settle; slide only keeps its last
     iterate, as the 2-D rule does). ``share`` (count,): the shares the points had the step
@@ -641,11 +641,11 @@ def _shared_friction(
     How it is solved: the system in the n normal impulses and the m = 3 (2 without the twist)
     tangential unknowns is symmetric positive semi-definite, [[A, B], [Bᵀ, D]] (the body's
     response restricted to those impulses, plus the compliance on A's diagonal). A does not
-    depend on the shares, so it is inverted once a call (by its Cholesky factor; a pivot at most
-    1e-12 of its largest entry is singular), and so is N0 = A⁻¹ (-u_y); B is linear in the
-    shares and D bilinear, so the terms they sum (``pairs`` (M, M, 9): for each pair of points,
-    the normal response at the first to the slides and twist at the second, and the slide and
-    twist response at the first to them) are made once a call too. Each share iteration sums
+    depend on the shares, so it is inverted once (by its Cholesky factor; a pivot at most 1e-12
+    of its largest entry is singular), and so is N0 = A⁻¹ (-u_y); B is linear in the shares
+    and D bilinear, so the terms they sum (``pairs`` (M, M, 9): for each pair of points, the
+    normal response at the first to the slides and twist at the second, and the slide and
+    twist response at the first to them) are made once too. Each share iteration sums
     them, forms the Schur complement S = D - Bᵀ Y, Y = A⁻¹ B (m × m), and solves S x = b - Bᵀ N0
     by S's adjugate, one division (singular where a pivot of S's Cholesky factor, the ratio of
     two leading minors, is at most 1e-12 of the system's largest entry); the normal impulses are
