@@ -316,9 +316,7 @@ def _check_size(script: AnimationScript, sources: ScriptSources, dt: float) -> N
             continue
         where = location(script.path, command.token)
         job = f"the run to the end of this line at dt {dt:g} s"
-        work = 0.0  # steps that are not finite are refused
-        if math.isfinite(steps):
-            work = max((c.run_work_bytes(round(steps)) for c in controllers), default=0.0)
+        work = max((c.run_work_bytes(steps) for c in controllers), default=0.0)
         check_job(where, job, steps, steps * row_bytes + work)
 
 

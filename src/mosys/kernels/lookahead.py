@@ -438,11 +438,10 @@ def undo_capacity(node_count, steps, dimensions):
     return min(node_count, steps << dimensions)
 
 
-def run_work_bytes(node_count: int, steps: int, dimensions: int) -> float:
-    """Bytes a ``simulate_lookahead`` run of ``steps`` steps on a table of ``node_count`` nodes
-    and ``dimensions`` axes allocates besides its records and its table: the put-back log
-    (``touched``, 1 byte a node; ``undo_index`` and ``undo_value``, 16 bytes an entry of
-    ``undo_capacity``)."""
+def undo_log_bytes(node_count: int, steps: int, dimensions: int) -> float:
+    """Bytes of the put-back log of a ``simulate_lookahead`` run of ``steps`` steps on a table
+    of ``node_count`` nodes and ``dimensions`` axes: ``touched``, 1 byte a node; ``undo_index``
+    and ``undo_value``, 16 bytes an entry of ``undo_capacity``."""
     # the Python function: exact for any count (the compiled one works in int64)
     return float(node_count) + 16.0 * float(undo_capacity.py_func(node_count, steps, dimensions))
 

@@ -311,16 +311,19 @@ class Controller:
             values = self._per_thread.value = self.lookahead.value.copy()
         return values
 
-    def run_work_bytes(self, steps: int) -> float:
+    def run_work_bytes(self, steps: float) -> float:
         """What a run of ``steps`` steps allocates besides its records, bytes: for a lookahead
         table, this thread's copy of the cost-to-go (8 bytes a node, at its first run) and the
-        run's put-back log (``kernels.lookahead.run_work_bytes``); 0 for any other."""
+        run's put-back log (``kernels.lookahead.undo_log_bytes``); 0 for any other. inf where
+        ``steps`` is not finite (``limits.check_job`` refuses those steps first)."""
         if self.lookahead is None:
             return 0.0
-        from mosys.kernels.lookahead import run_work_bytes
+        if not math.isfinite(steps):
+            return math.inf
+        from mosys.kernels.lookahead import undo_log_bytes
 
         nodes = self.lookahead.value.shape[0]
-        return 8.0 * nodes + run_work_bytes(nodes, steps, len(self.grid.names))
+        return 8.0 * nodes + undo_log_bytes(nodes, round(steps), len(self.grid.names))
 
     def simulate(
         self,

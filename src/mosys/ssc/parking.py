@@ -117,9 +117,7 @@ def evaluate_starts(
     starts = np.asarray(starts, dtype=np.float64)
     steps = seconds / dt
     state_size = len(controller.dynamics.STATE_NAMES) + len(controller.state_order)
-    run_bytes = steps * 8.0 * (2 * state_size + 8)
-    if math.isfinite(steps):  # else check_job refuses the steps
-        run_bytes += controller.run_work_bytes(round(steps))
+    run_bytes = steps * 8.0 * (2 * state_size + 8) + controller.run_work_bytes(steps)
     check_job(
         "mosys starts",
         f"{seconds:g} s at dt {dt:g} s per start, {threads} at once",
