@@ -538,17 +538,17 @@ ERRORS = [
     ),
     (
         replace_line(7, "score jump = max_t(max_i(cm_y))"),
-        "x.comp:7:20: expected an argument with rod endpoints (x_i or y_i, not yet reduced by "
+        "x.comp:7:26: expected an argument with rod endpoints (x_i or y_i, not yet reduced by "
         "min_i/max_i) for max_i, found 'cm_y'",
     ),
     (
         replace_line(7, "score jump = max_t(max_t(y_i))"),
-        "x.comp:7:14: expected an argument with samples over time (x_i, y_i, cm_x or cm_y, not "
+        "x.comp:7:20: expected an argument with samples over time (x_i, y_i, cm_x or cm_y, not "
         "yet reduced by min_t/max_t) for max_t, found 'max_t(y_i)'",
     ),
     (
         replace_line(7, "score jump = min_t(dtime)"),
-        "x.comp:7:14: expected an argument with samples over time (x_i, y_i, cm_x or cm_y, not "
+        "x.comp:7:20: expected an argument with samples over time (x_i, y_i, cm_x or cm_y, not "
         "yet reduced by min_t/max_t) for min_t, found 'dtime'",
     ),
     (
@@ -630,7 +630,7 @@ ERRORS = [
     ),
     (
         replace_line(9, "total = max_t(jump)"),
-        "x.comp:9:9: expected an argument with samples over time (x_i, y_i, cm_x or cm_y, not "
+        "x.comp:9:15: expected an argument with samples over time (x_i, y_i, cm_x or cm_y, not "
         "yet reduced by min_t/max_t) for max_t, found 'jump'",
     ),
     (

@@ -391,7 +391,7 @@ class _ExpressionParser:
             raise SpecError(
                 self.path,
                 self.line.number,
-                function.index + 1,
+                argument.start + 1,
                 f"{_AXIS_ARGUMENT[axis]} for {name}",
                 self.text[argument.start : argument.end],
             )
