@@ -210,11 +210,14 @@ def test_a_car_without_obstacles_parks_in_the_open(car, tmp_path):
     assert abs(final[0]) <= 0.1 and abs(final[1] - 1.0) <= 0.1
 
 
-def test_a_start_grid_runs_the_starts_that_can_park_and_excludes_the_others(small, tmp_path):
+def test_a_start_grid_runs_the_starts_that_can_park_and_excludes_the_others(
+    small, tmp_path, capsys
+):
     """Starts whose pose overlaps the curb or lies outside the domain are excluded (not run),
     with the reason; every start records the table's cost-to-go there; the rate counts only
-    the starts that are not excluded; two threads give the same file as one. The table keeps
-    no cost-to-go to the whole arrival box (``arrival_value``), so the grid has none."""
+    the starts that are not excluded; two threads give the same file as one; progress goes to
+    stderr unless quiet. The table keeps no cost-to-go to the whole arrival box
+    (``arrival_value``), so the grid has none."""
     starts = np.array(
         [
             [1.5, 2.0, 0.0, 0.0, 0.0],
@@ -224,6 +227,8 @@ def test_a_start_grid_runs_the_starts_that_can_park_and_excludes_the_others(smal
         ]
     )
     one = evaluate_starts(small, starts, 10.0, DT, threads=1)
+    shown = capsys.readouterr().err  # progress: the runs done, and the starts not run
+    assert "starts: done, 2 runs in " in shown and "(2 starts that cannot park not run)" in shown
     assert one.excluded.tolist() == ["", "", NOT_FREE, NOT_FREE]
     assert not one.parked[2:].any() and not one.collided[2:].any()
     assert np.isnan(one.parking_seconds[2:]).all() and np.isnan(one.path_length[2:]).all()
@@ -231,7 +236,8 @@ def test_a_start_grid_runs_the_starts_that_can_park_and_excludes_the_others(smal
     assert one.cost_to_go.tolist() == [small.cost_to_go(start) for start in starts]
     assert np.isfinite(one.cost_to_go[:2]).all()
     assert one.success_rate == one.parked[:2].mean()
-    two = evaluate_starts(small, starts, 10.0, DT, threads=2)
+    two = evaluate_starts(small, starts, 10.0, DT, threads=2, quiet=True)
+    assert capsys.readouterr().err == ""
     for name in ("parked", "collided", "parking_seconds", "cost_to_go", "path_length"):
         np.testing.assert_array_equal(getattr(one, name), getattr(two, name))
     write_start_grid(tmp_path / "grid.h5", one)

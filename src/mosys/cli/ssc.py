@@ -71,6 +71,7 @@ def _starts_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--dt", type=float, default=0.01, help="simulator step, s")
     parser.add_argument("--threads", type=int, default=1, help="runs at once")
     parser.add_argument("-o", "--output", required=True)
+    parser.add_argument("--quiet", action="store_true", help="no progress lines")
 
 
 MAX_STARTS = 1_000_000  # a start runs for seconds; a million take days on two cores
@@ -119,7 +120,8 @@ def _starts(args: argparse.Namespace) -> None:
     order = controller.state_order
     starts = np.array(list(itertools.product(*(axes[name] for name in order))))
     write_start_grid(
-        args.output, evaluate_starts(controller, starts, args.seconds, args.dt, args.threads)
+        args.output,
+        evaluate_starts(controller, starts, args.seconds, args.dt, args.threads, quiet=args.quiet),
     )
 
 

@@ -14,6 +14,7 @@ import numpy as np
 
 from mosys.errors import InputError
 from mosys.io.car_scene import CarScene, car_scene_attributes, controller_table_scene
+from mosys.io.progress import Progress
 from mosys.io.start_grid import NO_WAY, NOT_FREE, StartGrid
 from mosys.kernels.geometry import first_colliding_sample, pack_polygons
 from mosys.limits import check_job
@@ -107,11 +108,17 @@ def classify_starts(controller: Controller, starts: np.ndarray) -> tuple[np.ndar
 
 
 def evaluate_starts(
-    controller: Controller, starts: np.ndarray, seconds: float, dt: float, threads: int = 1
+    controller: Controller,
+    starts: np.ndarray,
+    seconds: float,
+    dt: float,
+    threads: int = 1,
+    quiet: bool = False,
 ) -> StartGrid:
     """Run ``controller`` (a car's) from every start (n, d) in its state order, spec units, for
     ``seconds`` with step ``dt``, and judge each run (``parking_outcome``), ``threads`` runs at
-    once. Starts that cannot park at all (``classify_starts``) are not run."""
+    once, showing progress (runs done, rate and ETA, on stderr) unless ``quiet``. Starts that
+    cannot park at all (``classify_starts``) are not run."""
     from concurrent.futures import ThreadPoolExecutor
 
     starts = np.asarray(starts, dtype=np.float64)
@@ -134,8 +141,15 @@ def evaluate_starts(
         return parking_outcome(t, state, controller.state_order, scene)
 
     included = np.flatnonzero(excluded == "")
+    progress = Progress("starts", included.size, "runs")
+    outcomes = {}
     with ThreadPoolExecutor(max_workers=max(1, threads)) as pool:
-        outcomes = dict(zip(included, pool.map(outcome, starts[included]), strict=True))
+        for i, run in zip(included, pool.map(outcome, starts[included]), strict=True):
+            outcomes[i] = run
+            if not quiet:
+                progress.update(len(outcomes))
+    if not quiet:
+        progress.finish(f"({len(starts) - included.size} starts that cannot park not run)")
     skipped = ParkingOutcome(-1, "", False, math.nan)
     runs = [outcomes.get(i, skipped) for i in range(len(starts))]
     return StartGrid(
