@@ -369,6 +369,30 @@ def no_display(monkeypatch):
     plt.switch_backend(backend)
 
 
+def test_run_editor_refuses_a_guess_past_the_limits_before_its_window(
+    no_display, composite_workspace, tmp_path, monkeypatch
+):
+    """The guess is run at once, so a script whose ticks are past the limits is refused as by
+    ``mosys composite``, at its line, before any window opens (here a window could open: the
+    backend check is told so)."""
+    import matplotlib.pyplot as plt
+
+    import mosys.editor.concatenation as concatenation
+    from mosys.limits import LimitError
+
+    text = composite_workspace.script.read_text().replace("ticks=100\n", "ticks=99999999999\n", 1)
+    script = copied_script(composite_workspace, tmp_path, text)
+    monkeypatch.setattr(concatenation, "interactive_backend", lambda: "tkagg")
+    figures = plt.get_fignums()
+    with pytest.raises(LimitError) as error:
+        run_editor(script, composite_workspace.bsr_results, SPECS / "figures", SPECS / "bsr")
+    assert str(error.value).startswith(
+        f"{script}:9:59: expected at most 10,000,000 integration steps per run, found "
+        "100,000,000,214 (the phases' 100,000,000,214 ticks to the end of this one)"
+    )
+    assert plt.get_fignums() == figures
+
+
 def test_run_editor_without_a_window_says_so(no_display, tmp_path):
     with pytest.raises(InputError) as error:  # before reading anything: no such script here
         run_editor(tmp_path / "missing.comp", tmp_path)

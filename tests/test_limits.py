@@ -167,6 +167,24 @@ def test_composite_ticks_are_limited(tmp_path, composite_workspace, capsys):
     assert_nothing_written(out)
 
 
+def test_composite_ticks_past_int64_are_limited_not_a_traceback(
+    tmp_path, composite_workspace, capsys
+):
+    """A whole number of ticks beyond int64 parses; the limits refuse it at its line, counted
+    exactly (the verb fuzz found an OverflowError in NumPy's conversion instead)."""
+    script = tmp_path / "starman_show.comp"
+    text = composite_workspace.script.read_text()
+    script.write_text(text.replace("ticks=100\n", f"ticks={2**70}\n", 1))
+    out = tmp_path / "show.h5"
+    argv = ["composite", str(script), "--bsr-results", str(composite_workspace.bsr_results)]
+    assert main([*argv, "-o", str(out)]) == 2
+    assert last_line(capsys).startswith(
+        f"{script}:9:59: expected at most 10,000,000 integration steps per run, found "
+        f"1.18e+21 (the phases' {215 + 2**70:,} ticks to the end of this one)"
+    )
+    assert_nothing_written(out)
+
+
 def test_a_stale_dynamics_module_is_refused(tmp_path, pendulum, capsys):
     """A module compiled before the bounds (reproducer 2): its zero inertia would divide by zero
     in the DP's kernels."""

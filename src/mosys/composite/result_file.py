@@ -57,15 +57,18 @@ def check_size(session: CompositeSession) -> None:
     limits allow, or at the ``figure`` line when the search's Q arrays do (``mosys.limits``)."""
     script = session.script
     step_bytes = motion_step_bytes(len(session.figure.endpoint_names))
-    ticks = 0.0
-    for phase, phase_ticks in zip(script.phases, session.guess, strict=True):
-        ticks += float(phase_ticks)
+    # the script's own counts where it has them: any whole number parses, and one past int64
+    # must reach the limits' message, not NumPy's conversion in ``session.guess``
+    guess = script.guessed_ticks if script.guessed_ticks is not None else session.guess
+    ticks = 0  # exact: a Python int
+    for phase, phase_ticks in zip(script.phases, guess, strict=True):
+        ticks += int(phase_ticks)
         token = script.tokens.get(f"phase.{phase.name}.ticks", script.tokens["figure"])
         check_job(
             location(script.path, token),
-            f"the phases' {ticks:,.0f} ticks to the end of this one",
-            ticks,
-            ticks * step_bytes,
+            f"the phases' {ticks:,} ticks to the end of this one",
+            float(ticks),
+            float(ticks) * step_bytes,
         )
     arrays, figure = script.search.q, script.tokens["figure"]
     check_job(  # the search's population: Q arrays of switch ticks and their scores, copied

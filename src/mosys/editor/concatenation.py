@@ -622,9 +622,11 @@ def run_editor(
     """Open the editor of the script ``script_path`` in a window and return when it is closed.
     Its phases' controllers are the best seeds under ``results_dir``/SEARCH/ (as ``mosys
     composite`` picks them). InputError (before reading anything) if matplotlib cannot open a
-    window; SpecError for a script, figure or controller that is not there."""
+    window; SpecError for a script, figure or controller that is not there; LimitError, before
+    the window opens, for a guess past the limits (``composite.result_file.check_size``)."""
     import matplotlib.pyplot as plt
 
+    from mosys.composite.result_file import check_size
     from mosys.composite.session import find_controller_files, open_session
     from mosys.parsing.composite import parse_composite_script
 
@@ -642,6 +644,7 @@ def run_editor(
     session = open_session(
         script, find_controller_files(script, results_dir), figures_dir, bsr_specs_dir
     )
+    check_size(session)  # the guess is run at once, as by ``mosys composite``
     with plot_style():
         figure = plt.figure(num=f"mosys edit {script.name}")
         editor = ConcatenationEditor(session, script_path, figure)
