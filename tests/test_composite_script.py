@@ -42,7 +42,7 @@ from mosys.parsing.composite_script import (
     SearchSettings,
     Unary,
 )
-from mosys.parsing.tokens import SpecError, Token
+from mosys.parsing.tokens import MAX_SEED, SpecError, Token
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = """\
@@ -660,6 +660,26 @@ ERRORS = [
         replace_line(10, "search q=16 seed=-1"),
         "x.comp:10:18: expected a whole number >= 0 for seed=, found '-1'",
     ),
+    # counts the kernels index, and seeds the result file stores as int64 (the verb fuzz wrote
+    # seed=100000000000000000000: it searched, then failed to store it)
+    (
+        replace_line(10, "search g=2147483648"),
+        "x.comp:10:10: expected a whole number from 1 to 2147483647 for g=, found '2147483648'",
+    ),
+    (
+        replace_line(10, f"search seed={MAX_SEED + 1}"),
+        f"x.comp:10:13: expected a whole number from 0 to {MAX_SEED} for seed=, found "
+        f"'{MAX_SEED + 1}'",
+    ),
+    (
+        replace_line(3, f"phase cartwheel controller=starman_cartwheel_robust seed={2**64}"),
+        f"x.comp:3:58: expected a whole number from 0 to {MAX_SEED} for seed=, found '{2**64}'",
+    ),
+    # a NUL, even in a comment: the result file keeps the text (HDF5 strings cannot hold one)
+    (
+        EXAMPLE.replace("a jump and", "a jump\x00 and"),
+        "x.comp:1:62: expected text without NUL characters, found '\\x00'",
+    ),
 ]
 
 
@@ -812,7 +832,7 @@ def composite_scripts(draw) -> tuple[CompositeScript, dict, object]:
             name,
             draw(IDENTIFIERS),
             draw(typed_expressions(frozenset(), 3, REFERENCE_NAMES))[0],
-            seed=draw(st.none() | st.integers(0, 2**64)),
+            seed=draw(st.none() | st.integers(0, MAX_SEED)),
             ticks=draw(st.integers(1, 10**6)) if with_ticks else None,
         )
         for name in names
@@ -823,7 +843,7 @@ def composite_scripts(draw) -> tuple[CompositeScript, dict, object]:
     }
     total, reference = draw(typed_expressions(frozenset(), 4, total_names))
     search = SearchSettings(
-        *(draw(st.integers(1, 10**6)) for _ in range(3)), draw(st.integers(0, 2**64))
+        *(draw(st.integers(1, 10**6)) for _ in range(3)), draw(st.integers(0, MAX_SEED))
     )
     script = CompositeScript("generated.comp", draw(IDENTIFIERS), phases, total, search)
     return script, scores, reference(0, 0)

@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 
 from mosys.cli import main
 from mosys.dynamics.model import build_model
-from mosys.parsing.bsr import MAX_SEED, parse_bsr_text
+from mosys.parsing.bsr import parse_bsr_text
 from mosys.parsing.composite import parse_composite_text
 from mosys.parsing.controller import parse_controller_text
 from mosys.parsing.figure import (
@@ -32,7 +32,7 @@ from mosys.parsing.figure import (
 )
 from mosys.parsing.motor import parse_motor_program_text
 from mosys.parsing.script import parse_script_text
-from mosys.parsing.tokens import SpecError
+from mosys.parsing.tokens import MAX_SEED, SpecError
 from mosys.parsing.vehicle import Vehicle
 
 FIGURES = SPECS / "figures"
@@ -256,7 +256,7 @@ def test_bsr_search_refuses_a_huge_seed_in_the_spec(tmp_path: Path) -> None:
     at = where(text, HUGE_SEED)
     assert_refused(
         done,
-        f"{spec}:{at}: expected a whole number from 0 to {MAX_SEED} (int64) for a seed, found "
+        f"{spec}:{at}: expected a whole number from 0 to {MAX_SEED} for a seed, found "
         f"'{HUGE_SEED}'",
         tmp_path,
     )

@@ -24,7 +24,7 @@ def _bsr_search_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _bsr_search_check(args: argparse.Namespace) -> str | None:
-    from mosys.parsing.bsr import MAX_SEED
+    from mosys.parsing.tokens import MAX_SEED
 
     return first_problem(
         whole_number_problem("bsr-search", "seed", args.seed, 0, MAX_SEED),

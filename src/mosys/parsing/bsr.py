@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from mosys.parsing.tokens import (
+    MAX_SEED,
     MAX_WHOLE,
     NAME,
     Line,
@@ -146,7 +147,6 @@ REQUIRED = ("figure", "controller", "simulate", "search", "seeds", "fitness")
 DEFAULT_REINITIALIZE = 0.5
 # rounding allowed in duration / dt being a whole number of steps, relative
 STEPS_TOLERANCE = 1e-9
-MAX_SEED = 2**63 - 1  # seeds are stored as int64 in the result file (and seed numpy's RNG)
 # simulator steps per evaluation (T / dt), a count the kernels index too (the paper's take 400);
 # how many one run may really take is the user's limit, checked before a search (mosys.limits)
 MAX_STEPS = MAX_WHOLE
@@ -410,9 +410,7 @@ class _Parser:
         seeds: dict[int, Token] = {}
         while True:
             token = reader.word(f"a whole number >= 0 for {what}")
-            seed = parse_int(token, self.path, what, 0)
-            if seed > MAX_SEED:
-                raise self.error(token, f"a whole number from 0 to {MAX_SEED} (int64) for {what}")
+            seed = parse_int(token, self.path, what, 0, MAX_SEED)  # stored as int64
             if seed in seeds:
                 raise self.error(
                     token, f"distinct seeds ({seed} is already at column {seeds[seed].column})"

@@ -76,6 +76,8 @@ from mosys.parsing.composite_script import (
 )
 from mosys.parsing.tokens import (
     END_OF_FILE,
+    MAX_SEED,
+    MAX_WHOLE,
     Line,
     SpecError,
     Token,
@@ -119,7 +121,13 @@ _PHASE_KEYS = {
     "seed": "a whole number >= 0 for seed=",
     "ticks": "a whole number >= 1 for ticks=",
 }
-_SEARCH_KEYS = {"q": 1, "g": 1, "h": 1, "seed": 0}  # key -> minimum
+# key -> (minimum, maximum): counts the kernels index; the seed, stored as int64
+_SEARCH_KEYS = {
+    "q": (1, MAX_WHOLE),
+    "g": (1, MAX_WHOLE),
+    "h": (1, MAX_WHOLE),
+    "seed": (0, MAX_SEED),
+}
 
 
 def parse_composite_script(path: str | Path) -> CompositeScript:
@@ -133,9 +141,15 @@ def parse_composite_text(
     text: str, path: str = "<text>", spec_sha256: str | None = None
 ) -> CompositeScript:
     """Parse ``.comp`` text; ``path`` names it in errors and becomes ``CompositeScript.path``.
-    ``spec_sha256`` defaults to the SHA-256 of the text's UTF-8 encoding."""
+    ``spec_sha256`` defaults to the SHA-256 of the text's UTF-8 encoding. A NUL character,
+    comments included, is an error: the result file keeps the script's text as an HDF5
+    string."""
     if spec_sha256 is None:
         spec_sha256 = hashlib.sha256(text.encode("utf-8")).hexdigest()
+    if "\x00" in text:  # even in a comment: the result file keeps the text, and HDF5 cannot
+        before = text[: text.index("\x00")]
+        line, column = before.count("\n") + 1, len(before) - before.rfind("\n")
+        raise SpecError(str(path), line, column, "text without NUL characters", "\x00")
     return _Parser(str(path)).parse(tokenize(text, str(path)), spec_sha256)
 
 
@@ -502,7 +516,7 @@ class _Parser:
         controller = parse_name(controller_token, self.path, "controller= (a BSR search)")
         seed = ticks = None
         if "seed" in found:
-            seed = parse_int(value_token(found["seed"][0], "seed"), self.path, "seed=", 0)
+            seed = parse_int(value_token(found["seed"][0], "seed"), self.path, "seed=", 0, MAX_SEED)
         if "ticks" in found:
             ticks = parse_int(value_token(found["ticks"][0], "ticks"), self.path, "ticks=", 1)
         if self.phases:
@@ -600,14 +614,14 @@ class _Parser:
 
     def line_search(self, line: Line) -> None:
         allowed = {
-            key: f"a whole number >= {minimum} for {key}=" for key, minimum in _SEARCH_KEYS.items()
+            key: f"a whole number >= {low} for {key}=" for key, (low, _) in _SEARCH_KEYS.items()
         }
         if len(line.tokens) == 1:
             choices = ", ".join(f"'{key}='" for key in allowed)
             raise SpecError(self.path, line.number, line.end_column, f"one of {choices}", None)
         found = line.reader().key_values(allowed)
         values = {
-            key: parse_int(value_token(token, key), self.path, f"{key}=", _SEARCH_KEYS[key])
+            key: parse_int(value_token(token, key), self.path, f"{key}=", *_SEARCH_KEYS[key])
             for key, (token, _) in found.items()
         }
         self.search = SearchSettings(**values)

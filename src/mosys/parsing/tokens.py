@@ -19,6 +19,7 @@ NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 ENDPOINT_ENDS = ("proximal", "distal")  # a rod's ends, as specs name them: ROD.END
 END_OF_FILE = "\x00end of file"  # the 'found' of an error about a line that never came
 MAX_WHOLE = 2**31 - 1  # the largest count (generations, controllers, sweeps...) kernels index
+MAX_SEED = 2**63 - 1  # seeds are stored as int64 in result files (and seed numpy's RNG)
 SHOWN_CHARACTERS = 200  # of one word an error quotes: a longer word is cut, its length said
 
 
@@ -153,8 +154,11 @@ def parse_number(token: Token, path: str, what: str, text: str | None = None) ->
     return value
 
 
-def parse_int(token: Token, path: str, what: str, minimum: int | None = None) -> int:
-    """A whole number (no sign, point or exponent), at least ``minimum`` if given."""
+def parse_int(
+    token: Token, path: str, what: str, minimum: int | None = None, maximum: int | None = None
+) -> int:
+    """A whole number (no sign, point or exponent), at least ``minimum`` and at most ``maximum``
+    if given."""
     if re.fullmatch(r"[+-]?\d+", token.text) is None:
         raise SpecError(path, token.line, token.column, f"a whole number for {what}", token.text)
     try:
@@ -166,6 +170,15 @@ def parse_int(token: Token, path: str, what: str, minimum: int | None = None) ->
     if minimum is not None and value < minimum:
         raise SpecError(
             path, token.line, token.column, f"a whole number >= {minimum} for {what}", token.text
+        )
+    if maximum is not None and value > maximum:
+        low = "" if minimum is None else f"from {minimum} "
+        raise SpecError(
+            path,
+            token.line,
+            token.column,
+            f"a whole number {low}to {maximum} for {what}",
+            token.text,
         )
     return value
 
