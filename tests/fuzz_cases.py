@@ -41,7 +41,7 @@ from dataclasses import dataclass, field
 from multiprocessing.connection import wait
 from pathlib import Path
 
-from hypothesis import HealthCheck, Phase, given, settings
+from hypothesis import HealthCheck, Phase, given, seed, settings
 from hypothesis import strategies as st
 from test_car import SMALL
 
@@ -679,15 +679,16 @@ STRATEGIES = {
 }
 
 
-def draw_cases(kind: str, count: int) -> list[Case]:
+def draw_cases(kind: str, count: int, fresh_seed: int | None = None) -> list[Case]:
     """``count`` cases of ``kind`` from its strategy, duplicates dropped, hypothesis
-    derandomized (its seed comes from this function's code). In this process: the cases depend
-    on what else it imported (see ``draw_profile``)."""
+    derandomized (its seed comes from this function's code), or with ``fresh_seed`` drawn from
+    that seed instead (other cases, the same for the same seed). In this process: the cases
+    depend on what else it imported (see ``draw_profile``)."""
     drawn: list[Case] = []
 
     @settings(
         max_examples=count,
-        derandomize=True,
+        derandomize=fresh_seed is None,
         database=None,
         deadline=None,
         phases=[Phase.generate],
@@ -697,22 +698,26 @@ def draw_cases(kind: str, count: int) -> list[Case]:
     def collect(case: Case) -> None:
         drawn.append(case)
 
+    if fresh_seed is not None:
+        collect = seed(fresh_seed)(collect)
     collect()
     return list(dict.fromkeys(drawn))
 
 
-def draw_profile(sizes: dict[str, int]) -> dict[str, list[Case]]:
-    """``draw_cases`` for each kind and count of ``sizes``, in a fresh interpreter that imports
-    this module only. Hypothesis also draws the constants of every local module imported
-    (``hypothesis.internal.conjecture.providers``: mosys's, once a verb has run), so in pytest's
-    process the cases would change with the tests run before and with every edit to src/; here
-    they depend on this file and hypothesis's version alone."""
+def draw_profile(sizes: dict[str, int], fresh_seed: int | None = None) -> dict[str, list[Case]]:
+    """``draw_cases`` for each kind and count of ``sizes`` (and ``fresh_seed``), in a fresh
+    interpreter that imports this module only. Hypothesis also draws the constants of every
+    local module imported (``hypothesis.internal.conjecture.providers``: mosys's, once a verb
+    has run), so in pytest's process the cases would change with the tests run before and with
+    every edit to src/; here they depend on this file, the seed and hypothesis's version
+    alone."""
     code = (
         "import pickle, sys\n"
         f"sys.path.insert(0, {str(Path(__file__).parent)!r})\n"
         "import fuzz_cases\n"
         f"sizes = {sizes!r}\n"
-        "drawn = {kind: fuzz_cases.draw_cases(kind, count) for kind, count in sizes.items()}\n"
+        "drawn = {kind: fuzz_cases.draw_cases(kind, count, "
+        f"{fresh_seed!r}) for kind, count in sizes.items()}}\n"
         "sys.stdout.buffer.write(pickle.dumps(drawn))\n"
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, cwd=ROOT)

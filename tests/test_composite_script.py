@@ -42,7 +42,7 @@ from mosys.parsing.composite_script import (
     SearchSettings,
     Unary,
 )
-from mosys.parsing.tokens import MAX_SEED, SpecError, Token
+from mosys.parsing.tokens import MAX_INT64, SpecError, Token
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = """\
@@ -667,13 +667,17 @@ ERRORS = [
         "x.comp:10:10: expected a whole number from 1 to 2147483647 for g=, found '2147483648'",
     ),
     (
-        replace_line(10, f"search seed={MAX_SEED + 1}"),
-        f"x.comp:10:13: expected a whole number from 0 to {MAX_SEED} for seed=, found "
-        f"'{MAX_SEED + 1}'",
+        replace_line(10, f"search seed={MAX_INT64 + 1}"),
+        f"x.comp:10:13: expected a whole number from 0 to {MAX_INT64} for seed=, found "
+        f"'{MAX_INT64 + 1}'",
+    ),
+    (
+        replace_line(3, f"phase cartwheel controller=starman_cartwheel_robust ticks={2**63}"),
+        f"x.comp:3:59: expected a whole number from 1 to {MAX_INT64} for ticks=, found '{2**63}'",
     ),
     (
         replace_line(3, f"phase cartwheel controller=starman_cartwheel_robust seed={2**64}"),
-        f"x.comp:3:58: expected a whole number from 0 to {MAX_SEED} for seed=, found '{2**64}'",
+        f"x.comp:3:58: expected a whole number from 0 to {MAX_INT64} for seed=, found '{2**64}'",
     ),
     # a NUL, even in a comment: the result file keeps the text (HDF5 strings cannot hold one)
     (
@@ -832,7 +836,7 @@ def composite_scripts(draw) -> tuple[CompositeScript, dict, object]:
             name,
             draw(IDENTIFIERS),
             draw(typed_expressions(frozenset(), 3, REFERENCE_NAMES))[0],
-            seed=draw(st.none() | st.integers(0, MAX_SEED)),
+            seed=draw(st.none() | st.integers(0, MAX_INT64)),
             ticks=draw(st.integers(1, 10**6)) if with_ticks else None,
         )
         for name in names
@@ -843,7 +847,7 @@ def composite_scripts(draw) -> tuple[CompositeScript, dict, object]:
     }
     total, reference = draw(typed_expressions(frozenset(), 4, total_names))
     search = SearchSettings(
-        *(draw(st.integers(1, 10**6)) for _ in range(3)), draw(st.integers(0, MAX_SEED))
+        *(draw(st.integers(1, 10**6)) for _ in range(3)), draw(st.integers(0, MAX_INT64))
     )
     script = CompositeScript("generated.comp", draw(IDENTIFIERS), phases, total, search)
     return script, scores, reference(0, 0)

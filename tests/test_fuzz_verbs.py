@@ -21,9 +21,11 @@ value of every numeric option among them, 2 to 4 minutes) that CI runs. The case
 on every run (hypothesis derandomized). A worker that hangs or dies is replaced, so one finding
 does not hide the next.
 
-``MOSYS_FUZZ_REPORT=FILE`` writes the findings (every failing case grouped, the smallest of each
-group with its spec diff, command lines, outcome and traceback) to FILE as Markdown;
-``MOSYS_FUZZ_KEEP=DIR`` copies each failing case's directory and logs there.
+``MOSYS_FUZZ_SEED=N`` draws other cases, from seed N (the same for the same N), for a hunt
+beyond the fixed draw. ``MOSYS_FUZZ_REPORT=FILE`` writes the findings (every failing case
+grouped, the smallest of each group with its spec diff, command lines, outcome and traceback)
+to FILE as Markdown; ``MOSYS_FUZZ_KEEP=DIR`` copies each failing case's directory and logs
+there.
 """
 
 from __future__ import annotations
@@ -54,13 +56,19 @@ def shared(tmp_path_factory) -> Path:
     return directory
 
 
+def fresh_seed() -> int | None:
+    """``MOSYS_FUZZ_SEED``: draw the cases from this seed instead of the fixed draw."""
+    text = os.environ.get("MOSYS_FUZZ_SEED")
+    return None if text is None else int(text)
+
+
 def run_profile(name: str, sizes: dict[str, int], timeout: float, root: Path, shared: Path,
                 record_property, grid: bool = False) -> list[fc.Outcome]:  # fmt: skip
     """Draw the profile's cases (and with ``grid``, add ``fc.cli_grid``), run them, judge them,
     print the table; the outcomes."""
     cases = [
         (f"{kind}-{number:04d}", case)
-        for kind, drawn in fc.draw_profile(sizes).items()
+        for kind, drawn in fc.draw_profile(sizes, fresh_seed()).items()
         for number, case in enumerate(drawn)
     ]
     if grid:

@@ -32,7 +32,7 @@ from mosys.parsing.figure import (
 )
 from mosys.parsing.motor import parse_motor_program_text
 from mosys.parsing.script import parse_script_text
-from mosys.parsing.tokens import MAX_SEED, SpecError
+from mosys.parsing.tokens import MAX_INT64, SpecError
 from mosys.parsing.vehicle import Vehicle
 
 FIGURES = SPECS / "figures"
@@ -225,6 +225,35 @@ def test_bsr_search_refuses_a_huge_mass(tmp_path: Path) -> None:
     )
 
 
+@pytest.mark.parametrize(("search", "figure"), [("starman_jump", "starman"), ("bob_walk", "bob")])
+def test_bsr_search_refuses_a_figure_without_gravity(tmp_path: Path, search, figure) -> None:
+    """2-D and 3-D: the senses are scaled by the weight and the speed of a fall, so gravity 0
+    (which a figure may have) is refused for a search at the spec's figure line (the verb fuzz,
+    freshly drawn, found the 2-D kernel dividing by zero; a 3-D search ran on senses of inf
+    and NaN)."""
+    figures = tmp_path / "figures"
+    figures.mkdir()
+    (figures / f"{figure}.fig").write_text(
+        edited(FIGURES / f"{figure}.fig", "gravity 9.81", "gravity 0")
+    )
+    spec = SPECS / "bsr" / f"{search}.bsr"
+    output = tmp_path / "seed1.h5"
+    done = mosys_command(
+        "bsr-search", str(spec), "--seed", "1", "--figures", str(figures), "--generations", "1",
+        "-o", str(output), cwd=tmp_path,
+    )  # fmt: skip
+    lines = spec.read_text().split("\n")
+    number = next(n for n, line in enumerate(lines, start=1) if line.startswith("figure"))
+    at = f"{number}:{lines[number - 1].index(figure) + 1}"
+    assert_refused(
+        done,
+        f"{spec}:{at}: expected a figure with gravity > 0 for a BSR search (the "
+        f"controllers' senses are scaled by its weight and its speed of fall; '{figure}' has "
+        f"gravity 0), found '{figure}'",
+        tmp_path,
+    )
+
+
 def test_bsr_search_refuses_a_tiny_dt(tmp_path: Path) -> None:
     text = edited(SPECS / "bsr/starman_jump.bsr", "dt=0.01", "dt=1e-300")
     spec = tmp_path / "jump.bsr"
@@ -256,7 +285,7 @@ def test_bsr_search_refuses_a_huge_seed_in_the_spec(tmp_path: Path) -> None:
     at = where(text, HUGE_SEED)
     assert_refused(
         done,
-        f"{spec}:{at}: expected a whole number from 0 to {MAX_SEED} for a seed, found "
+        f"{spec}:{at}: expected a whole number from 0 to {MAX_INT64} for a seed, found "
         f"'{HUGE_SEED}'",
         tmp_path,
     )
@@ -273,7 +302,7 @@ def test_bsr_search_refuses_a_huge_seed_argument(tmp_path: Path) -> None:
     assert "Traceback" not in done.stderr
     assert done.returncode == 2
     assert done.stderr.endswith(
-        f"mosys: error: bsr-search: --seed must be a whole number from 0 to {MAX_SEED}, got "
+        f"mosys: error: bsr-search: --seed must be a whole number from 0 to {MAX_INT64}, got "
         f"{HUGE_SEED}\n"
     )
     assert not list(tmp_path.glob("*.h5"))

@@ -167,20 +167,21 @@ def test_composite_ticks_are_limited(tmp_path, composite_workspace, capsys):
     assert_nothing_written(out)
 
 
-def test_composite_ticks_past_int64_are_limited_not_a_traceback(
+def test_composite_ticks_past_int64_together_are_limited_and_counted_exactly(
     tmp_path, composite_workspace, capsys
 ):
-    """A whole number of ticks beyond int64 parses; the limits refuse it at its line, counted
-    exactly (the verb fuzz found an OverflowError in NumPy's conversion instead)."""
+    """Each phase's ticks fit int64 (the parser's bound), their sum need not: the limits refuse
+    it at its line, counted exactly (the verb fuzz found an OverflowError in NumPy's conversion
+    of ticks past int64 before the parser bounded them)."""
     script = tmp_path / "starman_show.comp"
     text = composite_workspace.script.read_text()
-    script.write_text(text.replace("ticks=100\n", f"ticks={2**70}\n", 1))
+    script.write_text(text.replace("ticks=100\n", f"ticks={2**63 - 1}\n", 1))
     out = tmp_path / "show.h5"
     argv = ["composite", str(script), "--bsr-results", str(composite_workspace.bsr_results)]
     assert main([*argv, "-o", str(out)]) == 2
     assert last_line(capsys).startswith(
         f"{script}:9:59: expected at most 10,000,000 integration steps per run, found "
-        f"1.18e+21 (the phases' {215 + 2**70:,} ticks to the end of this one)"
+        f"9.22e+18 (the phases' {215 + 2**63 - 1:,} ticks to the end of this one)"
     )
     assert_nothing_written(out)
 

@@ -189,7 +189,16 @@ class BoundNames:
 def bind_names(spec: BsrSpec, figure, term_names: tuple[str, ...]) -> BoundNames:
     """Look the spec's start coordinates, fall endpoints and fitness terms up in the figure (a
     2-D or 3-D BSR figure: its ``root_angle``, ``root_x``, ``joint_names``, ``endpoint_names``)
-    and ``term_names``; a name it lacks raises SpecError at its word."""
+    and ``term_names``; a name it lacks raises SpecError at its word, and so does a figure
+    without gravity, at the spec's ``figure`` line."""
+    if not figure.gravity > 0.0:  # the senses' scales: the weight M g and the speed of a fall
+        raise SpecError.at(
+            spec.path,
+            spec.tokens["figure"],
+            f"a figure with gravity > 0 for a BSR search (the controllers' senses are scaled by "
+            f"its weight and its speed of fall; '{figure.figure.name}' has gravity "
+            f"{figure.gravity:g})",
+        )
     for term in spec.weights:
         if term not in term_names:
             raise SpecError.at(

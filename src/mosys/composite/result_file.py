@@ -57,11 +57,8 @@ def check_size(session: CompositeSession) -> None:
     limits allow, or at the ``figure`` line when the search's Q arrays do (``mosys.limits``)."""
     script = session.script
     step_bytes = motion_step_bytes(len(session.figure.endpoint_names))
-    # the script's own counts where it has them: any whole number parses, and one past int64
-    # must reach the limits' message, not NumPy's conversion in ``session.guess``
-    guess = script.guessed_ticks if script.guessed_ticks is not None else session.guess
-    ticks = 0  # exact: a Python int
-    for phase, phase_ticks in zip(script.phases, guess, strict=True):
+    ticks = 0  # exact, a Python int: each phase's ticks fit int64, their sum need not
+    for phase, phase_ticks in zip(script.phases, session.guess, strict=True):
         ticks += int(phase_ticks)
         token = script.tokens.get(f"phase.{phase.name}.ticks", script.tokens["figure"])
         check_job(

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from mosys.parsing.tokens import (
-    MAX_SEED,
+    MAX_INT64,
     MAX_WHOLE,
     NAME,
     Line,
@@ -410,7 +410,7 @@ class _Parser:
         seeds: dict[int, Token] = {}
         while True:
             token = reader.word(f"a whole number >= 0 for {what}")
-            seed = parse_int(token, self.path, what, 0, MAX_SEED)  # stored as int64
+            seed = parse_int(token, self.path, what, 0, MAX_INT64)  # stored as int64
             if seed in seeds:
                 raise self.error(
                     token, f"distinct seeds ({seed} is already at column {seeds[seed].column})"

@@ -76,7 +76,7 @@ from mosys.parsing.composite_script import (
 )
 from mosys.parsing.tokens import (
     END_OF_FILE,
-    MAX_SEED,
+    MAX_INT64,
     MAX_WHOLE,
     Line,
     SpecError,
@@ -126,7 +126,7 @@ _SEARCH_KEYS = {
     "q": (1, MAX_WHOLE),
     "g": (1, MAX_WHOLE),
     "h": (1, MAX_WHOLE),
-    "seed": (0, MAX_SEED),
+    "seed": (0, MAX_INT64),
 }
 
 
@@ -516,9 +516,13 @@ class _Parser:
         controller = parse_name(controller_token, self.path, "controller= (a BSR search)")
         seed = ticks = None
         if "seed" in found:
-            seed = parse_int(value_token(found["seed"][0], "seed"), self.path, "seed=", 0, MAX_SEED)
+            seed = parse_int(
+                value_token(found["seed"][0], "seed"), self.path, "seed=", 0, MAX_INT64
+            )
         if "ticks" in found:
-            ticks = parse_int(value_token(found["ticks"][0], "ticks"), self.path, "ticks=", 1)
+            ticks = parse_int(
+                value_token(found["ticks"][0], "ticks"), self.path, "ticks=", 1, MAX_INT64
+            )
         if self.phases:
             first_name, first = next(iter(self.phases.items()))
             if first.ticks is not None and ticks is None:

@@ -19,7 +19,7 @@ NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 ENDPOINT_ENDS = ("proximal", "distal")  # a rod's ends, as specs name them: ROD.END
 END_OF_FILE = "\x00end of file"  # the 'found' of an error about a line that never came
 MAX_WHOLE = 2**31 - 1  # the largest count (generations, controllers, sweeps...) kernels index
-MAX_SEED = 2**63 - 1  # seeds are stored as int64 in result files (and seed numpy's RNG)
+MAX_INT64 = 2**63 - 1  # the largest whole number a result file stores (int64): seeds, ticks
 SHOWN_CHARACTERS = 200  # of one word an error quotes: a longer word is cut, its length said
 
 
