@@ -172,13 +172,9 @@ def parse_int(
             path, token.line, token.column, f"a whole number >= {minimum} for {what}", token.text
         )
     if maximum is not None and value > maximum:
-        low = "" if minimum is None else f"from {minimum} "
+        bounds = f"<= {maximum}" if minimum is None else f"from {minimum} to {maximum}"
         raise SpecError(
-            path,
-            token.line,
-            token.column,
-            f"a whole number {low}to {maximum} for {what}",
-            token.text,
+            path, token.line, token.column, f"a whole number {bounds} for {what}", token.text
         )
     return value
 
