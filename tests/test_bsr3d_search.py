@@ -106,15 +106,49 @@ def test_continuing_a_result_without_a_final_state_is_a_clear_error(tmp_path):
 
     from mosys.bsr.search3d import chain_start
     from mosys.errors import InputError
+    from mosys.io.contracts import CONTRACT
 
     old = tmp_path / "seed1.h5"
-    with h5py.File(old, "w") as h5:
+    with h5py.File(old, "w") as h5:  # a result file as mosys wrote them before final_state
+        contract = CONTRACT["BSR search result"]
+        for group in contract.groups:
+            h5.create_group(group)
+        for dataset in contract.datasets:
+            h5[dataset] = np.zeros(1)
         h5.attrs["best_fitness"] = 1.0
         h5.attrs["seed"] = 1
+        h5.attrs["name"] = "cujo_bound"
     with pytest.raises(InputError, match="no best/final_state to continue from"):
         chain_start("cujo_bound", [old])
     with pytest.raises(InputError, match="no result files of search 'cujo_bound'"):
         chain_start("cujo_bound", [])
+    with pytest.raises(InputError) as error:  # the chain line names another search
+        chain_start("rex_walk", [old])
+    assert str(error.value) == (
+        f"{old}: a result of search 'cujo_bound', not of 'rex_walk' (the search the spec's "
+        "chain line continues)"
+    )
+    with h5py.File(old, "a") as h5:
+        del h5["best/controller"]
+    with pytest.raises(InputError) as error:
+        chain_start("cujo_bound", [old])
+    assert str(error.value) == (
+        f"{old}: not a BSR search result (it lacks best/controller; docs/formats/bsr_result.md)"
+    )
+
+
+def test_a_chain_whose_final_state_is_another_figures_is_refused_at_the_chain_line():
+    first = run_search(setup(), 1)
+    text = SPEC.replace("start spine=0\n", "") + "chain cujo_bound\n"
+    chain = ChainStart("cujo_bound", 1, first.final_state[:-2], first.final_force)
+    with pytest.raises(SpecError) as error:
+        setup(text, chain)
+    size = first.final_state.size
+    assert str(error.value).endswith(
+        f"expected a search of figure 'cujo' to continue ({size} state values and "
+        f"{first.final_force.size} endpoint forces; the final state of 'cujo_bound' has "
+        f"{size - 2} and {first.final_force.size}), found 'cujo_bound'"
+    )
 
 
 def test_final_spin_is_the_bodys_rate_at_the_end():

@@ -725,7 +725,7 @@ def test_a_trajectory_that_is_not_a_car(tmp_path):
     )
     with h5py.File(path, "a") as h5:
         del h5["t"]
-    with pytest.raises(PlotInputError, match=f"^{path}: not a trajectory file"):
+    with pytest.raises(PlotInputError, match=f"^{path}: not a trajectory \\(it lacks t;"):
         read_car_trajectory(path)
 
 

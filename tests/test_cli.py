@@ -94,8 +94,11 @@ def test_a_file_that_is_not_a_controller_table(tmp_path):
     table.write_text("not HDF5\n")
     done = mosys_command("plot", "controller", str(table), "--torque", "t.png", cwd=tmp_path)
     assert done.returncode == 2
-    # h5py's own words for a file that is not HDF5, after the "mosys: " of a bad input file
-    assert done.stderr == "mosys: Unable to synchronously open file (file signature not found)\n"
+    # the file, then h5py's own words for a file that is not HDF5 (mosys.io.contracts)
+    assert done.stderr == (
+        f"mosys: {table}: cannot read it as HDF5 (Unable to synchronously open file (file "
+        "signature not found))\n"
+    )
     assert not (tmp_path / "t.png").exists()
 
 

@@ -248,9 +248,9 @@ def test_bad_input_raises_and_writes_nothing(result_path: Path, tmp_path: Path, 
     with h5py.File(other, "w") as h5:
         h5.create_dataset("t", data=np.zeros(3))
     cases = {
-        tmp_path / "missing.h5": "cannot read",
-        not_hdf5: "cannot read",
-        other: "not a composite result file",
+        tmp_path / "missing.h5": "no such file",
+        not_hdf5: "cannot read it as HDF5",
+        other: "not a composite result",
         _without(result_path, tmp_path / "noscores.h5", "scores_after"): "'scores_after'",
     }
     for path, message in cases.items():

@@ -15,7 +15,6 @@ from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
 
-import h5py
 import numpy as np
 
 from mosys.bsr.figure3d import BsrFigure3D
@@ -32,6 +31,7 @@ from mosys.bsr.search import (
 from mosys.bsr.start3d import standing_state
 from mosys.errors import InputError
 from mosys.io.bsr_result import BsrController
+from mosys.io.contracts import open_contract
 from mosys.kernels.bsr3d_controller import Task, run_controller
 from mosys.kernels.bsr3d_population import run_population
 from mosys.kernels.bsr3d_simulate import CX, CY, JOINTS, LX, QW, VX
@@ -54,16 +54,23 @@ class ChainStart:
 
 def chain_start(name: str, result_paths: list[str | Path]) -> ChainStart:
     """The final state of the best seed (highest ``best_fitness``, the lowest seed on a tie)
-    among a search's result files."""
+    among a search's result files; InputError naming a file that is not a result of the search
+    ``name``."""
     best: tuple[float, int, Path] | None = None
     for path in map(Path, result_paths):
-        with h5py.File(path, "r") as h5:
+        with open_contract(path, "BSR search result") as h5:
+            searched = str(h5.attrs["name"]) if "name" in h5.attrs else path.parent.name
+            if searched != name:
+                raise InputError(
+                    f"{path}: a result of search '{searched}', not of '{name}' (the search the "
+                    "spec's chain line continues)"
+                )
             key = (float(h5.attrs["best_fitness"]), -int(h5.attrs["seed"]), path)
         if best is None or key[:2] > best[:2]:
             best = key
     if best is None:
         raise InputError(f"no result files of search '{name}' to continue")
-    with h5py.File(best[2], "r") as h5:
+    with open_contract(best[2], "BSR search result") as h5:
         if "best/final_state" not in h5 or "best/final_force" not in h5:
             raise InputError(
                 f"{best[2]}: no best/final_state to continue from (a result of an older mosys: "
@@ -199,6 +206,15 @@ def bind_search3d(
         start_force = np.zeros(figure.endpoints.shape[0])
     else:
         start, start_force = chain.state, chain.force
+        size = 13 + 2 * len(figure.joint_names)
+        if start.shape != (size,) or start_force.shape != (figure.endpoints.shape[0],):
+            raise SpecError.at(
+                spec.path,
+                spec.tokens["chain"],
+                f"a search of figure '{figure.figure.name}' to continue ({size} state values and "
+                f"{figure.endpoints.shape[0]} endpoint forces; the final state of "
+                f"'{chain.name}' has {start.size} and {start_force.size})",
+            )
     return SearchSetup.bound(
         spec,
         figure,

@@ -21,6 +21,7 @@ import numpy as np
 
 from mosys.io.atomic import write_atomically
 from mosys.io.attributes import DIMENSIONLESS, INDEX, SI_STATE, create_with_unit, string_tuple
+from mosys.io.contracts import open_contract
 from mosys.io.provenance import provenance_attributes
 from mosys.io.trajectory import FigureMotion, read_figure_motion, write_figure_motion
 
@@ -144,8 +145,9 @@ def _write_controller(group: h5py.Group, controller: BsrController) -> None:
 
 
 def read_bsr_result(path: str | Path) -> BsrResult:
-    """Read a result file."""
-    with h5py.File(path, "r") as h5:
+    """Read a result file; InputError naming the file if it is not one
+    (``contracts.open_contract``)."""
+    with open_contract(path, "BSR search result") as h5:
         group = h5["best/controller"]
         kind = str(group.attrs["kind"])
         rules = group["tau"].shape[0]

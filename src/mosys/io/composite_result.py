@@ -28,6 +28,7 @@ import numpy as np
 
 from mosys.io.atomic import write_atomically
 from mosys.io.attributes import DIMENSIONLESS, INDEX, create_with_unit
+from mosys.io.contracts import open_contract
 from mosys.io.provenance import provenance_attributes
 from mosys.io.trajectory import FigureMotion, read_figure_motion, write_figure_motion
 
@@ -121,8 +122,9 @@ def write_composite_result(path: str | Path, result: CompositeResult) -> None:
 
 
 def read_composite_result(path: str | Path) -> CompositeResult:
-    """Read a result file."""
-    with h5py.File(path, "r") as h5:
+    """Read a result file; InputError naming the file if it is not one
+    (``contracts.open_contract``)."""
+    with open_contract(path, "composite result") as h5:
         return CompositeResult(
             after=_read_motion(h5),
             before=_read_motion(h5["before"]),

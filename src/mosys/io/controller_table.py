@@ -23,6 +23,7 @@ from mosys.io.attributes import (
     set_column_units,
     string_tuple,
 )
+from mosys.io.contracts import open_contract
 from mosys.io.provenance import provenance_attributes
 from mosys.parsing.vehicle import INPUT_NAMES as VEHICLE_CONTROLS
 from mosys.parsing.vehicle import INPUT_UNITS as VEHICLE_CONTROL_UNITS
@@ -153,8 +154,8 @@ def torque_units(table: ControllerTable) -> tuple[str, ...]:
 
 def read_controller_table(path: str | Path) -> ControllerTable:
     """Read a controller table written by ``write_controller_table`` (or any file that meets the
-    contract)."""
-    with h5py.File(path, "r") as h5:
+    contract); InputError naming the file if it is not one (``contracts.open_contract``)."""
+    with open_contract(path, "controller table") as h5:
         state_order = string_tuple(h5.attrs["state_order"])
         axes = tuple(np.asarray(h5["axes"][name][()], dtype=np.float64) for name in state_order)
         units = tuple(str(h5["axes"][name].attrs["unit"]) for name in state_order)

@@ -11,7 +11,6 @@ from __future__ import annotations
 import json
 from collections import Counter
 from collections.abc import Iterator
-from dataclasses import dataclass
 from pathlib import Path
 
 import h5py
@@ -19,6 +18,7 @@ import numpy as np
 
 from mosys.errors import InputError
 from mosys.io.attributes import MIXED, string_attr, string_tuple
+from mosys.io.contracts import CONTRACTS, Contract, kind_of
 from mosys.io.provenance import PROVENANCE_KEYS
 
 BLOCK_ELEMENTS = 1 << 20  # values read at a time
@@ -27,46 +27,6 @@ ATTR_WIDTH = 76  # a shown attribute value is cut to this many characters
 PER_NODE = ("value", "torque", "dead_end", "destination_index", "arrival_value")
 # attributes HDF5 dimension scales keep for themselves (shown as the axes section instead)
 SCALE_ATTRS = {"CLASS", "NAME", "REFERENCE_LIST", "DIMENSION_LIST", "DIMENSION_LABELS"}
-
-
-@dataclass(frozen=True)
-class Contract:
-    """A kind of file mosys writes: its name, its page in docs/formats/, and the groups and
-    datasets (paths from the root) every such file has."""
-
-    name: str
-    page: str
-    groups: tuple[str, ...]
-    datasets: tuple[str, ...]
-
-    def met_by(self, h5: h5py.File) -> bool:
-        return all(isinstance(h5.get(p), h5py.Group) for p in self.groups) and all(
-            isinstance(h5.get(p), h5py.Dataset) for p in self.datasets
-        )
-
-
-CONTRACTS = (
-    Contract("controller table", "controller_table.md", ("axes",), ("torque", "value")),
-    Contract("trajectory", "trajectory.md", (), ("t", "state", "control", "controller")),
-    Contract(
-        "BSR search result",
-        "bsr_result.md",
-        ("best/controller", "best/figure_motion"),
-        ("learning_curve/evaluations", "learning_curve/best_fitness", "best/active_rule"),
-    ),
-    Contract(
-        "composite result",
-        "composite_result.md",
-        ("figure_motion", "before/figure_motion"),
-        ("search/best_score",),
-    ),
-    Contract(
-        "start grid",
-        "start_grid.md",
-        (),
-        ("start", "parked", "collided", "parking_seconds", "excluded", "cost_to_go"),
-    ),
-)
 
 
 def describe_file(path: str | Path) -> str:
@@ -81,7 +41,7 @@ def describe_file(path: str | Path) -> str:
                 f"{path}: not an HDF5 file (mosys info reads the .h5 files mosys writes)"
             )
         with h5py.File(path, "r") as h5:
-            contract = next((c for c in CONTRACTS if c.met_by(h5)), None)
+            contract = kind_of(h5)
             if contract is None:
                 known = ", ".join(c.name for c in CONTRACTS)
                 raise InputError(

@@ -23,6 +23,7 @@ from mosys.io.attributes import (
     set_column_units,
     string_tuple,
 )
+from mosys.io.contracts import open_contract
 from mosys.io.provenance import provenance_attributes
 from mosys.parsing import vehicle
 
@@ -189,8 +190,9 @@ def column_units_of(
 
 
 def read_trajectory(path: str | Path) -> Trajectory:
-    """Read a trajectory file."""
-    with h5py.File(path, "r") as h5:
+    """Read a trajectory file; InputError naming the file if it is not one
+    (``contracts.open_contract``)."""
+    with open_contract(path, "trajectory") as h5:
         known = {"state_order", "control_names", "controllers"}
         return Trajectory(
             t=h5["t"][()],

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from mosys.errors import InputError
 from mosys.io.atomic import write_text_atomically
 from mosys.io.bsr_result import BsrResult, read_bsr_result
 from mosys.parsing.bsr import FITNESS_TERMS
@@ -85,10 +86,21 @@ def write_table(frame: pd.DataFrame, caption: str, csv_path: str, md_path: str) 
     write_text_atomically(md_path, caption + frame.to_markdown(index=False) + "\n")
 
 
+def read_planar_result(path: str | Path) -> BsrResult:
+    """A 2-D search's result file; InputError naming the file for a 3-D one."""
+    result = read_bsr_result(path)
+    if result.motion.dimensions != 2:
+        raise InputError(
+            f"{path}: a {result.motion.dimensions}-D search result; bsr-table tabulates 2-D "
+            "searches (bsr3d-table the 3-D ones)"
+        )
+    return result
+
+
 def runs_frame(result_paths: list[str | Path]) -> pd.DataFrame:
     """One row per search (the seed files grouped by their ``name`` attribute, in order)."""
     rows = []
-    for name, results in group_by_search(map(read_bsr_result, result_paths)).items():
+    for name, results in group_by_search(map(read_planar_result, result_paths)).items():
         setup = setup_columns(results)
         kind = str(setup["kind"])
         seconds_40k = median_ms_per_evaluation(results) * PAPER_EVALUATIONS / 1000.0

@@ -110,10 +110,7 @@ def read_3d_result(path: str | Path) -> BsrResult:
     """Read one seed file of a 3-D search, checking that it is one: the root attributes and
     fitness terms the table reads are there and ``best/figure_motion`` is 3-D. Raises
     InputError naming the file otherwise."""
-    try:
-        result = read_bsr_result(path)
-    except KeyError as error:  # h5py: a group or attribute of the contract is missing
-        raise InputError(f"{path}: not a BSR result file: {error}") from None
+    result = read_bsr_result(path)  # InputError naming the file if it is not one
     absent = [key for key in REQUIRED_ATTRS if key not in result.attrs]
     if absent:
         raise InputError(

@@ -5,10 +5,12 @@ Figure 19 starts and from the start grid."""
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from mosys.errors import InputError
 from mosys.io.atomic import write_text_atomically
 from mosys.io.controller_table import read_controller_table
 from mosys.io.start_grid import (
@@ -60,6 +62,16 @@ def consistency_columns(prefix: str, ratios: np.ndarray | None) -> dict:
     return dict(zip(names, (round(v, 3) for v in consistency_summary(ratios)), strict=True))
 
 
+def parking_run(path: str | Path) -> dict:
+    """The root attributes of a car script's trajectory, with its parking outcome
+    (``ssc.parking.ParkingOutcome.attributes``); InputError naming the file for another
+    trajectory."""
+    attrs = read_trajectory(path).attrs
+    if "parked" not in attrs or "collision_index" not in attrs:
+        raise InputError(f"{path}: not a parking run (a trajectory with no parking outcome)")
+    return attrs
+
+
 def car_row(
     table_path: str, start_grid_path: str, trajectory_paths: list[str], budget: str
 ) -> pd.DataFrame:
@@ -67,7 +79,7 @@ def car_row(
     table = read_controller_table(table_path)
     attrs = table.attrs
     grid = read_start_grid(start_grid_path)
-    figure19 = [read_trajectory(path).attrs for path in trajectory_paths]
+    figure19 = [parking_run(path) for path in trajectory_paths]
     row = {
         "controller": str(table_path).rsplit("/", 1)[-1].removesuffix(".h5"),
         "grid": " x ".join(

@@ -32,6 +32,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 from matplotlib.ticker import FuncFormatter
 
+from mosys.errors import InputError
 from mosys.io.bsr_result import BsrResult, read_bsr_result
 from mosys.plots.style import (
     ASPECT_RANGE,
@@ -116,10 +117,8 @@ def read_result(path: str | Path, dimensions: int | None = 2) -> BsrResult:
     endpoints (N, rods, 2, 2); 3: (N, rods, 2, 3)); None: either."""
     try:
         result = read_bsr_result(path)
-    except KeyError as error:  # h5py: a dataset or attribute the contract requires is absent
-        raise PlotInputError(f"{path}: not a BSR result file: {error}") from None
-    except OSError as error:  # missing, unreadable, not HDF5: h5py's message omits the name
-        raise PlotInputError(f"{path}: cannot read: {error}") from None
+    except InputError as error:  # missing, not HDF5, another kind of file (io.contracts)
+        raise PlotInputError(str(error)) from None
     evaluations, best = result.evaluations, result.best_fitness
     if evaluations.ndim != 1 or evaluations.shape != best.shape or len(evaluations) == 0:
         raise PlotInputError(

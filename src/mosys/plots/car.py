@@ -288,8 +288,8 @@ def read_car_trajectory(path: str | Path) -> CarTrajectory:
     module docstring); PlotInputError naming the file and what is missing or malformed."""
     try:
         trajectory = read_trajectory(path)
-    except KeyError as error:  # h5py: a dataset or attribute the contract requires is absent
-        raise PlotInputError(f"{path}: not a trajectory file: {error}") from None
+    except InputError as error:  # missing, not HDF5, another kind of file (io.contracts)
+        raise PlotInputError(str(error)) from None
     attrs = trajectory.attrs
     _missing(path, "car trajectory (root attributes)", RUN_ATTRS, attrs)
     column = _columns(path, trajectory.state_order, POSE_NAMES)

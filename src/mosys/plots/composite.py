@@ -28,6 +28,7 @@ from matplotlib.colors import to_rgba
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
+from mosys.errors import InputError
 from mosys.io.composite_result import CompositeMotion, CompositeResult, read_composite_result
 from mosys.plots.style import (
     GIF_DPI,
@@ -105,10 +106,8 @@ def read_composite(path: str | Path) -> CompositeResult:
     file and what is missing or malformed."""
     try:
         result = read_composite_result(path)
-    except KeyError as error:  # h5py: a dataset or attribute the contract requires is absent
-        raise PlotInputError(f"{path}: not a composite result file: {error}") from None
-    except OSError as error:  # missing, unreadable, not HDF5: h5py's message omits the name
-        raise PlotInputError(f"{path}: cannot read: {error}") from None
+    except InputError as error:  # missing, not HDF5, another kind of file (io.contracts)
+        raise PlotInputError(str(error)) from None
     for key in ROOT_ATTRS:
         if key not in result.attrs:
             raise PlotInputError(f"{path}: not a composite result file: no root attribute {key!r}")

@@ -31,6 +31,7 @@ from matplotlib.patches import Patch, Polygon
 from matplotlib.transforms import blended_transform_factory
 
 from mosys.animation.motion_measures import Motion, motions
+from mosys.errors import InputError
 from mosys.io.trajectory import Trajectory, read_trajectory
 from mosys.plots.style import (
     ASPECT_RANGE,
@@ -90,8 +91,8 @@ def read_luxo_trajectory(path: str | Path, contacts: bool = False) -> Trajectory
     group if ``contacts``); PlotInputError naming the file and what is missing or malformed."""
     try:
         trajectory = read_trajectory(path)
-    except KeyError as error:  # h5py: a dataset or attribute the contract requires is absent
-        raise PlotInputError(f"{path}: not a trajectory file: {error}") from None
+    except InputError as error:  # missing, not HDF5, another kind of file (io.contracts)
+        raise PlotInputError(str(error)) from None
     samples = len(trajectory.t)
     if samples == 0:
         raise PlotInputError(f"{path}: the trajectory has no samples")

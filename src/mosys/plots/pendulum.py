@@ -621,7 +621,10 @@ def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | 
                 f"its controller {used[0]}, {tuple(a.name for a in axes)}"
             )
     else:
-        axes = trajectory_axes(trajectory)
+        try:
+            axes = trajectory_axes(trajectory)
+        except PlotInputError as error:
+            raise PlotInputError(f"{trajectory_path}: {error}") from None
     colors = controller_colors(trajectory.controllers)
     kinds = dict(
         zip(

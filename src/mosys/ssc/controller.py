@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from mosys.errors import NonFiniteStateError
+from mosys.errors import InputError, NonFiniteStateError
 from mosys.io.controller_table import ControllerTable, read_controller_table
 from mosys.kernels.interpolate import clamp_to_domain, falls_short, interpolate_into
 from mosys.kernels.simulate import simulate_controlled
@@ -71,6 +71,18 @@ class Controller:
     """A state-space controller table bound to its figure's dynamics module."""
 
     def __init__(self, name: str, table: ControllerTable, dynamics: ModuleType):
+        """InputError if the table's state variables or controls are not the model's (a table
+        of another figure)."""
+        for kind, wanted, have in (
+            ("state variables", table.state_order, figure_state_names(dynamics)),
+            ("controls", table.control_names, tuple(dynamics.INPUT_NAMES)),
+        ):
+            lacking = [variable for variable in wanted if variable not in have]
+            if lacking:
+                raise InputError(
+                    f"controller {name} (a table of figure '{table.figure}'): the dynamics "
+                    f"have no {kind} {', '.join(lacking)} (theirs: {', '.join(have)})"
+                )
         self.name = name
         self.table = table
         self.dynamics = dynamics
@@ -105,8 +117,13 @@ class Controller:
 
     @classmethod
     def load(cls, path: str | Path, dynamics: ModuleType) -> Controller:
-        """Read a controller table; its name is the file stem (``B`` for ``B.h5``)."""
-        return cls(Path(path).stem, read_controller_table(path), dynamics)
+        """Read a controller table; its name is the file stem (``B`` for ``B.h5``). InputError
+        naming the file if it is not a controller table, or not one of the model's figure."""
+        table = read_controller_table(path)
+        try:
+            return cls(Path(path).stem, table, dynamics)
+        except InputError as error:
+            raise InputError(f"{path}: {error}") from None
 
     @property
     def state_order(self) -> tuple[str, ...]:

@@ -1,0 +1,93 @@
+"""The kinds of file mosys writes (docs/formats/), and reading one as the kind a verb expects.
+
+A verb given the wrong file (a trajectory where a controller table belongs, a file that is not
+HDF5, a damaged one) stops with one message that names the file and what it is, instead of a
+KeyError from deep inside h5py: ``open_contract`` checks the kind before the reader looks
+inside, and turns what h5py raises while it reads into the same kind of message.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+import h5py
+
+from mosys.errors import InputError
+
+
+@dataclass(frozen=True)
+class Contract:
+    """A kind of file mosys writes: its name, its page in docs/formats/, and the groups and
+    datasets (paths from the root) every such file has."""
+
+    name: str
+    page: str
+    groups: tuple[str, ...]
+    datasets: tuple[str, ...]
+
+    def met_by(self, h5: h5py.File) -> bool:
+        return not self.missing(h5)
+
+    def missing(self, h5: h5py.File) -> list[str]:
+        """The groups and datasets of the contract that ``h5`` lacks (or has as the other)."""
+        return [p for p in self.groups if not isinstance(h5.get(p), h5py.Group)] + [
+            p for p in self.datasets if not isinstance(h5.get(p), h5py.Dataset)
+        ]
+
+
+CONTRACTS = (
+    Contract("controller table", "controller_table.md", ("axes",), ("torque", "value")),
+    Contract("trajectory", "trajectory.md", (), ("t", "state", "control", "controller")),
+    Contract(
+        "BSR search result",
+        "bsr_result.md",
+        ("best/controller", "best/figure_motion"),
+        ("learning_curve/evaluations", "learning_curve/best_fitness", "best/active_rule"),
+    ),
+    Contract(
+        "composite result",
+        "composite_result.md",
+        ("figure_motion", "before/figure_motion"),
+        ("search/best_score",),
+    ),
+    Contract(
+        "start grid",
+        "start_grid.md",
+        (),
+        ("start", "parked", "collided", "parking_seconds", "excluded", "cost_to_go"),
+    ),
+)
+CONTRACT = {contract.name: contract for contract in CONTRACTS}
+
+
+def kind_of(h5: h5py.File) -> Contract | None:
+    """The first contract ``h5`` meets (None: none)."""
+    return next((contract for contract in CONTRACTS if contract.met_by(h5)), None)
+
+
+@contextmanager
+def open_contract(path: str | Path, name: str) -> Iterator[h5py.File]:
+    """``path`` open for reading as a file of the contract ``name`` (a key of ``CONTRACT``).
+    InputError naming the file: missing, not HDF5 or unreadable; of another kind (which) or of
+    none (what it lacks); or lacking, inside the block, an attribute, group or dataset the
+    reader looks for (h5py's KeyError)."""
+    contract = CONTRACT[name]
+    try:
+        h5 = h5py.File(path, "r")
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such file") from None
+    except OSError as error:  # not HDF5, truncated, unreadable: h5py's message omits the name
+        raise InputError(f"{path}: cannot read it as HDF5 ({error})") from None
+    with h5:
+        missing = contract.missing(h5)
+        if missing:
+            other = kind_of(h5)
+            what = f"a {other.name}" if other is not None else f"it lacks {', '.join(missing)}"
+            raise InputError(f"{path}: not a {name} ({what}; docs/formats/{contract.page})")
+        try:
+            yield h5
+        except KeyError as error:  # an attribute or object the contract's readers need
+            raise InputError(f"{path}: a {name} that lacks what mosys reads ({error})") from None
