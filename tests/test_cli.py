@@ -120,6 +120,31 @@ def test_dynamics_module_from_an_older_mosys(tmp_path):
     assert not (tmp_path / "out.h5").exists()
 
 
+@pytest.mark.parametrize(
+    ("source", "raised"),
+    [
+        ('raise RuntimeError("boom")\n', "RuntimeError: boom"),
+        ("x = (\n", "SyntaxError: '(' was never closed"),
+        ("import sys\nsys.exit(3)\n", "SystemExit: 3"),
+    ],
+)
+def test_a_dynamics_file_that_fails_to_import(tmp_path, source, raised):
+    """Any Python file can be named as a figure's dynamics: importing it is checked as reading
+    any input is (the wrong-file matrix found the exception escaping, or exit 3)."""
+    dynamics = tmp_path / "bad.py"
+    dynamics.write_text(source)
+    done = mosys_command(
+        "starts", str(tmp_path / "park.h5"), "--dynamics", str(dynamics), "--x", "0", "1", "2",
+        "--y", "1", "2", "2", "-o", "g.h5", cwd=tmp_path,
+    )  # fmt: skip
+    assert done.returncode == 2
+    assert done.stderr.startswith(
+        f"mosys: {dynamics} is not a dynamics module of this mosys (importing it raised {raised}"
+    )
+    assert done.stderr.endswith("): compile its figure again (mosys compile)\n")
+    assert not (tmp_path / "g.h5").exists()
+
+
 def test_index_of_missing_files(tmp_path, capsys):
     present = tmp_path / "present.txt"
     present.write_text("")

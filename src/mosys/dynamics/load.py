@@ -81,7 +81,8 @@ def content_addressed_copy(path: Path) -> Path:
 
 def load_dynamics(path: str | Path) -> ModuleType:
     """Import the generated dynamics module at ``path`` (see the module docstring). Raises
-    FileNotFoundError if it does not exist and InputError if it lacks the generated names."""
+    FileNotFoundError if it does not exist, and InputError if importing it fails or it lacks
+    the generated names."""
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"no generated dynamics module at {str(path)!r}")
@@ -99,6 +100,12 @@ def load_dynamics(path: str | Path) -> ModuleType:
     sys.modules[name] = module
     try:
         spec.loader.exec_module(module)
+    except (Exception, SystemExit) as error:  # any Python file can be named, not only ours
+        sys.modules.pop(name, None)
+        raise InputError(
+            f"{path} is not a dynamics module of this mosys (importing it raised "
+            f"{type(error).__name__}: {error}): compile its figure again (mosys compile)"
+        ) from None
     except BaseException:
         sys.modules.pop(name, None)
         raise
