@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import codecs
+import dataclasses
 import hashlib
 from pathlib import Path
 
@@ -398,6 +400,18 @@ def test_error_messages(text, message):
     assert str(error.value) == message
 
 
+def test_a_byte_order_mark_is_dropped(tmp_path):
+    """Windows editors may save UTF-8 with a byte-order mark: the spec reads the same, and its
+    digest is still that of its bytes."""
+    plain, marked = tmp_path / "plain.ssc", tmp_path / "marked.ssc"
+    text = (Path(__file__).resolve().parents[1] / "specs/controllers/pendulum/A.ssc").read_bytes()
+    plain.write_bytes(text)
+    marked.write_bytes(codecs.BOM_UTF8 + text)
+    one, two = parse_controller_spec(plain), parse_controller_spec(marked)
+    assert two.spec_sha256 == hashlib.sha256(codecs.BOM_UTF8 + text).hexdigest()
+    assert dataclasses.replace(two, spec_sha256=one.spec_sha256, path=one.path) == one
+
+
 def test_file_errors_and_path(tmp_path):
     missing = tmp_path / "missing.ssc"
     with pytest.raises(SpecError) as error:
@@ -408,6 +422,11 @@ def test_file_errors_and_path(tmp_path):
     with pytest.raises(SpecError) as error:
         parse_controller_spec(binary)
     assert str(error.value) == f"{binary}:1:1: expected UTF-8 text, found 'byte 10'"
+    marked = tmp_path / "marked.ssc"  # a byte-order mark: dropped, and bytes still counted
+    marked.write_bytes(codecs.BOM_UTF8 + b"dyn link1\n\xff\n")
+    with pytest.raises(SpecError) as error:
+        parse_controller_spec(marked)
+    assert str(error.value) == f"{marked}:1:1: expected UTF-8 text, found 'byte 13'"
     bad = tmp_path / "bad.ssc"
     bad.write_text(replace_line(2, "ssd omega -500.0 fivehundred 21"))
     with pytest.raises(SpecError) as error:

@@ -7,6 +7,7 @@ grammar can report ``file:line:column: expected ..., found ...``.
 
 from __future__ import annotations
 
+import codecs
 import hashlib
 import math
 import re
@@ -114,8 +115,9 @@ def tokenize(text: str, path: str) -> list[Line]:
 
 
 def read_spec_text(path: str | Path) -> tuple[str, str]:
-    """The text of a spec file and the hex SHA-256 of its bytes, read once. A file that is
-    missing, unreadable or not UTF-8 raises SpecError at 1:1."""
+    """The text of a spec file (UTF-8, a leading byte-order mark dropped) and the hex SHA-256 of
+    its bytes, read once. A file that is missing, unreadable or not UTF-8 raises SpecError at
+    1:1."""
     path = Path(path)
     try:
         data = path.read_bytes()
@@ -123,10 +125,11 @@ def read_spec_text(path: str | Path) -> tuple[str, str]:
         raise SpecError(str(path), 1, 1, "an existing spec file", None) from None
     except OSError as error:
         raise SpecError(str(path), 1, 1, "a readable spec file", error.strerror) from None
+    mark = len(codecs.BOM_UTF8) if data.startswith(codecs.BOM_UTF8) else 0
     try:
-        text = data.decode("utf-8")
+        text = data[mark:].decode("utf-8")  # a byte-order mark (Windows editors write one) dropped
     except UnicodeDecodeError as error:
-        raise SpecError(str(path), 1, 1, "UTF-8 text", f"byte {error.start}") from None
+        raise SpecError(str(path), 1, 1, "UTF-8 text", f"byte {mark + error.start}") from None
     return text, hashlib.sha256(data).hexdigest()
 
 
