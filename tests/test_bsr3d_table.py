@@ -298,6 +298,19 @@ def test_a_2d_result_is_refused_and_nothing_written(
     assert not csv_path.exists() and not md_path.exists()
 
 
+def test_bsr_table_refuses_a_3d_result_and_writes_nothing(
+    seed_files: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    csv_path, md_path = tmp_path / "runs.csv", tmp_path / "runs.md"
+    spatial = str(seed_files[0])
+    assert main(["bsr-table", spatial, "--csv", str(csv_path), "--md", str(md_path)]) == 2
+    assert capsys.readouterr().err == (
+        f"mosys: {spatial}: a 3-D search result; bsr-table tabulates 2-D searches (bsr3d-table "
+        "the 3-D ones)\n"
+    )
+    assert not csv_path.exists() and not md_path.exists()
+
+
 def test_a_missing_attribute_or_term_is_named(tmp_path: Path) -> None:
     old = write_seed(tmp_path, "old", 1, chain=None, searched_variables=None)
     with pytest.raises(InputError) as error:

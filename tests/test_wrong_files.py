@@ -77,6 +77,12 @@ CASES = [
         "mosys: {text}: cannot read it as HDF5 (",
     ),
     (
+        "car-table text start grid",
+        lambda f, o: ["car-table", f["car table"], "--starts", f["text"], "--trajectories",
+                      f["odd"], "--csv", o / "t.csv", "--md", o / "t.md"],
+        "mosys: {text}: cannot read it as HDF5 (",
+    ),
+    (
         "starts pendulum table",
         lambda f, o: ["starts", f["pendulum table"], "--dynamics", f["car"], "--x", "0", "1", "2",
                       "--y", "1", "2", "2", "--quiet", "-o", o / "g.h5"],

@@ -68,6 +68,17 @@ def kind_of(h5: h5py.File) -> Contract | None:
     return next((contract for contract in CONTRACTS if contract.met_by(h5)), None)
 
 
+def open_hdf5(path: str | Path) -> h5py.File:
+    """``path`` open for reading; InputError naming the file if it is missing, not HDF5 or
+    unreadable (h5py's own messages omit the name)."""
+    try:
+        return h5py.File(path, "r")
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such file") from None
+    except OSError as error:  # not HDF5, truncated, unreadable
+        raise InputError(f"{path}: cannot read it as HDF5 ({error})") from None
+
+
 @contextmanager
 def open_contract(path: str | Path, name: str) -> Iterator[h5py.File]:
     """``path`` open for reading as a file of the contract ``name`` (a key of ``CONTRACT``).
@@ -75,13 +86,7 @@ def open_contract(path: str | Path, name: str) -> Iterator[h5py.File]:
     none (what it lacks); or lacking, inside the block, an attribute, group or dataset the
     reader looks for (h5py's KeyError)."""
     contract = CONTRACT[name]
-    try:
-        h5 = h5py.File(path, "r")
-    except FileNotFoundError:
-        raise InputError(f"{path}: no such file") from None
-    except OSError as error:  # not HDF5, truncated, unreadable: h5py's message omits the name
-        raise InputError(f"{path}: cannot read it as HDF5 ({error})") from None
-    with h5:
+    with open_hdf5(path) as h5:
         missing = contract.missing(h5)
         if missing:
             other = kind_of(h5)

@@ -31,6 +31,7 @@ from mosys.io.attributes import (
     set_column_units,
     string_tuple,
 )
+from mosys.io.contracts import open_hdf5
 from mosys.io.provenance import provenance_attributes
 from mosys.parsing import vehicle
 
@@ -154,8 +155,8 @@ DATASETS = (
 
 def read_start_grid(path: str | Path) -> StartGrid:
     """Read a start grid written by ``write_start_grid``; InputError naming the file and the
-    datasets (or ``state_order``) it lacks."""
-    with h5py.File(path, "r") as h5:
+    datasets (or ``state_order``) it lacks, or that it cannot be read (``contracts.open_hdf5``)."""
+    with open_hdf5(path) as h5:
         for kind, names, present in (
             ("datasets", DATASETS, h5),
             ("root attributes", ("state_order",), h5.attrs),

@@ -86,14 +86,25 @@ def write_table(frame: pd.DataFrame, caption: str, csv_path: str, md_path: str) 
     write_text_atomically(md_path, caption + frame.to_markdown(index=False) + "\n")
 
 
+TABLE_VERBS = {2: "bsr-table", 3: "bsr3d-table"}  # the runs table of each figure dimension
+
+
+def check_dimensions(result: BsrResult, path: str | Path, dimensions: int) -> None:
+    """InputError naming the file unless ``result`` is the search of a ``dimensions``-D figure,
+    which ``TABLE_VERBS[dimensions]`` tabulates."""
+    found = result.motion.dimensions
+    if found != dimensions:
+        other = f" ({TABLE_VERBS[found]} the {found}-D ones)" if found in TABLE_VERBS else ""
+        raise InputError(
+            f"{path}: a {found}-D search result; {TABLE_VERBS[dimensions]} tabulates "
+            f"{dimensions}-D searches{other}"
+        )
+
+
 def read_planar_result(path: str | Path) -> BsrResult:
     """A 2-D search's result file; InputError naming the file for a 3-D one."""
     result = read_bsr_result(path)
-    if result.motion.dimensions != 2:
-        raise InputError(
-            f"{path}: a {result.motion.dimensions}-D search result; bsr-table tabulates 2-D "
-            "searches (bsr3d-table the 3-D ones)"
-        )
+    check_dimensions(result, path, 2)
     return result
 
 

@@ -19,6 +19,7 @@ import pandas as pd
 from mosys.errors import InputError
 from mosys.io.bsr_result import BsrResult, read_bsr_result
 from mosys.paper_tables.bsr import (
+    check_dimensions,
     cost_columns,
     fitness_columns,
     group_by_search,
@@ -116,11 +117,7 @@ def read_3d_result(path: str | Path) -> BsrResult:
         raise InputError(
             f"{path}: not a 3-D BSR result file: no root attribute {', '.join(absent)}"
         )
-    if result.motion.dimensions != 3:
-        raise InputError(
-            f"{path}: a {result.motion.dimensions}-D search result; bsr3d-table tabulates 3-D "
-            "searches (bsr-table the 2-D ones)"
-        )
+    check_dimensions(result, path, 3)
     try:
         terms = result.fitness_terms
     except json.JSONDecodeError as error:

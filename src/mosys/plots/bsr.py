@@ -23,7 +23,6 @@ import textwrap
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-import h5py
 import numpy as np
 from matplotlib.cm import ScalarMappable
 from matplotlib.colors import Normalize
@@ -34,6 +33,7 @@ from matplotlib.ticker import FuncFormatter
 
 from mosys.errors import InputError
 from mosys.io.bsr_result import BsrResult, read_bsr_result
+from mosys.io.contracts import open_hdf5
 from mosys.plots.style import (
     ASPECT_RANGE,
     GIF_DPI,
@@ -154,10 +154,10 @@ def read_result(path: str | Path, dimensions: int | None = 2) -> BsrResult:
 def root_attrs(path: str | Path) -> dict:
     """A result file's root attributes, without reading its datasets."""
     try:
-        with h5py.File(path, "r") as h5:
+        with open_hdf5(path) as h5:
             return {key: h5.attrs[key] for key in h5.attrs}
-    except OSError as error:  # missing, unreadable, not HDF5: h5py's message omits the name
-        raise PlotInputError(f"{path}: cannot read: {error}") from None
+    except InputError as error:  # missing, unreadable, not HDF5
+        raise PlotInputError(str(error)) from None
 
 
 def search_name(attrs: Mapping, path: str | Path) -> str:
