@@ -173,6 +173,27 @@ def test_set_duration_moves_the_slider_and_refuses_what_no_slider_gives(at_guess
 
 
 @pytest.mark.slow
+def test_a_slider_moved_past_the_limits_goes_back_and_says_why(at_guess, monkeypatch):
+    """The sliders reach 3x a phase's guess, so a script near the step limit can be dragged
+    past it: the move is refused in the status line (not raised into the GUI loop) and the
+    slider and motion stay where they were."""
+    editor = at_guess
+    monkeypatch.setenv("MOSYS_MAX_STEPS", "600")  # the guess, 415 ticks, fits
+    scored = editor.scored
+    slider_click(editor.sliders[0], 500)  # 700 ticks in all
+    assert editor.ticks.tolist() == [215, 100, 100]
+    assert editor.sliders[0].val == 215
+    assert editor.scored is scored
+    assert editor.status_text.get_text() == (
+        "not run: expected at most 600 integration steps per run, found 700 (the phases' 700 "
+        'ticks to the end of this one); raise MOSYS_MAX_STEPS to allow it (README, "Limits")'
+    )
+    slider_click(editor.sliders[0], 300)  # 500 ticks: runs
+    assert editor.ticks.tolist() == [300, 100, 100]
+    assert editor.status_text.get_text().startswith("unsaved")
+
+
+@pytest.mark.slow
 def test_reset_returns_to_the_start(at_guess):
     editor = at_guess
     editor.set_durations([10, 20, 30])

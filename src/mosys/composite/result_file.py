@@ -51,14 +51,17 @@ def stored_motion(session: CompositeSession, scored: ScoredMotion) -> CompositeM
     )
 
 
-def check_size(session: CompositeSession) -> None:
+def check_size(session: CompositeSession, durations: Sequence[int] | None = None) -> None:
     """LimitError at the first phase's ``ticks=`` (or the ``figure`` line, without them) where
-    the guessed concatenation, counted from its start, needs more steps or memory than the
-    limits allow, or at the ``figure`` line when the search's Q arrays do (``mosys.limits``)."""
+    the concatenation of ``durations`` (P,) ticks (None: the guess), counted from its start,
+    needs more steps or memory than the limits allow, or at the ``figure`` line when the
+    search's Q arrays do (``mosys.limits``)."""
     script = session.script
     step_bytes = motion_step_bytes(len(session.figure.endpoint_names))
+    if durations is None:
+        durations = session.guess
     ticks = 0  # exact, a Python int: each phase's ticks fit int64, their sum need not
-    for phase, phase_ticks in zip(script.phases, session.guess, strict=True):
+    for phase, phase_ticks in zip(script.phases, durations, strict=True):
         ticks += int(phase_ticks)
         token = script.tokens.get(f"phase.{phase.name}.ticks", script.tokens["figure"])
         check_job(

@@ -26,6 +26,7 @@ from __future__ import annotations
 import hashlib
 import math
 import os
+import re
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -40,9 +41,11 @@ from matplotlib.patches import Patch
 from matplotlib.text import Text
 from matplotlib.widgets import Button, Slider
 
+from mosys.composite.result_file import check_size
 from mosys.composite.session import CompositeSession
-from mosys.errors import InputError
+from mosys.errors import InputError, NonFiniteStateError
 from mosys.io.atomic import write_text_atomically
+from mosys.limits import LimitError
 from mosys.parsing.composite import parse_composite_text, render_expression
 from mosys.parsing.composite_script import CompositeScript
 from mosys.parsing.tokens import read_spec_text
@@ -286,8 +289,19 @@ class ConcatenationEditor:
                     f"phase {name}: at most {top} ticks (its slider's end), got {value}"
                 )
         if not np.array_equal(durations, self.scored.ticks):
+            check_size(self.session, durations)
             self.scored = self.session.score(durations)
         self._redraw()
+
+    def _slider_moved(self, k: int, ticks: float) -> None:
+        """Phase k's slider moved to ``ticks``: ``set_duration``, or, where those durations are
+        past the limits or the motion becomes unsound, the slider back where it was and why in
+        the status line (shown, not raised into the GUI loop)."""
+        try:
+            self.set_duration(k, ticks)
+        except (LimitError, NonFiniteStateError) as error:  # at the script's line: drop that
+            where = re.match(rf"{re.escape(str(self.script_path))}:\d+:\d+: ", str(error))
+            self._redraw(status=f"not run: {str(error)[where.end() if where else 0 :]}")
 
     def reset(self) -> None:
         """Back to the durations the editor started from (``session.guess``). The Reset button."""
@@ -452,7 +466,7 @@ class ConcatenationEditor:
             )
             slider.drawon = False  # drawn here, with the rest of a move
             slider.label.set_fontweight("bold")
-            slider.on_changed(lambda value, k=k: self.set_duration(k, value))
+            slider.on_changed(lambda value, k=k: self._slider_moved(k, value))
             self.sliders.append(slider)
             # right of the track (x in the slider's axes: 1 is its end): time and score, formula
             text = ax.text(
@@ -489,7 +503,13 @@ class ConcatenationEditor:
         self.reset_button = Button(reset_axes, "Reset")
         self.reset_button.on_clicked(lambda _event: self.reset())
         self.status_text = reset_axes.text(
-            1 + BUTTON_GAP * 2 / BUTTON_WIDTH, 0.5, "", va="center", fontsize=9, color="0.25"
+            1 + BUTTON_GAP * 2 / BUTTON_WIDTH,
+            0.5,
+            "",
+            va="center",
+            fontsize=9,
+            color="0.25",
+            wrap=True,  # a refusal's reason can be longer than the row
         )  # changes seldom: drawn with the background
 
     def _redraw(self, status: str | None = None) -> None:
@@ -626,7 +646,6 @@ def run_editor(
     the window opens, for a guess past the limits (``composite.result_file.check_size``)."""
     import matplotlib.pyplot as plt
 
-    from mosys.composite.result_file import check_size
     from mosys.composite.session import find_controller_files, open_session
     from mosys.parsing.composite import parse_composite_script
 
