@@ -163,6 +163,23 @@ def test_what_the_script_names_must_exist(composite_workspace, tmp_path, edit, m
     assert str(error.value) == f"{script}{message}"
 
 
+def test_a_result_of_another_search_in_a_phases_folder_is_refused(composite_workspace, tmp_path):
+    """The files are grouped by folder: one of another search (the same figure) copied into
+    the jump's folder is refused at the phase's controller, not run as the jump."""
+    files = composite_workspace.controller_files()
+    stray = tmp_path / "starman_jump_robust" / "seed1.h5"
+    stray.parent.mkdir()
+    shutil.copy(files["starman_shuffle_robust"][0], stray)
+    files["starman_jump_robust"] = [stray]
+    script = parse_composite_script(composite_workspace.script)
+    with pytest.raises(SpecError) as error:
+        open_session(script, files, SPECS / "figures", SPECS / "bsr")
+    assert str(error.value) == (
+        f"{script.path}:9:28: expected results of the search starman_jump_robust ({stray} is a "
+        "result of starman_shuffle_robust), found 'starman_jump_robust'"
+    )
+
+
 @pytest.mark.parametrize(
     ("edit", "message"),
     [

@@ -179,6 +179,13 @@ def open_session(
             results = {k: read_bsr_result(path) for k, path in sorted(candidates.items())}
             seed = max(results, key=lambda k: float(results[k].attrs["nominal_fitness"]))
             result = results[seed]
+        if str(result.attrs["name"]) != phase.controller:  # a file put in another's folder
+            raise SpecError.at(
+                script.path,
+                token,
+                f"results of the search {phase.controller} ({candidates[seed]} is a result of "
+                f"{result.attrs['name']})",
+            )
         if str(result.attrs["figure"]) != script.figure:
             raise SpecError.at(
                 script.path,
