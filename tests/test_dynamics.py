@@ -19,6 +19,7 @@ from numba import njit, types
 import mosys
 from mosys.dynamics.compile import compile_figure, generate_source
 from mosys.dynamics.load import content_addressed_copy, load_dynamics, module_name
+from mosys.errors import InputError
 from mosys.parsing.tokens import SpecError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -372,16 +373,14 @@ def test_broken_spec_leaves_no_output(tmp_path: Path) -> None:
 
 def test_bad_out_path_is_refused(tmp_path: Path) -> None:
     for bad, message in (
-        (
-            "link1.txt",
-            f"out_path must end in .py (a Python module), got '{tmp_path / 'link1.txt'}'",
-        ),
+        ("link1.txt", f"{tmp_path / 'link1.txt'}: expected a Python module's name, ending in .py"),
         (
             "link-1.py",
-            "out_path's stem must be a Python identifier (it names the module), got 'link-1'",
+            f"{tmp_path / 'link-1.py'}: expected a module name that is a Python identifier "
+            "(letters, digits and _, not starting with a digit), found 'link-1'",
         ),
     ):
-        with pytest.raises(ValueError) as error:
+        with pytest.raises(InputError) as error:
             compile_figure(FIGURES / "link1.fig", tmp_path / bad)
         assert str(error.value) == message
     assert list(tmp_path.iterdir()) == []
@@ -397,9 +396,9 @@ def test_compile_writes_atomically(tmp_path: Path, monkeypatch: pytest.MonkeyPat
 
     monkeypatch.setattr(Path, "write_text", dies_half_way)
     out = tmp_path / "link1.py"
-    with pytest.raises(OSError) as error:
+    with pytest.raises(InputError) as error:  # the final name, not the partial's
         compile_figure(FIGURES / "link1.fig", out)
-    assert str(error.value) == "disk full"
+    assert str(error.value) == f"{out}: cannot write it: disk full"
     assert list(tmp_path.iterdir()) == []
     monkeypatch.undo()
     compile_figure(FIGURES / "link1.fig", out)

@@ -169,13 +169,24 @@ def test_a_served_job_compiles_on_a_cold_cache_with_its_own_thread_count(tmp_pat
 
 
 def test_signals_reach_the_job_and_a_job_whose_client_dies_is_stopped(server, tmp_path):
-    """A dp whose spec is a FIFO nobody writes blocks in open(): a job that runs until told."""
-    fifo = tmp_path / "blocked.ssc"
-    os.mkfifo(fifo)
+    """A plot whose dynamics module sleeps as it is imported: a job that runs until told. (A
+    FIFO as an input, which would block forever, is refused.)"""
+    sleeper = tmp_path / "sleeper.py"
+    sleeper.write_text("import time\n\ntime.sleep(600)\n")
     for kill_client in (signal.SIGTERM, signal.SIGKILL):
         known = {pid for pid, _ in server.jobs()}
         client = subprocess.Popen(
-            [sys.executable, "-m", "mosys.command", "dp", str(fifo), "-o", "x.h5"],
+            [
+                sys.executable,
+                "-m",
+                "mosys.command",
+                "plot",
+                "free-swing",
+                "--dynamics",
+                str(sleeper),
+                "-o",
+                "x.png",
+            ],
             cwd=tmp_path,
             env={**environment(), "MOSYS_JOB_SERVER": str(server.socket)},
             stderr=subprocess.PIPE,
@@ -185,13 +196,13 @@ def test_signals_reach_the_job_and_a_job_whose_client_dies_is_stopped(server, tm
             assert time.monotonic() < deadline, server.log.read_text()
             time.sleep(0.02)
         (job,) = new
-        time.sleep(0.3)  # the job is blocked opening the FIFO
+        time.sleep(0.3)  # the job is asleep importing the module
         client.send_signal(kill_client)
         client.wait(timeout=20)
         assert server.wait_for_end(job) == "ended: exit 143"  # SIGTERM, forwarded or sent
         if kill_client == signal.SIGTERM:
             assert client.returncode == 143  # the job's status became the client's
-    assert not (tmp_path / "x.h5").exists()
+    assert not (tmp_path / "x.png").exists()
 
 
 def test_a_request_the_server_cannot_serve_runs_in_the_client(server, tmp_path):

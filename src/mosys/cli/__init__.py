@@ -17,7 +17,7 @@ import textwrap
 
 from mosys import __version__
 from mosys.cli import animation, bsr, composite, dynamics, index, info, paper_tables, plots, ssc
-from mosys.cli.verb import Family
+from mosys.cli.verb import Family, output_options, same_file_problem
 
 # In `mosys --help` order: the pipeline's steps, then what is drawn and tabulated from them.
 FAMILIES: tuple[Family, ...] = (
@@ -96,7 +96,7 @@ def build_parser() -> argparse.ArgumentParser:
                 groups[group] = verbs.add_parser(group).add_subparsers(dest="kind", required=True)
             subparser = (groups[group] if group else verbs).add_parser(name, help=verb.summary)
             verb.add_arguments(subparser)
-            subparser.set_defaults(command=verb)
+            subparser.set_defaults(command=verb, output_options=output_options(subparser))
     return parser
 
 
@@ -104,14 +104,16 @@ def main(argv: list[str] | None = None) -> int:
     """Run the verb ``argv`` names (None: this command line's); its exit code."""
     parser = build_parser()
     args = parser.parse_args(argv)
-    problem = args.command.check(args)
+    problem = args.command.check(args) or same_file_problem(args, args.output_options)
     if problem:
         parser.error(problem)
     from mosys.errors import InputError, SimulationError
+    from mosys.files import command_files
     from mosys.parsing.tokens import SpecError
 
     try:
-        args.command.handler(args)
+        with command_files():  # no output replaces a file the verb read
+            args.command.handler(args)
     except (SpecError, SimulationError) as error:
         print(error, file=sys.stderr)  # file:line:column: first, as compilers do
         return 2

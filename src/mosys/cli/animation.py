@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from mosys.cli.verb import Family, Verb, positive_number_problem
+from mosys.cli.verb import HDF5, Family, OutputPath, Verb, positive_number_problem
 
 
 def _run_arguments(parser: argparse.ArgumentParser) -> None:
@@ -15,7 +15,7 @@ def _run_arguments(parser: argparse.ArgumentParser) -> None:
         "--motor-dir", default="specs/motor", help="motor programs: DIR/FIGURE/NAME.mot"
     )
     parser.add_argument("--dt", type=float, default=0.001, help="simulator step, s")
-    parser.add_argument("-o", "--output", required=True)
+    parser.add_argument("-o", "--output", required=True, type=OutputPath(*HDF5))
 
 
 def _run_check(args: argparse.Namespace) -> str | None:

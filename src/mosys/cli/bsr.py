@@ -4,7 +4,15 @@ from __future__ import annotations
 
 import argparse
 
-from mosys.cli.verb import Family, Verb, add_budget, first_problem, whole_number_problem
+from mosys.cli.verb import (
+    HDF5,
+    Family,
+    OutputPath,
+    Verb,
+    add_budget,
+    first_problem,
+    whole_number_problem,
+)
 
 
 def _bsr_search_arguments(parser: argparse.ArgumentParser) -> None:
@@ -20,7 +28,7 @@ def _bsr_search_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="RESULT",
         help="3-D: the result files of the search the spec's 'chain' line continues",
     )
-    parser.add_argument("-o", "--output", required=True)
+    parser.add_argument("-o", "--output", required=True, type=OutputPath(*HDF5))
 
 
 def _bsr_search_check(args: argparse.Namespace) -> str | None:

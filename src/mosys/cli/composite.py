@@ -5,7 +5,15 @@ from __future__ import annotations
 
 import argparse
 
-from mosys.cli.verb import Family, Verb, add_budget, first_problem, whole_number_problem
+from mosys.cli.verb import (
+    HDF5,
+    Family,
+    OutputPath,
+    Verb,
+    add_budget,
+    first_problem,
+    whole_number_problem,
+)
 
 
 def _composite_arguments(parser: argparse.ArgumentParser) -> None:
@@ -23,7 +31,7 @@ def _composite_arguments(parser: argparse.ArgumentParser) -> None:
     for key, what in (("q", "Q arrays"), ("g", "G generations"), ("h", "H mutations")):
         parser.add_argument(f"--{key}", type=int, help=f"override the script's {what}")
     add_budget(parser)
-    parser.add_argument("-o", "--output", required=True)
+    parser.add_argument("-o", "--output", required=True, type=OutputPath(*HDF5))
 
 
 def _composite_check(args: argparse.Namespace) -> str | None:

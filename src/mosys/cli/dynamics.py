@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import argparse
 
-from mosys.cli.verb import Family, Verb
+from mosys.cli.verb import Family, OutputPath, Verb
 
 
 def _compile_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("spec")
-    parser.add_argument("-o", "--output", required=True)
+    parser.add_argument("-o", "--output", required=True, type=OutputPath(".py"))
 
 
 def _compile(args: argparse.Namespace) -> None:

@@ -6,12 +6,12 @@ import argparse
 from pathlib import Path
 
 from mosys.cli import job_server
-from mosys.cli.verb import Family, Verb
+from mosys.cli.verb import Family, OutputPath, Verb
 
 
 def _index_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("inputs", nargs="*")
-    parser.add_argument("-o", "--output", required=True)
+    parser.add_argument("-o", "--output", required=True, type=OutputPath())
 
 
 def _index(args: argparse.Namespace) -> None:

@@ -32,6 +32,7 @@ import selectors
 import shlex
 import signal
 import socket
+import stat
 import struct
 import sys
 import time
@@ -404,6 +405,14 @@ def _arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _check(args: argparse.Namespace) -> str | None:
+    """Usage errors: a bad --idle; a socket path in no folder, or naming a file that is not a
+    socket (a stale socket is replaced; anything else would be destroyed)."""
+    folder = os.path.dirname(args.socket) or "."
+    if not os.path.isdir(folder):
+        return f"job-server: {args.socket}: expected a path in an existing folder ({folder})"
+    with contextlib.suppress(OSError):
+        if not stat.S_ISSOCK(os.lstat(args.socket).st_mode):
+            return f"job-server: {args.socket} exists and is not a socket; not replaced"
     return positive_number_problem("job-server", "idle", args.idle)
 
 

@@ -3,15 +3,26 @@
 from __future__ import annotations
 
 import argparse
+import os
 
-from mosys.cli.verb import Family, Verb
+from mosys.cli.verb import (
+    GIF,
+    PLOT,
+    Family,
+    OutputPath,
+    Verb,
+    first_problem,
+    output_path_problem,
+)
 
 
 def _controller_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("table", help="controller table (.h5)")
     parser.add_argument("--dynamics", help="generated dynamics module (for --portrait)")
-    parser.add_argument("--portrait", help="state-space portrait PNG (Figure 14 style)")
-    parser.add_argument("--torque", help="torque-table heat map PNG")
+    parser.add_argument(
+        "--portrait", type=OutputPath(*PLOT), help="state-space portrait PNG (Figure 14 style)"
+    )
+    parser.add_argument("--torque", type=OutputPath(*PLOT), help="torque-table heat map PNG")
 
 
 def _controller_check(args: argparse.Namespace) -> str | None:
@@ -36,8 +47,10 @@ def _controller(args: argparse.Namespace) -> None:
 def _script_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("trajectory")
     parser.add_argument("tables", nargs="*", help="the controller tables (their destinations)")
-    parser.add_argument("--path", help="state-space path PNG")
-    parser.add_argument("--gif", help="animated GIF of the trajectory's figure_motion")
+    parser.add_argument("--path", type=OutputPath(*PLOT), help="state-space path PNG")
+    parser.add_argument(
+        "--gif", type=OutputPath(*GIF), help="animated GIF of the trajectory's figure_motion"
+    )
 
 
 def _script_check(args: argparse.Namespace) -> str | None:
@@ -58,7 +71,7 @@ def _script(args: argparse.Namespace) -> None:
 def _controls_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("trajectories", nargs="+", help="trajectories (.h5) to compare")
     parser.add_argument("--control", help="the control drawn (default: the first)")
-    parser.add_argument("-o", "--output", required=True, help="PNG")
+    parser.add_argument("-o", "--output", required=True, type=OutputPath(*PLOT), help="PNG")
 
 
 def _controls(args: argparse.Namespace) -> None:
@@ -69,7 +82,7 @@ def _controls(args: argparse.Namespace) -> None:
 
 def _free_swing_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--dynamics", required=True, help="generated dynamics of a 1-joint figure")
-    parser.add_argument("-o", "--output", required=True, help="PNG")
+    parser.add_argument("-o", "--output", required=True, type=OutputPath(*PLOT), help="PNG")
 
 
 def _free_swing(args: argparse.Namespace) -> None:
@@ -81,8 +94,12 @@ def _free_swing(args: argparse.Namespace) -> None:
 
 def _car_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("trajectories", nargs="*", help="car trajectories (.h5)")
-    parser.add_argument("--frames", help="PNG: one panel per trajectory, the car every 0.3 s")
-    parser.add_argument("--gif", help="animated GIF of the first trajectory")
+    parser.add_argument(
+        "--frames",
+        type=OutputPath(*PLOT),
+        help="PNG: one panel per trajectory, the car every 0.3 s",
+    )
+    parser.add_argument("--gif", type=OutputPath(*GIF), help="animated GIF of the first trajectory")
     parser.add_argument("--map", nargs=2, metavar=("START_GRID", "PNG"), help="success map")
     parser.add_argument(
         "--consistency",
@@ -97,7 +114,14 @@ def _car_check(args: argparse.Namespace) -> str | None:
         return "plot car: give --frames, --gif, --map and/or --consistency"
     if (args.frames or args.gif) and not args.trajectories:
         return "plot car: --frames and --gif need trajectories"
-    return None
+    pngs = {"--map": args.map, "--consistency": args.consistency}
+    outputs = [args.frames, args.gif] + [pair[1] for pair in pngs.values() if pair]
+    named = [os.path.realpath(path) for path in outputs if path]
+    if len(set(named)) < len(named):
+        return "plot car: two of --frames, --gif, --map and --consistency name the same file"
+    return first_problem(
+        *(output_path_problem(option, pair[1], *PLOT) for option, pair in pngs.items() if pair)
+    )
 
 
 def _car(args: argparse.Namespace) -> None:
@@ -120,10 +144,22 @@ def _car(args: argparse.Namespace) -> None:
 
 def _luxo_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("trajectory", help="a trajectory of Luxo's figure (.h5)")
-    parser.add_argument("--strip", help="PNG: the lamp every few frames of one motion")
+    parser.add_argument(
+        "--strip", type=OutputPath(*PLOT), help="PNG: the lamp every few frames of one motion"
+    )
     parser.add_argument("--motion", default="backflip", help="the motion the strip draws")
-    parser.add_argument("--forces", help="PNG: joint torques and contact forces over time")
-    parser.add_argument("--gif", help="animated GIF of the whole trajectory, terrain drawn")
+    parser.add_argument(
+        "--forces", type=OutputPath(*PLOT), help="PNG: joint torques and contact forces over time"
+    )
+    parser.add_argument(
+        "--gif", type=OutputPath(*GIF), help="animated GIF of the whole trajectory, terrain drawn"
+    )
+
+
+def _luxo_check(args: argparse.Namespace) -> str | None:
+    if not (args.strip or args.forces or args.gif):
+        return "plot luxo: give --strip, --forces and/or --gif"
+    return None
 
 
 def _luxo(args: argparse.Namespace) -> None:
@@ -139,9 +175,17 @@ def _luxo(args: argparse.Namespace) -> None:
 
 def _bsr_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("results", nargs="+", help="all seed files of one search (.h5)")
-    parser.add_argument("--learning", help="PNG: best fitness per seed (Figure 8 style)")
-    parser.add_argument("--filmstrip", help="PNG: the best seed's motion (Figures 9-12 style)")
-    parser.add_argument("--gif", help="animated GIF of the best seed's motion")
+    parser.add_argument(
+        "--learning", type=OutputPath(*PLOT), help="PNG: best fitness per seed (Figure 8 style)"
+    )
+    parser.add_argument(
+        "--filmstrip",
+        type=OutputPath(*PLOT),
+        help="PNG: the best seed's motion (Figures 9-12 style)",
+    )
+    parser.add_argument(
+        "--gif", type=OutputPath(*GIF), help="animated GIF of the best seed's motion"
+    )
 
 
 def _bsr_check(args: argparse.Namespace) -> str | None:
@@ -167,7 +211,7 @@ def _bsr_learning_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "results", nargs="+", help="seed files (.h5) of one or more searches, grouped by name"
     )
-    parser.add_argument("-o", "--output", required=True, help="PNG")
+    parser.add_argument("-o", "--output", required=True, type=OutputPath(*PLOT), help="PNG")
 
 
 def _bsr_learning(args: argparse.Namespace) -> None:
@@ -182,9 +226,13 @@ def _bsr3d_arguments(parser: argparse.ArgumentParser) -> None:
         nargs="+",
         help="seed files (.h5) of one 3-D search, or of a chain's searches in order",
     )
-    parser.add_argument("--filmstrip", help="PNG: the best motion (Figures 15-17 style)")
-    parser.add_argument("--gif", help="animated GIF of that motion")
-    parser.add_argument("--rest", help="PNG: the figure at rest, seen from four sides")
+    parser.add_argument(
+        "--filmstrip", type=OutputPath(*PLOT), help="PNG: the best motion (Figures 15-17 style)"
+    )
+    parser.add_argument("--gif", type=OutputPath(*GIF), help="animated GIF of that motion")
+    parser.add_argument(
+        "--rest", type=OutputPath(*PLOT), help="PNG: the figure at rest, seen from four sides"
+    )
     parser.add_argument(
         "--interval", type=float, help="seconds between the filmstrip's poses (default: chosen)"
     )
@@ -193,7 +241,7 @@ def _bsr3d_arguments(parser: argparse.ArgumentParser) -> None:
 def _bsr3d_check(args: argparse.Namespace) -> str | None:
     if not (args.filmstrip or args.gif or args.rest):
         return "plot bsr3d: give --filmstrip, --gif and/or --rest"
-    if args.interval is not None and not args.interval > 0:
+    if args.interval is not None and not 0 < args.interval < float("inf"):
         return f"plot bsr3d: --interval must be a positive number of seconds, got {args.interval}"
     return None
 
@@ -220,7 +268,7 @@ def _bsr3d_kinds_arguments(parser: argparse.ArgumentParser) -> None:
             metavar="RESULT",
             help=f"seed files (.h5) of the {kind}-based search",
         )
-    parser.add_argument("-o", "--output", required=True, help="PNG")
+    parser.add_argument("-o", "--output", required=True, type=OutputPath(*PLOT), help="PNG")
     parser.add_argument("--log-x", action="store_true", help="evaluations on a log axis")
 
 
@@ -238,7 +286,7 @@ def _bsr3d_kinds(args: argparse.Namespace) -> None:
 
 def _bsr3d_seeds_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("results", nargs="+", help="all seed files of one search (.h5)")
-    parser.add_argument("-o", "--output", required=True, help="PNG")
+    parser.add_argument("-o", "--output", required=True, type=OutputPath(*PLOT), help="PNG")
 
 
 def _bsr3d_seeds(args: argparse.Namespace) -> None:
@@ -249,9 +297,13 @@ def _bsr3d_seeds(args: argparse.Namespace) -> None:
 
 def _composite_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("result", help="results/composite/NAME.h5")
-    parser.add_argument("--filmstrips", help="PNG: before and after (Figures 13-14 style)")
-    parser.add_argument("--search", help="PNG: the best total after each generation")
-    parser.add_argument("--gif", help="animated GIF of the refined motion")
+    parser.add_argument(
+        "--filmstrips", type=OutputPath(*PLOT), help="PNG: before and after (Figures 13-14 style)"
+    )
+    parser.add_argument(
+        "--search", type=OutputPath(*PLOT), help="PNG: the best total after each generation"
+    )
+    parser.add_argument("--gif", type=OutputPath(*GIF), help="animated GIF of the refined motion")
 
 
 def _composite_check(args: argparse.Namespace) -> str | None:
@@ -312,6 +364,7 @@ FAMILY = Family(
             "Luxo: a motion's strip (Figure 22), forces, a GIF",
             _luxo_arguments,
             _luxo,
+            _luxo_check,
         ),
         Verb(
             "plot bsr",

@@ -7,7 +7,9 @@ import argparse
 import math
 
 from mosys.cli.verb import (
+    HDF5,
     Family,
+    OutputPath,
     Verb,
     first_problem,
     positive_number_problem,
@@ -18,7 +20,7 @@ from mosys.cli.verb import (
 def _dp_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("spec")
     parser.add_argument("--dynamics-dir", default="results/dynamics", help="generated dynamics")
-    parser.add_argument("-o", "--output", required=True)
+    parser.add_argument("-o", "--output", required=True, type=OutputPath(*HDF5))
     parser.add_argument("--tol", type=float, default=None, help="override the spec's tolerance, s")
     parser.add_argument("--max-iterations", type=int, default=None)
     parser.add_argument("--quiet", action="store_true")
@@ -70,7 +72,7 @@ def _starts_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seconds", type=float, default=20.0, help="simulated time per start")
     parser.add_argument("--dt", type=float, default=0.01, help="simulator step, s")
     parser.add_argument("--threads", type=int, default=1, help="runs at once")
-    parser.add_argument("-o", "--output", required=True)
+    parser.add_argument("-o", "--output", required=True, type=OutputPath(*HDF5))
     parser.add_argument("--quiet", action="store_true", help="no progress lines")
 
 

@@ -4,9 +4,11 @@ its checks and its handler, kept together in the module of its family."""
 from __future__ import annotations
 
 import argparse
+import os
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from mosys.files import output_problem
 from mosys.parsing.tokens import MAX_WHOLE
 
 
@@ -35,15 +37,97 @@ def first_problem(*problems: str | None) -> str | None:
     return next((problem for problem in problems if problem), None)
 
 
+HDF5 = (".h5", ".hdf5")
+PLOT = (".png", ".pdf", ".svg")  # plots.style.FIGURE_FORMATS
+GIF = (".gif",)
+
+
+class OutputPath:
+    """An argparse type: a file a verb writes, its name ending in one of ``suffixes`` (any
+    case; none given: any name), which can be written as a whole new file
+    (``files.output_problem``). Checked as the command line is read, so that a verb writing
+    several files refuses a bad one before it writes any."""
+
+    def __init__(self, *suffixes: str):
+        self.suffixes = suffixes
+
+    def __call__(self, text: str) -> str:
+        problem = output_problem(text)
+        if problem:
+            raise argparse.ArgumentTypeError(f"cannot write {text!r}: {problem}")
+        if self.suffixes and not text.lower().endswith(self.suffixes):
+            raise argparse.ArgumentTypeError(
+                f"expected a file name ending in {' or '.join(self.suffixes)}, got {text!r}"
+            )
+        return text
+
+
+def output_path_problem(option: str, text: str, *suffixes: str) -> str | None:
+    """``OutputPath``'s refusal of ``text`` as a usage error of ``option`` (None: fine), for
+    an option whose values are not all outputs (``--map START_GRID PNG``)."""
+    try:
+        OutputPath(*suffixes)(text)
+    except argparse.ArgumentTypeError as error:
+        return f"argument {option}: {error}"
+    return None
+
+
+def output_options(parser: argparse.ArgumentParser) -> tuple[tuple[str, str], ...]:
+    """The (dest, option) of each of the parser's arguments of type ``OutputPath``."""
+    return tuple(
+        (action.dest, action.option_strings[-1] if action.option_strings else action.dest)
+        for action in parser._actions  # argparse keeps no public list of a parser's arguments
+        if isinstance(action.type, OutputPath)
+    )
+
+
+def same_file_problem(args: argparse.Namespace, outputs: tuple[tuple[str, str], ...]) -> str | None:
+    """The usage error of two outputs (``output_options``) naming one file, or of an output
+    naming a file the command line also gives as an input (it would be replaced before or
+    while it is read); None if neither."""
+    written: dict[str, str] = {}
+    for dest, option in outputs:
+        value = getattr(args, dest)
+        if value:
+            other = written.setdefault(os.path.realpath(value), option)
+            if other != option:
+                return f"{args.command.name}: {other} and {option} name the same file, {value}"
+    output_dests = {dest for dest, _ in outputs}
+    for dest, value in vars(args).items():
+        if dest in output_dests:
+            continue
+        for text in value if isinstance(value, list) else [value]:
+            for path in text if isinstance(text, list) else [text]:
+                if isinstance(path, str) and os.path.isfile(path):
+                    option = written.get(os.path.realpath(path))
+                    if option:
+                        return (
+                            f"{args.command.name}: {option} {path} is also an input of this "
+                            "command; write the output elsewhere"
+                        )
+    return None
+
+
+def budget_name(text: str) -> str:
+    """An argparse type: a config's name, written into the outputs as text."""
+    if not text or not text.isprintable() or len(text) > 200:  # bytes not UTF-8: surrogates
+        raise argparse.ArgumentTypeError(
+            f"expected a config's name (printable text, 1 to 200 characters), got {text!r:.60}"
+        )
+    return text
+
+
 def add_budget(parser: argparse.ArgumentParser) -> None:
     """``--budget``: the name of the config that built an output (it is written into it)."""
-    parser.add_argument("--budget", default="paper", help="name of the config that built it")
+    parser.add_argument(
+        "--budget", type=budget_name, default="paper", help="name of the config that built it"
+    )
 
 
 def add_table_outputs(parser: argparse.ArgumentParser) -> None:
     """``--csv`` and ``--md``: the two files every paper table is written to."""
-    parser.add_argument("--csv", required=True)
-    parser.add_argument("--md", required=True)
+    parser.add_argument("--csv", required=True, type=OutputPath(".csv"))
+    parser.add_argument("--md", required=True, type=OutputPath(".md"))
 
 
 @dataclass(frozen=True)

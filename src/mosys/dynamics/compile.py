@@ -23,8 +23,10 @@ from typing import TYPE_CHECKING
 import mosys
 from mosys.dynamics.load import cache_directory, write_once
 from mosys.dynamics.vehicle import vehicle_source
+from mosys.errors import InputError
 from mosys.io.atomic import write_text_atomically
 from mosys.parsing.figure import Figure, parse_figure_spec
+from mosys.parsing.tokens import check_spec_file
 from mosys.parsing.vehicle import Vehicle
 
 if TYPE_CHECKING:
@@ -94,13 +96,15 @@ def cached_source(spec_path: str | Path) -> str:
 
 def compile_figure(spec_path: str | Path, out_path: str | Path) -> None:
     """Compile the figure spec ``spec_path`` (``.fig``) into the Python module ``out_path``
-    (``.py``), written atomically. Raises SpecError for a bad spec, ValueError for a bad
+    (``.py``), written atomically. Raises SpecError for a bad spec, InputError for a bad
     ``out_path``; in both cases nothing is written."""
     out = Path(out_path)
     if out.suffix != ".py":
-        raise ValueError(f"out_path must end in .py (a Python module), got {str(out_path)!r}")
+        raise InputError(f"{out_path}: expected a Python module's name, ending in .py")
     if not out.stem.isidentifier():
-        raise ValueError(
-            f"out_path's stem must be a Python identifier (it names the module), got {out.stem!r}"
+        raise InputError(
+            f"{out_path}: expected a module name that is a Python identifier (letters, digits "
+            f"and _, not starting with a digit), found {out.stem!r}"
         )
+    check_spec_file(spec_path)  # a FIFO would block the read of its bytes forever
     write_text_atomically(out, cached_source(spec_path))

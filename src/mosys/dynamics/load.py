@@ -24,6 +24,7 @@ from pathlib import Path
 from types import ModuleType
 
 from mosys.errors import InputError
+from mosys.files import input_problem
 from mosys.parsing.figure import (
     MAX_GRAVITY,
     ROD_INERTIA_RANGE,
@@ -84,7 +85,7 @@ def load_dynamics(path: str | Path) -> ModuleType:
     FileNotFoundError if it does not exist, and InputError if importing it fails or it lacks
     the generated names."""
     path = Path(path)
-    if not path.is_file():
+    if input_problem(path) or not path.is_file():  # recorded as read: no output replaces it
         raise FileNotFoundError(f"no generated dynamics module at {str(path)!r}")
     copy = content_addressed_copy(path)
     name = copy.stem

@@ -16,6 +16,7 @@ from pathlib import Path
 import h5py
 
 from mosys.errors import InputError
+from mosys.files import input_problem
 
 
 @dataclass(frozen=True)
@@ -69,8 +70,12 @@ def kind_of(h5: h5py.File) -> Contract | None:
 
 
 def open_hdf5(path: str | Path) -> h5py.File:
-    """``path`` open for reading; InputError naming the file if it is missing, not HDF5 or
-    unreadable (h5py's own messages omit the name)."""
+    """``path`` open for reading (recorded as read by this command); InputError naming the file
+    if it is missing, a directory or FIFO, not HDF5 or unreadable (h5py's own messages omit the
+    name)."""
+    problem = input_problem(path)  # a FIFO would block the open forever
+    if problem:
+        raise InputError(f"{path}: {problem}, not an HDF5 file")
     try:
         return h5py.File(path, "r")
     except FileNotFoundError:

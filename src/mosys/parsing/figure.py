@@ -48,7 +48,7 @@ from mosys.parsing.tokens import (
     parse_endpoint,
     parse_name,
     parse_number,
-    read_spec,
+    read_spec_text,
     record_once,
     tokenize,
     unknown_keyword,
@@ -302,13 +302,8 @@ class Figure:
 
 def parse_figure_spec(path: str | Path) -> Figure | Vehicle:
     """Parse a ``.fig`` file; any problem raises SpecError naming file, line and column."""
-    try:
-        data = Path(path).read_bytes()
-        text = data.decode("utf-8")
-    except (FileNotFoundError, UnicodeDecodeError):
-        read_spec(path)  # raises the shared SpecError for a missing or non-UTF-8 file
-        raise
-    return parse_figure_text(text, str(path), hashlib.sha256(data).hexdigest())
+    text, digest = read_spec_text(path)  # SpecError at 1:1 for a file it cannot read
+    return parse_figure_text(text, str(path), digest)
 
 
 def parse_figure_text(

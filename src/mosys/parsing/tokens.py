@@ -15,6 +15,8 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
+from mosys.files import input_problem
+
 NUMBER = re.compile(r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?")
 NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 ENDPOINT_ENDS = ("proximal", "distal")  # a rod's ends, as specs name them: ROD.END
@@ -114,11 +116,20 @@ def tokenize(text: str, path: str) -> list[Line]:
     return lines
 
 
+def check_spec_file(path: str | Path) -> None:
+    """SpecError at 1:1 if ``path`` is a directory, a FIFO (whose read would block forever) or
+    a device; else it is recorded as read by this command (``files.input_problem``)."""
+    problem = input_problem(path)
+    if problem:
+        raise SpecError(str(path), 1, 1, "a spec file", problem)
+
+
 def read_spec_text(path: str | Path) -> tuple[str, str]:
     """The text of a spec file (UTF-8, a leading byte-order mark dropped) and the hex SHA-256 of
     its bytes, read once. A file that is missing, unreadable or not UTF-8 raises SpecError at
-    1:1."""
+    1:1, as does one that is a directory, a FIFO or a device."""
     path = Path(path)
+    check_spec_file(path)
     try:
         data = path.read_bytes()
     except FileNotFoundError:

@@ -115,6 +115,7 @@ TERMS_3D = {
     "final_spin": ("final spin", "deg/s", ".0f"),
     **TERMS,
 }
+MAX_POSES = 500  # a filmstrip drawing more is a grey smear: an --interval that short is refused
 LEGEND_WIDTH = 130  # characters of a filmstrip legend's line of terms
 CHAIN_TOLERANCE = 1e-3  # m: a continuing search's first pose is its predecessor's last pose
 
@@ -558,6 +559,11 @@ def filmstrip_figure(
         interval = choose_interval(duration, (max(count - 2, 2), count + 2))
     if not interval > 0:
         raise ValueError(f"interval must be a positive number of seconds, got {interval!r}")
+    if duration / interval > MAX_POSES:  # before a time is listed for each pose
+        raise PlotInputError(
+            f"{result_paths[-1]}: poses every {interval:g} s over {duration:g} s make more than "
+            f"{MAX_POSES} poses; expected an interval of at least {duration / MAX_POSES:g} s"
+        )
     samples = samples_to_the_end(t, interval)
     poses = motion.endpoints[samples]
     size = pose_size(motion.endpoints)
