@@ -587,7 +587,10 @@ def touched(tmp_path_factory) -> Path:
     """A copy of the workflow where every output of ``all`` (CI's config) is an empty file that
     ``snakemake --touch`` marked up to date: the whole pipeline's dry runs, and no job run."""
     work = copy_workflow(tmp_path_factory.mktemp("touched"))
-    for line in re.findall(r"^\s+output: (.+)$", snakemake(work, "--dry-run", "all", *CI), re.M):
+    plan = snakemake(work, "--dry-run", "all", *CI)
+    # no rule's input function fails on the way (slew_torque.png is no controller's plot)
+    assert "Traceback" not in plan and "Exception" not in plan, plan
+    for line in re.findall(r"^\s+output: (.+)$", plan, re.M):
         for path in line.split(", "):
             (work / path).parent.mkdir(parents=True, exist_ok=True)
             (work / path).touch()

@@ -1,5 +1,6 @@
 """Mistakes the workflow catches before any job runs (dry runs of a copy of the workflow, nothing
-built): a config key the schema does not know, a target no rule makes, a spec that is missing
+built): a config key the schema does not know, a config naming a spec that is not there, a
+target no rule makes, a spec that is missing
 or malformed (the parser's own file:line:column message), and a controller drawn with its own
 figure's dynamics."""
 
@@ -27,6 +28,35 @@ def test_a_mistyped_config_key_is_refused_before_anything_runs(work):
     assert "Additional properties are not allowed ('generation' was unexpected)" in output
     code, output = dry_run(work, "results/pendulum_all", "--config", "pendulm={group: x}")
     assert code != 0 and "'pendulm' was unexpected" in output
+    assert not (work / "results").exists()
+
+
+@pytest.mark.parametrize(
+    ("config", "message"),
+    [
+        ("bsr:\n  searches: [nope]\n", "config bsr.searches: 'nope' names no spec"),
+        ("car:\n  gif_script: nope\n", "config car.gif_script: 'nope' names no spec"),
+        (
+            "pendulum:\n  compare_controls: [pendulum, nope]\n",
+            "config pendulum.compare_controls: 'nope' names no spec (specs/scripts/nope.anim",
+        ),
+        (
+            "car:\n  start_grid:\n    x: [-2.0, 7.5, 2.5]\n",
+            "2.5 is not of type 'integer'",
+        ),
+        ("car:\n  start_grid:\n    heading: []\n", "[] should be non-empty"),
+    ],
+)
+def test_a_config_naming_no_spec_or_an_impossible_grid_is_refused_before_anything_runs(
+    work, tmp_path, config, message
+):
+    """A name with no spec used to fail inside a rule's input function (a traceback naming only
+    the spec); a start grid of 2.5 x values passed the schema and failed in its job."""
+    extra = tmp_path / "extra.yaml"
+    extra.write_text(config, encoding="utf-8")
+    code, output = dry_run(work, "all", "--configfile", "config/config.yaml", str(extra))
+    assert code != 0
+    assert message in output, output
     assert not (work / "results").exists()
 
 

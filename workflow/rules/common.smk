@@ -20,6 +20,55 @@ from snakemake.utils import validate
 
 validate(config, "../schemas/config.schema.yaml")
 
+
+def configured_specs():
+    """(config key, spec file) for every spec the config names."""
+    pendulum, car, luxo = config["pendulum"], config["car"], config["luxo"]
+    bsr3d, composite = config["bsr3d"], config["composite"]
+    named = [
+        ("pendulum.figure", f"specs/figures/{pendulum['figure']}.fig"),
+        ("car.figure", f"specs/figures/{car['figure']}.fig"),
+        ("luxo.figure", f"specs/figures/{luxo['figure']}.fig"),
+        ("car.controller", f"specs/controllers/{car['group']}/{car['controller']}.ssc"),
+        ("luxo.controller", f"specs/controllers/{luxo['group']}/{luxo['controller']}.ssc"),
+        ("pendulum.script", f"specs/scripts/{pendulum['script']}.anim"),
+        ("car.gif_script", f"specs/scripts/{car['gif_script']}.anim"),
+        ("luxo.script", f"specs/scripts/{luxo['script']}.anim"),
+    ]
+    named += [
+        ("pendulum.controllers", f"specs/controllers/{pendulum['group']}/{name}.ssc")
+        for name in pendulum["controllers"]
+    ]
+    for key, names in (
+        ("pendulum.scripts", pendulum["scripts"]),
+        ("pendulum.compare_controls", pendulum["compare_controls"]),
+        ("car.scripts", car["scripts"]),
+    ):
+        named += [(key, f"specs/scripts/{name}.anim") for name in names]
+    searches = [
+        ("bsr.searches", config["bsr"]["searches"]),
+        ("bsr.full_budget", config["bsr"]["full_budget"]),
+        ("bsr3d.searches", bsr3d["searches"]),
+        ("bsr3d.full_budget", bsr3d["full_budget"]),
+        ("bsr3d.kinds", list(bsr3d["kinds"].values())),
+        ("bsr3d.variability", [bsr3d["variability"]]),
+        ("composite.robustness", [*composite["robustness"], *composite["robustness"].values()]),
+    ]
+    searches += [(f"bsr3d.motions.{motion}", chain) for motion, chain in bsr3d["motions"].items()]
+    for part, value in bsr3d["targets"].items():
+        searches.append((f"bsr3d.targets.{part}", value if isinstance(value, list) else [value]))
+    for key, names in searches:
+        named += [(key, f"specs/bsr/{name}.bsr") for name in names]
+    named += [("composite.scripts", f"specs/composite/{name}.comp") for name in composite["scripts"]]
+    return named
+
+
+# A name in the config with no spec stops the run here, naming the key (it used to surface as
+# a rule's InputFunctionException with a traceback, naming only the spec path).
+for _key, _spec in configured_specs():
+    if not Path(_spec).is_file():
+        raise WorkflowError(f"config {_key}: {Path(_spec).stem!r} names no spec ({_spec} does not exist)")
+
 # The limits on one job's memory and steps (README, "Limits"), for every job this run starts.
 for _key, _variable in (("memory_gib", "MOSYS_MAX_MEMORY_GIB"), ("steps", "MOSYS_MAX_STEPS")):
     if config["limits"].get(_key) is not None:
@@ -296,9 +345,14 @@ def parsed_spec(path):
 
 
 def controller_dynamics(wildcards):
-    """The generated dynamics a controller spec names in its 'dyn' line."""
-    spec = parsed_spec(f"specs/controllers/{wildcards.group}/{wildcards.name}.ssc")
-    return [f"results/dynamics/{spec.figure}.py"]
+    """The generated dynamics a controller spec names in its 'dyn' line. Without the spec, the
+    spec itself (a missing input): another rule may make the file asked for (slew_torque.png
+    is compared_controls', not a plot of a controller 'slew'), and if none does, Snakemake
+    names the spec it lacks."""
+    path = f"specs/controllers/{wildcards.group}/{wildcards.name}.ssc"
+    if not Path(path).is_file():
+        return [path]
+    return [f"results/dynamics/{parsed_spec(path).figure}.py"]
 
 
 def script_figure(script):
