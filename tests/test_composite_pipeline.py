@@ -163,6 +163,21 @@ def test_what_the_script_names_must_exist(composite_workspace, tmp_path, edit, m
     assert str(error.value) == f"{script}{message}"
 
 
+def test_a_phase_whose_search_is_not_among_the_controllers_given_says_so(
+    composite_workspace, tmp_path, capsys
+):
+    jump = composite_workspace.controller_files()["starman_jump_robust"][0]
+    script = composite_workspace.script
+    argv = ["composite", script, "--controllers", jump, "-o", tmp_path / "c.h5"]
+    assert main([str(arg) for arg in argv]) == 2
+    assert capsys.readouterr().err.strip() == (
+        f"{script}:8:28: expected a built BSR search (no --controllers file "
+        "starman_cartwheel_robust/seedK.h5: build it with snakemake results/bsr_all or a "
+        "composite target), found 'starman_cartwheel_robust'"
+    )
+    assert not list(tmp_path.iterdir())
+
+
 def test_a_result_of_another_search_in_a_phases_folder_is_refused(composite_workspace, tmp_path):
     """The files are grouped by folder: one of another search (the same figure) copied into
     the jump's folder is refused at the phase's controller, not run as the jump."""
@@ -241,12 +256,20 @@ def test_a_search_the_pipeline_has_no_results_for_is_named_at_its_column(
     output = tmp_path / "out.h5"
     assert main(["composite", str(script), "--controllers", *files, "-o", str(output)]) == 2
     assert capsys.readouterr().err == (
-        f"{script}:9:28: expected a built BSR search (no results/bsr/starman_jmp/seed*.h5: "
-        "build it with snakemake results/bsr_all or a composite target), found 'starman_jmp'\n"
+        f"{script}:9:28: expected a built BSR search (no --controllers file "
+        "starman_jmp/seedK.h5: build it with snakemake results/bsr_all or a composite target), "
+        "found 'starman_jmp'\n"
     )
     assert main(["composite", str(script), "--controllers", "-o", str(output)]) == 2
     assert capsys.readouterr().err == (
-        f"{script}:8:28: expected a built BSR search (no results/bsr/starman_cartwheel_robust/"
+        f"{script}:8:28: expected a built BSR search (no --controllers file "
+        "starman_cartwheel_robust/seedK.h5: build it with snakemake results/bsr_all or a "
+        "composite target), found 'starman_cartwheel_robust'\n"
+    )
+    empty = tmp_path / "bsr"
+    assert main(["composite", str(script), "--bsr-results", str(empty), "-o", str(output)]) == 2
+    assert capsys.readouterr().err == (
+        f"{script}:8:28: expected a built BSR search (no {empty}/starman_cartwheel_robust/"
         "seed*.h5: build it with snakemake results/bsr_all or a composite target), "
         "found 'starman_cartwheel_robust'\n"
     )

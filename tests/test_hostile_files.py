@@ -219,3 +219,53 @@ def test_the_job_server_replaces_only_a_socket(tmp_path, capsys):
         f"mosys: error: job-server: {tmp_path}/no/sock: expected a path in an existing folder "
         f"({tmp_path}/no)"
     )
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["robustness-table", "r.h5", "--pair", "a", "a", "--csv", "t.csv", "--md", "t.md"],
+         "mosys: error: robustness-table: --pair a a: a robust search and another, its twin"),
+        (["plot", "controls", "t.h5", "--control", "", "-o", "c.png"],
+         "mosys: error: plot controls: --control must name a control (default: the first)"),
+        (["plot", "luxo", "t.h5"], "mosys: error: plot luxo: give --strip, --forces and/or --gif"),
+        (["plot", "bsr3d", "r.h5", "--filmstrip", "f.png", "--interval", "inf"],
+         "mosys: error: plot bsr3d: --interval must be a positive number of seconds, got inf"),
+        (["plot", "car", "--map", "g.h5", "map.gif"],
+         "mosys: error: argument --map: expected a file name ending in .png or .pdf or .svg, "
+         "got 'map.gif'"),
+        (["composite", "s.comp", "--controllers", "a/seed1.h5", "--bsr-results", "r", "-o",
+          "c.h5"], "mosys: error: composite: give --controllers or --bsr-results, not both"),
+        (["composite", "s.comp", "--controllers", "a/table.h5", "-o", "c.h5"],
+         "mosys: error: composite: --controllers a/table.h5: expected a seed file, "
+         "SEARCH/seedK.h5"),
+    ],
+)  # fmt: skip
+def test_options_that_would_do_nothing_or_the_wrong_thing_are_usage_errors(
+    tmp_path, monkeypatch, capsys, argv, message
+):
+    monkeypatch.chdir(tmp_path)
+    assert refused(argv, capsys) == message
+    assert not list(tmp_path.iterdir())
+
+
+def test_a_chain_given_to_a_search_that_continues_none_is_refused(tmp_path, capsys):
+    chain = tmp_path / "seed1.h5"
+    chain.write_bytes(b"")
+    spec = SPECS / "bsr" / "starman_jump.bsr"
+    message = refused(
+        ["bsr-search", spec, "--seed", 1, "--chain", chain, "-o", tmp_path / "s.h5"], capsys
+    )
+    assert message == (
+        f"mosys: {spec}: --chain given, but the spec has no 'chain' line (it starts at rest)"
+    )
+    assert sorted(tmp_path.iterdir()) == [chain]
+
+
+def test_an_environment_numba_cannot_start_in_is_a_usage_error(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("NUMBA_NUM_THREADS", "0")
+    argv = ["dp", SPECS / "controllers" / "pendulum" / "A.ssc", "-o", tmp_path / "A.h5"]
+    assert refused(argv, capsys) == (
+        "mosys: error: the environment's NUMBA_NUM_THREADS='0': expected a whole number >= 1"
+    )
+    assert not list(tmp_path.iterdir())

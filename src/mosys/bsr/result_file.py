@@ -18,6 +18,7 @@ from mosys.bsr.search import (
     searched_variables,
 )
 from mosys.bsr.search3d import bind_search3d, chain_start, standing_height
+from mosys.errors import InputError
 from mosys.io.bsr_result import BsrResult, write_bsr_result
 from mosys.limits import check_job
 from mosys.parsing.bsr import BsrSpec, parse_bsr_spec
@@ -113,6 +114,10 @@ def _bind(
 ) -> tuple[SearchSetup, dict]:
     """The search set-up of a 2-D or 3-D figure (as its .fig says), and the root attrs only
     3-D results have."""
+    if chain_results and not spec.chain:  # given to continue a search the spec does not
+        raise InputError(
+            f"{spec.path}: --chain given, but the spec has no 'chain' line (it starts at rest)"
+        )
     parsed = load_rod_figure(figures_dir, spec.path, spec.tokens["figure"])
     if parsed.dimensions != 3:
         if spec.chain:

@@ -12,6 +12,7 @@ message, no traceback, no output file) or bad arguments; 1 any other failure.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import textwrap
 
@@ -100,11 +101,23 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def environment_problem() -> str | None:
+    """The usage error of an environment numba cannot start in (its import would raise)."""
+    threads = os.environ.get("NUMBA_NUM_THREADS")
+    if threads is not None and not (threads.strip().isdecimal() and int(threads) >= 1):
+        return f"the environment's NUMBA_NUM_THREADS={threads!r}: expected a whole number >= 1"
+    return None
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the verb ``argv`` names (None: this command line's); its exit code."""
     parser = build_parser()
     args = parser.parse_args(argv)
-    problem = args.command.check(args) or same_file_problem(args, args.output_options)
+    problem = (
+        args.command.check(args)
+        or same_file_problem(args, args.output_options)
+        or environment_problem()
+    )
     if problem:
         parser.error(problem)
     from mosys.errors import InputError, SimulationError

@@ -4,6 +4,7 @@ concatenation editor)."""
 from __future__ import annotations
 
 import argparse
+import re
 
 from mosys.cli.verb import (
     HDF5,
@@ -15,6 +16,8 @@ from mosys.cli.verb import (
     whole_number_problem,
 )
 
+SEED_FILE = re.compile(r"(^|/)seed\d+\.h5$")  # what the pipeline passes: SEARCH/seedK.h5
+
 
 def _composite_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("script", help="the composite-motion script (.comp)")
@@ -24,7 +27,7 @@ def _composite_arguments(parser: argparse.ArgumentParser) -> None:
         help="BSR result files (SEARCH/seedK.h5) the phases may use (the pipeline lists them)",
     )
     parser.add_argument(
-        "--bsr-results", default="results/bsr", help="where SEARCH/seedK.h5 live (no --controllers)"
+        "--bsr-results", help="where SEARCH/seedK.h5 live (default results/bsr; no --controllers)"
     )
     parser.add_argument("--figures", default="specs/figures", help="where NAME.fig lives")
     parser.add_argument("--bsr-specs", default="specs/bsr", help="where SEARCH.bsr lives")
@@ -35,19 +38,26 @@ def _composite_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _composite_check(args: argparse.Namespace) -> str | None:
+    if args.controllers is not None and args.bsr_results is not None:
+        return "composite: give --controllers or --bsr-results, not both"
+    odd = [path for path in args.controllers or () if not SEED_FILE.search(path)]
+    if odd:
+        return f"composite: --controllers {odd[0]}: expected a seed file, SEARCH/seedK.h5"
     return first_problem(
         *(whole_number_problem("composite", key, getattr(args, key), 1) for key in ("q", "g", "h"))
     )
 
 
-def _composite_controller_files(args: argparse.Namespace, script) -> dict:
+def _composite_controller_files(args: argparse.Namespace, script) -> tuple[dict, str]:
     """The BSR result files the script may use: the ``--controllers`` given (grouped by their
-    directory, the search's name), else every seed file under ``--bsr-results``."""
+    directory, the search's name), else every seed file under ``--bsr-results``; and where a
+    search's files were looked for (``session.open_session``'s ``looked_in``)."""
     from mosys.composite.session import files_by_search, find_controller_files
 
     if args.controllers is None:
-        return find_controller_files(script, args.bsr_results)
-    return files_by_search(args.controllers)
+        results = args.bsr_results or "results/bsr"
+        return find_controller_files(script, results), f"{results}/{{search}}/seed*.h5"
+    return files_by_search(args.controllers), "--controllers file {search}/seedK.h5"
 
 
 def _composite(args: argparse.Namespace) -> None:
@@ -56,14 +66,16 @@ def _composite(args: argparse.Namespace) -> None:
 
     script = parse_composite_script(args.script)
     sizes = {key: getattr(args, key) for key in ("q", "g", "h") if getattr(args, key) is not None}
+    files, looked_in = _composite_controller_files(args, script)
     found = composite_to_file(
         args.script,
-        _composite_controller_files(args, script),
+        files,
         args.output,
         args.figures,
         args.bsr_specs,
         sizes,
         args.budget,
+        looked_in,
     )
     print(
         f"{args.output}: total {found.guess_score:.3f} -> {found.score:.3f}, durations "

@@ -123,6 +123,15 @@ def _robustness_table_arguments(parser: argparse.ArgumentParser) -> None:
     add_table_outputs(parser)
 
 
+def _robustness_table_check(args: argparse.Namespace) -> str | None:
+    same = next((pair for pair in args.pair if pair[0] == pair[1]), None)
+    if same:
+        return (
+            f"robustness-table: --pair {same[0]} {same[1]}: a robust search and another, its twin"
+        )
+    return None
+
+
 def _robustness_table(args: argparse.Namespace) -> None:
     from mosys.paper_tables.robustness import write_robustness_table
 
@@ -186,6 +195,7 @@ FAMILY = Family(
             "robust BSR searches against their plain twins",
             _robustness_table_arguments,
             _robustness_table,
+            _robustness_table_check,
         ),
     ),
 )

@@ -74,6 +74,12 @@ def _controls_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-o", "--output", required=True, type=OutputPath(*PLOT), help="PNG")
 
 
+def _controls_check(args: argparse.Namespace) -> str | None:
+    if args.control is not None and not args.control.strip():
+        return "plot controls: --control must name a control (default: the first)"
+    return None
+
+
 def _controls(args: argparse.Namespace) -> None:
     from mosys.plots.controls import plot_controls
 
@@ -87,9 +93,14 @@ def _free_swing_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _free_swing(args: argparse.Namespace) -> None:
     from mosys.dynamics.load import load_dynamics
+    from mosys.errors import InputError
     from mosys.plots.free_swing import plot_free_swing
 
-    plot_free_swing(load_dynamics(args.dynamics), args.output)
+    dynamics = load_dynamics(args.dynamics)
+    try:
+        plot_free_swing(dynamics, args.output)
+    except InputError as error:  # about the module: say which
+        raise InputError(f"{args.dynamics}: {error}") from None
 
 
 def _car_arguments(parser: argparse.ArgumentParser) -> None:
@@ -345,6 +356,7 @@ FAMILY = Family(
             "a control against time in several scripts, with slew limits",
             _controls_arguments,
             _controls,
+            _controls_check,
         ),
         Verb(
             "plot free-swing",

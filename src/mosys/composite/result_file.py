@@ -86,14 +86,16 @@ def composite_to_file(
     bsr_specs_dir: str | Path = "specs/bsr",
     search_sizes: Mapping[str, int] | None = None,
     budget: str = "paper",
+    looked_in: str = "results/bsr/{search}/seed*.h5",
 ) -> TransitionSearch:
     """Parse the script, bind it to its controllers (``controller_files``: search -> its
-    seedK.h5 files), score the guess, run Figure 5's search and write both motions atomically.
-    ``search_sizes`` overrides the script's q, g, h or seed (a config's budget)."""
+    seedK.h5 files; ``looked_in``: where, for a message, as ``open_session``), score the guess,
+    run Figure 5's search and write both motions atomically. ``search_sizes`` overrides the
+    script's q, g, h or seed (a config's budget)."""
     script = parse_composite_script(script_path)
     if search_sizes:
         script = replace(script, search=replace(script.search, **search_sizes))
-    session = open_session(script, controller_files, figures_dir, bsr_specs_dir)
+    session = open_session(script, controller_files, figures_dir, bsr_specs_dir, looked_in)
     check_size(session)
     before = session.score(session.guess)  # also compiles the kernels before the clock starts
     settings = script.search

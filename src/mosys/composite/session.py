@@ -146,10 +146,12 @@ def open_session(
     controller_files: Mapping[str, Sequence[str | Path]],
     figures_dir: str | Path = "specs/figures",
     bsr_specs_dir: str | Path = "specs/bsr",
+    looked_in: str = "results/bsr/{search}/seed*.h5",
 ) -> CompositeSession:
     """Bind the script: ``controller_files`` maps each phase's search to its result files
     (``.../seedK.h5``). A figure, search or seed that is not there raises SpecError at the word
-    of the script that names it."""
+    of the script that names it; ``looked_in`` says where a search's files were looked for
+    (``{search}``: its name)."""
     figure = load_bsr_figure(figures_dir, script.path, script.tokens["figure"])
     controllers, seeds, files, dts, lengths = [], [], [], [], []
     for phase in script.phases:
@@ -163,8 +165,8 @@ def open_session(
             raise SpecError.at(
                 script.path,
                 token,
-                f"a built BSR search (no results/bsr/{phase.controller}/seed*.h5: build it with"
-                f" snakemake results/bsr_all or a composite target)",
+                f"a built BSR search (no {looked_in.format(search=phase.controller)}: build it "
+                f"with snakemake results/bsr_all or a composite target)",
             )
         if phase.seed is not None:
             if phase.seed not in candidates:

@@ -75,9 +75,10 @@ def _check_one_coordinate(dynamics: ModuleType) -> None:
     """InputError unless the figure's state is one coordinate and its rate (the kernels would
     read past the end of a shorter state)."""
     if dynamics.COORDINATE_COUNT != 1 or len(dynamics.STATE_NAMES) != 2:
+        coordinates = dynamics.STATE_NAMES[: dynamics.COORDINATE_COUNT]
         raise InputError(
-            "a figure with one coordinate, such as the pendulum (this one has "
-            f"{dynamics.COORDINATE_COUNT}: {', '.join(dynamics.STATE_NAMES)})"
+            "expected a figure with one coordinate, such as the pendulum; this one has "
+            f"{dynamics.COORDINATE_COUNT} ({', '.join(coordinates)})"
         )
 
 

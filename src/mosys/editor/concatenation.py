@@ -661,7 +661,11 @@ def run_editor(
         )
     script = parse_composite_script(script_path)
     session = open_session(
-        script, find_controller_files(script, results_dir), figures_dir, bsr_specs_dir
+        script,
+        find_controller_files(script, results_dir),
+        figures_dir,
+        bsr_specs_dir,
+        f"{results_dir}/{{search}}/seed*.h5",
     )
     check_size(session)  # the guess is run at once, as by ``mosys composite``
     with plot_style():
