@@ -269,3 +269,10 @@ def test_an_environment_numba_cannot_start_in_is_a_usage_error(tmp_path, monkeyp
         "mosys: error: the environment's NUMBA_NUM_THREADS='0': expected a whole number >= 1"
     )
     assert not list(tmp_path.iterdir())
+
+
+def test_the_plot_suffixes_the_command_line_allows_are_those_plots_write():
+    from mosys.cli.verb import PLOT
+    from mosys.plots.style import FIGURE_FORMATS
+
+    assert tuple(f".{name}" for name in FIGURE_FORMATS) == PLOT
