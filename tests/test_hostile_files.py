@@ -276,3 +276,13 @@ def test_the_plot_suffixes_the_command_line_allows_are_those_plots_write():
     from mosys.plots.style import FIGURE_FORMATS
 
     assert tuple(f".{name}" for name in FIGURE_FORMATS) == PLOT
+
+
+def test_only_the_verbs_own_arguments_count_as_its_inputs(tmp_path, monkeypatch):
+    """``mosys index listed.txt -o index`` run again: the output's name is also the verb's,
+    which is no input of it (the start-up benchmark's second run was refused)."""
+    monkeypatch.chdir(tmp_path)
+    Path("listed.txt").write_text("")
+    for _ in range(2):
+        assert main(["index", "listed.txt", "-o", "index"]) == 0
+    assert Path("index").is_file()

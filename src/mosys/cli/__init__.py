@@ -18,7 +18,7 @@ import textwrap
 
 from mosys import __version__
 from mosys.cli import animation, bsr, composite, dynamics, index, info, paper_tables, plots, ssc
-from mosys.cli.verb import Family, output_options, same_file_problem
+from mosys.cli.verb import Family, file_options, same_file_problem
 
 # In `mosys --help` order: the pipeline's steps, then what is drawn and tabulated from them.
 FAMILIES: tuple[Family, ...] = (
@@ -97,7 +97,7 @@ def build_parser() -> argparse.ArgumentParser:
                 groups[group] = verbs.add_parser(group).add_subparsers(dest="kind", required=True)
             subparser = (groups[group] if group else verbs).add_parser(name, help=verb.summary)
             verb.add_arguments(subparser)
-            subparser.set_defaults(command=verb, output_options=output_options(subparser))
+            subparser.set_defaults(command=verb, file_options=file_options(subparser))
     return parser
 
 
@@ -115,7 +115,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     problem = (
         args.command.check(args)
-        or same_file_problem(args, args.output_options)
+        or same_file_problem(args, args.file_options)
         or environment_problem()
     )
     if problem:

@@ -72,30 +72,40 @@ def output_path_problem(option: str, text: str, *suffixes: str) -> str | None:
     return None
 
 
-def output_options(parser: argparse.ArgumentParser) -> tuple[tuple[str, str], ...]:
-    """The (dest, option) of each of the parser's arguments of type ``OutputPath``."""
-    return tuple(
-        (action.dest, action.option_strings[-1] if action.option_strings else action.dest)
-        for action in parser._actions  # argparse keeps no public list of a parser's arguments
-        if isinstance(action.type, OutputPath)
+@dataclass(frozen=True)
+class FileOptions:
+    """A verb's arguments by role: ``outputs`` (dest, option) of those of type ``OutputPath``;
+    ``others`` the dests of the rest that take values (the inputs among them)."""
+
+    outputs: tuple[tuple[str, str], ...]
+    others: tuple[str, ...]
+
+
+def file_options(parser: argparse.ArgumentParser) -> FileOptions:
+    """The ``FileOptions`` of a verb's parser."""
+    actions = [  # argparse keeps no public list of a parser's arguments
+        action for action in parser._actions if action.nargs != 0 and action.dest != "help"
+    ]
+    outputs = [action for action in actions if isinstance(action.type, OutputPath)]
+    return FileOptions(
+        tuple((a.dest, a.option_strings[-1] if a.option_strings else a.dest) for a in outputs),
+        tuple(action.dest for action in actions if action not in outputs),
     )
 
 
-def same_file_problem(args: argparse.Namespace, outputs: tuple[tuple[str, str], ...]) -> str | None:
-    """The usage error of two outputs (``output_options``) naming one file, or of an output
-    naming a file the command line also gives as an input (it would be replaced before or
-    while it is read); None if neither."""
+def same_file_problem(args: argparse.Namespace, options: FileOptions) -> str | None:
+    """The usage error of two outputs naming one file, or of an output naming a file the
+    command line also gives as an input (it would be replaced before or while it is read);
+    None if neither."""
     written: dict[str, str] = {}
-    for dest, option in outputs:
+    for dest, option in options.outputs:
         value = getattr(args, dest)
         if value:
             other = written.setdefault(os.path.realpath(value), option)
             if other != option:
                 return f"{args.command.name}: {other} and {option} name the same file, {value}"
-    output_dests = {dest for dest, _ in outputs}
-    for dest, value in vars(args).items():
-        if dest in output_dests:
-            continue
+    for dest in options.others:
+        value = getattr(args, dest)
         for text in value if isinstance(value, list) else [value]:
             for path in text if isinstance(text, list) else [text]:
                 if isinstance(path, str) and os.path.isfile(path):
