@@ -1,16 +1,29 @@
 """Atomic output (``io.atomic``): two writers of one path at once each finish whole, and the file
 left is one of theirs, never a mix; a writer that fails leaves neither its partial file nor a
-change at the path."""
+change at the path; a command's outputs appear together or not at all, also when a later one
+fails, the disk is full or a signal stops it."""
 
 from __future__ import annotations
 
+import errno
+import os
+import signal
 import threading
 import time
 from pathlib import Path
 
+import h5py
+import numpy as np
 import pytest
 
-from mosys.io.atomic import write_atomically
+from mosys.cli import main, stop_signals_raise
+from mosys.errors import InputError, Stopped
+from mosys.io.atomic import (
+    outputs_together,
+    write_atomically,
+    write_hdf5_atomically,
+    write_text_atomically,
+)
 
 
 def slow_writer(letter: str, started: threading.Barrier):
@@ -58,3 +71,96 @@ def test_a_failed_write_leaves_the_old_file_and_no_partial(tmp_path):
         write_atomically(path, fail)
     assert path.read_text() == "old"
     assert [p.name for p in tmp_path.iterdir()] == ["plot.png"]
+
+
+def no_room(real_method):
+    """``real_method`` (a Path writer) failing as on a full disk."""
+
+    def write(self: Path, *args, **kwargs):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(self))
+
+    return write
+
+
+def test_an_hdf5_file_is_built_in_memory_and_a_full_disk_is_one_clear_error(tmp_path, monkeypatch):
+    """HDF5 flushing a file on a full disk crashed the process at teardown (exit 139) and could
+    leave its partial file: the file is now made in memory and written as bytes."""
+    path = tmp_path / "x.h5"
+
+    def fill(h5: h5py.File) -> None:
+        h5["x"] = np.arange(5.0)
+        h5["x"].make_scale("x")
+        h5.attrs["kind"] = "test"
+
+    write_hdf5_atomically(path, fill)
+    with h5py.File(path, "r") as h5:
+        np.testing.assert_array_equal(h5["x"][()], np.arange(5.0))
+        assert h5.attrs["kind"] == "test" and h5["x"].is_scale
+    monkeypatch.setattr(Path, "write_bytes", no_room(Path.write_bytes))
+    with pytest.raises(InputError) as error:
+        write_hdf5_atomically(tmp_path / "y.h5", fill)
+    assert str(error.value) == f"{tmp_path / 'y.h5'}: cannot write it: No space left on device"
+    assert sorted(tmp_path.iterdir()) == [path]
+
+
+def test_a_commands_outputs_appear_together_or_not_at_all(tmp_path):
+    first, second = tmp_path / "t.csv", tmp_path / "t.md"
+    with outputs_together():
+        write_text_atomically(first, "csv")
+        assert not first.exists()  # held back until the command ends
+        write_text_atomically(second, "md")
+    assert (first.read_text(), second.read_text()) == ("csv", "md")
+    first.write_text("old")
+    with pytest.raises(ValueError, match="the table failed"), outputs_together():
+        write_text_atomically(first, "new")
+        raise ValueError("the table failed")
+    assert first.read_text() == "old"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.csv", "t.md"]
+
+
+def test_a_full_disk_under_a_tables_second_file_leaves_neither(
+    pendulum, tmp_path, monkeypatch, capsys
+):
+    """Every table verb writes a CSV and then a Markdown file: the CSV stayed when the second
+    could not be written."""
+    real_write_text = Path.write_text
+
+    def write_text(self: Path, *args, **kwargs):
+        if ".md." in self.name:  # the Markdown file's partial
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(self))
+        return real_write_text(self, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "write_text", write_text)
+    out = tmp_path / "out"
+    out.mkdir()
+    argv = ["pendulum-table", pendulum / "controllers" / "A.h5", "--dynamics",
+            pendulum / "dynamics" / "link1.py", "--csv", out / "t.csv",
+            "--md", out / "t.md"]  # fmt: skip
+    assert main([str(arg) for arg in argv]) == 2
+    assert capsys.readouterr().err.strip() == (
+        f"mosys: {out / 't.md'}: cannot write it: No space left on device"
+    )
+    assert not list(out.iterdir())
+
+
+def test_sigterm_stops_a_command_and_leaves_no_partial(tmp_path):
+    handler = signal.getsignal(signal.SIGTERM)
+    with pytest.raises(Stopped) as stopped, stop_signals_raise(), outputs_together():
+        write_text_atomically(tmp_path / "a.txt", "written, held back")
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(5)  # the handler raises at the next instruction
+    assert stopped.value.code == 128 + signal.SIGTERM
+    assert not list(tmp_path.iterdir())
+    assert signal.getsignal(signal.SIGTERM) == handler  # restored
+
+
+def test_ctrl_c_is_one_line_and_exit_130(tmp_path, monkeypatch, capsys):
+    import mosys.io.info
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(mosys.io.info, "describe_file", interrupted)
+    (tmp_path / "x.h5").write_bytes(b"")
+    assert main(["info", str(tmp_path / "x.h5")]) == 130
+    assert capsys.readouterr().err == "mosys: interrupted; nothing written\n"

@@ -11,6 +11,7 @@ import os
 import re
 import signal
 import socket
+import struct
 import subprocess
 import sys
 import time
@@ -229,6 +230,7 @@ def test_a_request_the_server_cannot_serve_runs_in_the_client(server, tmp_path):
         b"\x00\x00\x00\x02{}",
         b"\x00\x00\x00\x0f" + b'{"argv": [1,2]}',
         b"\xff\xff\xff\xff",
+        struct.pack(">I", 200_000) + b"[" * 200_000,  # json's RecursionError ended the server
     ],
 )
 def test_a_malformed_request_is_refused_and_the_server_serves_on(server, tmp_path, request_bytes):
@@ -242,6 +244,22 @@ def test_a_malformed_request_is_refused_and_the_server_serves_on(server, tmp_pat
     done = mosys(server, "index", "a.txt", "-o", "listed.txt", cwd=tmp_path)
     assert done.returncode == 0 and server.process.poll() is None
     assert [line for _, line in server.jobs()][0] == "started: mosys index a.txt -o listed.txt"
+
+
+def test_a_second_server_on_a_live_servers_socket_is_refused(server):
+    """It used to take the socket over: stopping the first then removed the second's."""
+    done = subprocess.run(
+        [sys.executable, "-m", "mosys.command", "job-server", str(server.socket), "--idle", "1"],
+        capture_output=True,
+        text=True,
+        env=environment(),
+        timeout=60,
+    )
+    assert done.returncode == 2
+    assert done.stderr.strip().splitlines()[-1] == (
+        f"mosys: error: job-server: a job server is already listening on {server.socket}"
+    )
+    assert server.process.poll() is None and server.socket.exists()
 
 
 def test_the_server_stops_on_sigterm_and_removes_its_socket(server):

@@ -21,3 +21,14 @@ class NonFiniteStateError(SimulationError):
         super().__init__(message)
         self.t = t
         self.state = state
+
+
+class Stopped(BaseException):
+    """A stop signal (SIGTERM, SIGHUP) received while a command ran, raised where it arrived as
+    Ctrl-C raises KeyboardInterrupt, so that the command's partial outputs are removed on the
+    way out (``cli.stops_as_exit``); ``code`` is the exit code, 128 + the signal's number. Not
+    an Exception: nothing on the way catches it as an error."""
+
+    def __init__(self, number: int):
+        super().__init__(f"stopped by signal {number}")
+        self.code = 128 + number

@@ -345,14 +345,18 @@ def parsed_spec(path):
 
 
 def controller_dynamics(wildcards):
-    """The generated dynamics a controller spec names in its 'dyn' line. Without the spec, the
-    spec itself (a missing input): another rule may make the file asked for (slew_torque.png
-    is compared_controls', not a plot of a controller 'slew'), and if none does, Snakemake
-    names the spec it lacks."""
+    """The generated dynamics a controller spec names in its 'dyn' line."""
+    spec = parsed_spec(f"specs/controllers/{wildcards.group}/{wildcards.name}.ssc")
+    return [f"results/dynamics/{spec.figure}.py"]
+
+
+def plotted_controller_dynamics(wildcards):
+    """``controller_dynamics`` for a controller's plots; without the spec, the spec itself (a
+    missing input), since the file asked for may be another's to make (slew_torque.png is
+    compared_controls', not the torque plot of a controller 'slew', whose missing spec
+    printed a traceback in every dry run of all)."""
     path = f"specs/controllers/{wildcards.group}/{wildcards.name}.ssc"
-    if not Path(path).is_file():
-        return [path]
-    return [f"results/dynamics/{parsed_spec(path).figure}.py"]
+    return controller_dynamics(wildcards) if Path(path).is_file() else [path]
 
 
 def script_figure(script):

@@ -7,7 +7,7 @@ PENDULUM_GROUP = re.escape(config["pendulum"]["group"])
 rule controller_plots:
     input:
         table="results/controllers/{group}/{name}.h5",
-        dynamics=controller_dynamics,
+        dynamics=plotted_controller_dynamics,
         code=code_inputs("mosys.cli.plots", "mosys.plots.pendulum", "mosys.dynamics.load"),  # mosys plot controller
     output:
         portrait=report("results/plots/{group}/{name}_portrait.png", caption="../report/portrait.rst", category="1990 paper: the pendulum", subcategory="Figure 14 portraits"),

@@ -13,12 +13,17 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
 import textwrap
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 from mosys import __version__
 from mosys.cli import animation, bsr, composite, dynamics, index, info, paper_tables, plots, ssc
 from mosys.cli.verb import Family, file_options, same_file_problem
+from mosys.errors import Stopped
 
 # In `mosys --help` order: the pipeline's steps, then what is drawn and tabulated from them.
 FAMILIES: tuple[Family, ...] = (
@@ -122,10 +127,12 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(problem)
     from mosys.errors import InputError, SimulationError
     from mosys.files import command_files
+    from mosys.io.atomic import outputs_together
     from mosys.parsing.tokens import SpecError
 
     try:
-        with command_files():  # no output replaces a file the verb read
+        # no output replaces a file the verb read; its outputs appear all together or none
+        with stop_signals_raise(), command_files(), outputs_together():
             args.command.handler(args)
     except (SpecError, SimulationError) as error:
         print(error, file=sys.stderr)  # file:line:column: first, as compilers do
@@ -133,4 +140,30 @@ def main(argv: list[str] | None = None) -> int:
     except (OSError, InputError) as error:  # a missing, unreadable or corrupt input file
         print(f"mosys: {error}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("mosys: interrupted; nothing written", file=sys.stderr)
+        return 128 + signal.SIGINT
+    except Stopped as stop:  # SIGTERM or SIGHUP: whoever sent it knows
+        return stop.code
     return 0
+
+
+@contextmanager
+def stop_signals_raise() -> Iterator[None]:
+    """Within the block, SIGTERM and SIGHUP (a scheduler or a closed terminal stopping the
+    command) raise ``Stopped``, as Ctrl-C raises KeyboardInterrupt, so that the partial outputs
+    are removed on the way out; the handlers before are restored after. Outside the main
+    thread (signals reach only it) the block changes nothing."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(number: int, _frame) -> None:
+        raise Stopped(number)
+
+    before = {number: signal.signal(number, stop) for number in (signal.SIGTERM, signal.SIGHUP)}
+    try:
+        yield
+    finally:
+        for number, handler in before.items():
+            signal.signal(number, handler)

@@ -65,6 +65,7 @@ PER_JOB_VARIABLES = ("NUMBA_NUM_THREADS",)  # each job's own: numba's config re-
 PRELOAD_TRIES = 3  # tries of a module that needed compiling, one after each job's end
 POLL_S = 1.0  # how often the server looks for its parent and its idle time
 REQUEST_TIMEOUT_S = 10.0
+SOCKET_PATH_BYTES = 107  # a Unix socket's path, its NUL aside (sockaddr_un)
 
 
 def serve(path: str, idle_seconds: float) -> None:
@@ -91,12 +92,17 @@ def serve(path: str, idle_seconds: float) -> None:
             os.unlink(path)
 
 
+def _unready_path(path: str) -> str:
+    """Where the server's socket is bound before it is renamed to ``path``."""
+    return os.path.join(os.path.dirname(path), f".mosys-job-server-{os.getpid()}")
+
+
 def _listening_socket(path: str) -> socket.socket:
     """A Unix socket listening at ``path`` (replacing a stale one). It is bound and listening
     under a name of its own first, then renamed: a client that sees ``path`` can connect (a
     socket bound at ``path`` refuses connections until ``listen``)."""
     listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
-    unready = os.path.join(os.path.dirname(path), f".mosys-job-server-{os.getpid()}")
+    unready = _unready_path(path)
     with contextlib.suppress(FileNotFoundError):
         os.unlink(unready)
     try:
@@ -238,7 +244,9 @@ def _log(line: str) -> None:
     """A line of the server's log (its standard output), stamped with the wall-clock time."""
     now = time.time()
     stamp = time.strftime("%H:%M:%S", time.localtime(now)) + f".{int(now % 1 * 1000):03d}"
-    print(f"{stamp} {line}", flush=True)
+    text = f"{stamp} {line}".encode("utf-8", "backslashreplace").decode("utf-8")  # argv's bytes
+    with contextlib.suppress(OSError):  # a log that cannot be written loses a line, not the server
+        print(text, flush=True)
 
 
 def _send_line(connection: socket.socket, line: str) -> None:
@@ -250,21 +258,24 @@ def _receive_request(connection: socket.socket) -> tuple[dict, list[int]]:
     """The client's request and the descriptors of its standard streams."""
     connection.settimeout(REQUEST_TIMEOUT_S)
     data, fds, _, _ = socket.recv_fds(connection, 1 << 16, 3)
-    if len(data) < 4:
-        raise OSError("short request")
-    (length,) = struct.unpack(">I", data[:4])
-    body = data[4:]
-    while len(body) < length:
-        chunk = connection.recv(length - len(body))
-        if not chunk:
-            raise OSError("truncated request")
-        body += chunk
-    connection.settimeout(None)
-    request = json.loads(body)
-    if not _well_formed(request, fds):
+    try:
+        if len(data) < 4:
+            raise OSError("short request")
+        (length,) = struct.unpack(">I", data[:4])
+        body = data[4:]
+        while len(body) < length:
+            chunk = connection.recv(length - len(body))
+            if not chunk:
+                raise OSError("truncated request")
+            body += chunk
+        connection.settimeout(None)
+        request = json.loads(body)  # ValueError, or RecursionError for a deeply nested body
+        if not _well_formed(request, fds):
+            raise ValueError("malformed request")
+    except Exception:  # the descriptors it sent are the server's to close
         for fd in fds:
             os.close(fd)
-        raise ValueError("malformed request")
+        raise
     return request, fds
 
 
@@ -308,7 +319,7 @@ def _start_job(connection, selector) -> tuple[int, int] | None:
     then runs it)."""
     try:
         request, fds = _receive_request(connection)
-    except (OSError, ValueError, KeyError):
+    except Exception:  # noqa: BLE001 - whatever a request holds, the server goes on serving
         return None
     try:
         reason = decline_reason(request)
@@ -340,8 +351,9 @@ def _run_job(request: dict, fds: list[int]) -> int:
     Python's own exit would give it."""
     try:
         _become_client(request, fds)
-    except BaseException:
-        traceback.print_exc()
+    except Exception as error:  # noqa: BLE001 - e.g. its working directory is gone
+        with contextlib.suppress(OSError):
+            os.write(2, f"mosys: the job server could not run this job: {error}\n".encode())
         return 1
     code = _exit_code(importlib.import_module("mosys.cli").main, request["argv"])
     with contextlib.suppress(BaseException):
@@ -410,9 +422,15 @@ def _check(args: argparse.Namespace) -> str | None:
     folder = os.path.dirname(args.socket) or "."
     if not os.path.isdir(folder):
         return f"job-server: {args.socket}: expected a path in an existing folder ({folder})"
+    longest = max(len(os.fsencode(args.socket)), len(os.fsencode(_unready_path(args.socket))))
+    if longest > SOCKET_PATH_BYTES:
+        return f"job-server: {args.socket}: a socket's path is at most {SOCKET_PATH_BYTES} bytes"
     with contextlib.suppress(OSError):
         if not stat.S_ISSOCK(os.lstat(args.socket).st_mode):
             return f"job-server: {args.socket} exists and is not a socket; not replaced"
+        with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as probe:
+            probe.connect(args.socket)  # answered: not stale
+            return f"job-server: a job server is already listening on {args.socket}"
     return positive_number_problem("job-server", "idle", args.idle)
 
 

@@ -94,13 +94,15 @@ def _free_swing_arguments(parser: argparse.ArgumentParser) -> None:
 def _free_swing(args: argparse.Namespace) -> None:
     from mosys.dynamics.load import load_dynamics
     from mosys.errors import InputError
-    from mosys.plots.free_swing import plot_free_swing
+    from mosys.plots.free_swing import free_swing_figure
+    from mosys.plots.style import save_figure
 
     dynamics = load_dynamics(args.dynamics)
     try:
-        plot_free_swing(dynamics, args.output)
+        figure = free_swing_figure(dynamics)
     except InputError as error:  # about the module: say which
         raise InputError(f"{args.dynamics}: {error}") from None
+    save_figure(figure, args.output)
 
 
 def _car_arguments(parser: argparse.ArgumentParser) -> None:

@@ -323,7 +323,7 @@ class ConcatenationEditor:
         written = parse_composite_text(new_text, str(self.script_path))
         if written.guessed_ticks != ticks:  # the rewrite's own check, before touching the file
             raise AssertionError(f"rewritten script has ticks {written.guessed_ticks}, not {ticks}")
-        write_text_atomically(self.script_path, new_text, replaces_input=True)
+        write_text_atomically(self.script_path, new_text, saves_opened_file=True)
         self._file_sha256 = hashlib.sha256(new_text.encode("utf-8")).hexdigest()
         self.saved_ticks = ticks
         self._redraw(status=f"saved ticks {', '.join(map(str, ticks))} to {self.script_path}")

@@ -5,8 +5,11 @@ from __future__ import annotations
 import contextlib
 import os
 import secrets
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
+
+import h5py
 
 from mosys.errors import InputError
 from mosys.files import output_problem
@@ -14,40 +17,86 @@ from mosys.files import output_problem
 PARTIAL_NAME_BYTES = 120  # of the final name kept in the partial's: NAME_MAX is 255 bytes
 
 
+_held: list[tuple[Path, Path]] | None = None  # (partial, path) a command holds back; None: none
+
+
+@contextmanager
+def outputs_together() -> Iterator[None]:
+    """One command's outputs, all or none: within the block every ``write_atomically`` writes
+    its partial file and holds it back; when the block ends they are renamed onto their paths
+    together, and if it raises (a later output failing, a signal made an exception) every
+    partial is removed and no output changes."""
+    global _held
+    outer, _held = _held, []
+    try:
+        yield
+        for partial, path in _held:
+            try:
+                os.replace(partial, path)
+            except OSError as error:
+                raise InputError(f"{path}: cannot write it: {error.strerror or error}") from None
+    finally:
+        for partial, _ in _held:
+            with contextlib.suppress(FileNotFoundError, NotADirectoryError):
+                partial.unlink()
+        _held = outer
+
+
 def write_atomically(
-    path: str | Path, write: Callable[[Path], None], replaces_input: bool = False
+    path: str | Path, write: Callable[[Path], None], saves_opened_file: bool = False
 ) -> None:
-    """Call ``write(partial)`` on a hidden sibling path, then rename it onto ``path``.
+    """Call ``write(partial)`` on a hidden sibling path, then rename it onto ``path`` (within
+    ``outputs_together``, when the command ends).
 
     The rename is atomic on POSIX file systems; on any exception the partial file is removed and
     ``path`` is left as it was. The partial path is this call's own (``.NAME.PID.RANDOM.partial``,
     NAME cut short if long), so that two writers of one path at once (parallel jobs, tests)
     never rename a file the other is still writing: the last rename wins, whole. InputError
     naming ``path``, before anything is written, where it is no file name, an existing
-    directory or special file, or (unless ``replaces_input``: an editor saving the file it
-    opened) a file this command read (``files.output_problem``); and for a write the system
-    refuses (a folder that cannot be made, no room, a name too long).
+    directory or special file, or a file this command read (``files.output_problem``); and for
+    a write the system refuses (a folder that cannot be made, no room, a name too long).
+    ``saves_opened_file``: the editor's Save, writing the file it opened, which may be an input
+    of the command and is written at once.
     """
     problem = output_problem(path)
-    if problem and not (replaces_input and problem.startswith("it is an input")):
+    if problem and not (saves_opened_file and problem.startswith("it is an input")):
         raise InputError(f"{os.fspath(path) or repr('')}: cannot write it: {problem}")
     path = Path(path)
     name = path.name.encode("utf-8", "surrogateescape")[:PARTIAL_NAME_BYTES]
     short = name.decode("utf-8", "ignore")
     partial = path.with_name(f".{short}.{os.getpid()}.{secrets.token_hex(4)}.partial")
+    held_back = False  # the partial handed to ``outputs_together``, which renames or removes it
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         write(partial)
-        os.replace(partial, path)
+        if _held is not None and not saves_opened_file:
+            _held.append((partial, path))
+            held_back = True
+        else:
+            os.replace(partial, path)
     except OSError as error:  # the partial's name in the system's message means nothing to a user
         raise InputError(f"{path}: cannot write it: {error.strerror or error}") from None
     finally:
-        with contextlib.suppress(FileNotFoundError, NotADirectoryError):
-            partial.unlink()
+        if not held_back:
+            with contextlib.suppress(FileNotFoundError, NotADirectoryError):
+                partial.unlink()
 
 
-def write_text_atomically(path: str | Path, text: str, replaces_input: bool = False) -> None:
+def write_hdf5_atomically(path: str | Path, fill: Callable[[h5py.File], None]) -> None:
+    """Write the HDF5 file that ``fill(h5)`` makes to ``path`` atomically. The file is built in
+    memory (HDF5's core driver, nothing on disk) and written as plain bytes: a write the system
+    refuses (no room left) is then an OSError like any other file's, where HDF5 failing to
+    flush a file on disk crashed the process as it tore the file's objects down."""
+    name = f"mosys-{secrets.token_hex(8)}.h5"  # HDF5 knows an open file by its name
+    with h5py.File(name, "w", driver="core", backing_store=False) as h5:
+        fill(h5)
+        h5.flush()
+        image = h5.id.get_file_image()
+    write_atomically(path, lambda partial: partial.write_bytes(image))
+
+
+def write_text_atomically(path: str | Path, text: str, saves_opened_file: bool = False) -> None:
     """Write ``text`` (UTF-8) to ``path`` atomically (``write_atomically``)."""
     write_atomically(
-        path, lambda partial: partial.write_text(text, encoding="utf-8"), replaces_input
+        path, lambda partial: partial.write_text(text, encoding="utf-8"), saves_opened_file
     )

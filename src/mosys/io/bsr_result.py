@@ -19,7 +19,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from mosys.io.atomic import write_atomically
+from mosys.io.atomic import write_hdf5_atomically
 from mosys.io.attributes import DIMENSIONLESS, INDEX, SI_STATE, create_with_unit, string_tuple
 from mosys.io.contracts import open_contract
 from mosys.io.provenance import provenance_attributes
@@ -102,31 +102,30 @@ class BsrResult:
 def write_bsr_result(path: str | Path, result: BsrResult) -> None:
     """Write a result file atomically."""
 
-    def write(partial: Path) -> None:
-        with h5py.File(partial, "w") as h5:
-            curve = h5.create_group("learning_curve")
-            evaluations = np.asarray(result.evaluations, np.int64)
-            create_with_unit(curve, "evaluations", evaluations, DIMENSIONLESS)
-            fitness = np.asarray(result.best_fitness, np.float64)
-            create_with_unit(curve, "best_fitness", fitness, DIMENSIONLESS)
-            best = h5.create_group("best")
-            controller = best.create_group("controller")
-            _write_controller(controller, result.controller)
-            controller.attrs["joint_names"] = list(result.joint_names)
-            controller.attrs["sense_names"] = list(result.sense_names)
-            write_figure_motion(best.create_group("figure_motion"), result.motion)
-            create_with_unit(best, "active_rule", np.asarray(result.active_rule, np.int64), INDEX)
-            if result.final_state is not None:
-                final_state = np.asarray(result.final_state, np.float64)
-                create_with_unit(best, "final_state", final_state, SI_STATE)
-                final_force = np.asarray(result.final_force, np.float64)
-                create_with_unit(best, "final_force", final_force, "N")
-            h5.attrs["format_version"] = FORMAT_VERSION
-            for key, value in result.attrs.items():
-                h5.attrs[key] = value
-            h5.attrs.update(provenance_attributes())  # this process wrote it, whatever was read
+    def fill(h5: h5py.File) -> None:
+        curve = h5.create_group("learning_curve")
+        evaluations = np.asarray(result.evaluations, np.int64)
+        create_with_unit(curve, "evaluations", evaluations, DIMENSIONLESS)
+        fitness = np.asarray(result.best_fitness, np.float64)
+        create_with_unit(curve, "best_fitness", fitness, DIMENSIONLESS)
+        best = h5.create_group("best")
+        controller = best.create_group("controller")
+        _write_controller(controller, result.controller)
+        controller.attrs["joint_names"] = list(result.joint_names)
+        controller.attrs["sense_names"] = list(result.sense_names)
+        write_figure_motion(best.create_group("figure_motion"), result.motion)
+        create_with_unit(best, "active_rule", np.asarray(result.active_rule, np.int64), INDEX)
+        if result.final_state is not None:
+            final_state = np.asarray(result.final_state, np.float64)
+            create_with_unit(best, "final_state", final_state, SI_STATE)
+            final_force = np.asarray(result.final_force, np.float64)
+            create_with_unit(best, "final_force", final_force, "N")
+        h5.attrs["format_version"] = FORMAT_VERSION
+        for key, value in result.attrs.items():
+            h5.attrs[key] = value
+        h5.attrs.update(provenance_attributes())  # this process wrote it, whatever was read
 
-    write_atomically(path, write)
+    write_hdf5_atomically(path, fill)
 
 
 def _write_controller(group: h5py.Group, controller: BsrController) -> None:

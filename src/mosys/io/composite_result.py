@@ -26,7 +26,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from mosys.io.atomic import write_atomically
+from mosys.io.atomic import write_hdf5_atomically
 from mosys.io.attributes import DIMENSIONLESS, INDEX, create_with_unit
 from mosys.io.contracts import open_contract
 from mosys.io.provenance import provenance_attributes
@@ -106,19 +106,18 @@ def _read_motion(group: h5py.Group) -> CompositeMotion:
 def write_composite_result(path: str | Path, result: CompositeResult) -> None:
     """Write a result file atomically."""
 
-    def write(partial: Path) -> None:
-        with h5py.File(partial, "w") as h5:
-            _write_motion(h5, result.after)
-            _write_motion(h5.create_group("before"), result.before)
-            search = h5.create_group("search")
-            best_score = np.asarray(result.best_by_generation, np.float64)
-            create_with_unit(search, "best_score", best_score, DIMENSIONLESS)
-            h5.attrs["format_version"] = FORMAT_VERSION
-            for key, value in result.attrs.items():
-                h5.attrs[key] = value
-            h5.attrs.update(provenance_attributes())  # this process wrote it, whatever was read
+    def fill(h5: h5py.File) -> None:
+        _write_motion(h5, result.after)
+        _write_motion(h5.create_group("before"), result.before)
+        search = h5.create_group("search")
+        best_score = np.asarray(result.best_by_generation, np.float64)
+        create_with_unit(search, "best_score", best_score, DIMENSIONLESS)
+        h5.attrs["format_version"] = FORMAT_VERSION
+        for key, value in result.attrs.items():
+            h5.attrs[key] = value
+        h5.attrs.update(provenance_attributes())  # this process wrote it, whatever was read
 
-    write_atomically(path, write)
+    write_hdf5_atomically(path, fill)
 
 
 def read_composite_result(path: str | Path) -> CompositeResult:

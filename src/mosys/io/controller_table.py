@@ -15,7 +15,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from mosys.io.atomic import write_atomically
+from mosys.io.atomic import write_hdf5_atomically
 from mosys.io.attributes import (
     INDEX,
     column_units,
@@ -96,47 +96,46 @@ def write_controller_table(path: str | Path, table: ControllerTable) -> None:
             "a table with several destinations needs both destinations and destination_index"
         )
 
-    def write(partial: Path) -> None:
-        with h5py.File(partial, "w") as h5:
-            axes = h5.create_group("axes")
-            for name, axis, unit, wrap in zip(
-                table.state_order, table.axes, table.axis_units, table.wrap, strict=True
-            ):
-                scale = create_with_unit(axes, name, np.asarray(axis, dtype=np.float64), unit)
-                scale.attrs["wrap"] = bool(wrap)
-                scale.make_scale(name)
-            torque = h5.create_dataset("torque", data=table.torque.astype(np.float64))
-            set_column_units(torque, torque_units(table))
-            torque.dims[len(table.state_order)].label = "control"
-            per_node = [torque, create_with_unit(h5, "value", table.value.astype(float), "s")]
-            if table.dead_end is not None:
-                dead_end = np.asarray(table.dead_end, dtype=np.bool_)
-                per_node.append(create_with_unit(h5, "dead_end", dead_end, INDEX))
-            if table.destination_index is not None:
-                index = np.asarray(table.destination_index, dtype=np.int64)
-                per_node.append(create_with_unit(h5, "destination_index", index, INDEX))
-            if table.arrival_value is not None:
-                arrival = np.asarray(table.arrival_value, dtype=np.float64)
-                per_node.append(create_with_unit(h5, "arrival_value", arrival, "s"))
-            for dataset in per_node:
-                for k, name in enumerate(table.state_order):
-                    dataset.dims[k].attach_scale(axes[name])
-                    dataset.dims[k].label = name
-            h5.attrs["format_version"] = FORMAT_VERSION
-            h5.attrs["state_order"] = list(table.state_order)
-            h5.attrs["control_names"] = list(table.control_names)
-            h5.attrs["control_min"] = np.asarray(table.control_min, dtype=np.float64)
-            h5.attrs["control_max"] = np.asarray(table.control_max, dtype=np.float64)
-            h5.attrs["K"] = np.asarray(table.effort_weight, dtype=np.float64)
-            h5.attrs["dest"] = json.dumps(table.dest)
-            if table.destinations is not None:
-                h5.attrs["destinations"] = json.dumps(list(table.destinations))
-            h5.attrs["figure"] = table.figure
-            for key, value in table.attrs.items():
-                h5.attrs[key] = value
-            h5.attrs.update(provenance_attributes())  # this process wrote it, whatever was read
+    def fill(h5: h5py.File) -> None:
+        axes = h5.create_group("axes")
+        for name, axis, unit, wrap in zip(
+            table.state_order, table.axes, table.axis_units, table.wrap, strict=True
+        ):
+            scale = create_with_unit(axes, name, np.asarray(axis, dtype=np.float64), unit)
+            scale.attrs["wrap"] = bool(wrap)
+            scale.make_scale(name)
+        torque = h5.create_dataset("torque", data=table.torque.astype(np.float64))
+        set_column_units(torque, torque_units(table))
+        torque.dims[len(table.state_order)].label = "control"
+        per_node = [torque, create_with_unit(h5, "value", table.value.astype(float), "s")]
+        if table.dead_end is not None:
+            dead_end = np.asarray(table.dead_end, dtype=np.bool_)
+            per_node.append(create_with_unit(h5, "dead_end", dead_end, INDEX))
+        if table.destination_index is not None:
+            index = np.asarray(table.destination_index, dtype=np.int64)
+            per_node.append(create_with_unit(h5, "destination_index", index, INDEX))
+        if table.arrival_value is not None:
+            arrival = np.asarray(table.arrival_value, dtype=np.float64)
+            per_node.append(create_with_unit(h5, "arrival_value", arrival, "s"))
+        for dataset in per_node:
+            for k, name in enumerate(table.state_order):
+                dataset.dims[k].attach_scale(axes[name])
+                dataset.dims[k].label = name
+        h5.attrs["format_version"] = FORMAT_VERSION
+        h5.attrs["state_order"] = list(table.state_order)
+        h5.attrs["control_names"] = list(table.control_names)
+        h5.attrs["control_min"] = np.asarray(table.control_min, dtype=np.float64)
+        h5.attrs["control_max"] = np.asarray(table.control_max, dtype=np.float64)
+        h5.attrs["K"] = np.asarray(table.effort_weight, dtype=np.float64)
+        h5.attrs["dest"] = json.dumps(table.dest)
+        if table.destinations is not None:
+            h5.attrs["destinations"] = json.dumps(list(table.destinations))
+        h5.attrs["figure"] = table.figure
+        for key, value in table.attrs.items():
+            h5.attrs[key] = value
+        h5.attrs.update(provenance_attributes())  # this process wrote it, whatever was read
 
-    write_atomically(path, write)
+    write_hdf5_atomically(path, fill)
 
 
 def torque_units(table: ControllerTable) -> tuple[str, ...]:

@@ -22,7 +22,7 @@ import h5py
 import numpy as np
 
 from mosys.errors import InputError
-from mosys.io.atomic import write_atomically
+from mosys.io.atomic import write_hdf5_atomically
 from mosys.io.attributes import (
     INDEX,
     TEXT,
@@ -109,26 +109,25 @@ class StartGrid:
 def write_start_grid(path: str | Path, grid: StartGrid) -> None:
     """Write a start grid atomically."""
 
-    def write(partial: Path) -> None:
-        with h5py.File(partial, "w") as h5:
-            start = h5.create_dataset("start", data=np.asarray(grid.start, dtype=np.float64))
-            set_column_units(start, start_units(grid))
-            create_with_unit(h5, "parked", np.asarray(grid.parked, dtype=np.bool_), INDEX)
-            create_with_unit(h5, "collided", np.asarray(grid.collided, dtype=np.bool_), INDEX)
-            create_with_unit(h5, "parking_seconds", np.asarray(grid.parking_seconds, float), "s")
-            excluded = np.asarray(grid.excluded, dtype=object)
-            create_with_unit(h5, "excluded", excluded, TEXT, dtype=STRING)
-            create_with_unit(h5, "cost_to_go", np.asarray(grid.cost_to_go, float), "s")
-            create_with_unit(h5, "path_length", np.asarray(grid.path_length, float), "m")
-            if grid.arrival_cost_to_go is not None:
-                arrival = np.asarray(grid.arrival_cost_to_go, float)
-                create_with_unit(h5, "arrival_cost_to_go", arrival, "s")
-            h5.attrs["state_order"] = list(grid.state_order)
-            for key, value in grid.attrs.items():
-                h5.attrs[key] = value
-            h5.attrs.update(provenance_attributes())  # this process wrote it, whatever was read
+    def fill(h5: h5py.File) -> None:
+        start = h5.create_dataset("start", data=np.asarray(grid.start, dtype=np.float64))
+        set_column_units(start, start_units(grid))
+        create_with_unit(h5, "parked", np.asarray(grid.parked, dtype=np.bool_), INDEX)
+        create_with_unit(h5, "collided", np.asarray(grid.collided, dtype=np.bool_), INDEX)
+        create_with_unit(h5, "parking_seconds", np.asarray(grid.parking_seconds, float), "s")
+        excluded = np.asarray(grid.excluded, dtype=object)
+        create_with_unit(h5, "excluded", excluded, TEXT, dtype=STRING)
+        create_with_unit(h5, "cost_to_go", np.asarray(grid.cost_to_go, float), "s")
+        create_with_unit(h5, "path_length", np.asarray(grid.path_length, float), "m")
+        if grid.arrival_cost_to_go is not None:
+            arrival = np.asarray(grid.arrival_cost_to_go, float)
+            create_with_unit(h5, "arrival_cost_to_go", arrival, "s")
+        h5.attrs["state_order"] = list(grid.state_order)
+        for key, value in grid.attrs.items():
+            h5.attrs[key] = value
+        h5.attrs.update(provenance_attributes())  # this process wrote it, whatever was read
 
-    write_atomically(path, write)
+    write_hdf5_atomically(path, fill)
 
 
 def start_units(grid: StartGrid) -> tuple[str, ...] | None:

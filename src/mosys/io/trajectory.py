@@ -15,7 +15,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from mosys.io.atomic import write_atomically
+from mosys.io.atomic import write_hdf5_atomically
 from mosys.io.attributes import (
     INDEX,
     column_units,
@@ -136,35 +136,34 @@ class Trajectory:
 def write_trajectory(path: str | Path, trajectory: Trajectory) -> None:
     """Write a trajectory file atomically."""
 
-    def write(partial: Path) -> None:
-        with h5py.File(partial, "w") as h5:
-            state_units, control_units = column_units_of(trajectory)
-            create_with_unit(h5, "t", np.asarray(trajectory.t, dtype=np.float64), "s")
-            state = h5.create_dataset("state", data=np.asarray(trajectory.state, np.float64))
-            set_column_units(state, state_units)
-            control = h5.create_dataset("control", data=np.asarray(trajectory.control, float))
-            set_column_units(control, control_units)
-            controller = np.asarray(trajectory.controller, np.int64)
-            create_with_unit(h5, "controller", controller, INDEX)
-            h5.attrs["format_version"] = FORMAT_VERSION
-            h5.attrs["state_order"] = list(trajectory.state_order)
-            h5.attrs["control_names"] = list(trajectory.control_names)
-            h5.attrs["controllers"] = list(trajectory.controllers)
-            for key, value in trajectory.attrs.items():
-                h5.attrs[key] = value
-            if trajectory.motion is not None:
-                write_figure_motion(h5.create_group("figure_motion"), trajectory.motion)
-            if trajectory.contacts is not None:
-                group = h5.create_group("contacts")
-                contacts = trajectory.contacts
-                position = np.asarray(contacts.position, np.float64)
-                create_with_unit(group, "position", position, "m")
-                create_with_unit(group, "force", np.asarray(contacts.force, np.float64), "N")
-                group.attrs["rods"] = list(contacts.rods)
-                group.attrs["fraction"] = np.asarray(contacts.fraction, np.float64)
-            h5.attrs.update(provenance_attributes())  # this process wrote it, whatever was read
+    def fill(h5: h5py.File) -> None:
+        state_units, control_units = column_units_of(trajectory)
+        create_with_unit(h5, "t", np.asarray(trajectory.t, dtype=np.float64), "s")
+        state = h5.create_dataset("state", data=np.asarray(trajectory.state, np.float64))
+        set_column_units(state, state_units)
+        control = h5.create_dataset("control", data=np.asarray(trajectory.control, float))
+        set_column_units(control, control_units)
+        controller = np.asarray(trajectory.controller, np.int64)
+        create_with_unit(h5, "controller", controller, INDEX)
+        h5.attrs["format_version"] = FORMAT_VERSION
+        h5.attrs["state_order"] = list(trajectory.state_order)
+        h5.attrs["control_names"] = list(trajectory.control_names)
+        h5.attrs["controllers"] = list(trajectory.controllers)
+        for key, value in trajectory.attrs.items():
+            h5.attrs[key] = value
+        if trajectory.motion is not None:
+            write_figure_motion(h5.create_group("figure_motion"), trajectory.motion)
+        if trajectory.contacts is not None:
+            group = h5.create_group("contacts")
+            contacts = trajectory.contacts
+            position = np.asarray(contacts.position, np.float64)
+            create_with_unit(group, "position", position, "m")
+            create_with_unit(group, "force", np.asarray(contacts.force, np.float64), "N")
+            group.attrs["rods"] = list(contacts.rods)
+            group.attrs["fraction"] = np.asarray(contacts.fraction, np.float64)
+        h5.attrs.update(provenance_attributes())  # this process wrote it, whatever was read
 
-    write_atomically(path, write)
+    write_hdf5_atomically(path, fill)
 
 
 def column_units_of(
