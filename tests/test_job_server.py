@@ -22,6 +22,8 @@ import h5py
 import numpy as np
 import pytest
 
+from mosys.cli import job_server
+
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = ROOT / "specs" / "controllers" / "pendulum" / "A.ssc"
 
@@ -244,6 +246,41 @@ def test_a_malformed_request_is_refused_and_the_server_serves_on(server, tmp_pat
     done = mosys(server, "index", "a.txt", "-o", "listed.txt", cwd=tmp_path)
     assert done.returncode == 0 and server.process.poll() is None
     assert [line for _, line in server.jobs()][0] == "started: mosys index a.txt -o listed.txt"
+
+
+HUNG_UP_CLIENT = """
+import socket, sys
+from mosys.job_client import request_bytes
+with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as connection:
+    connection.connect(sys.argv[1])
+    socket.send_fds(connection, [request_bytes(sys.argv[2:], [2])], [2])
+"""  # sends a whole request and hangs up at once, as a client that gave up waiting does
+
+
+def test_a_request_whose_client_hung_up_is_not_run(server, tmp_path):
+    """A client that waited too long runs the command itself: the server, reaching its request
+    late, used to run it a second time. Here a silent connection holds the server for its
+    request timeout while the request's client hangs up."""
+    (tmp_path / "a.txt").write_text("a")
+    with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as silent:
+        silent.connect(str(server.socket))
+        time.sleep(0.2)  # the server is now waiting for the silent client's request
+        argv = ["index", "a.txt", "-o", "late.txt"]
+        subprocess.run(
+            [sys.executable, "-c", HUNG_UP_CLIENT, str(server.socket), *argv],
+            cwd=tmp_path,
+            env=environment(),
+            check=True,
+            timeout=60,
+        )
+        time.sleep(job_server.REQUEST_TIMEOUT_S + 1.0)
+    done = mosys(server, "index", "a.txt", "-o", "listed.txt", cwd=tmp_path)
+    assert done.returncode == 0
+    assert [line for _, line in server.jobs()] == [
+        "started: mosys index a.txt -o listed.txt",
+        "ended: exit 0",
+    ]
+    assert not (tmp_path / "late.txt").exists()
 
 
 def test_a_second_server_on_a_live_servers_socket_is_refused(server):

@@ -28,6 +28,7 @@ import importlib
 import json
 import os
 import random
+import select
 import selectors
 import shlex
 import signal
@@ -64,7 +65,7 @@ NUMBA_PREFIX = "NUMBA_"
 PER_JOB_VARIABLES = ("NUMBA_NUM_THREADS",)  # each job's own: numba's config re-read in the fork
 PRELOAD_TRIES = 3  # tries of a module that needed compiling, one after each job's end
 POLL_S = 1.0  # how often the server looks for its parent and its idle time
-REQUEST_TIMEOUT_S = 10.0
+REQUEST_TIMEOUT_S = 2.0  # a client sends its request as it connects; others wait meanwhile
 SOCKET_PATH_BYTES = 107  # a Unix socket's path, its NUL aside (sockaddr_un)
 
 
@@ -313,6 +314,18 @@ def decline_reason(request: dict) -> str | None:
     return None
 
 
+def _client_gone(connection: socket.socket) -> bool:
+    """Whether the client has hung up: once its request is sent it only waits, so anything to
+    read is the end of its connection."""
+    readable, _, _ = select.select([connection], [], [], 0)
+    if not readable:
+        return False
+    try:
+        return connection.recv(1, socket.MSG_PEEK) == b""
+    except OSError:
+        return True
+
+
 def _start_job(connection, selector) -> tuple[int, int] | None:
     """Fork a job for the request on ``connection``: its pid and a pidfd that becomes readable
     when it ends; None if the request is unreadable or declined, or the fork failed (the client
@@ -322,6 +335,8 @@ def _start_job(connection, selector) -> tuple[int, int] | None:
     except Exception:  # noqa: BLE001 - whatever a request holds, the server goes on serving
         return None
     try:
+        if _client_gone(connection):  # it gave up waiting and runs the command itself
+            return None
         reason = decline_reason(request)
         if reason is not None:
             _send_line(connection, f"declined {reason}")
