@@ -584,12 +584,16 @@ def run_search(setup: SearchSetup, seed: int, label: str = "search") -> SearchOu
     began = time.perf_counter()
     current = _Population(setup, rng)
     first = f"seed {seed}, generation 0"
+    # silent unless slow (many rules): a line at most every second, and no closing line
+    starting = Progress(f"{label}: first population", 1 + setup.enrich_rounds, "rounds")
     current.fitness[:] = _evaluated(setup, current, rng, first)
-    for _ in range(setup.enrich_rounds):
+    starting.update(1)
+    for round_ in range(setup.enrich_rounds):
         # §4.2: rounds of the relevance-heuristic mutation enrich the first population
         for k in range(c):
             current.draw_rule(k, int(rng.integers(spec.rules)), rng, current.senses[k])
         current.fitness[:] = _evaluated(setup, current, rng, first)
+        starting.update(2 + round_)
     mutant = current.copy()
     best_k = int(np.argmax(current.fitness))
     best = current.controller(best_k)
