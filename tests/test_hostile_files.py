@@ -262,12 +262,31 @@ def test_a_chain_given_to_a_search_that_continues_none_is_refused(tmp_path, caps
     assert sorted(tmp_path.iterdir()) == [chain]
 
 
-def test_an_environment_numba_cannot_start_in_is_a_usage_error(tmp_path, monkeypatch, capsys):
-    monkeypatch.setenv("NUMBA_NUM_THREADS", "0")
+@pytest.mark.parametrize(
+    ("variable", "value", "message"),
+    [
+        ("NUMBA_NUM_THREADS", "0", "NUMBA_NUM_THREADS='0': expected a whole number >= 1"),
+        (
+            "MPLBACKEND",
+            "bogus",
+            "MPLBACKEND='bogus': expected one of matplotlib's backends, such as Agg (or unset it)",
+        ),
+    ],
+)
+def test_an_environment_numba_or_matplotlib_cannot_start_in_is_a_usage_error(
+    tmp_path, variable, value, message
+):
+    """In a new process: a failed import of matplotlib leaves it half imported."""
     argv = ["dp", SPECS / "controllers" / "pendulum" / "A.ssc", "-o", tmp_path / "A.h5"]
-    assert refused(argv, capsys) == (
-        "mosys: error: the environment's NUMBA_NUM_THREADS='0': expected a whole number >= 1"
+    done = subprocess.run(
+        [sys.executable, "-m", "mosys.command", *map(str, argv)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, variable: value, "MOSYS_JOB_SERVER": ""},
     )
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.strip().splitlines()[-1] == f"mosys: error: the environment's {message}"
     assert not list(tmp_path.iterdir())
 
 

@@ -107,10 +107,22 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def environment_problem() -> str | None:
-    """The usage error of an environment numba cannot start in (its import would raise)."""
+    """The usage error of an environment numba or matplotlib cannot start in (their imports
+    would raise)."""
     threads = os.environ.get("NUMBA_NUM_THREADS")
     if threads is not None and not (threads.strip().isdecimal() and int(threads) >= 1):
         return f"the environment's NUMBA_NUM_THREADS={threads!r}: expected a whole number >= 1"
+    backend = os.environ.get("MPLBACKEND")
+    if backend:  # matplotlib is imported for this check only when the variable is set
+        try:  # the import itself refuses a backend it does not know, unless already imported
+            from matplotlib import rcsetup
+
+            rcsetup.validate_backend(backend)
+        except ValueError:
+            return (
+                f"the environment's MPLBACKEND={backend!r}: expected one of matplotlib's "
+                "backends, such as Agg (or unset it)"
+            )
     return None
 
 
