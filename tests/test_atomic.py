@@ -113,8 +113,10 @@ def test_a_commands_outputs_appear_together_or_not_at_all(tmp_path):
     first.write_text("old")
     with pytest.raises(ValueError, match="the table failed"), outputs_together():
         write_text_atomically(first, "new")
+        write_text_atomically(tmp_path / "new" / "folders" / "t.md", "md")
         raise ValueError("the table failed")
     assert first.read_text() == "old"
+    # nothing new: the folders made for the outputs are gone with them
     assert sorted(p.name for p in tmp_path.iterdir()) == ["t.csv", "t.md"]
 
 

@@ -7,6 +7,7 @@ import os
 import secrets
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import h5py
@@ -17,7 +18,16 @@ from mosys.files import output_problem
 PARTIAL_NAME_BYTES = 120  # of the final name kept in the partial's: NAME_MAX is 255 bytes
 
 
-_held: list[tuple[Path, Path]] | None = None  # (partial, path) a command holds back; None: none
+@dataclass
+class _Outputs:
+    """What a command has written so far: its partial files held back, (partial, path), and
+    the folders made for them."""
+
+    partials: list[tuple[Path, Path]] = field(default_factory=list)
+    folders: list[Path] = field(default_factory=list)
+
+
+_held: _Outputs | None = None  # the running command's; None: each write is renamed at once
 
 
 @contextmanager
@@ -25,21 +35,42 @@ def outputs_together() -> Iterator[None]:
     """One command's outputs, all or none: within the block every ``write_atomically`` writes
     its partial file and holds it back; when the block ends they are renamed onto their paths
     together, and if it raises (a later output failing, a signal made an exception) every
-    partial is removed and no output changes."""
+    partial is removed, and every folder made for them, and no output changes."""
     global _held
-    outer, _held = _held, []
+    outer, _held = _held, _Outputs()
+    held, renamed = _held, False
     try:
         yield
-        for partial, path in _held:
+        for partial, path in held.partials:
             try:
                 os.replace(partial, path)
             except OSError as error:
                 raise InputError(f"{path}: cannot write it: {error.strerror or error}") from None
+        renamed = True
     finally:
-        for partial, _ in _held:
+        for partial, _ in held.partials:
             with contextlib.suppress(FileNotFoundError, NotADirectoryError):
                 partial.unlink()
+        if not renamed:
+            _remove_empty(held.folders)
         _held = outer
+
+
+def _missing_folders(folder: Path) -> list[Path]:
+    """``folder`` and its parents that do not exist yet, deepest first."""
+    missing = []
+    for candidate in (folder, *folder.parents):
+        if candidate.exists():
+            break
+        missing.append(candidate)
+    return missing
+
+
+def _remove_empty(folders: list[Path]) -> None:
+    """Remove those of ``folders`` that are empty, deepest first."""
+    for folder in sorted(folders, key=lambda folder: len(folder.parts), reverse=True):
+        with contextlib.suppress(OSError):
+            folder.rmdir()
 
 
 def write_atomically(
@@ -65,21 +96,27 @@ def write_atomically(
     name = path.name.encode("utf-8", "surrogateescape")[:PARTIAL_NAME_BYTES]
     short = name.decode("utf-8", "ignore")
     partial = path.with_name(f".{short}.{os.getpid()}.{secrets.token_hex(4)}.partial")
+    made = _missing_folders(path.parent.absolute())
     held_back = False  # the partial handed to ``outputs_together``, which renames or removes it
+    written = False
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         write(partial)
         if _held is not None and not saves_opened_file:
-            _held.append((partial, path))
+            _held.partials.append((partial, path))
+            _held.folders += made
             held_back = True
         else:
             os.replace(partial, path)
+        written = True
     except OSError as error:  # the partial's name in the system's message means nothing to a user
         raise InputError(f"{path}: cannot write it: {error.strerror or error}") from None
     finally:
         if not held_back:
             with contextlib.suppress(FileNotFoundError, NotADirectoryError):
                 partial.unlink()
+        if not written:
+            _remove_empty(made)
 
 
 def write_hdf5_atomically(path: str | Path, fill: Callable[[h5py.File], None]) -> None:
