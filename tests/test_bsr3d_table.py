@@ -16,13 +16,13 @@ from mosys.cli import main
 from mosys.errors import InputError
 from mosys.io.bsr_result import BsrController, BsrResult, write_bsr_result
 from mosys.io.trajectory import FigureMotion
+from mosys.paper_tables.bsr import speed_up
 from mosys.paper_tables.bsr3d import (
     COLUMNS,
     PAPER_FIGURE,
     SPEED_UP,
     budget_sentence,
     runs3d_frame,
-    speed_up,
     write_bsr3d_table,
 )
 

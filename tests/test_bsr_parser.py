@@ -355,6 +355,11 @@ ERRORS = [
         replace_line(9, "fitness distance=1e999"),
         "x.bsr:9:18: expected a finite number for distance= (weight), found '1e999'",
     ),
+    (  # a fitness that overflowed, or learning curves no plot could scale
+        replace_line(9, "fitness distance=1 max_height=-1.7e308"),
+        "x.bsr:9:31: expected a number from -1e+06 to 1e+06 for max_height= (weight), found "
+        "'-1.7e308'",
+    ),
     (replace_line(9, "fitness"), f"x.bsr:9:8: expected one of {TERMS}, found end of line"),
     (
         replace_line(9, "fitness fall=1 fall=2"),
@@ -449,6 +454,7 @@ IDENTIFIERS = st.tuples(
 NUMBERS = st.floats(allow_nan=False, allow_infinity=False)
 POSITIVE = st.floats(min_value=1e-9, max_value=1e6)
 NON_NEGATIVE = st.floats(min_value=0, max_value=1e6)
+WEIGHTS = st.floats(min_value=-1e6, max_value=1e6)  # parsing.bsr.MAX_WEIGHT
 WHOLE = st.integers(1, 10**6)
 
 
@@ -478,7 +484,7 @@ def bsr_specs(draw) -> BsrSpec:
         seeds=tuple(draw(st.lists(st.integers(0, 2**63 - 1), min_size=1, max_size=5, unique=True))),
         start={} if chain else draw(st.dictionaries(IDENTIFIERS, NUMBERS, max_size=5)),
         perturbation=Perturbation(*(draw(st.just(0.0) | NON_NEGATIVE) for _ in range(4))),
-        weights={term: draw(NUMBERS) for term in terms},
+        weights={term: draw(WEIGHTS) for term in terms},
         fall=tuple(fall),
         tau_min=draw(st.none() | st.floats(2 * dt, duration / 4, exclude_max=True)),
         fall_below=draw(st.just(DEFAULT_FALL_BELOW) | st.floats(0, 1)),

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import h5py
 import numpy as np
+import pandas as pd
 import pytest
 
 from mosys.bsr.search import nominal_run
@@ -385,3 +386,18 @@ def test_the_composite_table(composite_workspace):
     assert (
         row["cartwheel ticks after"] + row["jump ticks after"] + row["shuffle ticks after"] == 415
     )
+
+
+def test_the_markdown_table_leaves_another_scripts_phases_empty_and_keeps_nan():
+    """The CSV leaves the cells of phases a script does not have empty; the Markdown showed
+    nan there, which its caption gives to a division by zero."""
+    from mosys.paper_tables.composite import markdown_table
+
+    rows = [
+        {"script": "one", "a score after": float("nan")},
+        {"script": "two", "b score after": 1.5},
+    ]
+    frame = pd.DataFrame(rows)
+    lines = markdown_table(frame, rows).splitlines()
+    cells = [[cell.strip() for cell in line.strip("|").split("|")] for line in lines[2:]]
+    assert cells == [["one", "nan", ""], ["two", "", "1.5"]]

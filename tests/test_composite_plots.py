@@ -23,6 +23,7 @@ from mosys.plots.composite import (
     plot_filmstrips,
     plot_search,
     read_composite,
+    score_limits,
     search_curve,
     search_figure,
     shade,
@@ -200,6 +201,35 @@ def test_search_plot(result_path: Path, tmp_path: Path) -> None:
     out = tmp_path / "search.png"
     plot_search(result_path, out)
     assert_png(out, least_width=600)
+
+
+def test_score_limits_hold_only_finite_scores() -> None:
+    """A script's arithmetic may give ±inf or nan (README, "Expressions"): the axis took them
+    and matplotlib raised 'Axis limits cannot be NaN or Inf'."""
+    assert score_limits(np.array([1.0, 2.0, 3.0]), 1.0) == pytest.approx((0.76, 3.16))
+    assert score_limits(np.array([np.inf, np.inf]), np.inf) is None
+    assert score_limits(np.array([np.nan, 2.0]), np.nan) == pytest.approx((1.76, 2.16))
+    assert score_limits(np.array([1e308, 1.5e308]), -1e308) is None  # the margin overflows
+
+
+def test_a_search_of_infinite_scores_is_drawn_with_a_note(
+    composite_workspace, tmp_path: Path
+) -> None:
+    from mosys.cli import main
+
+    script = tmp_path / "inf.comp"
+    script.write_text(
+        "figure starman\nphase a controller=starman_jump_robust ticks=5\nscore a = 1/0\ntotal = a\n"
+    )
+    result = tmp_path / "inf.h5"
+    argv = ["composite", script, "--bsr-results", composite_workspace.bsr_results, "--q", "2",
+            "--g", "1", "--h", "1", "-o", result]  # fmt: skip
+    assert main([str(arg) for arg in argv]) == 0
+    out = tmp_path / "search.png"
+    plot_search(result, out)
+    assert_png(out, least_width=600)
+    (ax,) = search_figure(result).axes
+    assert "scores of ±inf or nan (the script's arithmetic) are not drawn" in ax.texts[1].get_text()
 
 
 @pytest.mark.slow

@@ -108,6 +108,12 @@ def read_planar_result(path: str | Path) -> BsrResult:
     return result
 
 
+def speed_up(ratio: float) -> str:
+    """A speed-up factor as text: ``375x``; below 10 two significant digits, ``2.5x``, ``0.03x``
+    (a reduced budget's slow run printed ``0x``)."""
+    return f"{ratio:.0f}x" if ratio >= 10 else f"{ratio:.2g}x"
+
+
 def runs_frame(result_paths: list[str | Path]) -> pd.DataFrame:
     """One row per search (the seed files grouped by their ``name`` attribute, in order)."""
     rows = []
@@ -124,7 +130,10 @@ def runs_frame(result_paths: list[str | Path]) -> pd.DataFrame:
             "steps per second": f"{steps_per_second:.3g}",
             "40k evaluations (s)": round(seconds_40k, 1),
             "paper": PAPER_FIGURE[kind],
-            "speed-up vs paper": f"{paper_low / seconds_40k:.0f}-{paper_high / seconds_40k:.0f}x",
+            "speed-up vs paper": (
+                f"{speed_up(paper_low / seconds_40k).removesuffix('x')}-"
+                f"{speed_up(paper_high / seconds_40k)}"
+            ),
             **fitness_columns(results),
         }
         for term in FITNESS_TERMS:

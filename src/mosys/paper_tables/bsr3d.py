@@ -25,6 +25,7 @@ from mosys.paper_tables.bsr import (
     group_by_search,
     median_ms_per_evaluation,
     setup_columns,
+    speed_up,
     write_table,
 )
 
@@ -147,11 +148,6 @@ def best_seed(results: Sequence[BsrResult]) -> BsrResult:
         results,
         key=lambda result: (-float(result.attrs["best_fitness"]), int(result.attrs["seed"])),
     )
-
-
-def speed_up(ratio: float) -> str:
-    """A speed-up factor as text: ``375x``; below 10 two significant digits, ``2.5x``."""
-    return f"{ratio:.0f}x" if ratio >= 10 else f"{ratio:.2g}x"
 
 
 def chain_text(attrs: dict) -> str:

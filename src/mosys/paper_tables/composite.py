@@ -19,6 +19,11 @@ PAPER_FIGURE = "1,024 simulations in under a minute (DEC 3000/400)"
 
 def composite_frame(result_paths: Sequence[str | Path]) -> pd.DataFrame:
     """One row per composite result file."""
+    return pd.DataFrame(composite_rows(result_paths))
+
+
+def composite_rows(result_paths: Sequence[str | Path]) -> list[dict]:
+    """``composite_frame``'s rows, each with the columns of its own script's phases."""
     rows = []
     for path in result_paths:
         result = read_composite_result(path)
@@ -44,14 +49,15 @@ def composite_frame(result_paths: Sequence[str | Path]) -> pd.DataFrame:
             row[f"{name} score before"] = round(before[name], 3)
             row[f"{name} score after"] = round(after[name], 3)
         rows.append(row)
-    return pd.DataFrame(rows)
+    return rows
 
 
 def write_composite_table(
     result_paths: Sequence[str | Path], csv_path: str | Path, md_path: str | Path
 ) -> pd.DataFrame:
     """Write the composite table as CSV and Markdown (each atomically)."""
-    frame = composite_frame(result_paths)
+    rows = composite_rows(result_paths)
+    frame = pd.DataFrame(rows)
     write_text_atomically(csv_path, frame.to_csv(index=False))
     caption = (
         "Composite motions after Auslander et al. (1995), §3 (Table 4, Figures 13-14): the "
@@ -64,5 +70,13 @@ def write_composite_table(
         "division by zero in the script's expressions (IEEE arithmetic); the search ranks nan "
         "as -inf, never as the best.\n\n"
     )
-    write_text_atomically(md_path, caption + frame.to_markdown(index=False) + "\n")
+    write_text_atomically(md_path, caption + markdown_table(frame, rows) + "\n")
     return frame
+
+
+def markdown_table(frame: pd.DataFrame, rows: list[dict]) -> str:
+    """``frame`` (made of ``rows``) as Markdown, the cells of phases a script does not have
+    left empty (as the CSV leaves them) rather than ``nan``, which the caption gives to a
+    division by zero."""
+    has = pd.DataFrame([dict.fromkeys(row, True) for row in rows], columns=frame.columns)
+    return frame.astype(object).where(has.notna(), "").to_markdown(index=False)

@@ -175,8 +175,12 @@ _PERTURB_KEYS = {
     "speed": (">=0", "speed= (m/s)"),
     "spin": (">=0", "spin= (deg/s)"),
 }
+MAX_WEIGHT = 1e6  # |a fitness weight|: its terms are metres, degrees, counts and fractions,
+# so a fitness stays far from overflowing (a weight of 1.7e308 gave fitness inf, or finite
+# learning curves whose span overflowed every plot's axis)
 _FITNESS_KEYS = {
-    term: (None, f"{term}= (weight)") for term in dict.fromkeys(FITNESS_TERMS + FITNESS_TERMS_3D)
+    term: ("weight", f"{term}= (weight)")
+    for term in dict.fromkeys(FITNESS_TERMS + FITNESS_TERMS_3D)
 }
 
 
@@ -188,6 +192,7 @@ def _expected(check: int | str | None, what: str) -> str:
         ">0": f"a number > 0 for {what}",
         ">=0": f"a number >= 0 for {what}",
         "0..1": f"a number from 0 to 1 for {what}",
+        "weight": f"a number from {-MAX_WEIGHT:g} to {MAX_WEIGHT:g} for {what}",
         None: f"a number for {what}",
     }[check]
 
@@ -316,6 +321,7 @@ class _Parser:
             ">0": value <= 0,
             ">=0": value < 0,
             "0..1": not 0 <= value <= 1,
+            "weight": not abs(value) <= MAX_WEIGHT,
             None: False,
         }[check]
         if bad:

@@ -513,6 +513,25 @@ def plot_search(result_path: str | Path, path: str | Path) -> None:
         save_figure(search_figure(result_path), path)
 
 
+def score_limits(scores: np.ndarray, before: float) -> tuple[float, float] | None:
+    """The y-axis limits of the search's scores (G + 1,) and the guess's total ``before``:
+    their finite values with a margin below and above (the script's arithmetic may give ±inf
+    or nan, which no axis can hold); None, matplotlib's own, where no value is finite or the
+    limits or their distance overflow."""
+    finite_scores = scores[np.isfinite(scores)]
+    finite_before = [before] if np.isfinite(before) else []
+    if finite_scores.size == 0 and not finite_before:
+        return None
+    low = min([*finite_scores, *finite_before])
+    high = max(finite_scores) if finite_scores.size else before
+    with np.errstate(over="ignore"):
+        span = float(np.ptp(finite_scores)) if finite_scores.size else 0.0
+        span = span or max(abs(before) if finite_before else abs(high), 1.0)
+        limits = (low - 0.12 * span, high + 0.08 * span)
+        width = limits[1] - limits[0]  # what the tick locator divides: it must be finite too
+    return limits if np.isfinite([*limits, width]).all() and width > 0 else None
+
+
 def search_figure(result_path: str | Path) -> Figure:
     """Figure 5's transition-point search: the best script total (the script's ``total``,
     unitless) after each generation 0 to G (0: the guessed transition points), a dotted line at
@@ -531,8 +550,10 @@ def search_figure(result_path: str | Path) -> Figure:
         f"{size}{int(attrs['simulations']):,} simulations in {float(attrs['wall_seconds']):.3g} s"
         f"\nscript total {score_text(before)} → {score_text(after)}"
     )
-    if before > 0:
+    if before > 0 and np.isfinite(before) and np.isfinite(after):
         note += f" (× {after / before:.3g})"
+    if not np.isfinite(np.append(scores, before)).all():
+        note += "\nscores of ±inf or nan (the script's arithmetic) are not drawn"
     with plot_style():
         figure = new_figure(SEARCH_WIDTH, SEARCH_HEIGHT)
         ax = figure.subplots()
@@ -560,8 +581,9 @@ def search_figure(result_path: str | Path) -> Figure:
             bbox={"boxstyle": "round,pad=0.35", "facecolor": "white", "alpha": 0.9},
         )
         ax.set_xlim(-0.3, max(generations[-1], 1) + 0.3)
-        span = float(np.ptp(scores)) or max(abs(before), 1.0)
-        ax.set_ylim(min(scores.min(), before) - 0.12 * span, scores.max() + 0.08 * span)
+        limits = score_limits(scores, before)
+        if limits is not None:
+            ax.set_ylim(*limits)
         ax.xaxis.get_major_locator().set_params(integer=True)
         ax.set_xlabel("generation (0: the guessed transition points)")
         ax.set_ylabel("best script total so far")
