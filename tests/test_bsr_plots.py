@@ -419,3 +419,9 @@ def test_cli_rejects_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture) ->
     assert not (tmp_path / "l.png").exists()
     with pytest.raises(SystemExit):
         main(["plot", "bsr", str(bogus)])  # no output asked for
+
+
+def test_counts_read_as_words():
+    from mosys.plots.style import seeds_text
+
+    assert [seeds_text(n) for n in (1, 2)] == ["1 seed", "2 seeds"]  # "1 seeds" in a title

@@ -64,6 +64,7 @@ from mosys.plots.style import (
     save_figure,
     scene_figure,
     scene_limits,
+    seeds_text,
     spread_labels,
     write_real_time_gif,
 )
@@ -244,6 +245,9 @@ def _kind(result: BsrResult) -> str:
 
 
 def _thousands(axis) -> None:
+    """A count axis: whole ticks (a short search's 4 evaluations were labelled 0 0 1 2 2 2 3 4
+    4), with thousands separated."""
+    axis.get_major_locator().set_params(integer=True)
     axis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:,.0f}"))
 
 
@@ -297,7 +301,7 @@ def learning_figure(results: Sequence[str | Path]) -> Figure:
     figure_name = first.attrs.get("figure", "")
     title = (
         f"BSR search {name}: {KIND_TEXT.get(kind, kind)} controller"
-        f"{f' for {figure_name}' if figure_name else ''}, {len(loaded)} seeds\n"
+        f"{f' for {figure_name}' if figure_name else ''}, {seeds_text(len(loaded))}\n"
         + wrapped(
             f"best fitness found so far by each seed; {fitness_formula(first.fitness_weights)}"
         )
@@ -422,7 +426,7 @@ def learning_comparison_figure(results_by_search: Mapping[str, Sequence[str | Pa
             entries.append(
                 (
                     (Patch(color=colors[name], alpha=BAND_ALPHA * 1.6), Line2D([], [], **style)),
-                    f"{name} ({KIND_TEXT.get(kind, kind)}, {len(loaded)} seeds)",
+                    f"{name} ({KIND_TEXT.get(kind, kind)}, {seeds_text(len(loaded))})",
                 )
             )
         for ax in (raw, scaled):

@@ -97,6 +97,7 @@ from mosys.plots.style import (
     samples_to_the_end,
     save_figure,
     scene_figure,
+    seeds_text,
     spread_labels,
     write_real_time_gif,
 )
@@ -812,7 +813,7 @@ def learning_kinds_figure(
     figures = sorted({str(r.attrs.get("figure", "")) for _, _, rs in kinds for r in rs} - {""})
     formulas = {fitness_formula(results[0].fitness_weights) for _, _, results in kinds}
     versus = " vs ".join(
-        f"{KIND_TEXT[kind]} {name} ({len(results)} seeds)" for kind, name, results in kinds
+        f"{KIND_TEXT[kind]} {name} ({seeds_text(len(results))})" for kind, name, results in kinds
     )
     if len(formulas) == 1:
         fitness = formulas.pop()
@@ -856,7 +857,7 @@ def learning_kinds_figure(
             entries.append(
                 (
                     Line2D([], [], color=color, linewidth=MEDIAN_WIDTH, linestyle=style),
-                    f"{name} ({KIND_TEXT[kind]}): median over {len(results)} seeds",
+                    f"{name} ({KIND_TEXT[kind]}): median over {seeds_text(len(results))}",
                 )
             )
             entries.append(
@@ -870,6 +871,7 @@ def learning_kinds_figure(
             ax.set_xlim(first / 1.2, last * 1.6)
         else:
             ax.set_xlim(0, last * 1.07 if last > 0 else 1)
+            ax.xaxis.get_major_locator().set_params(integer=True)  # whole counts
         ax.xaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))
         ax.set_xlabel(f"controller evaluations (count{', log scale' if log_x else ''})")
         ax.set_ylabel("best fitness so far (Σ weight × term)")

@@ -109,6 +109,11 @@ def save_figure(figure: Figure, path: str | Path) -> None:
     write_atomically(path, lambda partial: figure.savefig(partial, format=extension, dpi=DPI))
 
 
+def seeds_text(count: int) -> str:
+    """``1 seed``, ``3 seeds``."""
+    return f"{count} seed{'' if count == 1 else 's'}"
+
+
 def minus_signs(text: str) -> str:
     """A true minus sign for hyphens in numbers."""
     return text.replace("-", "−")
