@@ -55,10 +55,11 @@ def input_problem(path: str | Path) -> str | None:
     return None
 
 
-def output_problem(path: str | Path) -> str | None:
+def output_problem(path: str | Path, may_replace_input: bool = False) -> str | None:
     """Why ``path`` cannot be written as a whole new file, or None: no file name in it, a
     folder in its way that is a file, an existing directory or special file (a FIFO, a
-    device: replacing it would destroy it), or a file this command read."""
+    device: replacing it would destroy it), or (unless ``may_replace_input``) a file this
+    command read."""
     text = os.fspath(path)
     if not text or text.endswith(os.sep) or Path(text).name in ("", ".", ".."):
         return "expected a file name to write"
@@ -76,6 +77,6 @@ def output_problem(path: str | Path) -> str | None:
             if not folder.is_dir():
                 return f"{folder} is a file, not a folder"
             break
-    if _read is not None and os.path.realpath(path) in _read:
+    if not may_replace_input and _read is not None and os.path.realpath(path) in _read:
         return "it is an input of this command; write the output elsewhere"
     return None

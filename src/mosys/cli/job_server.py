@@ -432,8 +432,9 @@ def _arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _check(args: argparse.Namespace) -> str | None:
-    """Usage errors: a bad --idle; a socket path in no folder, or naming a file that is not a
-    socket (a stale socket is replaced; anything else would be destroyed)."""
+    """Usage errors: a bad --idle; a socket path in no folder, longer than a Unix socket's
+    path may be, naming a file that is not a socket (a stale socket is replaced; anything else
+    would be destroyed), or where a server already answers."""
     folder = os.path.dirname(args.socket) or "."
     if not os.path.isdir(folder):
         return f"job-server: {args.socket}: expected a path in an existing folder ({folder})"

@@ -89,8 +89,8 @@ def write_atomically(
     ``saves_opened_file``: the editor's Save, writing the file it opened, which may be an input
     of the command and is written at once.
     """
-    problem = output_problem(path)
-    if problem and not (saves_opened_file and problem.startswith("it is an input")):
+    problem = output_problem(path, may_replace_input=saves_opened_file)
+    if problem:
         raise InputError(f"{os.fspath(path) or repr('')}: cannot write it: {problem}")
     path = Path(path)
     name = path.name.encode("utf-8", "surrogateescape")[:PARTIAL_NAME_BYTES]
