@@ -4,7 +4,7 @@ concatenation editor)."""
 from __future__ import annotations
 
 import argparse
-import re
+from pathlib import Path
 
 from mosys.cli.verb import (
     HDF5,
@@ -15,8 +15,6 @@ from mosys.cli.verb import (
     first_problem,
     whole_number_problem,
 )
-
-SEED_FILE = re.compile(r"(^|/)seed\d+\.h5$")  # what the pipeline passes: SEARCH/seedK.h5
 
 
 def _composite_arguments(parser: argparse.ArgumentParser) -> None:
@@ -40,7 +38,9 @@ def _composite_arguments(parser: argparse.ArgumentParser) -> None:
 def _composite_check(args: argparse.Namespace) -> str | None:
     if args.controllers is not None and args.bsr_results is not None:
         return "composite: give --controllers or --bsr-results, not both"
-    odd = [path for path in args.controllers or () if not SEED_FILE.search(path)]
+    from mosys.composite.session import SEED_FILE
+
+    odd = [path for path in args.controllers or () if not SEED_FILE.fullmatch(Path(path).name)]
     if odd:
         return f"composite: --controllers {odd[0]}: expected a seed file, SEARCH/seedK.h5"
     return first_problem(

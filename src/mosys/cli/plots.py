@@ -3,17 +3,8 @@
 from __future__ import annotations
 
 import argparse
-import os
 
-from mosys.cli.verb import (
-    GIF,
-    PLOT,
-    Family,
-    OutputPath,
-    Verb,
-    first_problem,
-    output_path_problem,
-)
+from mosys.cli.verb import GIF, PLOT, Family, InputThenOutput, OutputPath, Verb
 
 
 def _controller_arguments(parser: argparse.ArgumentParser) -> None:
@@ -113,10 +104,17 @@ def _car_arguments(parser: argparse.ArgumentParser) -> None:
         help="PNG: one panel per trajectory, the car every 0.3 s",
     )
     parser.add_argument("--gif", type=OutputPath(*GIF), help="animated GIF of the first trajectory")
-    parser.add_argument("--map", nargs=2, metavar=("START_GRID", "PNG"), help="success map")
+    parser.add_argument(
+        "--map",
+        action=InputThenOutput,
+        suffixes=PLOT,
+        metavar=("START_GRID", "PNG"),
+        help="success map",
+    )
     parser.add_argument(
         "--consistency",
-        nargs=2,
+        action=InputThenOutput,
+        suffixes=PLOT,
         metavar=("START_GRID", "PNG"),
         help="parking time / cost-to-go of the starts that parked",
     )
@@ -127,14 +125,7 @@ def _car_check(args: argparse.Namespace) -> str | None:
         return "plot car: give --frames, --gif, --map and/or --consistency"
     if (args.frames or args.gif) and not args.trajectories:
         return "plot car: --frames and --gif need trajectories"
-    pngs = {"--map": args.map, "--consistency": args.consistency}
-    outputs = [args.frames, args.gif] + [pair[1] for pair in pngs.values() if pair]
-    named = [os.path.realpath(path) for path in outputs if path]
-    if len(set(named)) < len(named):
-        return "plot car: two of --frames, --gif, --map and --consistency name the same file"
-    return first_problem(
-        *(output_path_problem(option, pair[1], *PLOT) for option, pair in pngs.items() if pair)
-    )
+    return None
 
 
 def _car(args: argparse.Namespace) -> None:

@@ -62,23 +62,41 @@ class OutputPath:
         return text
 
 
-def output_path_problem(option: str, text: str, *suffixes: str) -> str | None:
-    """``OutputPath``'s refusal of ``text`` as a usage error of ``option`` (None: fine), for
-    an option whose values are not all outputs (``--map START_GRID PNG``)."""
-    try:
-        OutputPath(*suffixes)(text)
-    except argparse.ArgumentTypeError as error:
-        return f"argument {option}: {error}"
-    return None
+class InputThenOutput(argparse.Action):
+    """An argparse action for an option of two values, an input file then an output file
+    (``--map START_GRID PNG``), the output checked as ``OutputPath(*suffixes)`` checks one."""
+
+    def __init__(self, option_strings, dest, suffixes: tuple[str, ...] = (), **kwargs):
+        self.output = OutputPath(*suffixes)
+        super().__init__(option_strings, dest, nargs=2, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        try:
+            self.output(values[1])
+        except argparse.ArgumentTypeError as error:
+            raise argparse.ArgumentError(self, str(error)) from None
+        setattr(namespace, self.dest, values)
 
 
 @dataclass(frozen=True)
 class FileOptions:
-    """A verb's arguments by role: ``outputs`` (dest, option) of those of type ``OutputPath``;
-    ``others`` the dests of the rest that take values (the inputs among them)."""
+    """A verb's arguments by role: ``outputs`` (dest, option) of those that name an output
+    (of type ``OutputPath``, or ``InputThenOutput``: the dests in ``pairs``); ``others`` the
+    dests of the rest that take values (the inputs among them)."""
 
     outputs: tuple[tuple[str, str], ...]
+    pairs: frozenset[str]
     others: tuple[str, ...]
+
+    def output(self, args: argparse.Namespace, dest: str) -> str | None:
+        """The output path ``args`` give for ``dest`` (None: not given)."""
+        value = getattr(args, dest)
+        return value[1] if value and dest in self.pairs else value
+
+    def inputs(self, args: argparse.Namespace) -> list:
+        """The values ``args`` give that may name input files (strings, or lists of them)."""
+        pairs = [getattr(args, dest) for dest in self.pairs]
+        return [getattr(args, dest) for dest in self.others] + [pair[0] for pair in pairs if pair]
 
 
 def file_options(parser: argparse.ArgumentParser) -> FileOptions:
@@ -86,9 +104,11 @@ def file_options(parser: argparse.ArgumentParser) -> FileOptions:
     actions = [  # argparse keeps no public list of a parser's arguments
         action for action in parser._actions if action.nargs != 0 and action.dest != "help"
     ]
-    outputs = [action for action in actions if isinstance(action.type, OutputPath)]
+    pairs = [action for action in actions if isinstance(action, InputThenOutput)]
+    outputs = pairs + [action for action in actions if isinstance(action.type, OutputPath)]
     return FileOptions(
         tuple((a.dest, a.option_strings[-1] if a.option_strings else a.dest) for a in outputs),
+        frozenset(action.dest for action in pairs),
         tuple(action.dest for action in actions if action not in outputs),
     )
 
@@ -99,13 +119,12 @@ def same_file_problem(args: argparse.Namespace, options: FileOptions) -> str | N
     None if neither."""
     written: dict[str, str] = {}
     for dest, option in options.outputs:
-        value = getattr(args, dest)
+        value = options.output(args, dest)
         if value:
             other = written.setdefault(os.path.realpath(value), option)
             if other != option:
                 return f"{args.command.name}: {other} and {option} name the same file, {value}"
-    for dest in options.others:
-        value = getattr(args, dest)
+    for value in options.inputs(args):
         for text in value if isinstance(value, list) else [value]:
             for path in text if isinstance(text, list) else [text]:
                 if isinstance(path, str) and os.path.isfile(path):

@@ -33,7 +33,7 @@ from mosys.parsing.bsr import parse_bsr_spec
 from mosys.parsing.composite_script import CompositeScript
 from mosys.parsing.tokens import SpecError, location
 
-_SEED_FILE = re.compile(r"seed(\d+)\.h5$")
+SEED_FILE = re.compile(r"seed(\d+)\.h5$")  # a search's result files: SEARCH/seedK.h5
 
 
 @dataclass(frozen=True)
@@ -135,8 +135,8 @@ def find_controller_files(script: CompositeScript, results_dir: str | Path) -> d
     for phase in script.phases:
         files = Path(results_dir, phase.controller).glob("seed*.h5")
         found[phase.controller] = sorted(
-            (path for path in files if _SEED_FILE.search(path.name)),
-            key=lambda path: int(_SEED_FILE.search(path.name).group(1)),
+            (path for path in files if SEED_FILE.search(path.name)),
+            key=lambda path: int(SEED_FILE.search(path.name).group(1)),
         )
     return found
 
@@ -158,7 +158,7 @@ def open_session(
         token = script.tokens[f"phase.{phase.name}.controller"]
         candidates = {}
         for path in controller_files.get(phase.controller, ()):
-            match = _SEED_FILE.search(Path(path).name)
+            match = SEED_FILE.search(Path(path).name)
             if match:
                 candidates[int(match.group(1))] = Path(path)
         if not candidates:
