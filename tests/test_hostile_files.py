@@ -232,8 +232,8 @@ def test_the_job_server_replaces_only_a_socket(tmp_path, capsys):
         (["plot", "bsr3d", "r.h5", "--filmstrip", "f.png", "--interval", "inf"],
          "mosys: error: plot bsr3d: --interval must be a positive number of seconds, got inf"),
         (["plot", "car", "--map", "g.h5", "map.gif"],
-         "mosys plot car: error: argument --map: expected a file name ending in .png or .pdf or .svg, "
-         "got 'map.gif'"),
+         "mosys plot car: error: argument --map: expected a file name ending in .png or .pdf "
+         "or .svg, got 'map.gif'"),
         (["plot", "car", "--map", "g.h5", "same.png", "--consistency", "g.h5", "same.png"],
          "mosys: error: plot car: --map and --consistency name the same file, same.png"),
         (["composite", "s.comp", "--controllers", "a/seed1.h5", "--bsr-results", "r", "-o",
