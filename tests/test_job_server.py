@@ -208,6 +208,42 @@ def test_signals_reach_the_job_and_a_job_whose_client_dies_is_stopped(server, tm
     assert not (tmp_path / "x.png").exists()
 
 
+def test_a_job_reports_its_own_exit_code_when_the_server_is_killed(server, tmp_path):
+    """The job is the server's fork and outlives it; its client used to exit 1 ("the job
+    server ended before job N did") although the job went on and ended with its own code."""
+    sleeper = tmp_path / "sleeper.py"
+    sleeper.write_text("import time\n\ntime.sleep(2)\n")  # then it is no dynamics module: exit 2
+    client = subprocess.Popen(
+        [sys.executable, "-m", "mosys.command", "plot", "free-swing", "--dynamics", str(sleeper)]
+        + ["-o", "x.png"],
+        cwd=tmp_path,
+        env={**environment(), "MOSYS_JOB_SERVER": str(server.socket)},
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    deadline = time.monotonic() + 20.0
+    while not server.jobs():
+        assert time.monotonic() < deadline, server.log.read_text()
+        time.sleep(0.02)
+    server.process.kill()
+    server.process.wait(timeout=20)
+    _, stderr = client.communicate(timeout=60)
+    assert client.returncode == 2, stderr
+    assert "ended before" not in stderr and "sleeper.py" in stderr
+
+
+@pytest.mark.parametrize("replacement", ["", "a file"])
+def test_the_server_stops_when_its_socket_is_removed_or_replaced(server, replacement):
+    """No client can reach it any more: it used to run on until --idle (an hour), and on
+    stopping removed whatever then had its socket's name."""
+    server.socket.unlink()
+    if replacement:
+        server.socket.write_text(replacement)
+    assert server.process.wait(timeout=20) == 0
+    assert "is no longer this server's socket: stopping" in server.log.read_text()
+    assert server.socket.exists() == bool(replacement)
+
+
 def test_a_request_the_server_cannot_serve_runs_in_the_client(server, tmp_path):
     """numba set up its kernels' caches (NUMBA_CACHE_DIR) and their optimisation (NUMBA_OPT)
     when the server imported it: a job asking for others runs itself; so does a job whose

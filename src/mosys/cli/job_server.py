@@ -15,8 +15,10 @@ itself) when any other of them, the interpreter or the mosys package differs fro
 since the kernels' caches were set up at import. The server never runs a kernel itself: a numba
 thread pool started before a fork would not survive it.
 
-It stops on SIGTERM or SIGINT, when the process that started it exits, or after
-``--idle`` seconds without a job; a job whose client goes away is sent SIGTERM.
+It stops on SIGTERM or SIGINT, when the process that started it exits, after ``--idle``
+seconds without a job, or, once no job runs, when its socket file is removed or replaced; a job
+whose client goes away is sent SIGTERM. A job whose server has gone (killed meanwhile) sends
+its exit code to its client itself.
 """
 
 from __future__ import annotations
@@ -81,16 +83,27 @@ def serve(path: str, idle_seconds: float) -> None:
     for number in FORWARDED_SIGNALS:  # before the socket exists: a stop is never missed
         signal.signal(number, lambda received, frame: stopping.append(received))
     listener = _listening_socket(path)
+    ours = _file_identity(path)
     _log(f"listening on {path}")
     selector = selectors.DefaultSelector()
     selector.register(listener, selectors.EVENT_READ, ("listener", 0))
     selector.register(woken, selectors.EVENT_READ, ("signal", 0))
     try:
-        _serve_requests(selector, listener, os.getppid(), idle_seconds, stopping)
+        _serve_requests(selector, listener, os.getppid(), idle_seconds, stopping, path, ours)
     finally:
         listener.close()
-        with contextlib.suppress(FileNotFoundError):
+        if _file_identity(path) == ours:  # not another server's, nor gone
             os.unlink(path)
+
+
+def _file_identity(path: str) -> tuple[int, int] | None:
+    """The device and inode of the file at ``path`` (None if there is none): whether the
+    socket there is still this server's."""
+    try:
+        status = os.lstat(path)
+    except OSError:
+        return None
+    return status.st_dev, status.st_ino
 
 
 def _unready_path(path: str) -> str:
@@ -118,15 +131,21 @@ def _listening_socket(path: str) -> socket.socket:
     return listener
 
 
-def _serve_requests(selector, listener, parent: int, idle_seconds: float, stopping) -> None:
+def _serve_requests(
+    selector, listener, parent: int, idle_seconds: float, stopping, path: str, ours
+) -> None:
     """The server's loop: accept requests and fork their jobs, report each job's exit code to
     its client, SIGTERM a job whose client went away, preload while idle; until a stop signal,
-    the parent's exit or ``idle_seconds`` without a job."""
+    the parent's exit, ``idle_seconds`` without a job, or, once its jobs have ended, its
+    socket's leaving ``path`` (removed or replaced: no client can reach it any more)."""
     jobs: dict[int, tuple[socket.socket, int]] = {}  # pid -> (its client's connection, pidfd)
     preloads = Preloads(PRELOADED)
     last_activity = time.monotonic()
     while not stopping and os.getppid() == parent:
         if not jobs and time.monotonic() - last_activity > idle_seconds:
+            break
+        if not jobs and _file_identity(path) != ours:
+            _log(f"{path} is no longer this server's socket: stopping")
             break
         events = selector.select(0.0 if preloads.pending else POLL_S)
         if not events and preloads.pending:
@@ -346,11 +365,13 @@ def _start_job(connection, selector) -> tuple[int, int] | None:
         except OSError:
             return None
         if pid == 0:  # the job: it keeps none of the server's sockets, and never returns
-            code = 1
+            server, code = os.getppid(), 1
             try:
                 _leave_server(selector)
                 code = _run_job(request, fds)
             finally:
+                if os.getppid() != server:  # the server is gone: tell the client its code
+                    _send_line(connection, f"exit {code}")
                 os._exit(code)
         pidfd = os.pidfd_open(pid)
         _send_line(connection, f"started {pid}")
