@@ -402,9 +402,10 @@ def test_an_error_quotes_at_most_the_start_of_a_huge_word(path: Path) -> None:
 # --- 6. a step longer than a sim line -----------------------------------------------------------
 
 
-def test_run_with_a_step_longer_than_its_sim_line(tmp_path: Path, pendulum: Path) -> None:
+def test_run_with_a_step_longer_than_its_sim_line(tmp_path: Path, pendulum: Path, capsys) -> None:
     """``mosys run --dt 2`` (reproducer 6, once an AssertionError): a 0.4 s ``sim`` rounds to no
-    step, a 4 s one to two steps of 2 s; the run ends with a finite trajectory."""
+    step, and says so (it used to say nothing), a 4 s one to two steps of 2 s; the run ends with
+    a finite trajectory."""
     script = tmp_path / "long_steps.anim"
     script.write_text("state link -135,350\nswapcon link conA.ctab\nsim 0.4\nsim 4\n")
     out = tmp_path / "long_steps.h5"
@@ -414,6 +415,9 @@ def test_run_with_a_step_longer_than_its_sim_line(tmp_path: Path, pendulum: Path
     with h5py.File(out) as file:
         assert np.isfinite(file["state"][...]).all() and np.isfinite(file["t"][...]).all()
         assert file["t"][-1] == 4.0
+    assert capsys.readouterr().err.splitlines() == [
+        f"warning: {script}:3: sim 0.4 is less than half a step (dt = 2 s): no step simulated"
+    ]
 
 
 # --- 8. a composite score that divides by zero ------------------------------------------------

@@ -4,7 +4,8 @@ motor programs it names → one motion.
 ``state`` values in positional form are read in the state order of the active controller (or,
 before any ``swapcon``, of the script's first controller); figure state variables that order
 leaves out start at 0. ``swapcon`` switches controller at once; ``sim`` runs the active
-controller for that many seconds in whole steps of ``dt`` (with ``until=dest``, it stops at the
+controller for that many seconds in whole steps of ``dt``, rounded (one shorter than half a step
+simulates none, with a warning on stderr; with ``until=dest``, it stops at the
 first step in an arrival box of the controller's, ``Controller.arrival_boxes``: one per
 destination); during a ``sim``, the
 first breakpoint (``when``) whose box holds the state drives instead, switching as the state
@@ -416,6 +417,12 @@ def _simulate(
     spent. Each change of controller is checked against the new one's domain. A state that
     becomes non-finite raises SimulationError at the ``sim`` line."""
     remaining = int(round(command.seconds / dt))
+    if remaining == 0:  # a coarse --dt, for a quick look: say what it skips
+        print(
+            f"warning: {script.path}:{command.token.line}: sim {command.seconds:g} is less "
+            f"than half a step (dt = {dt:g} s): no step simulated",
+            file=sys.stderr,
+        )
     while remaining > 0:
         boxes = [box for box, _ in exchange.breakpoints]
         breakpoints = len(boxes)
