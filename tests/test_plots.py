@@ -21,6 +21,7 @@ from mosys.cli import main
 from mosys.io.controller_table import ControllerTable, write_controller_table
 from mosys.io.trajectory import FigureMotion, Trajectory, read_trajectory, write_trajectory
 from mosys.parsing.controller import parse_controller_spec
+from mosys.plots.controls import controls_figure
 from mosys.plots.pendulum import (
     StateAxis,
     cylinder_pieces,
@@ -491,3 +492,29 @@ def test_a_plot_file_name_without_a_known_format_is_refused(tmp_path):
         with pytest.raises(PlotInputError, match=r"ends in \.png, \.pdf, \.svg"):
             save_figure(Figure(), tmp_path / name)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_controls_figure_draws_a_single_sample_and_says_it_has_no_rate(trajectory, tmp_path):
+    """A run that begins at its destination has one sample: its control was drawn as a line of
+    one point, which shows nothing, above an empty rate panel."""
+    whole = read_trajectory(trajectory)
+    lone = tmp_path / "at_destination.h5"
+    first = dataclasses.replace(
+        whole,
+        t=whole.t[:1],
+        state=whole.state[:1],
+        control=whole.control[:1],
+        controller=whole.controller[:1],
+        attrs={**whole.attrs, "script": "at_destination.anim", "switch_times": [0.0]},
+        motion=None,
+    )
+    write_trajectory(lone, first)
+    figure = controls_figure([lone])
+    top, bottom = figure.axes
+    (point,) = top.lines
+    assert point.get_marker() == "o" and list(point.get_xdata()) == [0.0]
+    assert legend_labels(figure) == ["at_destination.anim (no limit; a single sample)"]
+    (note,) = bottom.texts
+    assert note.get_text() == "no rate of change: no two samples apart in time"
+    both = controls_figure([trajectory, lone])
+    assert not both.axes[1].texts and both.axes[0].lines[0].get_marker() in ("", "None", None)

@@ -48,25 +48,39 @@ def controls_figure(trajectory_paths: Sequence[str | Path], control: str | None 
         figure = new_figure(8.0, 6.6)
         top, bottom = figure.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 2]})
         legend = []
-        largest_rate = 0.0
+        largest_rate, rates = 0.0, 0
         for k, (trajectory, path, limit) in enumerate(
             zip(trajectories, trajectory_paths, limits, strict=True)
         ):
             color = SCRIPT_COLORS[k % len(SCRIPT_COLORS)]
             t = trajectory.t
             value = trajectory.control[:, trajectory.control_names.index(name)]
-            top.plot(t, value, color=color, linewidth=1.4, drawstyle="steps-post")
+            lone = t.size == 1  # a run that began at its destination: a point, not a line
+            marker = "o" if lone else None
+            top.plot(t, value, color=color, linewidth=1.4, drawstyle="steps-post", marker=marker)
             moving = np.diff(t) > 0
             rate = np.diff(value)[moving] / np.diff(t)[moving]
             bottom.plot(t[1:][moving], np.abs(rate), color=color, linewidth=1.0)
+            rates += rate.size
             largest_rate = max(largest_rate, float(np.abs(rate).max(initial=0.0)))
-            label = _script_name(trajectory, path)
-            label += f" (slew limit {limit:g} {unit}/s)" if limit is not None else " (no limit)"
+            notes = [f"slew limit {limit:g} {unit}/s" if limit is not None else "no limit"]
+            notes += ["a single sample"] if lone else []
+            label = f"{_script_name(trajectory, path)} ({'; '.join(notes)})"
             legend.append((Line2D([], [], color=color, linewidth=2), label))
             if limit is not None:
                 bottom.axhline(limit, color=color, linestyle="--", linewidth=1.4)
             for switch in np.atleast_1d(trajectory.attrs.get("switch_times", []))[1:]:
                 top.axvline(float(switch), color=color, linewidth=0.6, alpha=0.35)
+        if not rates:
+            bottom.text(
+                0.5,
+                0.5,
+                "no rate of change: no two samples apart in time",
+                transform=bottom.transAxes,
+                ha="center",
+                va="center",
+                color="0.3",
+            )
         finite = [limit for limit in limits if limit is not None]
         if finite:
             legend.append(
