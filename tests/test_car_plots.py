@@ -21,7 +21,7 @@ from matplotlib.patches import Polygon
 from PIL import Image
 
 import mosys.plots.car as car
-from mosys.io.start_grid import NO_WAY, NOT_FREE, consistency_summary
+from mosys.io.start_grid import NO_WAY, NOT_FREE, consistency_ratios, consistency_summary
 from mosys.io.trajectory import Trajectory, write_trajectory
 from mosys.kernels.geometry import first_colliding_sample, pack_polygons
 from mosys.plots.car import (
@@ -591,6 +591,13 @@ def test_success_map_png(tmp_path):
     out = tmp_path / "map.png"
     plot_success_map(write_start_grid(tmp_path / "grid.h5"), out)
     assert_png(out)
+
+
+def test_a_start_at_the_destination_keeps_the_promise():
+    """Parked in 0 s against a cost-to-go of 3e-15 s (or 0): nothing promised, nothing taken.
+    It counted as inconsistent (ratio 0, or NaN for 0 / 0)."""
+    ratios = consistency_ratios(np.array([0.0, 0.0, 0.0, 2.0]), np.array([3e-15, 0.0, 0.5, np.inf]))
+    assert ratios[:3].tolist() == [1.0, 1.0, 0.0] and np.isnan(ratios[3])
 
 
 def test_consistency_summary():

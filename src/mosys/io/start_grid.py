@@ -40,13 +40,17 @@ STRING = h5py.string_dtype()
 NOT_FREE = "start pose overlaps an obstacle or lies outside the domain"  # why a start is
 NO_WAY = "no collision-free path to the destination (pose search)"  # excluded (``excluded``)
 CONSISTENCY_BAND = 0.25  # consistent: |parking time / cost-to-go - 1| <= this (within 25 %)
+NOTHING_S = 1e-9  # a parking time and cost-to-go both under this are both none: consistent
 
 
 def consistency_ratios(parking_seconds: np.ndarray, cost_to_go: np.ndarray) -> np.ndarray:
     """Parking time / cost-to-go at the start (both (p,) s) of starts that parked; NaN where the
-    table knows no cost-to-go (inf)."""
+    table knows no cost-to-go (inf); 1 where both are under ``NOTHING_S`` (a start at the
+    destination: nothing promised, nothing taken; 0 / 3e-15 made it inconsistent)."""
     known = np.isfinite(cost_to_go)
-    return np.where(known, parking_seconds / np.where(known, cost_to_go, 1.0), np.nan)
+    with np.errstate(divide="ignore", invalid="ignore"):  # 0 / 0 at the destination
+        ratios = np.where(known, parking_seconds / np.where(known, cost_to_go, 1.0), np.nan)
+    return np.where((parking_seconds < NOTHING_S) & (cost_to_go < NOTHING_S), 1.0, ratios)
 
 
 def consistency_summary(ratios: np.ndarray) -> tuple[float, float, float]:
