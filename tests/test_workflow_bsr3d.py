@@ -147,6 +147,17 @@ def test_the_targets_table_measures_each_target_on_the_files(built):
     assert frame["met"][0] == (
         "yes" if lengths >= 3 and "fell" not in frame["measured"][0] else "no"
     )
+    # Rex: an angle only between walks long enough to have a direction (at the CI budget a
+    # walk of a few centimetres gave one)
+    rex = re.fullmatch(
+        r"(\d+) deg apart|no direction to compare \(a walk under 0.5 m\)",
+        frame["measured"][1].split(";")[0],
+    )
+    walked = [float(m) for m in re.findall(r"([\d.]+) m", frame["measured"][1].split(";")[1])]
+    assert rex is not None and len(walked) == 2
+    assert (rex[1] is not None) == (min(walked) >= 0.5)
+    if rex[1] is None:
+        assert frame["met"][1] == "no"
     # the physics holds at any budget
     assert frame["met"][4] == "yes"
     assert set(frame["budget"][:4]) == {"ci"}

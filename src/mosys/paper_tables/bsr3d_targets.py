@@ -1,7 +1,8 @@
 """The 3-D motions against the targets set for them (issue 22, after the 1995 paper's §4),
 measured on the result files: Cujo bounds at least three body lengths without falling; Rex walks,
 turns so that his second walk heads at least 45° away from his first, and walks on, without
-falling; Bob walks at least four steps (alternating foot touch-downs), facing forward, without
+falling (each walk at least WALK_ON on the floor: a shorter one has no direction to compare);
+Bob walks at least four steps (alternating foot touch-downs), facing forward, without
 falling, in at least one seed, and the time-based Bob does worse than the sense-based one (the
 paper's finding, reported either way: here, it walks in fewer of its seeds and has the lower
 median fitness; the best fitness of each is shown too); no endpoint sinks more than 1 cm into
@@ -144,20 +145,22 @@ def targets_frame(
     turn = _continued(_need(searches, turn_name), again)
     first = _continued(_need(searches, walk_name), turn)
     one, two = direction(first), direction(again)
-    angle = math.degrees(
-        math.acos(np.clip(one @ two / (np.linalg.norm(one) * np.linalg.norm(two)), -1.0, 1.0))
-    )
-    distance = float(again.fitness_terms["distance"])
+    lengths = np.linalg.norm(one), np.linalg.norm(two)  # m on the floor
     fallen = any(fell(result) for result in (first, turn, again))
+    if min(lengths) >= WALK_ON:
+        angle = math.degrees(math.acos(np.clip(one @ two / (lengths[0] * lengths[1]), -1.0, 1.0)))
+        apart = f"{angle:.0f} deg apart"
+    else:  # a few centimetres of shuffling have no direction to compare
+        angle, apart = math.nan, f"no direction to compare (a walk under {WALK_ON:g} m)"
     rows.append(
         _row(
             f"{walk_name} -> {turn_name} -> {again_name}",
-            f"second walk >= {TURN:g} deg from the first, walks on (>= {WALK_ON:g} m), "
-            "never fallen",
-            f"{angle:.0f} deg apart, second walk {distance:.2f} m (seeds "
+            f"both walks >= {WALK_ON:g} m on the floor, the second >= {TURN:g} deg from the "
+            "first, never fallen",
+            f"{apart}; walks {lengths[0]:.2f} m and {lengths[1]:.2f} m (seeds "
             f"{int(first.attrs['seed'])}, {int(turn.attrs['seed'])}, {int(again.attrs['seed'])})"
             + (", fell" if fallen else ""),
-            angle >= TURN and distance >= WALK_ON and not fallen,
+            angle >= TURN and not fallen,  # NaN when a walk is too short: not met
             str(again.attrs["budget"]),
         )
     )
@@ -228,8 +231,9 @@ def write_bsr3d_targets(
         "The 3-D motions against their targets (issue 22, after Auslander et al. 1995, §4), "
         "measured on the best seed's best motion of each search. A body length is the heading "
         "rod's length (Cujo's spine); fallen: the centre of mass below half its standing "
-        "height; a walk's direction: its centre of mass's displacement on the floor; facing "
-        "forward: the heading within 45 deg of the start's on average and at the end. "
+        "height; a walk's direction: its centre of mass's displacement on the floor (a walk "
+        f"under {WALK_ON:g} m has none to compare); facing forward: the heading within "
+        f"{FACING:g} deg of the start's on average and at the end. "
         f"{budget_sentence(budgets)} Targets are set for "
         "the paper's budgets; a reduced budget (ci) runs the same measures.\n\n"
     )
