@@ -90,15 +90,23 @@ class StartGrid:
 
     @property
     def success_rate(self) -> float:
+        """The share of the counted starts that succeeded (NaN: none counted)."""
         counted = self.counted
-        return float(self.parked[counted].mean()) if counted.any() else float("nan")
+        return float(self.succeeded[counted].mean()) if counted.any() else float("nan")
+
+    @property
+    def succeeded(self) -> np.ndarray:
+        """(n,) bool: the counted starts that parked without a collision (a collision never
+        counts as parking)."""
+        return np.asarray(self.parked & ~self.collided & self.counted, dtype=bool)
 
     @property
     def consistency(self) -> np.ndarray:
-        """(p,) parking seconds / cost-to-go at the start, for each counted start that parked;
-        NaN where the table knows no cost-to-go at the start (inf)."""
-        parked = self.parked & self.counted
-        return consistency_ratios(self.parking_seconds[parked], self.cost_to_go[parked])
+        """(p,) parking time / cost-to-go at the start (both s) of each start that succeeded, in
+        grid order: 1 where the run takes as long as the table predicts, NaN where the table
+        knows no cost-to-go there (inf)."""
+        succeeded = self.succeeded
+        return consistency_ratios(self.parking_seconds[succeeded], self.cost_to_go[succeeded])
 
     @property
     def arrival_consistency(self) -> np.ndarray | None:
@@ -106,8 +114,10 @@ class StartGrid:
         without ``arrival_cost_to_go``."""
         if self.arrival_cost_to_go is None:
             return None
-        parked = self.parked & self.counted
-        return consistency_ratios(self.parking_seconds[parked], self.arrival_cost_to_go[parked])
+        succeeded = self.succeeded
+        return consistency_ratios(
+            self.parking_seconds[succeeded], self.arrival_cost_to_go[succeeded]
+        )
 
 
 def write_start_grid(path: str | Path, grid: StartGrid) -> None:

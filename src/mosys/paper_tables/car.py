@@ -28,14 +28,15 @@ PAPER_STATES = 13250  # the paper's car controller, after removing collision sta
 
 def start_grid_columns(grid: StartGrid) -> dict:
     """The start grid's columns of the car table: its starts, those that count (not excluded),
-    the excluded ones by reason (``NOT_FREE``, ``NO_WAY``), the counted ones that parked, the
-    success rate over the counted starts, the collisions, the mean parking time (s) of the
-    parked starts and the consistency of the table (``StartGrid.consistency``: parking time /
-    cost-to-go at the start): its median, its 90th percentile (linear interpolation) and the
-    share of parked starts within CONSISTENCY_BAND of 1; the same against the cost-to-go to the
-    whole arrival box (``arrival_consistency_*``, ``StartGrid.arrival_consistency``). NaN where
-    no start parked or the grid has no such cost-to-go."""
-    parked = grid.parked & grid.counted
+    the excluded ones by reason (``NOT_FREE``, ``NO_WAY``), the counted ones that parked
+    (``StartGrid.succeeded``: never with a collision), the success rate over the counted starts,
+    the collisions, the mean parking time (s) of the parked starts and the consistency of the
+    table (``StartGrid.consistency``: parking time / cost-to-go at the start): its median, its
+    90th percentile (linear interpolation) and the share of parked starts within
+    CONSISTENCY_BAND of 1; the same against the cost-to-go to the whole arrival box
+    (``arrival_consistency_*``, ``StartGrid.arrival_consistency``). NaN where no start parked
+    or the grid has no such cost-to-go."""
+    parked = grid.succeeded
     arrival = grid.arrival_consistency
     return {
         "grid_starts": int(grid.start.shape[0]),

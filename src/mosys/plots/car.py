@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import matplotlib
@@ -40,7 +40,7 @@ from mosys.io.start_grid import (
     DATASETS,
     NO_WAY,
     NOT_FREE,
-    consistency_ratios,
+    StartGrid,
     consistency_summary,
 )
 from mosys.io.start_grid import read_start_grid as read_start_grid_file
@@ -208,55 +208,15 @@ class CarTrajectory:
 
 
 @dataclass(frozen=True)
-class StartGrid:
-    """Outcomes from a grid of start states. start: (n, d) spec units in ``state_order``;
-    parked, collided: (n,) bool; parking_seconds: (n,) s (NaN where not parked); excluded: (n,)
-    str, why the start cannot park at all (``NOT_FREE`` or ``NO_WAY``; "" for the starts that
-    count and were run); cost_to_go: (n,) s, the controller table's at the start (inf: unknown);
-    path_length: (n,) m, the shortest collision-free path the pose search found (inf: none, NaN:
-    the start is not free); arrival_cost_to_go: (n,) s, the table's cost-to-go to its whole
-    arrival box at the start (inf: unknown; None: the file has none)."""
+class DrawnStartGrid:
+    """A start grid checked for drawing (``read_start_grid``): its starts and outcomes
+    (``io.start_grid.StartGrid``, arrays of the right shapes and types), the scene they were
+    run in, the controller's name and how long each run was simulated (s)."""
 
-    start: np.ndarray
-    state_order: tuple[str, ...]
-    parked: np.ndarray
-    collided: np.ndarray
-    parking_seconds: np.ndarray
-    excluded: np.ndarray
-    cost_to_go: np.ndarray
-    path_length: np.ndarray
+    outcomes: StartGrid
     scene: CarScene
     controller: str
     simulated_seconds: float
-    arrival_cost_to_go: np.ndarray | None = None
-
-    @property
-    def counted(self) -> np.ndarray:
-        """(n,) bool: the starts the success rate counts (not excluded)."""
-        return self.excluded == ""
-
-    @property
-    def succeeded(self) -> np.ndarray:
-        """(n,) bool: parked without a collision (a collision never counts as parking)."""
-        return self.parked & ~self.collided
-
-    @property
-    def consistency(self) -> np.ndarray:
-        """(p,) parking time / cost-to-go at the start (both s) of each start that parked, in
-        grid order: 1 where the run takes as long as the table predicts, NaN where the table
-        knows no cost-to-go there."""
-        succeeded = self.succeeded
-        return consistency_ratios(self.parking_seconds[succeeded], self.cost_to_go[succeeded])
-
-    @property
-    def arrival_consistency(self) -> np.ndarray | None:
-        """``consistency`` against ``arrival_cost_to_go``; None where there is none."""
-        if self.arrival_cost_to_go is None:
-            return None
-        succeeded = self.succeeded
-        return consistency_ratios(
-            self.parking_seconds[succeeded], self.arrival_cost_to_go[succeeded]
-        )
 
 
 def _missing(path, kind: str, names: Sequence[str], present) -> None:
@@ -342,7 +302,7 @@ def read_car_trajectory(path: str | Path) -> CarTrajectory:
     )
 
 
-def read_start_grid(path: str | Path) -> StartGrid:
+def read_start_grid(path: str | Path) -> DrawnStartGrid:
     """Read ``results/car/start_grid.h5`` (see ``success_map_figure``); PlotInputError naming the
     file and what is missing or malformed: a dataset of the wrong shape, a parked start without
     a finite parking time, an exclusion reason other than ``NOT_FREE`` and ``NO_WAY``, an
@@ -395,21 +355,23 @@ def read_start_grid(path: str | Path) -> StartGrid:
         raise PlotInputError(
             f"{path}: start {first} parked but its parking_seconds is {parking_seconds[first]}"
         )
-    return StartGrid(
+    outcomes = replace(
+        grid,
         start=start,
-        state_order=state_order,
         parked=parked,
         collided=collided,
         parking_seconds=parking_seconds,
-        excluded=excluded,
         cost_to_go=per_start["cost_to_go"].astype(np.float64),
         path_length=per_start["path_length"].astype(np.float64),
-        scene=_read_scene(path, attrs),
-        controller=string_attr(attrs["controller"]),
-        simulated_seconds=float(attrs["simulated_seconds"]),
         arrival_cost_to_go=per_start["arrival_cost_to_go"].astype(np.float64)
         if "arrival_cost_to_go" in per_start
         else None,
+    )
+    return DrawnStartGrid(
+        outcomes=outcomes,
+        scene=_read_scene(path, attrs),
+        controller=string_attr(attrs["controller"]),
+        simulated_seconds=float(attrs["simulated_seconds"]),
     )
 
 
@@ -999,11 +961,12 @@ def success_map_figure(start_grid_path: str | Path) -> Figure:
     (n,) s and ``path_length`` (n,) m; root attributes ``body_outline``, ``obstacles``,
     ``obstacle_names``, ``destination`` (JSON, as in a car trajectory), ``controller`` and
     ``simulated_seconds`` (s)."""
-    grid = read_start_grid(start_grid_path)
+    drawn = read_start_grid(start_grid_path)
+    grid = drawn.outcomes
     column = {name: k for k, name in enumerate(grid.state_order)}
     xy = grid.start[:, [column["x"], column["y"]]]
     panels = _group_starts(grid)
-    limits = view_limits(np.concatenate([xy, _scene_points(grid.scene)]), grid.scene.obstacles)
+    limits = view_limits(np.concatenate([xy, _scene_points(drawn.scene)]), drawn.scene.obstacles)
     parked, counted = grid.succeeded, grid.counted
     times = grid.parking_seconds[parked]
     if len(times):
@@ -1013,16 +976,16 @@ def success_map_figure(start_grid_path: str | Path) -> Figure:
         norm = Normalize(0.0, 1.0)
     count, total = int(parked.sum()), int(counted.sum())
     rate = f" ({100 * count / total:.1f} %)" if total else ""
-    headline = f"Controller {grid.controller}: parks from {count} of {total} starts{rate}"
+    headline = f"Controller {drawn.controller}: parks from {count} of {total} starts{rate}"
     if total < len(counted):
         headline += f"; {len(counted) - total} more cannot park at all, not counted"
     details = f"every start: {', '.join(panels.common)}; " if panels.common else ""
-    details += f"each run simulated for up to {grid.simulated_seconds:g} s"
+    details += f"each run simulated for up to {drawn.simulated_seconds:g} s"
     kinds = [  # (legend text, marker, which starts)
         ("parked", PARKED, parked),
         ("collision", COLLIDED, grid.collided),
         (
-            f"not parked in {grid.simulated_seconds:g} s",
+            f"not parked in {drawn.simulated_seconds:g} s",
             TIMED_OUT,
             counted & ~parked & ~grid.collided,
         ),
@@ -1053,7 +1016,7 @@ def success_map_figure(start_grid_path: str | Path) -> Figure:
         diameter = _marker_diameter(xy, panel_inches * 72 / (limits[1, 0] - limits[0, 0]))
         mappable = None
         for ax, title, rows in zip(layout.panels, panels.titles, panels.groups, strict=True):
-            _draw_scene(ax, grid.scene, limits)
+            _draw_scene(ax, drawn.scene, limits)
             for label, marker, which in kinds:
                 chosen = rows[which[rows]]
                 if marker is PARKED:  # coloured by the parking time; none: no colour scale
@@ -1097,14 +1060,15 @@ def consistency_figure(start_grid_path: str | Path) -> Figure:
     (``StartGrid.arrival_consistency``) adds the ratios against it as an outlined histogram
     and a title line (share within the band and median). Reads the start grid as
     ``success_map_figure`` does."""
-    grid = read_start_grid(start_grid_path)
+    drawn = read_start_grid(start_grid_path)
+    grid = drawn.outcomes
     ratios = grid.consistency
     median, p90, within = consistency_summary(ratios)
     finite = ratios[np.isfinite(ratios)]
     arrival = grid.arrival_consistency if len(ratios) else None
     arrival_finite = np.zeros(0) if arrival is None else arrival[np.isfinite(arrival)]
     headline = (
-        f"Controller {grid.controller}: parking time / cost-to-go at the start, "
+        f"Controller {drawn.controller}: parking time / cost-to-go at the start, "
         f"{len(ratios)} starts that parked"
     )
     if len(ratios):
