@@ -518,3 +518,27 @@ def test_controls_figure_draws_a_single_sample_and_says_it_has_no_rate(trajector
     assert note.get_text() == "no rate of change: no two samples apart in time"
     both = controls_figure([trajectory, lone])
     assert not both.axes[1].texts and both.axes[0].lines[0].get_marker() in ("", "None", None)
+
+
+def test_a_colour_few_frames_show_keeps_its_own_palette_entry():
+    """A GIF's palette was cut from 8 sampled frames: a rule active in none of them was drawn in
+    another rule's colour (Star-Man's cartwheel: rule D red drawn brown). Here 300 shades fill
+    every frame, and a red square shows in one frame of 40."""
+    from mosys.plots.style import shared_palette
+
+    shades = np.zeros((30, 100, 3), np.uint8)
+    shades[..., 0] = np.arange(100)[None, :]
+    shades[..., 1] = np.arange(30)[:, None] * 8
+    shades[..., 2] = 120
+    red = (214, 39, 40)
+    frames = []
+    for k in range(40):
+        pixels = np.full((60, 100, 3), 255, np.uint8)
+        pixels[:30] = shades
+        if k == 13:
+            pixels[40:50, 40:50] = red
+        frames.append(Image.fromarray(pixels))
+    quantized = shared_palette(frames)
+    shown = np.asarray(quantized[13].convert("RGB"))
+    assert tuple(shown[45, 45]) == red
+    assert len({tuple(frame.getpalette()) for frame in quantized}) == 1  # one palette
