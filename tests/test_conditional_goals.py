@@ -379,6 +379,23 @@ def test_portrait_tints_each_basin(pendulum_g, link1):
     ]
 
 
+def test_torque_table_marks_every_destination(pendulum_g):
+    """It marked only the first (90 deg), and its title named that one alone."""
+    from mosys.plots.pendulum import torque_figure
+
+    figure = torque_figure(pendulum_g)
+    ax = figure.axes[0]
+    assert ax.get_title() == (
+        "Controller G: torque table, 36 × 21 nodes\n2 destinations, the cheapest from each state"
+    )
+    circles = [line for line in ax.lines if line.get_marker() == "o" and line.get_zorder() == 6]
+    assert sorted((line.get_xdata()[0], line.get_ydata()[0]) for line in circles) == [
+        (-90.0, 0.0),
+        (90.0, 0.0),
+    ]
+    assert [text.get_text() for text in figure.legends[0].get_texts()][-1] == "destinations"
+
+
 def test_a_single_destination_portrait_has_no_basins(link1, tmp_path):
     from matplotlib.collections import QuadMesh
 

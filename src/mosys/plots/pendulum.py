@@ -247,6 +247,25 @@ def _mark_table_destination(
     return line
 
 
+def _mark_table_destinations(ax: Axes, table: ControllerTable, axes) -> list:
+    """Mark every destination of the table (``_mark_table_destination``); the legend entry
+    (none if no destination names a plotted variable)."""
+    handle = None
+    for destination in table.all_destinations:
+        handle = _mark_table_destination(ax, table, axes, destination=destination) or handle
+    if handle is None:
+        return []
+    return [(handle, "destination" + ("s" if len(table.all_destinations) > 1 else ""))]
+
+
+def _destinations_heading(table: ControllerTable) -> str:
+    """The title's words for the table's destination, or how many it has."""
+    if len(table.all_destinations) == 1:
+        units = dict(zip(table.state_order, table.axis_units, strict=True))
+        return f"destination {describe_state(table.dest, units)}"
+    return f"{len(table.all_destinations)} destinations, the cheapest from each state"
+
+
 def _destination_is_periodic(table: ControllerTable, destination: dict | None = None) -> bool:
     """A destination with a non-zero rate is passed through, not held: a periodic motion.
     ``destination``: as in ``destination_point``."""
@@ -381,18 +400,10 @@ def portrait_figure(
             mark_start(ax, start[0], start[1], color)
             drawn.append(path)
         legend.append((Line2D([], [], **start_style("white")), "start state (one colour per path)"))
-        handle = None
-        for destination in destinations:
-            handle = _mark_table_destination(ax, table, axes, destination=destination) or handle
-        if handle is not None:
-            legend.append((handle, "destination" + ("s" if len(destinations) > 1 else "")))
+        legend.extend(_mark_table_destinations(ax, table, axes))
         format_state_axes(ax, axes, np.concatenate(drawn))
-        if len(destinations) == 1:
-            heading = f"destination {describe_state(table.dest, units)}"
-        else:
-            heading = f"{len(destinations)} destinations, the cheapest from each state"
         ax.set_title(
-            f"Controller {controller.name}: {heading}\n"
+            f"Controller {controller.name}: {_destinations_heading(table)}\n"
             f"closed-loop paths, {seconds:g} s from each of {starts} start states"
         )
         if table.destination_index is not None:
@@ -417,7 +428,6 @@ def torque_figure(table_path: str | Path, contours: bool = True) -> Figure:
     table = read_controller_table(table_path)
     axes = table_axes(table, table_path)
     name = Path(table_path).stem
-    units = dict(zip(table.state_order, table.axis_units, strict=True))
     centres = []
     for axis, grid in zip(axes, table.axes, strict=True):
         # a periodic axis repeats its first node at the far edge, so the plot closes up
@@ -474,14 +484,12 @@ def torque_figure(table_path: str | Path, contours: bool = True) -> Figure:
                         "cost-to-go, contours labelled in s",
                     )
                 )
-            handle = _mark_table_destination(ax, table, axes)
-            if handle is not None:
-                legend.append((handle, "destination"))
+            legend.extend(_mark_table_destinations(ax, table, axes))
             format_state_axes(ax, axes)
             ax.set_title(
                 f"Controller {name}: {control} table, "
                 f"{' × '.join(str(len(g)) for g in table.axes)} nodes\n"
-                f"destination {describe_state(table.dest, units)}"
+                f"{_destinations_heading(table)}"
             )
         add_legend(figure, legend)
     return figure
