@@ -372,10 +372,23 @@ def test_parking_frames_figure(parks, crashes, lost):
         "obstacle",
         "destination (car outline)",
         "car every 0.3 s, light → dark",
-        "start and final outline",
+        "start outline and its front-axle midpoint",
+        "final outline",
         "path of the front-axle midpoint",
         "first collision",
     ]
+    # the swatches are drawn as the outlines are: the start light, the final dark
+    handles = {
+        text.get_text(): handle
+        for text, handle in zip(
+            figure.legends[0].get_texts(), figure.legends[0].legend_handles, strict=True
+        )
+    }
+    start, final = panels[0].patches[-2:]  # after the obstacles and destination: start, final
+    assert same_color(
+        handles["start outline and its front-axle midpoint"].get_color(), start.get_edgecolor()
+    )
+    assert same_color(handles["final outline"].get_color(), final.get_edgecolor())
     parked, crashed, wandered = (outcome_label(ax) for ax in panels)
     assert parked.get_text().startswith("parked in") and parked.get_color() == "black"
     assert crashed.get_text().startswith("FAILED: hits front_car")

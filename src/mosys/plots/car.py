@@ -769,7 +769,20 @@ def parking_frames_figure(
             Line2D([], [], color=_shade(0.5), linewidth=0.7),
             f"car every {interval:g} s, light → dark",
         ),
-        (Line2D([], [], color=_shade(1.0), linewidth=2.0), "start and final outline"),
+        (
+            Line2D(
+                [],
+                [],
+                color=_shade(0.0),
+                linewidth=2.0,
+                marker="o",
+                markersize=4,
+                markeredgecolor="black",
+                markeredgewidth=0.6,
+            ),
+            "start outline and its front-axle midpoint",
+        ),
+        (Line2D([], [], color=_shade(1.0), linewidth=2.0), "final outline"),
         (Line2D([], [], color=PATH_COLOR, linewidth=0.8), "path of the front-axle midpoint"),
         (
             Patch(facecolor=(1, 0, 0, 0.25), edgecolor=FAILURE_COLOR, linewidth=2.0),
@@ -789,7 +802,7 @@ def parking_frames_figure(
             _draw_manoeuvre(ax, run, drawn)
             _panel_title(ax, head, outcome_text(run), run.failed)
         _suptitle(layout.figure, f"The car parking under controller {_controller_names(runs)}")
-        add_legend(layout.figure, legend, ncols=3)
+        add_legend(layout.figure, legend, ncols=4)
     return layout.figure
 
 
