@@ -626,7 +626,8 @@ def _draw_scene(ax: Axes, scene: CarScene, limits: np.ndarray) -> None:
                 fontsize=OBSTACLE_LABEL_SIZE,
                 color="0.15",
                 clip_on=True,
-                zorder=1.5,
+                zorder=6.5,  # over the start map's markers (6), which hid it
+                bbox={"boxstyle": "round,pad=0.2", "facecolor": OBSTACLE_FACE, "edgecolor": "none"},
             )
     destination = scene.destination
     goal = place_outline(
