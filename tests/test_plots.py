@@ -542,3 +542,21 @@ def test_a_colour_few_frames_show_keeps_its_own_palette_entry():
     shown = np.asarray(quantized[13].convert("RGB"))
     assert tuple(shown[45, 45]) == red
     assert len({tuple(frame.getpalette()) for frame in quantized}) == 1  # one palette
+
+
+def test_script_figure_names_a_motor_programs_start_by_its_name(trajectory, drawn_tables, tmp_path):
+    """A motor program 'swing' was labelled 'sswing' and counted as a controller invocation."""
+    whole = read_trajectory(trajectory)
+    motor = tmp_path / "with_motor.h5"
+    attrs = {**whole.attrs, "switch_controllers": ["A", "swing"]}
+    attrs["controller_kinds"] = ["controller", "motor"]
+    write_trajectory(motor, dataclasses.replace(whole, controllers=("A", "swing"), attrs=attrs))
+    figure = script_path_figure(motor, [drawn_tables["A"]])
+    (ax,) = figure.axes
+    assert ax.get_title().splitlines()[1] == (
+        "1 controller invocation and 1 motor program over 1.00 s"
+    )
+    assert {"sA", "swing", "dA"} <= {text.get_text() for text in ax.texts}
+    labels = legend_labels(figure)
+    assert "motor program swing" in labels
+    assert "sX: controller X invoked; P: motor program P started" in labels

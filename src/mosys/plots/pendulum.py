@@ -45,6 +45,7 @@ from mosys.plots.style import (
     animation_frames,
     axis_label,
     controller_colors,
+    counted,
     destination_handle,
     mark_destination,
     mark_start,
@@ -611,7 +612,8 @@ def plot_script(
 
 def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | Path]) -> Figure:
     """Figure 16: an animation script's path in state space, each controller's stretch in its
-    own colour; ``sX`` marks where controller X is invoked and ``dX`` its destination (read
+    own colour; ``sX`` marks where controller X is invoked (a motor program's start is marked
+    with its name) and ``dX`` its destination (read
     from the controller tables in ``table_paths``, matched to the script's controllers by file
     stem; without them no destinations are drawn, and the axes are the pendulum's: see
     ``trajectory_axes``)."""
@@ -634,13 +636,7 @@ def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | 
         except PlotInputError as error:
             raise PlotInputError(f"{trajectory_path}: {error}") from None
     colors = controller_colors(trajectory.controllers)
-    kinds = dict(
-        zip(
-            trajectory.controllers,
-            string_tuple(trajectory.attrs.get("controller_kinds", ())),
-            strict=False,
-        )
-    )
+    kinds = _source_kinds(trajectory)
     state = trajectory.state.copy()
     for k, axis in enumerate(axes):  # a motor program's stretch keeps the angle unwrapped
         if axis.period:
@@ -655,14 +651,20 @@ def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | 
                 ax, state[first:stop], axes, color=colors[name], linewidth=1.8, zorder=3
             )
         for name in dict.fromkeys(trajectory.controllers):
-            kind = kinds.get(name, "controller").replace("motor", "motor program")
-            legend.append((Line2D([], [], color=colors[name], linewidth=2), f"{kind} {name}"))
+            legend.append(
+                (Line2D([], [], color=colors[name], linewidth=2), f"{kinds[name]} {name}")
+            )
         labels, obstacles = [], []
+        motor = {name for name in trajectory.controllers if kinds[name] == "motor program"}
         for i, name in switches:
             mark_start(ax, state[i, 0], state[i, 1], colors[name], zorder=6.5)  # over dX
-            labels.append((state[i, 0], state[i, 1], f"s{name}", colors[name]))
+            label = name if name in motor else f"s{name}"  # 'sswing' read as a typo
+            labels.append((state[i, 0], state[i, 1], label, colors[name]))
             obstacles.append((state[i, 0], state[i, 1], 4.0))
-        legend.append((Line2D([], [], **start_style("white")), "sX: controller X invoked"))
+        started = "sX: controller X invoked"
+        if motor:
+            started += "; P: motor program P started"
+        legend.append((Line2D([], [], **start_style("white")), started))
         for name in used:
             x, y = destination_point(tables[name], axes)
             if x is None or y is None:
@@ -683,14 +685,28 @@ def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | 
             )
         )
         script = str(trajectory.attrs.get("script", Path(trajectory_path).name))
+        programs = sum(name in motor for _, name in switches)
+        invoked = counted(len(switches) - programs, "controller invocation")
+        if programs:
+            invoked += f" and {counted(programs, 'motor program')}"
         ax.set_title(
             f"State-space path of the animation script {Path(script).name}\n"
-            f"{len(switches)} controller invocations over "
-            f"{trajectory.t[-1] - trajectory.t[0]:.2f} s"
+            f"{invoked} over {trajectory.t[-1] - trajectory.t[0]:.2f} s"
         )
         add_legend(figure, legend, ncols=3 if len(legend) > 4 else 4)
         place_labels(figure, ax, labels, obstacles)
     return figure
+
+
+def _source_kinds(trajectory: Trajectory) -> dict[str, str]:
+    """What drives the figure in each of the trajectory's stretches, by name: "controller" or
+    "motor program" (root attr ``controller_kinds``; a file without it: controllers)."""
+    kinds = string_tuple(trajectory.attrs.get("controller_kinds", ()))
+    found = dict(zip(trajectory.controllers, kinds, strict=False))
+    return {
+        name: found.get(name, "controller").replace("motor", "motor program")
+        for name in trajectory.controllers
+    }
 
 
 def _shade_breakpoints(
@@ -750,6 +766,7 @@ def write_script_gif(trajectory_path: str | Path, out_path: str | Path, fps: int
     sample_index = np.clip(np.searchsorted(trajectory.t, motion.t + 1e-9) - 1, 0, None)
     active = [trajectory.controllers[trajectory.controller[sample_index[s]]] for s in samples]
     colors = controller_colors(trajectory.controllers)
+    kinds = _source_kinds(trajectory)
     endpoints, com = motion.endpoints, motion.com
     corners = np.concatenate([endpoints.reshape(-1, 2), com])
     centre = (corners.min(axis=0) + corners.max(axis=0)) / 2
@@ -765,7 +782,9 @@ def write_script_gif(trajectory_path: str | Path, out_path: str | Path, fps: int
         ax.set_ylabel("y (m)")
         script = str(trajectory.attrs.get("script", Path(trajectory_path).name))
         figure_name = str(trajectory.attrs.get("figure", "figure"))
-        ax.set_title(f"{figure_name} through the script {Path(script).name}")
+        # the caption's line, under the title and above the axes: inside them it hid the
+        # hanging pendulum's tip
+        ax.set_title(f"{figure_name} through the script {Path(script).name}\n")
         if motion.terrain:
             ground = np.asarray(motion.terrain, dtype=np.float64)
             ax.plot(ground[:, 0], ground[:, 1], color="0.3", linewidth=1.5, zorder=1)
@@ -785,17 +804,10 @@ def write_script_gif(trajectory_path: str | Path, out_path: str | Path, fps: int
         pivot = ax.plot([], [], zorder=5, **pivot_style)[0]
         centre_of_mass = ax.plot([], [], zorder=6, **com_style)[0]
         caption = ax.text(
-            0.03,
-            0.03,
-            "",
-            transform=ax.transAxes,
-            family="monospace",
-            fontsize=10,
-            zorder=7,
-            bbox={"facecolor": "white", "alpha": 0.85, "edgecolor": "0.6"},
+            0.5, 1.02, "", transform=ax.transAxes, ha="center", va="bottom", family="monospace"
         )
         legend = [
-            (Line2D([], [], color=colors[n], linewidth=5), f"controller {n}")
+            (Line2D([], [], color=colors[n], linewidth=5), f"{kinds[n]} {n}")
             for n in dict.fromkeys(active)
         ]
         legend += [
@@ -812,7 +824,7 @@ def write_script_gif(trajectory_path: str | Path, out_path: str | Path, fps: int
             joints.set_data(endpoints[s, :, 1, 0], endpoints[s, :, 1, 1])
             pivot.set_data([endpoints[s, 0, 0, 0]], [endpoints[s, 0, 0, 1]])
             centre_of_mass.set_data([com[s, 0]], [com[s, 1]])
-            caption.set_text(f"t = {motion.t[s]:5.2f} s   controller {active[frame]}")
+            caption.set_text(f"t = {motion.t[s]:5.2f} s   {kinds[active[frame]]} {active[frame]}")
             return False
 
         moving = [*rods, joints, pivot, centre_of_mass, caption]  # in drawing (z) order

@@ -109,9 +109,14 @@ def save_figure(figure: Figure, path: str | Path) -> None:
     write_atomically(path, lambda partial: figure.savefig(partial, format=extension, dpi=DPI))
 
 
+def counted(number: int, noun: str) -> str:
+    """``1 seed``, ``3 seeds``: ``number`` and ``noun``, plural unless one."""
+    return f"{number} {noun}{'' if number == 1 else 's'}"
+
+
 def seeds_text(count: int) -> str:
     """``1 seed``, ``3 seeds``."""
-    return f"{count} seed{'' if count == 1 else 's'}"
+    return counted(count, "seed")
 
 
 def minus_signs(text: str) -> str:
