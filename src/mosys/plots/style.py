@@ -443,7 +443,7 @@ def spread_labels(values: np.ndarray, gap: float, low: float, high: float) -> np
 
 # --------------------------------------------------------------------------- animations
 
-GIF_DPI = 80  # dots per inch of animation frames
+GIF_DPI = 100  # dots per inch of animation frames (at 80 their text was 7 px high)
 GIF_HOLD_MS = 1500  # ms the last frame of an animation stays up before the loop restarts
 GIF_FPS = 25  # frames per second of motion time: a frame every 40 ms
 GIF_MAX_FRAMES = 150  # a longer motion gets a wider step (``frame_samples``)
