@@ -68,7 +68,9 @@ HEAD_LENGTH = 0.06  # m, the lamp shade from its neck to its mouth, along the up
 HEAD_MOUTH = 0.032  # m, half the shade's mouth
 HEAD_NECK = 0.008  # m, half the shade's neck
 COM_COLOR = "#d62728"  # the centre of mass's path in the strip
-STRIP_EVERY = 0.05  # s between the poses of a strip
+TIMELINE_LABEL_SIZE, TIMELINE_LABEL_MIN = 8.5, 6.0  # pt, a motion's name on the timeline
+CHAR_WIDTH = 0.6  # ems: a character's width, about, in the plots' sans-serif font
+STRIP_EVERY = 0.1  # s between the poses of a strip (at 0.05 a backflip in place was a pile)
 STILL_DISTANCE = 0.005  # m: a strip leaves out a pose no end of which moved this far
 STRIP_WIDTH = 7.5  # inches, the strip's data area
 GIF_WIDTH = 6.0  # inches, the animation's data area
@@ -422,6 +424,23 @@ def _program_end(trajectory: Trajectory, motion: Motion) -> int:
     return motion.start + (int(changes[0]) if changes.size else len(driver))
 
 
+def _fitted_label(name: str, width: float) -> tuple[str, float]:
+    """A motion's name and font size (pt) for a timeline bar ``width`` points wide: the name
+    at TIMELINE_LABEL_SIZE, smaller down to TIMELINE_LABEL_MIN if it is wider than the bar,
+    and then broken at its underscores (at full size the last of the show's names ran off the
+    axes as 'backflip_down_ste')."""
+
+    def fits(text: str, size: float) -> bool:
+        longest = max(len(line) for line in text.splitlines())
+        return CHAR_WIDTH * size * longest + size <= width
+
+    for text in (name, name.replace("_", "_\n")):
+        for size in np.arange(TIMELINE_LABEL_SIZE, TIMELINE_LABEL_MIN - 0.01, -0.5):
+            if fits(text, float(size)):
+                return text, float(size)
+    return name.replace("_", "_\n"), TIMELINE_LABEL_MIN
+
+
 def _mark_motions(
     axes: Sequence[Axes], timeline: Axes, trajectory: Trajectory, found: Sequence[Motion]
 ) -> list[tuple[object, str]]:
@@ -432,6 +451,7 @@ def _mark_motions(
     t = trajectory.t
     colors = controller_colors(trajectory.controllers)
     final = len(t) - 1
+    points_per_second = SERIES_WIDTH * 72 / max(float(t[-1] - t[0]), 1e-9)  # the axes' xlim
     landing = []
     for k, motion in enumerate(found):
         start, stop = t[motion.start], t[min(motion.end, final)]
@@ -444,14 +464,16 @@ def _mark_motions(
         timeline.axvspan(start, switch, color=color, linewidth=0)
         timeline.axvspan(switch, stop, color=to_rgba(color, 0.3), linewidth=0)
         timeline.axvline(start, color="white", linewidth=1.5)
+        label, size = _fitted_label(motion.name, (stop - start) * points_per_second)
         timeline.text(
             (start + stop) / 2,
             0.5,
-            motion.name,
+            label,
             transform=blended_transform_factory(timeline.transData, timeline.transAxes),
             ha="center",
             va="center",
-            fontsize=8.5,
+            fontsize=size,
+            linespacing=0.9,
             clip_on=True,
             bbox={"boxstyle": "round,pad=0.15", "facecolor": "white", "alpha": 0.8, "lw": 0},
         )
