@@ -25,6 +25,7 @@ from mosys.plots.controls import controls_figure
 from mosys.plots.pendulum import (
     StateAxis,
     cylinder_pieces,
+    format_state_axes,
     plot_script,
     plot_torque,
     portrait_figure,
@@ -560,3 +561,20 @@ def test_script_figure_names_a_motor_programs_start_by_its_name(trajectory, draw
     labels = legend_labels(figure)
     assert "motor program swing" in labels
     assert "sX: controller X invoked; P: motor program P started" in labels
+
+
+def test_the_ends_of_a_range_a_path_leaves_are_dashed_and_named():
+    """The slew script's path passes 500 deg/s: the dashed lines at ±500 had no legend entry."""
+    from matplotlib.figure import Figure
+
+    inside = np.array([[0.0, 0.0], [90.0, 400.0]])
+    outside = np.array([[0.0, 0.0], [90.0, 520.0]])
+    ax = Figure().add_subplot()
+    assert format_state_axes(ax, PENDULUM_AXES, inside) == []
+    assert not [line for line in ax.lines if line.get_linestyle() == "--"]
+    ax = Figure().add_subplot()
+    ((handle, text),) = format_state_axes(ax, PENDULUM_AXES, outside)
+    assert text == "ends of the table's ω range (the path leaves it)"
+    dashed = [line for line in ax.lines if line.get_linestyle() == "--"]
+    assert sorted(line.get_ydata()[0] for line in dashed) == [-500.0, 500.0]
+    assert handle.get_linestyle() == "--"

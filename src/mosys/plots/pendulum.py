@@ -177,10 +177,15 @@ def trajectory_axes(trajectory: Trajectory) -> tuple[StateAxis, StateAxis]:
     )
 
 
-def format_state_axes(ax: Axes, axes: Sequence[StateAxis], data: np.ndarray | None = None):
+def format_state_axes(
+    ax: Axes, axes: Sequence[StateAxis], data: np.ndarray | None = None
+) -> list[tuple[object, str]]:
     """Limits, labels and ticks of a state-space plot. A periodic axis spans exactly one period;
     a non-periodic one its range (widened to ``data`` (N, 2) if that strays outside, the
-    range's edges then dashed) plus a 2 % margin so that lines along the edge stay visible."""
+    range's edges then dashed) plus a 2 % margin so that lines along the edge stay visible.
+    Returns the legend entry of the dashed edges (none if none is drawn)."""
+    edge_style = {"color": "0.4", "linestyle": "--", "linewidth": 0.8}
+    widened = []
     for k, (axis, limits, ticker) in enumerate(
         zip(axes, (ax.set_xlim, ax.set_ylim), (ax.xaxis, ax.yaxis), strict=True)
     ):
@@ -190,7 +195,8 @@ def format_state_axes(ax: Axes, axes: Sequence[StateAxis], data: np.ndarray | No
                 low, high = min(low, float(data[:, k].min())), max(high, float(data[:, k].max()))
                 for edge in (axis.low, axis.high) if (low, high) != (axis.low, axis.high) else ():
                     line = ax.axvline if k == 0 else ax.axhline
-                    line(edge, color="0.4", linestyle="--", linewidth=0.8, zorder=2)
+                    line(edge, zorder=2, **edge_style)
+                    widened += [] if axis.name in widened else [axis.name]
             margin = 0.02 * (high - low)
             low, high = low - margin, high + margin
         limits(low, high)
@@ -201,6 +207,12 @@ def format_state_axes(ax: Axes, axes: Sequence[StateAxis], data: np.ndarray | No
     labels = [axis_label(a.name, a.unit) + (" — cylindrical" if a.period else "") for a in axes]
     ax.set_xlabel(labels[0])
     ax.set_ylabel(labels[1])
+    if not widened:
+        return []
+    names = " and ".join(SYMBOLS.get(name, name) for name in widened)
+    return [
+        (Line2D([], [], **edge_style), f"ends of the table's {names} range (the path leaves it)")
+    ]
 
 
 def _format_value(value: float) -> str:
@@ -402,7 +414,7 @@ def portrait_figure(
             drawn.append(path)
         legend.append((Line2D([], [], **start_style("white")), "start state (one colour per path)"))
         legend.extend(_mark_table_destinations(ax, table, axes))
-        format_state_axes(ax, axes, np.concatenate(drawn))
+        legend += format_state_axes(ax, axes, np.concatenate(drawn))
         ax.set_title(
             f"Controller {controller.name}: {_destinations_heading(table)}\n"
             f"closed-loop paths, {seconds:g} s from each of {starts} start states"
@@ -674,7 +686,7 @@ def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | 
             obstacles.append((x, y, 7.0))
         if used:
             legend.append((destination_handle(), "dX: destination of controller X"))
-        format_state_axes(ax, axes, state)
+        legend += format_state_axes(ax, axes, state)
         legend += _shade_breakpoints(ax, trajectory, axes, colors)
         ax.plot(state[-1, 0], state[-1, 1], marker="o", markersize=5, color="black", zorder=6)
         obstacles.append((state[-1, 0], state[-1, 1], 3.0))
