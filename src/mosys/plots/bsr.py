@@ -637,7 +637,8 @@ def filmstrip_figure(result_path: str | Path, interval: float | None = None) -> 
         side = "left" if offsets[-1] < 0 else "right"
         subtitle += (
             f"\neach pose shifted {side} by {spacing:g} m more than the one before, so that "
-            f"they do not overlap (the figure itself travels {minus_signs(f'{travel:+.2f}')} m)"
+            "they do not overlap (unshifted, the poses' middles move "
+            f"{minus_signs(f'{travel:+.2f}')} m)"
         )
     title = _result_title(result, result_path) + "\n" + subtitle
     title_lines = title.count("\n") + 1
