@@ -498,7 +498,11 @@ def test_seeds_figure_is_figure_8(kinds: dict[str, list[Path]], tmp_path: Path) 
         "BSR search dog_sense: sense-based controller for cujo, 3 seeds\n"
     )
     assert [line.get_label() for line in curves.lines] == ["seed 1", "seed 2", "seed 3"]
-    assert [text.get_text() for text in finals.texts] == ["seed 1: 2", "seed 2: 1.2", "seed 3: 2.6"]
+    assert [text.get_text() for text in finals.texts] == [
+        "seed 1: 2.00",
+        "seed 2: 1.20",
+        "seed 3: 2.60",
+    ]
     with pytest.raises(PlotInputError) as error:
         seeds_figure([])
     assert str(error.value) == "plot_seeds: no BSR result files given"

@@ -342,6 +342,7 @@ def learning_figure(results: Sequence[str | Path]) -> Figure:
         height = finals.get_position().height * figure.get_size_inches()[1]
         gap = (high - low) * (11.5 / 72) / height  # a label's height, data units
         labels = spread_labels(final_values, gap, low + gap / 2, high - gap / 2)
+        decimals = shared_decimals(final_values)
         for value, label_y, seed in zip(final_values, labels, seeds, strict=True):
             color = colors[str(seed)]
             finals.plot(
@@ -351,13 +352,23 @@ def learning_figure(results: Sequence[str | Path]) -> Figure:
             finals.text(
                 0.32,
                 label_y,
-                f"seed {seed}: {minus_signs(f'{value:.3g}')}",
+                f"seed {seed}: {minus_signs(f'{value:.{decimals}f}')}",
                 va="center",
                 ha="left",
                 fontsize=8.5,
             )
         finals.set_ylim(low, high)
     return figure
+
+
+def shared_decimals(values: np.ndarray, digits: int = 3) -> int:
+    """Decimals that give the largest of ``values`` (finite ones) ``digits`` significant
+    digits, for labels that all show the same precision ('-36' beside '-30.1' did not)."""
+    finite = np.abs(values[np.isfinite(values)])
+    largest = float(finite.max()) if finite.size else 0.0
+    if largest == 0.0:
+        return digits - 1
+    return max(0, digits - 1 - math.floor(math.log10(largest)))
 
 
 def _layout_learning(figure, title: str) -> None:
