@@ -462,6 +462,14 @@ def test_learning_kinds_figure(kinds: dict[str, list[Path]]) -> None:
     grid, values = bsr3d.curves_on_grid(results)
     np.testing.assert_allclose(bold[1].get_ydata(), np.nanmedian(values, axis=0))
     assert [text.get_text() for text in ax.texts] == ["2.75", "2"]  # the final medians
+    # both beyond the longest curve's end, apart: a shorter curve's label sat on the other
+    right = max(line.get_xdata()[-1] for line in bold)
+    assert all(text.get_position()[0] > right for text in ax.texts)
+    heights = sorted(text.get_position()[1] for text in ax.texts)
+    low, high = ax.get_ylim()
+    assert heights[1] - heights[0] >= 0.9 * (high - low) * (11.5 / 72) / (
+        ax.get_position().height * figure.get_size_inches()[1]
+    )
     (legend,) = figure.legends
     assert legend_labels(legend) == [
         "dog_time (time-based): median over 4 seeds",

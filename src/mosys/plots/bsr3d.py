@@ -785,6 +785,28 @@ def plot_learning_kinds(
         save_figure(learning_kinds_figure(time_results, sense_results, log_x), path)
 
 
+def _label_ends(ax, ends: list[tuple[object, float, float]], x: float) -> None:
+    """Each median curve's final value, in its colour, at ``x`` beyond the longest curve's end
+    and spread so that no two overlap, with a thin line from a shorter curve's end (at its own
+    end a shorter curve's label sat on the longer curve)."""
+    low, high = ax.get_ylim()
+    height = ax.get_position().height * ax.figure.get_size_inches()[1]
+    gap = (high - low) * (11.5 / 72) / height  # a label's height, data units
+    heights = spread_labels(np.array([end[2] for end in ends]), gap, low + gap / 2, high - gap / 2)
+    for (color, evaluations, value), label_y in zip(ends, heights, strict=True):
+        ax.annotate(
+            minus_signs(f"{value:.3g}"),
+            (evaluations, value),
+            xytext=(x, label_y),
+            va="center",
+            fontsize=9,
+            color=color,
+            fontweight="bold",
+            arrowprops={"arrowstyle": "-", "color": color, "lw": 0.8, "shrinkA": 0, "shrinkB": 2},
+        )
+    ax.set_ylim(low, high)
+
+
 def learning_kinds_figure(
     time_results: Sequence[str | Path],
     sense_results: Sequence[str | Path],
@@ -826,6 +848,7 @@ def learning_kinds_figure(
         f"{': ' + ', '.join(figures) if figures else ''}\n{versus}\n{fitness}"
     )
     entries: list[tuple[object, str]] = []
+    ends = []  # (colour, evaluations, median) at each median curve's end
     with plot_style():
         figure = new_figure(LEARNING_WIDTH, LEARNING_HEIGHT)
         ax = figure.subplots()
@@ -844,16 +867,7 @@ def learning_kinds_figure(
             grid, values = curves_on_grid(results)
             median = np.nanmedian(values, axis=0)
             ax.step(grid, median, where="post", color=color, linewidth=MEDIAN_WIDTH, ls=style)
-            ax.annotate(
-                minus_signs(f"{median[-1]:.3g}"),
-                (grid[-1], median[-1]),
-                xytext=(4, 0),
-                textcoords="offset points",
-                va="center",
-                fontsize=9,
-                color=color,
-                fontweight="bold",
-            )
+            ends.append((color, float(grid[-1]), float(median[-1])))
             entries.append(
                 (
                     Line2D([], [], color=color, linewidth=MEDIAN_WIDTH, linestyle=style),
@@ -868,10 +882,11 @@ def learning_kinds_figure(
             )
         if log_x:
             ax.set_xscale("log")
-            ax.set_xlim(first / 1.2, last * 1.6)
+            ax.set_xlim(first / 1.2, last * 2.0)
         else:
-            ax.set_xlim(0, last * 1.07 if last > 0 else 1)
+            ax.set_xlim(0, last * 1.12 if last > 0 else 1)
             ax.xaxis.get_major_locator().set_params(integer=True)  # whole counts
+        _label_ends(ax, ends, last * (1.1 if log_x else 1.015))
         ax.xaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))
         ax.set_xlabel(f"controller evaluations (count{', log scale' if log_x else ''})")
         ax.set_ylabel("best fitness so far (Σ weight × term)")
