@@ -357,9 +357,9 @@ TOP_LEVEL_HELP = (
     "\n"
     "To build everything the 1990 pendulum example makes, from the repository root:\n"
     "  snakemake results/pendulum_all\n"
-    "README.md describes the other targets (results/car_all, results/bsr_all,\n"
-    "results/composite_all, results/paper_tables, all), the spec formats and the\n"
-    "verbs.\n"
+    "README.md describes the other targets (results/car_all, results/luxo_all,\n"
+    "results/bsr_all, results/bsr3d_all, results/composite_all,\n"
+    "results/paper_tables, all), the spec formats and the verbs.\n"
 )
 
 

@@ -58,8 +58,9 @@ EPILOG = (
     "To build everything the 1990 pendulum example makes, from the repository root:\n"
     "  snakemake results/pendulum_all\n"
     + _fill(
-        "README.md describes the other targets (results/car_all, results/bsr_all, "
-        "results/composite_all, results/paper_tables, all), the spec formats and the verbs."
+        "README.md describes the other targets (results/car_all, results/luxo_all, "
+        "results/bsr_all, results/bsr3d_all, results/composite_all, results/paper_tables, all), "
+        "the spec formats and the verbs."
     )
 )
 
