@@ -626,3 +626,18 @@ def test_cli_rejects_bad_input(
             main(arguments)
         assert exit_.value.code == 2
     assert "plot bsr3d-kinds: give --time and/or --sense result files" in capsys.readouterr().err
+
+
+def test_text_colour_reads_on_white() -> None:
+    """tab20's pale halves named rods in text hard to read; dark colours are kept as they are."""
+    from matplotlib.colors import to_rgb
+
+    from mosys.plots.style import TEXT_LUMINANCE, text_color
+
+    def luminance(rgb) -> float:
+        linear = [c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4 for c in rgb]
+        return 0.2126 * linear[0] + 0.7152 * linear[1] + 0.0722 * linear[2]
+
+    for pale in ("#ffbb78", "#aec7e8", "#98df8a", "white"):
+        assert luminance(text_color(pale)) <= TEXT_LUMINANCE
+    assert text_color("#1f77b4") == to_rgb("#1f77b4")  # tab:blue reads already

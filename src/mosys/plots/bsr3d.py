@@ -99,6 +99,7 @@ from mosys.plots.style import (
     scene_figure,
     seeds_text,
     spread_labels,
+    text_color,
     write_real_time_gif,
 )
 
@@ -1100,12 +1101,13 @@ def _draw_rest_oblique(
                 ha="left" if side > 0 else "right",
                 va="center",
                 fontsize=LABEL_SIZE,
-                color=color,
+                color=text_color(color),
                 fontweight="bold",
                 zorder=6,
             )
     ax.text(0.02, 0.02, f"floor squares {cell:g} m", transform=ax.transAxes, color="0.3")
     width, height = ax.figure.get_size_inches()
-    draw_axes_key(
-        ax.figure, (box.x0, box.y1 - KEY_SIZE / height, KEY_SIZE / width, KEY_SIZE / height), VIEW
-    )
+    # the key in the bottom left corner, above the floor's note: in the top left it sat on the
+    # names of the left column
+    bottom = box.y0 + 0.3 / height
+    draw_axes_key(ax.figure, (box.x0, bottom, KEY_SIZE / width, KEY_SIZE / height), VIEW)

@@ -22,7 +22,7 @@ from matplotlib.artist import Artist
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection
-from matplotlib.colors import LinearSegmentedColormap
+from matplotlib.colors import LinearSegmentedColormap, to_rgb
 from matplotlib.figure import Figure
 from matplotlib.legend_handler import HandlerTuple
 from matplotlib.lines import Line2D
@@ -107,6 +107,22 @@ def save_figure(figure: Figure, path: str | Path) -> None:
         allowed = ", ".join(f".{name}" for name in FIGURE_FORMATS)
         raise PlotInputError(f"{path}: a plot's file name ends in {allowed}")
     write_atomically(path, lambda partial: figure.savefig(partial, format=extension, dpi=DPI))
+
+
+TEXT_LUMINANCE = 0.18  # text on white at most this luminant: contrast about 4.5 : 1
+
+
+def text_color(color) -> tuple[float, float, float]:
+    """``color`` darkened, if it must be, until text in it reads on white: its relative
+    luminance (WCAG) at most TEXT_LUMINANCE (a contrast of about 4.5 : 1). Pale colours of a
+    20-colour cycle (tab20's light halves) drew names hard to read."""
+    rgb = np.array(to_rgb(color))
+    for _ in range(20):
+        linear = np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
+        if float(linear @ [0.2126, 0.7152, 0.0722]) <= TEXT_LUMINANCE:
+            break
+        rgb = rgb * 0.9
+    return float(rgb[0]), float(rgb[1]), float(rgb[2])
 
 
 def counted(number: int, noun: str) -> str:
