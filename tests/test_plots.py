@@ -265,6 +265,14 @@ def test_torque_figure_draws_the_table_as_a_heat_map(drawn_tables, name):
     assert 6 <= len(contours.levels) <= 12
     labels = [text.get_text() for text in ax.texts]
     assert labels and all(label.endswith(" s") for label in labels)
+    # apart from each other and from the destination's mark (they piled up where the contours
+    # converge on it)
+    size = ax.get_position().size * figure.get_size_inches()
+    inches = [ax.transLimits.transform(text.get_position()) * size for text in ax.texts]
+    mark = ax.transLimits.transform((dest["angle"], dest["omega"])) * size
+    for k, here in enumerate(inches):
+        assert np.hypot(*(here - mark)) >= 0.45
+        assert all(np.hypot(*(here - other)) >= 0.45 for other in inches[:k])
     assert_destination_marked(ax, dest["angle"], dest["omega"])
     assert legend_labels(figure) == ["cost-to-go, contours labelled in s", "destination"]
 

@@ -58,6 +58,7 @@ from mosys.plots.style import (
 
 PORTRAIT_STARTS = 8  # start states per portrait
 PORTRAIT_SECONDS = 3.0  # s simulated from each start
+LABEL_GAP_INCHES = 0.45  # contour labels at least this far apart and from the destination
 CYCLE_SECONDS = (3.0, 5.0)  # s: a periodic destination's cycle is drawn over this window
 # pale tints of the basins of a table with several destinations, one per destination in order
 # (ColorBrewer's Paired, light members), drawn at BASIN_ALPHA behind the paths
@@ -488,9 +489,11 @@ def torque_figure(table_path: str | Path, contours: bool = True) -> Figure:
                     zorder=2,
                 )
                 lines.set(path_effects=halo)
-                labels = ax.clabel(lines, fmt=lambda v: f"{v:g} s", fontsize=8, inline_spacing=3)
+                format_state_axes(ax, axes)  # the limits, for the labels' spacing
+                labels = ax.clabel(lines, fmt=lambda v: f"{v:g} s", fontsize=8, inline=False)
                 for text in labels:
                     text.set(path_effects=halo)
+                _thin_labels(ax, labels, _destination_points(table, axes))
                 legend.append(
                     (
                         Line2D([], [], color="black", linewidth=0.9),
@@ -512,6 +515,26 @@ def _cell_edges(centres: np.ndarray) -> np.ndarray:
     """Edges of cells centred on uniformly spaced nodes."""
     step = (centres[-1] - centres[0]) / (len(centres) - 1) if len(centres) > 1 else 1.0
     return np.append(centres - step / 2, centres[-1] + step / 2)
+
+
+def _destination_points(table: ControllerTable, axes) -> list[tuple[float, float]]:
+    """Where the table's destinations are marked (those naming both plotted variables)."""
+    points = [destination_point(table, axes, d) for d in table.all_destinations]
+    return [(x, y) for x, y in points if x is not None and y is not None]
+
+
+def _thin_labels(ax: Axes, labels: list, clear: list, gap: float = LABEL_GAP_INCHES) -> None:
+    """Remove each contour label that lies within ``gap`` inches of a label kept before it or
+    of a point of ``clear`` (data units; the destination's mark): where contours converge on
+    the destination their labels piled on each other and on the mark."""
+    size = ax.get_position().size * ax.figure.get_size_inches()
+    kept = [ax.transLimits.transform(point) * size for point in clear]
+    for text in labels:
+        here = ax.transLimits.transform(text.get_position()) * size
+        if any(np.hypot(*(here - other)) < gap for other in kept):
+            text.remove()
+        else:
+            kept.append(here)
 
 
 def _contour_levels(values: np.ndarray) -> np.ndarray:
