@@ -113,3 +113,34 @@ def test_a_kept_text_is_written_once_and_whole(tmp_path):
     write_once(kept, b"second\n")  # another process was first: its text stays
     assert kept.read_bytes() == b"first\n"
     assert [p.name for p in kept.parent.iterdir()] == ["key.py"]  # no partial file left
+
+
+def test_a_controller_is_not_made_from_a_module_its_spec_has_outgrown(
+    tmp_path, monkeypatch, capsys
+):
+    """A .fig edited after `mosys compile` (a heavier rod): `mosys dp` used the old module and
+    said nothing; a run would too. Now both name the spec and the command that brings the
+    module up to date. The pipeline recompiles first, so it never sees this."""
+    from mosys.cli import main
+
+    root = Path(__file__).resolve().parents[1]
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "specs").mkdir()
+    figure = tmp_path / "specs" / "link1.fig"
+    figure.write_bytes((root / "specs/figures/link1.fig").read_bytes())
+    spec = root / "specs/controllers/pendulum/A.ssc"
+    assert main(["compile", "specs/link1.fig", "-o", "dyn/link1.py"]) == 0
+    assert main(["dp", str(spec), "--dynamics-dir", "dyn", "-o", "a.h5", "--quiet"]) == 0
+    figure.write_text(figure.read_text().replace("mass=1", "mass=2"))
+    capsys.readouterr()
+    assert main(["dp", str(spec), "--dynamics-dir", "dyn", "-o", "b.h5", "--quiet"]) == 2
+    assert (
+        capsys.readouterr()
+        .err.strip()
+        .endswith(
+            "expected a figure compiled from its spec as it is (dyn/link1.py was compiled from an "
+            "earlier specs/link1.fig: run 'mosys compile specs/link1.fig -o dyn/link1.py', or "
+            "snakemake), found 'link1'"
+        )
+    )
+    assert not (tmp_path / "b.h5").exists()

@@ -208,7 +208,7 @@ def emit_module(equations: Equations, spec_path: str, spec_sha256: str, version:
     has_contact_forces = bool(figure.contacts) and bool(figure.terrain.vertices)
     parts = [
         _header(figure, spec_path, spec_sha256, version),
-        _metadata(figure, spec_sha256, has_contact_forces),
+        _metadata(figure, spec_path, spec_sha256, has_contact_forces),
         _constants(model.constants),
     ]
     if has_contact_forces:
@@ -255,7 +255,7 @@ _VECTOR = types.float64[::1]  # C-contiguous float64 1-D array
 _RODS_ARRAY = types.float64[:, :, ::1]  # (n_rods, 2, 2)'''
 
 
-def _metadata(figure: Figure, spec_sha256: str, has_contact_forces: bool) -> str:
+def _metadata(figure: Figure, spec_path: str, spec_sha256: str, has_contact_forces: bool) -> str:
     coordinates = figure.coordinates
     rods = figure.rods
 
@@ -281,6 +281,7 @@ def _metadata(figure: Figure, spec_sha256: str, has_contact_forces: bool) -> str
     return "\n".join(
         [
             'MODEL_KIND = "figure"  # an articulated figure (a built-in vehicle says "vehicle")',
+            f"SPEC_PATH = {_string(spec_path)}  # as given to mosys compile",
             f"SPEC_SHA256 = {_string(spec_sha256)}",
             f"Q_NAMES = {names(figure.q_names)}",
             f"QD_NAMES = {names(figure.qd_names)}",

@@ -160,4 +160,28 @@ def figure_dynamics(
     path = Path(dynamics_dir) / f"{figure}.py"
     if not path.exists():
         raise error(token, f"a compiled figure ({path} does not exist: run 'mosys compile')")
-    return load_dynamics(path)
+    module = load_dynamics(path)
+    changed = spec_changed_since(module)
+    if changed is not None:
+        raise error(
+            token,
+            f"a figure compiled from its spec as it is ({path} was compiled from an earlier "
+            f"{changed}: run 'mosys compile {changed} -o {path}', or snakemake)",
+        )
+    return module
+
+
+def spec_changed_since(module: ModuleType) -> str | None:
+    """The figure spec a generated module was compiled from (``SPEC_PATH``, as given to
+    ``mosys compile``, from the working directory) if that file has changed since
+    (``SPEC_SHA256``); None if it has not, or cannot be found (another directory, a module
+    compiled before SPEC_PATH was recorded): a controller or run made from a stale module
+    silently used the old figure."""
+    spec = getattr(module, "SPEC_PATH", None)
+    if not isinstance(spec, str):
+        return None
+    try:
+        text = Path(spec).read_bytes()
+    except OSError:
+        return None
+    return None if hashlib.sha256(text).hexdigest() == module.SPEC_SHA256 else spec

@@ -49,6 +49,7 @@ from numba import njit, types
 _VECTOR = types.float64[::1]
 
 MODEL_KIND = "vehicle"
+SPEC_PATH = {json.dumps(spec_path)}  # as given to mosys compile
 SPEC_SHA256 = {json.dumps(vehicle.spec_sha256)}
 STATE_NAMES = {STATE_NAMES!r}
 STATE_UNITS = {STATE_UNITS!r}  # spec units
