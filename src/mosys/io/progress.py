@@ -14,10 +14,21 @@ class Progress:
     >>> progress.finish()
     """
 
-    def __init__(self, label: str, total: int, unit: str = "items", interval: float = 1.0):
+    def __init__(
+        self,
+        label: str,
+        total: int,
+        unit: str = "items",
+        interval: float = 1.0,
+        at_most: bool = False,
+    ):
+        """``at_most``: ``total`` is a cap the work may stop well short of (value iteration's
+        sweeps until it converges): the line says so and its ETA is an upper bound (a DP that
+        took 16 s printed ETA 2883 s, its cap of 3,000 sweeps at the rate so far)."""
         self.label = label
         self.total = max(int(total), 1)
         self.unit = unit
+        self.at_most = at_most
         self.interval = interval
         self.start = time.perf_counter()
         self.last = self.start
@@ -35,9 +46,10 @@ class Progress:
         rate = self.done / elapsed
         eta = (self.total - self.done) / rate if rate > 0 else float("inf")
         extra = f" {note}" if note else ""
+        cap, bound = (f", {self.total} at most", "at most ") if self.at_most else ("", "")
         print(
-            f"{self.label}: {self.done}/{self.total} {self.unit} "
-            f"({rate:.1f} {self.unit}/s, ETA {eta:.1f} s){extra}",
+            f"{self.label}: {self.done}/{self.total} {self.unit}{cap} "
+            f"({rate:.1f} {self.unit}/s, ETA {bound}{eta:.1f} s){extra}",
             file=sys.stderr,
             flush=True,
         )

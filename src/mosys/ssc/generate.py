@@ -711,7 +711,7 @@ def value_iteration(
     control = np.zeros(grid.node_count, dtype=np.int64)
     policy = policy_tables(transitions.segment_cost.shape[0], transitions.exit_index.shape[2])
     prefetching = prefetch_pays(transitions.exit_index, transitions.exit_weight)
-    progress = Progress("value iteration", max_iterations, "sweeps")
+    progress = Progress("value iteration", max_iterations, "sweeps", at_most=True)
     residual = np.inf
     iterations = 0
     policy_sweeps = 0
