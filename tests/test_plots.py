@@ -586,3 +586,26 @@ def test_the_ends_of_a_range_a_path_leaves_are_dashed_and_named():
     dashed = [line for line in ax.lines if line.get_linestyle() == "--"]
     assert sorted(line.get_ydata()[0] for line in dashed) == [-500.0, 500.0]
     assert handle.get_linestyle() == "--"
+
+
+def test_torque_figure_greys_the_nodes_without_a_cost_to_go(drawn_tables, tmp_path):
+    """Unreachable nodes were drawn white, as if their torque were 0 N·m."""
+    from mosys.io.controller_table import read_controller_table
+
+    table = read_controller_table(drawn_tables["A"])
+    value = table.value.copy()
+    value[:5, :3] = np.inf
+    path = tmp_path / "A.h5"
+    write_controller_table(path, dataclasses.replace(table, value=value))
+    figure = torque_figure(path)
+    ax = figure.axes[0]
+    meshes = [c for c in ax.collections if isinstance(c, QuadMesh)]
+    assert len(meshes) == 2
+    grey = np.ma.getmaskarray(meshes[1].get_array()).reshape(21, 37)
+    assert (~grey).sum() == 15 + 3  # the 15 nodes, and -180 deg's 3 again at +180
+    assert legend_labels(figure)[0] == "no cost-to-go (15 unreachable nodes)"
+    assert not [
+        c
+        for c in torque_figure(drawn_tables["A"]).axes[0].collections
+        if isinstance(c, QuadMesh) and np.ma.is_masked(c.get_array())
+    ]

@@ -58,6 +58,7 @@ from mosys.plots.style import (
 
 PORTRAIT_STARTS = 8  # start states per portrait
 PORTRAIT_SECONDS = 3.0  # s simulated from each start
+UNKNOWN_COLOR = "0.55"  # a node without a cost-to-go on the torque map
 LABEL_GAP_INCHES = 0.45  # contour labels at least this far apart and from the destination
 CYCLE_SECONDS = (3.0, 5.0)  # s: a periodic destination's cycle is drawn over this window
 # pale tints of the basins of a table with several destinations, one per destination in order
@@ -478,6 +479,23 @@ def torque_figure(table_path: str | Path, contours: bool = True) -> Figure:
             colorbar = figure.colorbar(mesh, ax=ax, pad=0.02)
             colorbar.set_label(f"{control} (N·m)")
             legend = []
+            if not finite.all():  # drawn white, they read as 0 N·m
+                ax.pcolormesh(
+                    edges[0],
+                    edges[1],
+                    np.ma.masked_where(finite, np.zeros(value.shape)).T,
+                    cmap=ListedColormap([UNKNOWN_COLOR]),
+                    shading="flat",
+                    rasterized=True,
+                    zorder=0.5,
+                )
+                count = int(np.sum(~np.isfinite(table.value)))
+                legend.append(
+                    (
+                        Patch(facecolor=UNKNOWN_COLOR),
+                        f"no cost-to-go ({counted(count, 'unreachable node')})",
+                    )
+                )
             if contours and finite.sum() > 3 and np.ptp(value[finite]) > 0:
                 lines = ax.contour(
                     centres[0],
