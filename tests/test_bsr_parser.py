@@ -526,3 +526,20 @@ def test_a_seed_of_thousands_of_digits_is_a_spec_error():
         "x.bsr:6:7: expected a whole number of fewer digits for a seed, found "
         f"'{'9' * 200}'... (5,000 characters)"
     )
+
+
+def test_a_spec_naming_a_figure_unfit_for_bsr_is_refused_at_its_figure_line(tmp_path):
+    """A .bsr naming the pendulum: the error pointed at the sound link1.fig, as if it were
+    wrong, not at the spec's choice."""
+    from pathlib import Path
+
+    from mosys.bsr.figure import load_rod_figure
+
+    figures = Path(__file__).resolve().parents[1] / "specs" / "figures"
+    token = Token("link1", 4, 8)
+    with pytest.raises(SpecError) as error:
+        load_rod_figure(figures, "x.bsr", token)
+    assert str(error.value) == (
+        f"x.bsr:4:8: expected a BSR figure ({figures / 'link1.fig'}:11:5: expected a 'free' "
+        "root (BSR figures fly and fall), found 'link'), found 'link1'"
+    )

@@ -188,13 +188,19 @@ def check_bsr_figure(figure: Figure) -> Joint:
 
 def load_rod_figure(figures_dir: str | Path, spec_path: str, token: Token) -> Figure:
     """The figure a spec names (``token``, its word in ``spec_path``), parsed from
-    ``figures_dir``/NAME.fig; one that is missing or is a vehicle raises SpecError at the word."""
+    ``figures_dir``/NAME.fig; one that is missing, is a vehicle or is not a BSR figure
+    (``check_bsr_figure``: a pendulum named by a .bsr) raises SpecError at the word (it was
+    raised at the sound .fig, as if that were wrong)."""
     figure_path = Path(figures_dir) / f"{token.text}.fig"
     if not figure_path.is_file():
         raise SpecError.at(spec_path, token, f"a figure in {figures_dir}")
     parsed = parse_figure_spec(figure_path)
     if not isinstance(parsed, Figure):
         raise SpecError.at(spec_path, token, "a figure of rods, not a vehicle")
+    try:
+        check_bsr_figure(parsed)
+    except SpecError as error:  # a sound figure, but not one for BSR: the spec chose it
+        raise SpecError.at(spec_path, token, f"a BSR figure ({error})") from None
     return parsed
 
 
