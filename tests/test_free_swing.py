@@ -87,3 +87,25 @@ def test_free_motion_refuses_a_non_finite_swing(link1):
 
     with pytest.raises(InputError, match="non-finite"):
         free_motion(link1, 0.0, float("inf"), 0.01)
+
+
+def test_a_pendulum_with_a_joint_limit_is_refused_saying_why(tmp_path):
+    """A limit's spring adds rest angles; the refusal read like a description of the figure."""
+    from mosys.dynamics.free_swing import equilibria
+    from mosys.dynamics.load import load_dynamics
+    from mosys.errors import InputError
+
+    spec = tmp_path / "arm.fig"
+    spec.write_text(
+        "gravity 9.81\nrod forearm length=0.6 mass=2 com=0.8\n"
+        "pin forearm at=0,0 angle=theta rate=theta_dot actuator=motor\n"
+        "limit forearm lower=-120 upper=100 stiffness=200 damping=1\n"
+    )
+    compile_figure(spec, tmp_path / "arm.py")
+    with pytest.raises(InputError) as error:
+        equilibria(load_dynamics(tmp_path / "arm.py"))
+    assert str(error.value) == (
+        "expected a figure with one stable and one unstable rest angle, such as the pendulum; "
+        "this one has 2 stable and 2 unstable at rest (a joint limit or a contact adds rest "
+        "angles, and the free-swing orbits need none)"
+    )

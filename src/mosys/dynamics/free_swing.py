@@ -96,8 +96,12 @@ def equilibria(dynamics: ModuleType) -> tuple[float, float]:
     following = np.roll(acceleration, -1)
     stable = np.flatnonzero((acceleration > 0) & (following <= 0))
     unstable = np.flatnonzero((acceleration < 0) & (following >= 0))
-    if len(stable) != 1 or len(unstable) != 1:
-        raise InputError("a figure with one stable and one unstable rest angle (a pendulum)")
+    if len(stable) != 1 or len(unstable) != 1:  # e.g. a joint limit's spring adds rest angles
+        raise InputError(
+            "expected a figure with one stable and one unstable rest angle, such as the "
+            f"pendulum; this one has {len(stable)} stable and {len(unstable)} unstable at rest "
+            "(a joint limit or a contact adds rest angles, and the free-swing orbits need none)"
+        )
     step = angles[1] - angles[0]
 
     def crossing(k: int) -> float:
