@@ -132,7 +132,7 @@ def test_file(tmp_path):
     missing = tmp_path / "missing.bsr"
     with pytest.raises(SpecError) as error:
         parse_bsr_spec(missing)
-    assert str(error.value) == f"{missing}:1:1: expected an existing spec file, found end of line"
+    assert str(error.value) == f"{missing}:1:1: expected an existing spec file, found no such file"
     path.write_text(EXAMPLE.replace("dt=0.001", "dt=-1"))
     with pytest.raises(SpecError) as error:
         parse_bsr_spec(path)

@@ -158,7 +158,7 @@ def test_the_spec_in_the_repository_is_table_4(tmp_path):
     missing = tmp_path / "missing.comp"
     with pytest.raises(SpecError) as error:
         parse_composite_script(missing)
-    assert str(error.value) == f"{missing}:1:1: expected an existing spec file, found end of line"
+    assert str(error.value) == f"{missing}:1:1: expected an existing spec file, found no such file"
 
 
 def test_render_table_4():

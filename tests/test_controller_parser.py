@@ -416,7 +416,7 @@ def test_file_errors_and_path(tmp_path):
     missing = tmp_path / "missing.ssc"
     with pytest.raises(SpecError) as error:
         parse_controller_spec(missing)
-    assert str(error.value) == f"{missing}:1:1: expected an existing spec file, found end of line"
+    assert str(error.value) == f"{missing}:1:1: expected an existing spec file, found no such file"
     binary = tmp_path / "binary.ssc"
     binary.write_bytes(b"dyn link1\n\xff\n")
     with pytest.raises(SpecError) as error:

@@ -198,7 +198,7 @@ def test_missing_file(tmp_path: Path) -> None:
     path = tmp_path / "nothing.fig"
     with pytest.raises(SpecError) as error:
         parse_figure_spec(path)
-    assert str(error.value) == f"{path}:1:1: expected an existing spec file, found end of line"
+    assert str(error.value) == f"{path}:1:1: expected an existing spec file, found no such file"
 
 
 # --- hypothesis -------------------------------------------------------------------------------

@@ -116,7 +116,7 @@ def test_file(tmp_path):
     missing = tmp_path / "missing.mot"
     with pytest.raises(SpecError) as error:
         parse_motor_program(missing)
-    assert str(error.value) == f"{missing}:1:1: expected an existing spec file, found end of line"
+    assert str(error.value) == f"{missing}:1:1: expected an existing spec file, found no such file"
     path.write_text(HOP.replace("phase 0.2", "phase 0"))
     with pytest.raises(SpecError) as error:
         parse_motor_program(path)

@@ -226,7 +226,7 @@ def test_file_errors(tmp_path):
     missing = tmp_path / "missing.anim"
     with pytest.raises(SpecError) as error:
         parse_script(missing)
-    assert str(error.value) == f"{missing}:1:1: expected an existing spec file, found end of line"
+    assert str(error.value) == f"{missing}:1:1: expected an existing spec file, found no such file"
     bad = tmp_path / "bad.anim"
     bad.write_text(BASE.replace("sim 0.4", "sim 0"))
     with pytest.raises(SpecError) as error:

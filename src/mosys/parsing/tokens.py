@@ -21,6 +21,7 @@ NUMBER = re.compile(r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?")
 NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 ENDPOINT_ENDS = ("proximal", "distal")  # a rod's ends, as specs name them: ROD.END
 END_OF_FILE = "\x00end of file"  # the 'found' of an error about a line that never came
+NO_FILE = "\x00no such file"  # the 'found' of an error about a spec file that is not there
 MAX_WHOLE = 2**31 - 1  # the largest count (generations, controllers, sweeps...) kernels index
 MAX_INT64 = 2**63 - 1  # the largest whole number a result file stores (int64): seeds, ticks
 SHOWN_CHARACTERS = 200  # of one word an error quotes: a longer word is cut, its length said
@@ -46,7 +47,8 @@ def shortened_words(text: str) -> str:
 
 class SpecError(Exception):
     """A spec that does not parse: names the file, the 1-based line and column, what the grammar
-    expected there and what it found (``None`` for the end of the line, ``END_OF_FILE``)."""
+    expected there and what it found (``None`` for the end of the line, ``END_OF_FILE``,
+    ``NO_FILE`` for a file that is not there: 'found end of line' read as a parse error)."""
 
     def __init__(self, path: str, line: int, column: int, expected: str, found: str | None):
         self.path = str(path)
@@ -54,7 +56,8 @@ class SpecError(Exception):
         self.column = column
         self.expected = expected
         self.found = found
-        shown = {None: "end of line", END_OF_FILE: "end of file"}.get(found) or shown_text(found)
+        special = {None: "end of line", END_OF_FILE: "end of file", NO_FILE: "no such file"}
+        shown = special.get(found) or shown_text(found)
         super().__init__(
             f"{self.path}:{line}:{column}: expected {shortened_words(expected)}, found {shown}"
         )
@@ -133,7 +136,7 @@ def read_spec_text(path: str | Path) -> tuple[str, str]:
     try:
         data = path.read_bytes()
     except FileNotFoundError:
-        raise SpecError(str(path), 1, 1, "an existing spec file", None) from None
+        raise SpecError(str(path), 1, 1, "an existing spec file", NO_FILE) from None
     except OSError as error:
         raise SpecError(str(path), 1, 1, "a readable spec file", error.strerror) from None
     mark = len(codecs.BOM_UTF8) if data.startswith(codecs.BOM_UTF8) else 0
