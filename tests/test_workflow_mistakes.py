@@ -89,7 +89,12 @@ def test_a_script_naming_a_controller_without_a_spec_is_caught_in_the_dag(work):
     )
     code, output = dry_run(work, "results/trajectories/q.h5")
     assert code != 0
-    assert "specs/controllers/q/Q.ssc:1:1: expected an existing spec file" in output
+    assert (
+        "specs/scripts/q.anim:2: conQ.ctab names controller Q, whose spec "
+        "specs/controllers/q/Q.ssc does not exist: the script's controllers come from "
+        "specs/controllers/q/ (the script's own name, as for any script not configured "
+        "otherwise)"
+    ) in output
     (work / "specs/scripts/q.anim").unlink()
 
 

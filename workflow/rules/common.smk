@@ -387,12 +387,35 @@ def script_dt(script):
     return config["simulation"]["dt"]
 
 
+def script_group_reason(script):
+    """Why ``script_group`` chose the group it did, for a message."""
+    if script == config["pendulum"]["script"] or script in config["pendulum"]["scripts"]:
+        return "config pendulum.group: the script is the pendulum's, or in pendulum.scripts"
+    if script in config["car"]["scripts"]:
+        return "config car.group: the script is in car.scripts"
+    if script_figure(script) == config["luxo"]["figure"]:
+        return "config luxo.group: the script animates Luxo's figure"
+    return "the script's own name, as for any script not configured otherwise"
+
+
 def script_inputs(wildcards):
     """The tables, dynamics and motor programs a script needs (its 'swapcon', 'when', 'object'
-    and 'motor' lines), and the controller specs they are made from."""
-    script = parsed_spec(f"specs/scripts/{wildcards.script}.anim")
+    and 'motor' lines), and the controller specs they are made from. A controller without a
+    spec in the script's group stops the DAG naming the script's line and the group's reason
+    (it named only the missing spec, at '1:1')."""
+    path = f"specs/scripts/{wildcards.script}.anim"
+    script = parsed_spec(path)
     group = script_group(wildcards.script)
     names = script.controllers()
+    for command in script.commands:
+        name = getattr(command, "controller", None)
+        spec = f"specs/controllers/{group}/{name}.ssc"
+        if name is not None and not Path(spec).is_file():
+            raise WorkflowError(
+                f"{path}:{command.token.line}: {command.table_token.text} names controller "
+                f"{name}, whose spec {spec} does not exist: the script's controllers come from "
+                f"specs/controllers/{group}/ ({script_group_reason(wildcards.script)})"
+            )
     figures = {f"results/dynamics/{parsed_spec(f'specs/controllers/{group}/{name}.ssc').figure}.py"
                for name in names}
     figure = script_figure(wildcards.script)
