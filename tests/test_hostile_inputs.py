@@ -461,3 +461,25 @@ def test_a_joint_range_written_minus_zero_is_zero(tmp_path: Path) -> None:
     argv = ["bsr-search", str(SPECS / "bsr/rex_walk.bsr"), "--figures", str(figures)]
     assert main([*argv, "--seed", "1", "--generations", "1", "-o", str(out)]) == 0
     assert out.exists()
+
+
+def test_run_says_where_the_motion_ends(tmp_path: Path, pendulum: Path, capsys) -> None:
+    """A run whose controller never brought the figure to its destination was written without
+    a word: the command's line now says whether it ends in the last controller's arrival box."""
+    argv = ["--controllers", str(pendulum / "controllers"), "--dynamics-dir"]
+    argv += [str(pendulum / "dynamics")]
+    cases = {
+        "there.anim": (
+            "state link 0,0\nswapcon link conA.ctab\nsim 1 until=dest\n",
+            "0.00 s of motion; ends at controller A's destination (in its arrival box)",
+        ),
+        "short.anim": (
+            "state link -135,350\nswapcon link conA.ctab\nsim 0.05\n",
+            "0.05 s of motion; ends away from controller A's destination (not in its arrival box)",
+        ),
+    }
+    for name, (text, said) in cases.items():
+        (tmp_path / name).write_text(text)
+        out = tmp_path / f"{name}.h5"
+        assert main(["run", str(tmp_path / name), *argv, "-o", str(out)]) == 0
+        assert capsys.readouterr().out == f"{out}: {said}\n"

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from mosys import __version__
 from mosys.animation.runner import (
+    ScriptRun,
     ScriptSources,
     controller_table_path,
     load_controllers,
@@ -20,6 +21,7 @@ from mosys.io.controller_table import read_controller_table
 from mosys.io.trajectory import Trajectory, write_trajectory
 from mosys.parsing.script import SwapController, parse_script
 from mosys.ssc.grid import control_units, state_unit
+from mosys.ssc.regions import regions
 
 
 def run_animation_script(
@@ -105,4 +107,26 @@ def run_animation_script(
         contacts=contacts,
     )
     write_trajectory(out_path, trajectory)
+    print(run_summary(out_path, run, sources, extra))
     return trajectory
+
+
+def run_summary(out_path: str | Path, run: ScriptRun, sources: ScriptSources, extra: dict) -> str:
+    """The command's one line: the motion's length and where it ends. A run whose last
+    controller never brought the figure to its destination (a table that converged but cannot
+    swing the figure up) wrote its file without a word."""
+    head = f"{out_path}: {run.t[-1] - run.t[0]:.2f} s of motion"
+    if "parked" in extra:  # a car: its own outcome
+        if extra["parked"]:
+            return f"{head}; parked after {extra['parking_seconds']:.2f} s"
+        return f"{head}; not parked" + (
+            f", hit {extra['collided_with']}" if extra["collision_index"] >= 0 else ""
+        )
+    last = run.sources[run.source[-1]]
+    if run.source_kinds[run.source[-1]] != "controller":
+        return f"{head}; ends under motor program {last}"
+    controller = sources.controllers[last]
+    boxes = regions(sources.dynamics, controller.arrival_boxes())
+    if boxes.membership(run.figure_states[-1]).any():
+        return f"{head}; ends at controller {last}'s destination (in its arrival box)"
+    return f"{head}; ends away from controller {last}'s destination (not in its arrival box)"
