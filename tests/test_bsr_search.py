@@ -193,3 +193,26 @@ def test_a_term_of_the_other_dimension_is_an_error_at_its_word():
         setup(SPEC.replace("fitness distance=1", "fitness distance=1 sideways=-1"))
     assert "expected a fitness term of figure 'starman' (distance, max_height, " in str(error.value)
     assert str(error.value).endswith("found 'sideways=-1'")
+
+
+def test_a_search_by_hand_records_its_budget_and_threads(tmp_path, capsys):
+    """By hand with --generations the file said budget 'paper' (the tables then compared it
+    with the paper) and threads 0."""
+    from mosys.cli import main
+
+    root = Path(__file__).resolve().parents[1]
+    spec = root / "specs" / "bsr" / "starman_shuffle.bsr"
+    common = [str(spec), "--seed", "1", "--figures", str(root / "specs" / "figures")]
+    runs = {
+        "custom.h5": ["--generations", "2"],
+        "named.h5": ["--generations", "2", "--budget", "ci", "--threads", "1"],
+    }
+    try:
+        for name, options in runs.items():
+            assert main(["bsr-search", *common, *options, "-o", str(tmp_path / name)]) == 0
+    finally:
+        numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)  # this process's other tests
+    capsys.readouterr()
+    with h5py.File(tmp_path / "custom.h5") as custom, h5py.File(tmp_path / "named.h5") as named:
+        assert custom.attrs["budget"] == "custom" and custom.attrs["threads"] >= 1
+        assert named.attrs["budget"] == "ci" and named.attrs["threads"] == 1

@@ -4,7 +4,6 @@ out; a 3-D search that continues another also takes that search's result files."
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
 from mosys.bsr.figure import bsr_figure, load_rod_figure
@@ -60,9 +59,9 @@ def search_to_file(
         spec.steps,
         search_memory_bytes(setup, motion_step_bytes(len(figure.endpoint_names))),
     )
-    if threads:
-        import numba
+    import numba
 
+    if threads:
         numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
     outcome = run_search(setup, seed, label=f"{spec.name} seed {seed}")
     result = BsrResult(
@@ -97,7 +96,7 @@ def search_to_file(
             "steps": spec.steps,
             "perturbed": spec.perturbation.any,
             "steps_per_second": outcome.steps_per_second,
-            "threads": threads or int(os.environ.get("NUMBA_NUM_THREADS", "0") or 0),
+            "threads": numba.get_num_threads(),  # those that ran it (0 was written by hand)
             "searched_variables": searched_variables(setup),
             "min_com_height": float(outcome.com[:, 1].min()),
             **extra,

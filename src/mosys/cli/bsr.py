@@ -20,7 +20,7 @@ def _bsr_search_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, required=True, help="one of the spec's seeds")
     parser.add_argument("--figures", default="specs/figures", help="where NAME.fig lives")
     parser.add_argument("--generations", type=int, help="override the spec's G (a budget)")
-    add_budget(parser)
+    add_budget(parser, default=None)  # 'paper', or 'custom' with --generations
     parser.add_argument("--threads", type=int, help="threads that run the population")
     parser.add_argument(
         "--chain",
@@ -51,7 +51,7 @@ def _bsr_search(args: argparse.Namespace) -> None:
         args.seed,
         args.output,
         args.generations,
-        args.budget,
+        args.budget or ("paper" if args.generations is None else "custom"),
         args.threads,
         args.chain,
     )

@@ -146,10 +146,15 @@ def budget_name(text: str) -> str:
     return text
 
 
-def add_budget(parser: argparse.ArgumentParser) -> None:
-    """``--budget``: the name of the config that built an output (it is written into it)."""
+def add_budget(parser: argparse.ArgumentParser, default: str | None = "paper") -> None:
+    """``--budget``: the name of the config that built an output (it is written into it);
+    ``default`` None leaves the verb to choose (``bsr-search``: 'custom' when
+    ``--generations`` overrides the spec's G)."""
     parser.add_argument(
-        "--budget", type=budget_name, default="paper", help="name of the config that built it"
+        "--budget",
+        type=budget_name,
+        default=default,
+        help="name of the config that built it (default: paper)",
     )
 
 
