@@ -319,6 +319,18 @@ def test_learning_comparison_figure(searches: dict[str, list[Path]]) -> None:
     ]
 
 
+def test_learning_comparison_of_one_kind_names_only_that_kind(
+    searches: dict[str, list[Path]],
+) -> None:
+    """Sense-based searches alone: the title said 'time-based dashed' of no curve drawn."""
+    figure = learning_comparison_figure({"star_sense": searches["star_sense"]})
+    assert figure.get_suptitle() == (
+        "Learning curves of BSR searches\nsense-based controllers solid"
+    )
+    figure = learning_comparison_figure({"star_time": searches["star_time"]})
+    assert figure.get_suptitle().endswith("\ntime-based controllers dashed")
+
+
 def test_learning_comparison_writes_a_png(searches: dict[str, list[Path]], tmp_path: Path) -> None:
     out = tmp_path / "comparison.png"
     plot_learning_comparison(searches, out)

@@ -410,12 +410,14 @@ def learning_comparison_figure(results_by_search: Mapping[str, Sequence[str | Pa
         raw, scaled = figure.subplots(1, 2)
         left_out = []
         right_end = 0
+        drawn_kinds = set()
         for name in searches:
             loaded = [read_result(p) for p in results_by_search[name]]
             kinds = {_kind(r) for r in loaded}
             if len(kinds) > 1:
                 raise PlotInputError(f"search {name}: its files mix controller kinds {kinds}")
             kind = kinds.pop()
+            drawn_kinds.add(kind)
             grid, values = curves_on_grid(loaded)
             median = np.nanmedian(values, axis=0)
             low, high = np.nanmin(values, axis=0), np.nanmax(values, axis=0)
@@ -463,10 +465,17 @@ def learning_comparison_figure(results_by_search: Mapping[str, Sequence[str | Pa
         ncols = min(3, len(entries))
         add_legend(figure, entries, ncols=ncols)
         width, height = figure.get_size_inches()
-        title = (
-            "Learning curves for both kinds of motion controller\n"
-            "BSR searches: sense-based controllers solid, time-based dashed"
-        )
+        styles = {"sense": "sense-based controllers solid", "time": "time-based dashed"}
+        shown = [styles[kind] for kind in ("sense", "time") if kind in drawn_kinds]
+        if len(shown) == 1:  # it said 'time-based dashed' where none was drawn
+            shown = [shown[0].replace("time-based dashed", "time-based controllers dashed")]
+        if len(shown) == 2:
+            title = (
+                "Learning curves for both kinds of motion controller\n"
+                f"BSR searches: {shown[0]}, {shown[1]}"
+            )
+        else:
+            title = f"Learning curves of BSR searches\n{shown[0]}"
         figure.suptitle(title, y=1 - 0.1 / height, va="top", fontsize=11)
         figure.subplots_adjust(
             top=1 - (SUPTITLE_TOP + TITLE_LINE * 2 + AXES_TITLE) / height,
