@@ -289,3 +289,33 @@ def test_bad_input_raises_and_writes_nothing(result_path: Path, tmp_path: Path, 
         assert str(path) in str(error.value)
         assert not out.exists()
         assert not list(tmp_path.glob(".*.partial"))
+
+
+def test_scores_that_differ_are_written_so() -> None:
+    """A search that gained 0.0016 read '1.64 → 1.64 (× 1)'."""
+    from mosys.plots.composite import distinct_text, score_texts
+
+    assert score_texts(1.64289, 1.6445) == ("1.643", "1.645")
+    assert score_texts(5.8, 18.2) == ("5.8", "18.2")
+    assert distinct_text(1.6445 / 1.64289, 1.0) == "1.001"
+    assert score_texts(2.0, 2.0) == ("2", "2")
+    assert distinct_text(-3e-10, 0.0) == "0"
+
+
+def test_long_tick_labels_keep_the_axis_label_on_the_figure() -> None:
+    """Ticks of 1.64275..1.64450 pushed the y label off a figure with a fixed left margin."""
+    from mosys.plots.style import keep_left_labels_in, new_figure, plot_style
+
+    with plot_style():
+        figure = new_figure(8.0, 4.8)
+        ax = figure.subplots()
+        ax.plot([0, 8], [1.64289, 1.6445])
+        ax.set_ylabel("best script total so far")
+        figure.subplots_adjust(left=0.8 / 8.0)
+        figure.canvas.draw()
+        before = ax.get_tightbbox(figure.canvas.get_renderer()).x0
+        keep_left_labels_in(figure, ax)
+        figure.canvas.draw()
+        after = ax.get_tightbbox(figure.canvas.get_renderer()).x0
+    assert before < 0.07 * figure.dpi  # at the edge (in a search plot, beyond it)
+    assert after == pytest.approx(0.08 * figure.dpi, abs=1.0)

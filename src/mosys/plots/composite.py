@@ -53,6 +53,7 @@ from mosys.plots.style import (
     draw_terrain,
     frame_indices,
     frame_samples,
+    keep_left_labels_in,
     minus_signs,
     new_figure,
     plot_style,
@@ -176,8 +177,26 @@ def script_name(result: CompositeResult, path: str | Path) -> str:
 
 def score_text(value: float) -> str:
     """A score to three significant digits (a true minus sign; 0 for |value| < 1e-9)."""
-    value = float(value)
-    return "0" if abs(value) < 1e-9 else minus_signs(f"{value:.3g}")
+    return distinct_text(float(value), float(value))
+
+
+def score_texts(before: float, after: float) -> tuple[str, str]:
+    """Two scores as ``score_text`` writes them, with more digits where three would show a
+    change as none ('1.64 → 1.64' for 1.6429 → 1.6445)."""
+    return distinct_text(before, after), distinct_text(after, before)
+
+
+def distinct_text(value: float, other: float) -> str:
+    """``value`` to three significant digits, or as many more (up to 10) as it takes not to
+    read as ``other`` when the two differ; a true minus sign; 0 for |value| < 1e-9."""
+
+    def shown(number: float, digits: int) -> str:
+        return "0" if abs(number) < 1e-9 else f"{number:.{digits}g}"
+
+    digits = 3
+    while digits < 10 and value != other and shown(value, digits) == shown(other, digits):
+        digits += 1
+    return minus_signs(shown(value, digits))
 
 
 def phase_colors(phases: Sequence[Mapping]) -> list[tuple[float, float, float, float]]:
@@ -546,12 +565,13 @@ def search_figure(result_path: str | Path) -> Figure:
         if {"search_q", "search_g", "search_h"} <= attrs.keys()
         else ""
     )
+    shown_before, shown_after = score_texts(before, after)
     note = (
         f"{size}{int(attrs['simulations']):,} simulations in {float(attrs['wall_seconds']):.3g} s"
-        f"\nscript total {score_text(before)} → {score_text(after)}"
+        f"\nscript total {shown_before} → {shown_after}"
     )
     if before > 0 and np.isfinite(before) and np.isfinite(after):
-        note += f" (× {after / before:.3g})"
+        note += f" (× {distinct_text(after / before, 1.0)})"
     if not np.isfinite(np.append(scores, before)).all():
         note += "\nscores of ±inf or nan (the script's arithmetic) are not drawn"
     with plot_style():
@@ -561,7 +581,7 @@ def search_figure(result_path: str | Path) -> Figure:
         ax.step(generations, scores, where="post", color=CURVE_COLOR, linewidth=1.8, zorder=3)
         ax.plot(generations, scores, "o", color=CURVE_COLOR, markersize=4, zorder=4)
         ax.annotate(
-            f"the guess: {score_text(before)}",
+            f"the guess: {shown_before}",
             xy=(generations[-1], before),
             xytext=(0, -4),
             textcoords="offset points",
@@ -598,6 +618,7 @@ def search_figure(result_path: str | Path) -> Figure:
             bottom=MARGIN_BOTTOM / SEARCH_HEIGHT,
             top=1 - (MARGIN_TOP + 2 * TITLE_LINE + 0.1) / SEARCH_HEIGHT,
         )
+        keep_left_labels_in(figure, ax)  # a search that gained 0.002: ticks of 6 digits
     return figure
 
 

@@ -95,6 +95,19 @@ def arrange(figure: Figure, legend_rows: int = 0) -> None:
     )
 
 
+def keep_left_labels_in(figure: Figure, ax: Axes, pad: float = 0.08) -> None:
+    """Widen the left margin, if it must be, so that ``ax``'s y tick labels and y label lie
+    inside the figure (``pad`` inches from its edge): long tick labels (1.64450) pushed a
+    fixed margin's label off the figure. Draws the figure once to measure them."""
+    figure.canvas.draw()
+    box = ax.get_tightbbox(figure.canvas.get_renderer())
+    width = figure.get_size_inches()[0]
+    short = pad - box.x0 / figure.dpi  # inches the labels stick out beyond the pad
+    if short > 0:
+        position = ax.get_position()
+        figure.subplots_adjust(left=position.x0 + short / width)
+
+
 FIGURE_FORMATS = ("png", "pdf", "svg")  # what a plot's file name may end in
 
 
