@@ -729,11 +729,12 @@ def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | 
             legend.append((destination_handle(), "dX: destination of controller X"))
         legend += format_state_axes(ax, axes, state)
         legend += _shade_breakpoints(ax, trajectory, axes, colors)
-        ax.plot(state[-1, 0], state[-1, 1], marker="o", markersize=5, color="black", zorder=6)
+        end_style = {"marker": "o", "markersize": 5, "color": "black", "markeredgecolor": "white"}
+        ax.plot(state[-1, 0], state[-1, 1], zorder=7, **end_style)  # over an sX square there
         obstacles.append((state[-1, 0], state[-1, 1], 3.0))
         legend.append(
             (
-                Line2D([], [], marker="o", markersize=5, color="black", linestyle="none"),
+                Line2D([], [], linestyle="none", **end_style),
                 f"end, t = {trajectory.t[-1]:.2f} s",
             )
         )
