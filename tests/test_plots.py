@@ -609,3 +609,21 @@ def test_torque_figure_greys_the_nodes_without_a_cost_to_go(drawn_tables, tmp_pa
         for c in torque_figure(drawn_tables["A"]).axes[0].collections
         if isinstance(c, QuadMesh) and np.ma.is_masked(c.get_array())
     ]
+
+
+def test_script_figure_refuses_tables_of_which_none_drives_the_script(
+    trajectory, drawn_tables, tmp_path
+):
+    """They drew no destination and said nothing; a directory's tables, some used, still do."""
+    import shutil
+
+    from mosys.plots.style import PlotInputError
+
+    other = tmp_path / "Z.h5"
+    shutil.copy(drawn_tables["A"], other)
+    with pytest.raises(PlotInputError) as error:
+        script_path_figure(trajectory, [other])
+    assert str(error.value) == (
+        f"{trajectory}: none of the tables given (Z) is one of the script's controllers (A, D)"
+    )
+    script_path_figure(trajectory, [other, drawn_tables["A"]])  # one of them is used

@@ -669,13 +669,18 @@ def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | 
     with its name) and ``dX`` its destination (read
     from the controller tables in ``table_paths``, matched to the script's controllers by file
     stem; without them no destinations are drawn, and the axes are the pendulum's: see
-    ``trajectory_axes``)."""
+    ``trajectory_axes``; tables of which none drives the script are refused)."""
     trajectory = read_trajectory(trajectory_path)
     if len(trajectory.t) == 0:
         raise PlotInputError(f"{trajectory_path}: the trajectory has no samples")
     paths = {Path(p).stem: p for p in table_paths}
     tables = {name: read_controller_table(path) for name, path in paths.items()}
     used = [n for n in dict.fromkeys(trajectory.controllers) if n in tables]
+    if tables and not used:  # a mistake: they would draw no destination, and say nothing
+        raise PlotInputError(
+            f"{trajectory_path}: none of the tables given ({', '.join(tables)}) is one of the "
+            f"script's controllers ({', '.join(dict.fromkeys(trajectory.controllers))})"
+        )
     if used:
         axes = table_axes(tables[used[0]], paths[used[0]])
         if tuple(a.name for a in axes) != tuple(trajectory.state_order):
