@@ -6,6 +6,7 @@ figure's dynamics."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -29,6 +30,17 @@ def test_a_mistyped_config_key_is_refused_before_anything_runs(work):
     code, output = dry_run(work, "results/pendulum_all", "--config", "pendulm={group: x}")
     assert code != 0 and "'pendulm' was unexpected" in output
     assert not (work / "results").exists()
+
+
+def test_numbers_given_with_config_are_numbers(work):
+    """--config passes nested values as strings: bsr='{generations: 100, seeds: 1}' was refused
+    ('100' is not of type 'integer'). Where the schema wants a number, a numeral is one."""
+    budget = "bsr={generations: 100, seeds: 1}"
+    code, output = dry_run(work, "results/bsr_all", "--config", budget, "--quiet", "rules")
+    assert code == 0, output
+    assert re.search(r"^bsr_search\s+5$", output, re.M), output  # one seed of each search
+    code, output = dry_run(work, "results/bsr_all", "--config", "bsr={generations: many}")
+    assert code != 0 and "'many' is not of type 'integer', 'null'" in output
 
 
 @pytest.mark.parametrize(

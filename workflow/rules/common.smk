@@ -14,10 +14,45 @@ import time
 from importlib.machinery import PathFinder
 from pathlib import Path
 
+import yaml
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
 
+NUMBER = r"[+-]?([0-9]+[.]?[0-9]*|[.][0-9]+)([eE][+-]?[0-9]+)?"  # a number as YAML writes one
+
+
+def typed_overrides(value, schema):
+    """``value`` with the strings the schema wants as numbers, booleans or null made so:
+    Snakemake's ``--config`` passes nested values as strings, and bsr='{generations: 100}'
+    was refused ('100' is not of type 'integer'). A string that is none is left, for the
+    validation to refuse."""
+    if isinstance(value, dict):
+        properties = schema.get("properties", {})
+        return {key: typed_overrides(item, properties.get(key, {})) for key, item in value.items()}
+    if isinstance(value, list):
+        prefix, rest = schema.get("prefixItems", []), schema.get("items", {})
+        return [typed_overrides(item, prefix[k] if k < len(prefix) else rest)
+                for k, item in enumerate(value)]
+    if not isinstance(value, str):
+        return value
+    kinds = schema.get("type", [])
+    kinds = [kinds] if isinstance(kinds, str) else kinds
+    text = value.strip()
+    if "null" in kinds and text in ("null", "~"):
+        return None
+    if "boolean" in kinds and text.lower() in ("true", "false"):
+        return text.lower() == "true"
+    if "integer" in kinds and re.fullmatch(r"[+-]?[0-9]+", text):
+        return int(text)
+    if "number" in kinds and re.fullmatch(NUMBER, text):
+        return float(text)
+    return value
+
+
+CONFIG_SCHEMA = Path(workflow.current_basedir) / "../schemas/config.schema.yaml"
+for key, value in typed_overrides(dict(config), yaml.safe_load(CONFIG_SCHEMA.read_text())).items():
+    config[key] = value  # --config's strings, typed
 validate(config, "../schemas/config.schema.yaml")
 
 
