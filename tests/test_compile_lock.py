@@ -128,3 +128,34 @@ def test_a_kernel_another_process_compiles_is_left_for_last_within_deferring(tmp
     assert child.stdout.readline().strip() == "loaded kernel"  # once the lock was released
     assert child.wait(timeout=60) == 0
     assert list(cache.rglob("two_kernels.kernel-*.nbi"))
+
+
+TIMED = """
+import sys
+from mosys.kernels import compile_lock
+compile_lock.serialize_cold_compilation()
+told = []
+compile_lock.on_first_cold_compilation(told.append)
+sys.path.insert(0, sys.argv[1])
+from cold_kernel import kernel
+kernel(10)
+kernel(20)
+print(told, compile_lock.cold_compilation_seconds() > 0)
+"""
+
+
+def test_a_cold_compilation_is_timed_and_told_once(tmp_path):
+    """A fresh install's first BSR search counted a minute of compiling as search time; its
+    command said nothing meanwhile. Warm, nothing is compiled, told or counted."""
+    (tmp_path / "cold_kernel.py").write_text(KERNEL)
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    for expected in ("['cold_kernel.kernel'] True", "[] False"):  # cold, then warm
+        done = subprocess.run(
+            [sys.executable, "-c", TIMED, str(tmp_path)],
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+        assert done.returncode == 0, done.stderr
+        assert done.stdout.strip() == expected

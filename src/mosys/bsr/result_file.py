@@ -85,6 +85,7 @@ def search_to_file(
             "fitness_terms": outcome.terms_json(),
             "spec_sha256": spec.spec_sha256,
             "wall_seconds": outcome.wall_seconds,
+            "compile_seconds": outcome.compile_seconds,
             "name": spec.name,
             "budget": budget,
             "generations": setup.generations,

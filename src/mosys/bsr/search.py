@@ -56,6 +56,7 @@ from mosys.kernels.bsr_controller import (
     run_controller,
     run_population,
 )
+from mosys.kernels.compile_lock import cold_compilation_seconds
 from mosys.kernels.soundness import steps_before_blow_up, unsoundness
 from mosys.parsing.bsr import FITNESS_TERMS, BsrSpec
 from mosys.parsing.tokens import SpecError, Token, location
@@ -163,7 +164,8 @@ class SearchOutcome:
     rod_ends: np.ndarray
     com: np.ndarray
     wall_seconds: float
-    steps_per_second: float
+    steps_per_second: float  # numba's compilation left out (``compile_seconds``)
+    compile_seconds: float  # of wall_seconds: compiling kernels that missed numba's cache
     term_names: tuple[str, ...] = FITNESS_TERMS
     final_state: np.ndarray | None = None
     final_force: np.ndarray | None = None
@@ -581,6 +583,7 @@ def run_search(setup: SearchSetup, seed: int, label: str = "search") -> SearchOu
     spec = setup.spec
     c = spec.controllers
     rng = np.random.default_rng(seed)
+    compiled = cold_compilation_seconds()
     began = time.perf_counter()
     current = _Population(setup, rng)
     first = f"seed {seed}, generation 0"
@@ -628,6 +631,7 @@ def run_search(setup: SearchSetup, seed: int, label: str = "search") -> SearchOu
         progress.update(generation, f"best fitness {best_fitness:.3f}")
     progress.finish(f"best fitness {best_fitness:.3f}")
     wall = time.perf_counter() - began
+    compiling = cold_compilation_seconds() - compiled  # a fresh install's first search: a minute
     try:
         run = setup.simulation.record(setup, best)
     except NonFiniteStateError as error:
@@ -643,7 +647,8 @@ def run_search(setup: SearchSetup, seed: int, label: str = "search") -> SearchOu
         rod_ends=run.rod_ends,
         com=run.com,
         wall_seconds=wall,
-        steps_per_second=evaluations[-1] * spec.steps / wall,
+        steps_per_second=evaluations[-1] * spec.steps / max(wall - compiling, 1e-9),
+        compile_seconds=compiling,
         term_names=setup.simulation.term_names,
         final_state=run.final_state,
         final_force=run.final_force,

@@ -30,12 +30,30 @@ from __future__ import annotations
 
 import contextlib
 import os
-from collections.abc import Iterator
+import sys
+import time
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 _installed = False
 _cache_only = False
 _deferring = False
+_cold_seconds = 0.0  # this process's time in top-level compilations after cache misses
+
+
+def _tell_a_person(function: str) -> None:
+    """On a terminal, say what the minute of silence that follows is (a fresh install's first
+    3-D search printed nothing for a minute)."""
+    if sys.stderr.isatty():
+        print(
+            "mosys: compiling numba's kernels on this machine, once (they are kept in numba's "
+            f"cache; {function} first): seconds, or about a minute before a first 3-D search",
+            file=sys.stderr,
+            flush=True,
+        )
+
+
+_listeners: list[Callable[[str], None]] = [_tell_a_person]  # told of the first such compilation
 
 
 class ColdCompilationError(Exception):
@@ -71,6 +89,19 @@ def cache_only() -> Iterator[None]:
         yield
     finally:
         _cache_only = before
+
+
+def cold_compilation_seconds() -> float:
+    """Seconds this process has spent compiling functions that missed numba's cache (and
+    waiting for another process's compilation of them): what a timed run subtracts, since a
+    fresh install's first BSR search spent a minute of its 'search' time compiling."""
+    return _cold_seconds
+
+
+def on_first_cold_compilation(listener: Callable[[str], None]) -> None:
+    """Call ``listener(function)`` when this process first compiles a function that missed
+    the cache (once; the command line says a minute of silence is compilation)."""
+    _listeners.append(listener)
 
 
 def lock_path(function: str) -> Path:
@@ -145,6 +176,7 @@ def serialize_cold_compilation() -> None:
     depth = 0  # top-level compilations under the lock; numba's compiler lock guards it
 
     def compile_once(self: Dispatcher, sig):
+        global _cold_seconds
         nonlocal depth
         with global_compiler_lock:
             if depth or isinstance(self._cache, NullCache):
@@ -159,12 +191,18 @@ def serialize_cold_compilation() -> None:
             finally:
                 probe.armed = armed
             function = f"{self.py_func.__module__}.{self.py_func.__qualname__}"
-            with machine_lock(function, wait=not _deferring):
-                depth += 1
-                try:  # loads it if another process compiled it while this one waited
-                    return compile_signature(self, sig)
-                finally:
-                    depth -= 1
+            while _listeners:
+                _listeners.pop(0)(function)
+            began = time.perf_counter()
+            try:
+                with machine_lock(function, wait=not _deferring):
+                    depth += 1
+                    try:  # loads it if another process compiled it while this one waited
+                        return compile_signature(self, sig)
+                    finally:
+                        depth -= 1
+            finally:
+                _cold_seconds += time.perf_counter() - began
 
     compile_once.__doc__ = compile_signature.__doc__
     Dispatcher.compile = compile_once
