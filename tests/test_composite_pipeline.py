@@ -137,6 +137,28 @@ def test_the_motion_starts_from_the_first_searchs_start_pose(composite_workspace
     np.testing.assert_array_equal(motion.rod_ends[:101], run.rod_ends[:101])
 
 
+def test_seed_files_of_two_builds_of_a_search_are_refused(composite_workspace, tmp_path):
+    """A seed left from an earlier build (another G) beside a rebuilt one was mixed in without
+    a word: the best of them was taken as the phase's controller."""
+    import h5py
+
+    files = composite_workspace.controller_files()
+    folder = tmp_path / "starman_jump_robust"
+    folder.mkdir()
+    mixed = [shutil.copy(path, folder / Path(path).name) for path in files["starman_jump_robust"]]
+    with h5py.File(mixed[1], "r+") as stale:
+        stale.attrs["generations"] = 200
+    files["starman_jump_robust"] = [Path(path) for path in mixed]
+    script = parse_composite_script(composite_workspace.script)
+    with pytest.raises(SpecError) as error:
+        open_session(script, files, SPECS / "figures", SPECS / "bsr")
+    assert str(error.value) == (
+        f"{script.path}:9:28: expected the seed files of one build of starman_jump_robust "
+        f"({folder / 'seed1.h5'} and {folder / 'seed2.h5'} differ in generations: rebuild or "
+        "remove the stale ones, or name a seed), found 'starman_jump_robust'"
+    )
+
+
 @pytest.mark.parametrize(
     ("edit", "message"),
     [

@@ -141,6 +141,30 @@ def find_controller_files(script: CompositeScript, results_dir: str | Path) -> d
     return found
 
 
+BUILD_ATTRS = ("spec_sha256", "generations", "budget")  # what the seeds of one build share
+
+
+def _one_build(script, token, search: str, results: Mapping, files: Mapping) -> None:
+    """SpecError at the phase's search unless its seed files come from one build: one version
+    of the spec, one budget (a seed left from an earlier build, beside seeds rebuilt at another
+    G, was mixed in without a word)."""
+    first = min(results)
+    for seed, result in results.items():
+        differ = [
+            name
+            for name in BUILD_ATTRS
+            if str(result.attrs.get(name)) != str(results[first].attrs.get(name))
+        ]
+        if differ:
+            raise SpecError.at(
+                script.path,
+                token,
+                f"the seed files of one build of {search} ({files[first]} and {files[seed]} "
+                f"differ in {', '.join(differ)}: rebuild or remove the stale ones, or name a "
+                "seed)",
+            )
+
+
 def open_session(
     script: CompositeScript,
     controller_files: Mapping[str, Sequence[str | Path]],
@@ -179,6 +203,7 @@ def open_session(
             result = read_bsr_result(candidates[seed])
         else:
             results = {k: read_bsr_result(path) for k, path in sorted(candidates.items())}
+            _one_build(script, token, phase.controller, results, candidates)
             seed = max(results, key=lambda k: float(results[k].attrs["nominal_fitness"]))
             result = results[seed]
         if str(result.attrs["name"]) != phase.controller:  # a file put in another's folder
