@@ -543,3 +543,18 @@ def test_a_spec_naming_a_figure_unfit_for_bsr_is_refused_at_its_figure_line(tmp_
         f"x.bsr:4:8: expected a BSR figure ({figures / 'link1.fig'}:11:5: expected a 'free' "
         "root (BSR figures fly and fall), found 'link'), found 'link1'"
     )
+
+
+def test_a_composite_naming_a_3d_figure_is_refused_at_its_figure_line():
+    """It was refused at the sound cujo.fig, naming an internal module (bsr.figure3d)."""
+    from pathlib import Path
+
+    from mosys.bsr.figure import load_bsr_figure
+
+    figures = Path(__file__).resolve().parents[1] / "specs" / "figures"
+    with pytest.raises(SpecError) as error:
+        load_bsr_figure(figures, "x.comp", Token("cujo", 3, 8))
+    assert str(error.value) == (
+        "x.comp:3:8: expected a planar figure (composite motion is 2-D; 'cujo' is 3-D), "
+        "found 'cujo'"
+    )

@@ -205,8 +205,15 @@ def load_rod_figure(figures_dir: str | Path, spec_path: str, token: Token) -> Fi
 
 
 def load_bsr_figure(figures_dir: str | Path, spec_path: str, token: Token) -> BsrFigure:
-    """The 2-D BSR figure a spec names (``load_rod_figure``, then ``bsr_figure``)."""
-    return bsr_figure(load_rod_figure(figures_dir, spec_path, token))
+    """The 2-D BSR figure a spec names (``load_rod_figure``, then ``bsr_figure``); a 3-D one
+    raises SpecError at the spec's word (a composite script naming one was refused at the
+    sound .fig, naming an internal module)."""
+    parsed = load_rod_figure(figures_dir, spec_path, token)
+    if parsed.dimensions == 3:
+        raise SpecError.at(
+            spec_path, token, f"a planar figure (composite motion is 2-D; '{token.text}' is 3-D)"
+        )
+    return bsr_figure(parsed)
 
 
 def distinct_endpoints(parent: np.ndarray, hinge: np.ndarray, length: np.ndarray) -> np.ndarray:
