@@ -216,3 +216,17 @@ def test_a_search_by_hand_records_its_budget_and_threads(tmp_path, capsys):
     with h5py.File(tmp_path / "custom.h5") as custom, h5py.File(tmp_path / "named.h5") as named:
         assert custom.attrs["budget"] == "custom" and custom.attrs["threads"] >= 1
         assert named.attrs["budget"] == "ci" and named.attrs["threads"] == 1
+
+
+def test_a_seed_the_spec_does_not_list_is_refused_saying_where_the_seeds_are(tmp_path):
+    """It was 'S.bsr:1:1: expected seed 3 among the spec's seeds [1, 2], found end of line'."""
+    from mosys.errors import InputError
+
+    root = Path(__file__).resolve().parents[1]
+    spec = root / "specs" / "bsr" / "starman_shuffle.bsr"
+    with pytest.raises(InputError) as error:
+        search_to_file(spec, root / "specs" / "figures", 9, tmp_path / "s.h5", generations=1)
+    assert str(error.value) == (
+        f"{spec}: --seed 9 is not one of its seeds (1, 2, 3, 4, 5, line 8): give one of them, "
+        "or add it there"
+    )

@@ -46,9 +46,11 @@ def search_to_file(
     ``budget`` names the config that chose it; ``threads``: numba threads for the population;
     ``chain_results``: the result files of the search a ``chain`` line continues."""
     spec = parse_bsr_spec(spec_path)
-    if seed not in spec.seeds:
-        raise SpecError(
-            spec.path, 1, 1, f"seed {seed} among the spec's seeds {list(spec.seeds)}", None
+    if seed not in spec.seeds:  # the argument's mistake, or the spec's: say both
+        seeds = ", ".join(map(str, spec.seeds))
+        raise InputError(
+            f"{spec.path}: --seed {seed} is not one of its seeds ({seeds}, line "
+            f"{spec.tokens['seeds'].line}): give one of them, or add it there"
         )
     setup, extra = _bind(spec, figures_dir, generations, chain_results or [])
     figure = setup.figure

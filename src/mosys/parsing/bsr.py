@@ -411,6 +411,7 @@ class _Parser:
         self.search = self.values(found, _SEARCH_KEYS)
 
     def line_seeds(self, line: Line) -> None:
+        self.tokens["seeds"] = line.keyword
         reader = line.reader()
         what = "a seed"
         seeds: dict[int, Token] = {}
