@@ -341,7 +341,8 @@ def test_join_chain_says_what_does_not_join(chain: dict[str, list[Path]], tmp_pa
     with pytest.raises(PlotInputError) as error:
         join_chain([flat])
     assert str(error.value) == (
-        f"{flat}: best/figure_motion is the motion of a 2-D figure; this plot draws 3-D figures"
+        f"{flat}: best/figure_motion is the motion of a 2-D figure; this plot draws 3-D figures "
+        "(mosys plot bsr draws 2-D ones)"
     )
     with pytest.raises(PlotInputError) as error:
         join_chain([])
@@ -614,7 +615,7 @@ def test_cli_rejects_bad_input(
     assert main(["plot", "bsr3d", str(flat), "--filmstrip", str(out)]) == 2
     assert capsys.readouterr().err == (
         f"mosys: {flat}: best/figure_motion is the motion of a 2-D figure; this plot draws 3-D "
-        "figures\n"
+        "figures (mosys plot bsr draws 2-D ones)\n"
     )
     assert not out.exists()
     for arguments in (

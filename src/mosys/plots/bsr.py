@@ -131,9 +131,10 @@ def read_result(path: str | Path, dimensions: int | None = 2) -> BsrResult:
         raise PlotInputError(f"{path}: best/figure_motion has no samples")
     drawn = result.motion.dimensions
     if dimensions is not None and drawn != dimensions:
+        other = {2: "plot bsr", 3: "plot bsr3d"}.get(drawn)  # the verb that draws it
         raise PlotInputError(
             f"{path}: best/figure_motion is the motion of a {drawn}-D figure; this plot draws "
-            f"{dimensions}-D figures"
+            f"{dimensions}-D figures" + (f" (mosys {other} draws {drawn}-D ones)" if other else "")
         )
     endpoints = result.motion.endpoints
     if endpoints.ndim != 4 or endpoints.shape[0] != samples or endpoints.shape[2:] != (2, drawn):
@@ -291,7 +292,7 @@ def learning_figure(results: Sequence[str | Path]) -> Figure:
     kinds = {_kind(r) for r, _ in loaded}
     if len(names) > 1 or len(kinds) > 1:
         raise PlotInputError(
-            "plot_learning: the files are of more than one search: "
+            "the files are of more than one search (one search's seeds a plot): "
             + ", ".join(f"{p} ({search_name(r.attrs, p)}, {_kind(r)})" for r, p in loaded)
         )
     name, kind = names.pop(), kinds.pop()
