@@ -386,6 +386,7 @@ def no_display(monkeypatch):
     plt.switch_backend("agg")
     monkeypatch.delenv("DISPLAY", raising=False)
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    monkeypatch.delenv("MPLBACKEND", raising=False)
     yield
     plt.switch_backend(backend)
 
@@ -414,11 +415,25 @@ def test_run_editor_refuses_a_guess_past_the_limits_before_its_window(
     assert plt.get_fignums() == figures
 
 
-def test_run_editor_without_a_window_says_so(no_display, tmp_path):
+@pytest.mark.parametrize(
+    ("environment", "why"),
+    [
+        ({}, "no display: DISPLAY is not set"),
+        (  # matplotlib falls back to Agg without a word: the message named only 'agg'
+            {"MPLBACKEND": "TkAgg", "DISPLAY": ":99"},
+            "MPLBACKEND=TkAgg could not start; the display ':99' could not be opened, or no "
+            "GUI toolkit (tkinter, a Qt binding) is installed",
+        ),
+    ],
+)
+def test_run_editor_without_a_window_says_so(no_display, tmp_path, monkeypatch, environment, why):
+    for name, value in environment.items():
+        monkeypatch.setenv(name, value)
     with pytest.raises(InputError) as error:  # before reading anything: no such script here
         run_editor(tmp_path / "missing.comp", tmp_path)
     assert str(error.value) == (
-        "the editor needs a window, but matplotlib's backend 'agg' draws none (no display: "
-        "DISPLAY is not set); run it on a desktop or over ssh -X, with MPLBACKEND unset or an "
-        "interactive backend such as TkAgg or QtAgg"
+        f"the editor needs a window, but matplotlib's backend 'agg' draws none ({why}); run it "
+        "on a desktop or over ssh -X, with MPLBACKEND unset or an interactive backend such as "
+        "TkAgg or QtAgg; without a display, edit the phases' ticks= in the script and run mosys "
+        "composite and mosys plot composite"
     )

@@ -633,6 +633,25 @@ def interactive_backend() -> str | None:
     return None
 
 
+def no_window_reason(backend: str) -> str:
+    """Why matplotlib ended with the file backend ``backend``, in brackets ('' if it was asked
+    for): it falls back to Agg without a word when the backend asked for cannot start (the
+    message named only 'agg', with MPLBACKEND=TkAgg set) or the display cannot be opened."""
+    asked = os.environ.get("MPLBACKEND", "")
+    if asked.lower() == backend.lower():
+        return ""
+    display = os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+    reasons = [f"MPLBACKEND={asked} could not start"] if asked else []
+    if sys.platform.startswith("linux"):
+        reasons.append(
+            f"the display {display!r} could not be opened, or no GUI toolkit (tkinter, a Qt "
+            "binding) is installed"
+            if display
+            else "no display: DISPLAY is not set"
+        )
+    return f" ({'; '.join(reasons)})" if reasons else ""
+
+
 def run_editor(
     script_path: str | Path,
     results_dir: str | Path = "results/bsr",
@@ -650,14 +669,12 @@ def run_editor(
     from mosys.parsing.composite import parse_composite_script
 
     if interactive_backend() is None:
-        no_display = sys.platform.startswith("linux") and not (
-            os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
-        )
         raise InputError(
             f"the editor needs a window, but matplotlib's backend {plt.get_backend()!r} draws "
-            f"none{' (no display: DISPLAY is not set)' if no_display else ''}; run it on a "
-            f"desktop or over ssh -X, with MPLBACKEND unset or an interactive backend such as "
-            f"TkAgg or QtAgg"
+            f"none{no_window_reason(plt.get_backend())}; run it on a desktop or over ssh -X, "
+            "with MPLBACKEND unset or an interactive backend such as TkAgg or QtAgg; without a "
+            "display, edit the phases' ticks= in the script and run mosys composite and mosys "
+            "plot composite"
         )
     script = parse_composite_script(script_path)
     session = open_session(
