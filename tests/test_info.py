@@ -454,6 +454,31 @@ def test_info_of_each_other_kind(made, capsys):
     assert "  /before/figure_motion: " in out and "  /figure_motion: " in out
 
 
+def test_info_measures_the_papers_rules_on_each_bsr_motion(made, capsys):
+    """Depth below the floor and sliding lone contacts, measured as the tests of the pipeline's
+    files measure them (a user had to find those functions to check a search of their own)."""
+    from mosys.bsr.lone_contact import lone_contacts, sliding
+    from mosys.io.bsr_result import read_bsr_result
+
+    out = info_of(made["BSR search result"], capsys)
+    motion = read_bsr_result(made["BSR search result"]).motion
+    contacts = lone_contacts(motion.t, motion.endpoints)
+    depth = max(0.0, -float(motion.endpoints[..., 1].min()))
+    rules = section(out, "the paper's rules (README, 'The simulator'), measured:")
+    assert rules[1:] == [
+        f"  /best/figure_motion: deepest rod end {1000 * depth:.2f} mm below the floor; "
+        f"{len(contacts)} lone contact{'' if len(contacts) == 1 else 's'}, "
+        f"{len(sliding(contacts))} of them sliding 5 mm or more"
+    ]
+    out = info_of(made["composite result"], capsys)
+    rules = section(out, "the paper's rules (README, 'The simulator'), measured:")
+    assert [line.split(":")[0] for line in rules[1:]] == [
+        "  /before/figure_motion",
+        "  /figure_motion",
+    ]
+    assert "the paper's rules" not in info_of(made["trajectory"], capsys)  # a pendulum
+
+
 def test_info_of_a_file_of_an_older_mosys(tmp_path, capsys):
     """No units, no provenance, no scales: reported as such."""
     path = tmp_path / "old.h5"
