@@ -319,3 +319,12 @@ def test_long_tick_labels_keep_the_axis_label_on_the_figure() -> None:
         after = ax.get_tightbbox(figure.canvas.get_renderer()).x0
     assert before < 0.07 * figure.dpi  # at the edge (in a search plot, beyond it)
     assert after == pytest.approx(0.08 * figure.dpi, abs=1.0)
+
+
+def test_a_search_that_kept_the_guess_says_so_on_the_strips() -> None:
+    """Two identical panels with nothing said looked like a mistake."""
+    from mosys.plots.composite import _same_transitions
+
+    guess = [{"name": "a", "ticks": 200}, {"name": "b", "ticks": 150}]
+    assert _same_transitions(guess, [dict(phase) for phase in guess])
+    assert not _same_transitions(guess, [{"name": "a", "ticks": 190}, {"name": "b", "ticks": 160}])

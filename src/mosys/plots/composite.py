@@ -180,6 +180,11 @@ def score_text(value: float) -> str:
     return distinct_text(float(value), float(value))
 
 
+def _same_transitions(before: Sequence[Mapping], after: Sequence[Mapping]) -> bool:
+    """Whether the refined phases are the guessed ones (the same durations)."""
+    return [phase.get("ticks") for phase in before] == [phase.get("ticks") for phase in after]
+
+
 def score_texts(before: float, after: float) -> tuple[str, str]:
     """Two scores as ``score_text`` writes them, with more digits where three would show a
     change as none ('1.64 → 1.64' for 1.6429 → 1.6445)."""
@@ -333,7 +338,12 @@ def filmstrips_figure(result_path: str | Path, interval: float | None = None) ->
             result.scores_before,
         ),
         (
-            "After refinement (Figure 14): the transition points found by the search",
+            "After refinement (Figure 14): the transition points found by the search"
+            + (  # identical panels looked like a mistake
+                " (the guess's: the search found none better)"
+                if _same_transitions(result.phases_before, result.phases)
+                else ""
+            ),
             result.after,
             result.phases,
             result.attrs["score_after"],
