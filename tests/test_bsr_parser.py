@@ -89,6 +89,7 @@ def test_example():
         "fall.0": Token("upper.distal", 10, 6),
         "fall.1": Token("lower.distal", 10, 19),
         "perturb": Token("perturb", 8, 1),
+        "seeds": Token("seeds", 6, 1),
     }
     assert spec.fall[1].token == Token("lower.distal", 10, 19)
 
@@ -108,6 +109,7 @@ def test_defaults_and_a_time_controller():
     assert spec.tokens == {
         "figure": Token("link1", 1, 8),
         "fitness.rotations": Token("rotations=1", 6, 9),
+        "seeds": Token("seeds", 5, 1),
     }
     assert render_bsr_spec(spec) == MINIMAL
     periodic = parse_bsr_text(
@@ -504,7 +506,7 @@ def test_render_then_parse_round_trips(spec):
     assert parsed == dataclasses.replace(spec, spec_sha256=digest)
     assert render_bsr_spec(parsed) == text
     assert set(parsed.tokens) == (
-        {"figure"}
+        {"figure", "seeds"}
         | {f"start.{name}" for name in spec.start}
         | {f"fitness.{term}" for term in spec.weights}
         | {f"fall.{i}" for i in range(len(spec.fall))}
