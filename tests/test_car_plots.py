@@ -819,3 +819,13 @@ def test_a_start_grid_with_bad_exclusions(tmp_path):
 def test_no_trajectories(tmp_path):
     with pytest.raises(PlotInputError, match="no trajectories"):
         plot_parking_frames([], tmp_path / "x.png")
+
+
+def test_the_frames_legend_fits_the_figure_for_one_panel_or_three(parks, crashes, lost):
+    """Four legend columns, right under three panels, ran off both sides of one panel."""
+    for paths in ([parks], [parks, crashes, lost]):
+        figure = parking_frames_figure(paths)
+        figure.canvas.draw()
+        (legend,) = figure.legends
+        box = legend.get_window_extent()
+        assert box.x0 >= 0 and box.x1 <= figure.bbox.width and box.y0 >= 0

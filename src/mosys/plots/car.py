@@ -452,7 +452,7 @@ def _start_summary(runs: Sequence[CarTrajectory]) -> list[list[str]]:
     for run in runs:
         start, parts = run.start(), []
         if varying & {"x", "y"}:
-            position = f"from ({start['x']:.1f}, {start['y']:.1f}) m"
+            position = f"from ({start['x']:.3g}, {start['y']:.3g}) m"  # 3.25 read 3.2
             parts.append(minus_signs(position))
         for name in ("heading", "steer", "speed"):
             if name in varying:
@@ -797,13 +797,16 @@ def parking_frames_figure(
     ]
     title_lines = 1 + max(head.count("\n") + 1 for head in heads)
     with plot_style():
-        layout = _panel_figure(len(runs), limits, 1, title_lines, legend_rows=2)
+        # four legend columns fit under a row of three panels; one or two panels take two
+        columns = 4 if len(runs) >= COLUMNS else 2
+        rows = -(-len(legend) // columns)
+        layout = _panel_figure(len(runs), limits, 1, title_lines, legend_rows=rows)
         for ax, run, drawn, head in zip(layout.panels, runs, samples, heads, strict=True):
             _draw_scene(ax, run.scene, limits)
             _draw_manoeuvre(ax, run, drawn)
             _panel_title(ax, head, outcome_text(run), run.failed)
         _suptitle(layout.figure, f"The car parking under controller {_controller_names(runs)}")
-        add_legend(layout.figure, legend, ncols=4)
+        add_legend(layout.figure, legend, ncols=columns)
     return layout.figure
 
 
