@@ -107,3 +107,21 @@ def test_dropped_lamp_rests_on_the_floor_without_sinking(luxo: ModuleType) -> No
     assert deepest > -PENETRATION_TOLERANCE, deepest
     forces = luxo.contact_forces(q, qd)
     np.testing.assert_allclose(forces.sum(axis=0)[1], 1.3 * luxo.GRAVITY, rtol=1e-2)
+
+
+def test_depth_in_the_ground_is_to_the_nearest_point_of_the_terrain() -> None:
+    """As the contact model measures it: a point touching the ditch's wall just below the
+    floor's edge is 0.1 mm in, not the 9.8 cm down to the floor of the ditch above which it
+    sits; a point on the ditch's floor, 2 cm down, 2 cm in; the air, 0."""
+    from mosys.animation.motion_measures import ground_depth
+
+    terrain = [
+        [-1000.0, 0.0],
+        [-0.9, 0.0],
+        [-0.9, -0.3],
+        [-0.65, -0.3],
+        [-0.65, 0.0],
+        [1000.0, 0.0],
+    ]
+    points = np.array([[-0.6499, -0.2], [-0.8, -0.32], [0.3, 0.1], [0.3, -0.004]])
+    np.testing.assert_allclose(ground_depth(terrain, points), [0.0001, 0.02, 0.0, 0.004], atol=1e-9)

@@ -85,6 +85,7 @@ def test_every_motion_lands_and_settles_within_two_seconds(show) -> None:
         assert m.airborne_s > 0.05, (name, m)  # it really left the ground
         assert m.settle_s <= SETTLE_WITHIN, (name, m)
         assert m.max_penetration_m < PENETRATION_TOLERANCE, (name, m)
+        assert m.rod_in_ground_m < PENETRATION_TOLERANCE, (name, m)  # no rod through it
         assert not m.limb_touched, (name, m)  # it lands on its base, not on its head
 
 

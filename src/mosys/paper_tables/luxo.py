@@ -55,8 +55,11 @@ def write_luxo_table(
         f"{BASE_FLAT_DEG:g}°, joints within {JOINT_DEG:g}° of standing, |vx|, |vy| <= "
         f"{REST_SPEED:g} m/s and angular rates <= {REST_RATE:g} deg/s, to the motion's end; "
         f"landed: touched down and settled within {SETTLE_WITHIN:g} s. Penetration: the "
-        "deepest a contact point went below the ground (vertically). limb_touched: a contact "
-        "point off the base (the head) touched the ground during the motion.\n\n"
+        "deepest a contact point went into the ground, its distance to the nearest point of "
+        "the terrain as the contact model measures it; rod_in_ground_m: the same for any "
+        "point of a rod (the rods between the contact points meet no ground: an arm can pass "
+        "through a ditch's floor). limb_touched: a contact point off the base (the head) "
+        "touched the ground during the motion.\n\n"
     )
     write_text_atomically(md_path, caption + frame.to_markdown(index=False) + "\n")
     return frame
