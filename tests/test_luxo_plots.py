@@ -174,9 +174,19 @@ def test_motion_strip_writes_a_png(hop_path: Path, tmp_path: Path) -> None:
     assert width > height  # a strip
 
 
+def test_a_strip_without_a_motion_named_draws_the_first(hop_path: Path) -> None:
+    """The default was 'backflip': a show of your own without one failed in the pipeline."""
+    from mosys.plots.luxo import motion_strip_figure
+
+    figure = motion_strip_figure(hop_path, None)
+    assert figure.axes[0].get_title().startswith("Luxo: hop (")
+
+
 def test_motion_strip_names_the_motions_there_are(hop_path: Path, tmp_path: Path) -> None:
     out = tmp_path / "strip.png"
-    with pytest.raises(ValueError, match=r"no motion called 'backflip'; its motions: hop$"):
+    with pytest.raises(
+        ValueError, match=r"no motion called 'backflip' \(--motion\); its motions: hop$"
+    ):
         plot_motion_strip(hop_path, out, "backflip")
     with pytest.raises(ValueError, match="every must be a positive number of seconds, got 0"):
         plot_motion_strip(hop_path, out, "hop", every=0)

@@ -515,6 +515,14 @@ def luxo_script():
     return config["luxo"]["script"]
 
 
+def luxo_strip_motion(wildcards):
+    """'--motion NAME' for the strip of a Luxo script: config luxo.strip_motion if the script
+    runs it, else nothing (its first motion): a script of your own without a backflip failed."""
+    name = config["luxo"]["strip_motion"]
+    programs = parsed_spec(f"specs/scripts/{wildcards.script}.anim").motor_programs()
+    return f"--motion {name}" if name in programs else ""
+
+
 def luxo_table_targets():
     return ["results/tables/luxo_motions.csv", "results/tables/luxo_motions.md"]
 

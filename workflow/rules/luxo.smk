@@ -15,10 +15,10 @@ rule luxo_plots:
     benchmark:
         "results/benchmarks/plots/luxo/{script}.tsv"
     params:
-        motion=config["luxo"]["strip_motion"],
+        motion=luxo_strip_motion,
     threads: 1
     shell:
-        "mosys plot luxo {input.trajectory} --strip {output.strip} --motion {params.motion}"
+        "mosys plot luxo {input.trajectory} --strip {output.strip} {params.motion}"
         " --gif {output.gif} --forces {output.forces} > {log} 2>&1"
 
 

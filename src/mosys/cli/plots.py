@@ -151,7 +151,9 @@ def _luxo_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--strip", type=OutputPath(*PLOT), help="PNG: the lamp every few frames of one motion"
     )
-    parser.add_argument("--motion", default="backflip", help="the motion the strip draws")
+    parser.add_argument(
+        "--motion", help="the motion (motor program) the strip draws (default: the first)"
+    )
     parser.add_argument(
         "--forces", type=OutputPath(*PLOT), help="PNG: joint torques and contact forces over time"
     )

@@ -122,17 +122,17 @@ def read_luxo_trajectory(path: str | Path, contacts: bool = False) -> Trajectory
     return trajectory
 
 
-def find_motion(trajectory: Trajectory, name: str, path: str | Path = "") -> Motion:
-    """The first motion called ``name``; ValueError (a PlotInputError) listing the motions there
-    are when there is none."""
+def find_motion(trajectory: Trajectory, name: str | None, path: str | Path = "") -> Motion:
+    """The first motion called ``name`` (None: the trajectory's first motion); ValueError (a
+    PlotInputError) listing the motions there are when there is none."""
     found = motions(trajectory)
-    for motion in found:
-        if motion.name == name:
-            return motion
     if not found:
-        raise PlotInputError(f"{path}: no motion called {name!r}: it runs no motor program")
+        raise PlotInputError(f"{path}: no motion to draw: it runs no motor program")
+    for motion in found:
+        if name is None or motion.name == name:
+            return motion
     there = ", ".join(dict.fromkeys(m.name for m in found))
-    raise PlotInputError(f"{path}: no motion called {name!r}; its motions: {there}")
+    raise PlotInputError(f"{path}: no motion called {name!r} (--motion); its motions: {there}")
 
 
 def head_rod(names: Sequence[str]) -> int:
@@ -260,7 +260,7 @@ class _Lamp:
 def plot_motion_strip(
     trajectory_path: str | Path,
     out_path: str | Path,
-    motion: str,
+    motion: str | None,
     every: float = STRIP_EVERY,
 ) -> None:
     """Write ``motion_strip_figure`` as a PNG to ``out_path``."""
@@ -269,9 +269,10 @@ def plot_motion_strip(
 
 
 def motion_strip_figure(
-    trajectory_path: str | Path, motion: str, every: float = STRIP_EVERY
+    trajectory_path: str | Path, motion: str | None, every: float = STRIP_EVERY
 ) -> Figure:
-    """Figure 22 ("A Luxo back-flip"): the first motion called ``motion`` in one panel, to
+    """Figure 22 ("A Luxo back-flip"): the first motion called ``motion`` (None: the first
+    motion) in one panel, to
     scale in metres: the terrain (filled grey), the lamp every ``every`` seconds from the
     motion's start to its last sample (the landing included; a pose that hardly moved from the
     last one drawn is left out, see ``strip_samples``), light to dark with the time since the
