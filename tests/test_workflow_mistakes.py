@@ -110,6 +110,22 @@ def test_a_script_naming_a_controller_without_a_spec_is_caught_in_the_dag(work):
     (work / "specs/scripts/q.anim").unlink()
 
 
+def test_a_script_of_the_cars_figure_draws_on_the_cars_controllers(work):
+    """A parking script of your own was sent to a controller folder of its own name."""
+    script = work / "specs/scripts/my_park.anim"
+    script.write_text(
+        "object car figure=car\nstate car 6.5,3.25,-10,0,0\nswapcon car conpark.ctab\nsim 30\n",
+        encoding="utf-8",
+    )
+    try:
+        code, output = dry_run(work, "results/trajectories/my_park.h5")
+    finally:
+        script.unlink()
+    assert code == 0, output
+    assert "mosys run specs/scripts/my_park.anim --controllers results/controllers/car " in output
+    assert "--dt 0.01 " in output  # the car's step
+
+
 def test_a_malformed_spec_stops_the_dag_with_its_location(work):
     spec = work / "specs/scripts/pendulum_catch.anim"
     text = spec.read_text(encoding="utf-8")

@@ -402,10 +402,11 @@ def script_figure(script):
 
 def script_group(script):
     """The controller directory a script draws on: the configured one for the pendulum script,
-    the car's scripts and every script of Luxo's figure, else the script's own name."""
+    the car's scripts and every script of the car's or Luxo's figure (its object line), else
+    the script's own name."""
     if script == config["pendulum"]["script"] or script in config["pendulum"]["scripts"]:
         return config["pendulum"]["group"]
-    if script in config["car"]["scripts"]:
+    if script in config["car"]["scripts"] or script_figure(script) == config["car"]["figure"]:
         return config["car"]["group"]
     if script_figure(script) == config["luxo"]["figure"]:
         return config["luxo"]["group"]
@@ -417,7 +418,7 @@ def script_dt(script):
     car's scripts, else the default."""
     if script_figure(script) == config["luxo"]["figure"]:
         return config["luxo"]["dt"]
-    if script in config["car"]["scripts"]:
+    if script in config["car"]["scripts"] or script_figure(script) == config["car"]["figure"]:
         return config["car"]["dt"]
     return config["simulation"]["dt"]
 
@@ -426,8 +427,8 @@ def script_group_reason(script):
     """Why ``script_group`` chose the group it did, for a message."""
     if script == config["pendulum"]["script"] or script in config["pendulum"]["scripts"]:
         return "config pendulum.group: the script is the pendulum's, or in pendulum.scripts"
-    if script in config["car"]["scripts"]:
-        return "config car.group: the script is in car.scripts"
+    if script in config["car"]["scripts"] or script_figure(script) == config["car"]["figure"]:
+        return "config car.group: the script is in car.scripts, or drives the car's figure"
     if script_figure(script) == config["luxo"]["figure"]:
         return "config luxo.group: the script animates Luxo's figure"
     return "the script's own name, as for any script not configured otherwise"

@@ -147,9 +147,11 @@ def plot_state_path(ax: Axes, points: np.ndarray, axes: Sequence[StateAxis], **s
 def table_axes(table: ControllerTable, path: str | Path = "") -> tuple[StateAxis, StateAxis]:
     """The two plot axes of a 2-D controller table; PlotInputError for any other dimension."""
     if len(table.state_order) != 2:
+        car = table.figure == "car" or {"heading", "steer"} <= set(table.state_order)
         raise PlotInputError(
             f"{path}: a pendulum plot needs a 2-D controller table, this one has state "
             f"{', '.join(table.state_order)}"
+            + (" (a car's runs are drawn by mosys plot car)" if car else "")
         )
     axes = []
     for name, grid, unit, wrap in zip(
