@@ -231,6 +231,8 @@ def usage_error(message: str) -> str:
                     (),
                     "starts: at most 1,000,000 starts, asked for 2,000,000",
                 ),
+                (("2", "1", "2"), (), "starts: --y's MIN must not exceed its MAX, got 2 1"),
+                (("3.5", "3.6", "1"), (), "starts: --y 3.5 3.6 1: one start needs MIN = MAX"),
             )
         ),
         # issue 27's verb fuzz: numeric options nothing checked (tracebacks and hangs)
@@ -428,3 +430,32 @@ def test_help_imports_no_numerical_library():
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert (done.returncode, done.stderr) == (0, "[]\n")
+
+
+def test_starts_off_the_tables_heading_or_steer_axis_are_refused():
+    """A start at -70 deg of heading (the axis: -45..60) was run and counted as a failure;
+    one at 45 deg of steer (the axis: +-30, the model's stop 35) parked. A wrapping axis has
+    no ends."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from mosys.cli.ssc import off_table_problem
+    from mosys.errors import InputError
+
+    table = SimpleNamespace(
+        state_order=("x", "y", "heading", "steer", "speed"),
+        axes=(None, None, np.linspace(-45, 60, 43), np.linspace(-30, 30, 5), None),
+        wrap=(False, False, False, False, False),
+        axis_units=("m", "m", "deg", "deg", "m/s"),
+    )
+    off_table_problem(table, {"heading": np.array([-45.0, 60.0]), "steer": np.array([30.0])})
+    for name, value, axis in (("heading", -70.0, "-45..60"), ("steer", 45.0, "-30..30")):
+        with pytest.raises(InputError) as error:
+            off_table_problem(table, {name: np.array([0.0, value])})
+        assert str(error.value) == (
+            f"starts: --{name} {value:g} lies outside the table's {name} axis ({axis} deg): a "
+            "start there is off the table"
+        )
+    wrapped = SimpleNamespace(**{**vars(table), "wrap": (False, False, True, False, False)})
+    off_table_problem(wrapped, {"heading": np.array([-70.0])})

@@ -92,9 +92,13 @@ def _starts_check(args: argparse.Namespace) -> str | None:
         if not all(math.isfinite(value) for value in values):
             return f"starts: --{name} must be finite numbers, got {' '.join(map(str, values))}"
     for axis in ("x", "y"):
-        count = getattr(args, axis)[2]
+        low, high, count = getattr(args, axis)
         if count < 1 or count != int(count):
             return f"starts: --{axis}'s COUNT must be a whole number >= 1, got {count:g}"
+        if low > high:
+            return f"starts: --{axis}'s MIN must not exceed its MAX, got {low:g} {high:g}"
+        if count == 1 and low != high:  # it used MIN alone, without a word
+            return f"starts: --{axis} {low:g} {high:g} 1: one start needs MIN = MAX"
     starts = args.x[2] * args.y[2] * len(args.heading) * len(args.steer)
     if starts > MAX_STARTS:
         return f"starts: at most {MAX_STARTS:,} starts, asked for {starts:,.0f}"
@@ -120,11 +124,30 @@ def _starts(args: argparse.Namespace) -> None:
         "speed": np.array([0.0]),
     }
     order = controller.state_order
+    off_table_problem(controller.table, {name: axes[name] for name in ("heading", "steer")})
     starts = np.array(list(itertools.product(*(axes[name] for name in order))))
     write_start_grid(
         args.output,
         evaluate_starts(controller, starts, args.seconds, args.dt, args.threads, quiet=args.quiet),
     )
+
+
+def off_table_problem(table, values: dict) -> None:
+    """InputError for a start heading or steer outside the table's axis (one that does not
+    wrap): a start off the table was run and counted as a failure without a word."""
+    from mosys.errors import InputError
+
+    for name, asked in values.items():
+        if name not in table.state_order:
+            continue
+        k = table.state_order.index(name)
+        low, high = float(table.axes[k][0]), float(table.axes[k][-1])
+        outside = [v for v in asked if not table.wrap[k] and not low - 1e-9 <= v <= high + 1e-9]
+        if outside:
+            raise InputError(
+                f"starts: --{name} {outside[0]:g} lies outside the table's {name} axis "
+                f"({low:g}..{high:g} {table.axis_units[k]}): a start there is off the table"
+            )
 
 
 FAMILY = Family(
