@@ -483,3 +483,21 @@ def test_run_says_where_the_motion_ends(tmp_path: Path, pendulum: Path, capsys) 
         out = tmp_path / f"{name}.h5"
         assert main(["run", str(tmp_path / name), *argv, "-o", str(out)]) == 0
         assert capsys.readouterr().out == f"{out}: {said}\n"
+
+
+def test_a_car_started_on_an_obstacle_is_told_so() -> None:
+    """Its runs said only 'hit bollard'; the start itself overlapped it."""
+    from types import SimpleNamespace
+
+    from mosys.animation.trajectory_file import run_summary
+
+    run = SimpleNamespace(t=np.array([0.0, 20.0]))
+    hit = {"parked": False, "collision_index": 0, "collided_with": "bollard"}
+    assert run_summary("T.h5", run, None, hit) == (
+        "T.h5: 20.00 s of motion; not parked, hit bollard (its start pose overlaps it: no run "
+        "from there is free)"
+    )
+    later = {**hit, "collision_index": 7}
+    assert run_summary("T.h5", run, None, later).endswith("not parked, hit bollard")
+    parked = {"parked": True, "parking_seconds": 11.79}
+    assert run_summary("T.h5", run, None, parked).endswith("parked after 11.79 s")

@@ -119,8 +119,10 @@ def run_summary(out_path: str | Path, run: ScriptRun, sources: ScriptSources, ex
     if "parked" in extra:  # a car: its own outcome
         if extra["parked"]:
             return f"{head}; parked after {extra['parking_seconds']:.2f} s"
+        hit = extra["collision_index"]
+        where = " (its start pose overlaps it: no run from there is free)" if hit == 0 else ""
         return f"{head}; not parked" + (
-            f", hit {extra['collided_with']}" if extra["collision_index"] >= 0 else ""
+            f", hit {extra['collided_with']}{where}" if hit >= 0 else ""
         )
     last = run.sources[run.source[-1]]
     if run.source_kinds[run.source[-1]] != "controller":
