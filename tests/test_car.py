@@ -275,12 +275,6 @@ def test_bad_obstacle_lines_name_the_place(old, new, message):
     ("old", "new", "message"),
     [
         (
-            "obstacle front 3.0,0.15 7,0.15 7,1.85 3.0,1.85",
-            "obstacle front 30,0.15 34,0.15 34,1.85 30,1.85",
-            "x.ssc:13:10: expected an obstacle within the car's reach (3.31 m) of the domain "
-            "(x -2..2 m, y 1..2 m), found 'front'",
-        ),
-        (
             "obstacle front 3.0,0.15",
             "obstacle front 0.5,0.15",
             "x.ssc:9:6: expected a destination the car can occupy (the car's outline at (0, 1) "
@@ -306,6 +300,18 @@ def test_specs_that_do_not_fit_the_car_name_the_line(car, old, new, message):
     with pytest.raises(SpecError) as error:
         build_problem(parse_controller_text(text, "x.ssc"), car)
     assert str(error.value) == message
+
+
+def test_an_obstacle_beyond_the_cars_reach_is_kept_with_a_warning(car, capsys):
+    """It was refused, stopping the table: a scene's rear car moved 0.1 m back."""
+    far = "obstacle front 30,0.15 34,0.15 34,1.85 30,1.85"
+    text = SMALL.replace("obstacle front 3.0,0.15 7,0.15 7,1.85 3.0,1.85", far)
+    problem = build_problem(parse_controller_text(text, "x.ssc"), car)
+    assert problem is not None
+    assert capsys.readouterr().err == (
+        "warning: x.ssc:13:10: obstacle 'front' lies beyond the car's reach (3.31 m) of the "
+        "domain (x -2..2 m, y 1..2 m): no run can touch it\n"
+    )
 
 
 @pytest.mark.parametrize(
