@@ -471,7 +471,7 @@ MAP_LEGEND = [
     "parked",
     "collision",
     "not parked in 20 s",
-    "cannot park (start not free)",
+    "cannot park (start on an obstacle or off the domain)",
     "cannot park (no path found)",
     "destination (car outline)",
 ]
@@ -506,13 +506,18 @@ def test_excluded_starts_have_their_own_markers_and_are_not_counted(tmp_path):
     figure = success_map_figure(write_start_grid(tmp_path / "grid.h5"))
     panel = figure.axes[0]
     drawn = markers(panel)
-    np.testing.assert_array_equal(drawn["cannot park (start not free)"], [[6, 1]])
+    np.testing.assert_array_equal(
+        drawn["cannot park (start on an obstacle or off the domain)"], [[6, 1]]
+    )
     np.testing.assert_array_equal(drawn["cannot park (no path found)"], [[0, 1]])
     # drawn once each, in no outcome's collection
     every = np.concatenate(list(drawn.values()))
     assert len(every) == 8 and len(np.unique(every, axis=0)) == 8
     by_gid = {c.get_gid(): c for c in panel.collections if isinstance(c, PathCollection)}
-    not_free, no_way = by_gid["cannot park (start not free)"], by_gid["cannot park (no path found)"]
+    not_free, no_way = (
+        by_gid["cannot park (start on an obstacle or off the domain)"],
+        by_gid["cannot park (no path found)"],
+    )
     shapes = {c.get_gid(): c.get_paths()[0].vertices.round(3).tobytes() for c in by_gid.values()}
     assert len(set(shapes.values())) == 5, "each kind of start has a marker of its own shape"
     assert same_color(not_free.get_facecolor()[0], car.NOT_FREE_COLOR)
@@ -520,7 +525,7 @@ def test_excluded_starts_have_their_own_markers_and_are_not_counted(tmp_path):
     assert same_color(no_way.get_edgecolor()[0], car.NO_WAY_COLOR)
     (legend,) = figure.legends
     handles = dict(zip(legend_labels(figure), legend.legend_handles, strict=True))
-    assert handles["cannot park (start not free)"].get_marker() == "+"
+    assert handles["cannot park (start on an obstacle or off the domain)"].get_marker() == "+"
     assert handles["cannot park (no path found)"].get_marker() == "D"
     # 3 of the 6 starts run park: 50 %, not 3 of 8
     assert figure.get_suptitle().startswith(HEADLINE)

@@ -4,6 +4,7 @@ InputError naming the file."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -47,7 +48,10 @@ def test_written_attributes_read_back_the_same_scene():
     assert [p.tolist() for p in again.obstacles] == [CURB, FRONT]
     assert again.obstacle_names == scene.obstacle_names
     assert again.destination == scene.destination
-    assert again.domain.shape == (0, 2)  # trajectories do not carry the domain
+    # trajectories carry the domain, which the plots draw (they used to leave it out)
+    np.testing.assert_array_equal(again.domain, scene.domain)
+    no_domain = car_scene_attributes(dataclasses.replace(scene, domain=np.zeros((0, 2))))
+    assert "domain" not in no_domain
 
 
 def test_a_vehicle_without_obstacles_has_no_scene():

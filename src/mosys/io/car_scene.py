@@ -85,14 +85,19 @@ def controller_table_scene(table: ControllerTable) -> CarScene:
 
 
 def car_scene_attributes(scene: CarScene) -> dict:
-    """The root attributes a trajectory or start grid stores its scene in (all but the domain)."""
-    return {
+    """The root attributes a trajectory or start grid stores its scene in; the domain only where
+    there is one (the plots draw it, as Figure 17's dashed region; until 2026-12-05 it was left
+    out, and starts outside it read as starts in the open street that cannot park)."""
+    attributes = {
         "body_outline": json.dumps(scene.body_outline.tolist()),
         "obstacles": json.dumps([polygon.tolist() for polygon in scene.obstacles]),
         "obstacle_names": list(scene.obstacle_names),
         "destination": json.dumps(scene.destination),
         "wheelbase": scene.wheelbase,
     }
+    if len(scene.domain):
+        attributes["domain"] = json.dumps(scene.domain.tolist())
+    return attributes
 
 
 def _json_attr(attrs: Mapping, where: str, name: str):

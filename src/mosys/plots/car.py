@@ -92,6 +92,7 @@ RUN_ATTRS = (
 GRID_ATTRS = (*SCENE_ATTRS, "controller", "simulated_seconds")  # beside io.start_grid's
 
 OBSTACLE_FACE, OBSTACLE_EDGE = "0.72", "0.45"
+DOMAIN_STYLE = {"edgecolor": "0.35", "linestyle": "--", "linewidth": 1.0}
 FAILURE_COLOR = "#d62728"  # the collision outline, the FAILED titles, the collision markers
 TIMEOUT_COLOR = "#ff7f0e"
 PATH_COLOR = "0.2"
@@ -157,7 +158,10 @@ COLLIDED = _Marker("x", FAILURE_COLOR, FAILURE_COLOR, 1.6)
 TIMED_OUT = _Marker("s", TIMEOUT_COLOR, "black", 0.5, 0.85)
 # why a start cannot park at all (io.start_grid's excluded) -> its legend text and marker
 EXCLUSIONS = {
-    NOT_FREE: ("cannot park (start not free)", _Marker("+", NOT_FREE_COLOR, NOT_FREE_COLOR, 1.0)),
+    NOT_FREE: (
+        "cannot park (start on an obstacle or off the domain)",
+        _Marker("+", NOT_FREE_COLOR, NOT_FREE_COLOR, 1.0),
+    ),
     NO_WAY: ("cannot park (no path found)", _Marker("D", "none", NO_WAY_COLOR, 1.0, 0.75)),
 }
 
@@ -596,12 +600,22 @@ def _panel_title(ax: Axes, first_line: str, outcome: str | None = None, failed=F
     )
 
 
+def _domain_entries(scenes: Sequence[CarScene]) -> list[tuple[object, str]]:
+    """The legend entry of the domain, if any scene has one."""
+    if not any(len(scene.domain) >= 3 for scene in scenes):
+        return []
+    line = Line2D([], [], color=DOMAIN_STYLE["edgecolor"], linestyle="--", linewidth=1.0)
+    return [(line, "domain (the front-axle midpoint stays in it)")]
+
+
 def _draw_scene(ax: Axes, scene: CarScene, limits: np.ndarray) -> None:
     """Obstacles as grey polygons, each named where its name fits in the part in view, and the
     destination as the car's outline, dotted, at the destination pose. Call once the axes are
     placed: the name's size in metres comes from the axes' size in inches."""
     axes_inches = ax.get_position().width * ax.figure.get_size_inches()[0]
     metres_per_point = (limits[1, 0] - limits[0, 0]) / (axes_inches * 72)
+    if len(scene.domain) >= 3:  # Figure 17's dashed region: where the reference point stays
+        ax.add_patch(Polygon(scene.domain, closed=True, fill=False, zorder=1.2, **DOMAIN_STYLE))
     for name, polygon in zip(scene.obstacle_names, scene.obstacles, strict=True):
         ax.add_patch(
             Polygon(
@@ -789,6 +803,7 @@ def parking_frames_figure(
             Patch(facecolor=(1, 0, 0, 0.25), edgecolor=FAILURE_COLOR, linewidth=2.0),
             "first collision",
         ),
+        *_domain_entries([run.scene for run in runs]),
     ]
     width = _title_chars(SINGLE_PANEL_WIDTH if len(runs) == 1 else PANEL_WIDTH)
     summaries = _start_summary(runs)
@@ -1019,6 +1034,7 @@ def success_map_figure(start_grid_path: str | Path) -> Figure:
             "destination (car outline)",
         )
     )
+    legend += _domain_entries([drawn.scene])
     with plot_style():
         layout = _panel_figure(
             len(panels.groups),
