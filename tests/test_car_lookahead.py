@@ -580,3 +580,19 @@ def test_a_run_puts_back_what_it_learned_so_runs_do_not_depend_on_each_other(sma
     np.testing.assert_array_equal(small.lookahead.value, value)
     np.testing.assert_array_equal(small._learning_values(), value)
     np.testing.assert_array_equal(small.simulate(start, 8.0, DT).states, first)
+
+
+def test_a_start_grid_none_of_which_can_park_says_so(small, car, tmp_path, capsys):
+    """A grid off the domain ran nothing and wrote its file without a word."""
+    from mosys.cli import main
+    from mosys.io.controller_table import write_controller_table
+
+    table = tmp_path / "small.h5"
+    write_controller_table(table, small.table)
+    argv = ["starts", str(table), "--dynamics", car.__file__, "--x", "90", "91", "2"]
+    argv += ["--y", "50", "51", "2", "--heading", "0", "--steer", "0", "--quiet"]
+    assert main([*argv, "-o", str(tmp_path / "g.h5")]) == 0
+    assert capsys.readouterr().err == (
+        "warning: none of the 4 starts can park (each lies on an obstacle or off the domain, "
+        "or no path leads from it): none was run\n"
+    )

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 
 from mosys.cli.verb import (
     HDF5,
@@ -126,10 +127,16 @@ def _starts(args: argparse.Namespace) -> None:
     order = controller.state_order
     off_table_problem(controller.table, {name: axes[name] for name in ("heading", "steer")})
     starts = np.array(list(itertools.product(*(axes[name] for name in order))))
-    write_start_grid(
-        args.output,
-        evaluate_starts(controller, starts, args.seconds, args.dt, args.threads, quiet=args.quiet),
+    grid = evaluate_starts(
+        controller, starts, args.seconds, args.dt, args.threads, quiet=args.quiet
     )
+    if not grid.counted.any():  # a grid off the domain ran nothing, without a word
+        print(
+            f"warning: none of the {len(starts)} starts can park (each lies on an obstacle or "
+            "off the domain, or no path leads from it): none was run",
+            file=sys.stderr,
+        )
+    write_start_grid(args.output, grid)
 
 
 def off_table_problem(table, values: dict) -> None:
