@@ -191,7 +191,8 @@ BIND_ERRORS = [
     (
         HOP.replace("hip=10 ", "knee=10 "),
         "x.mot:5:12: expected a joint angle or an actuator of figure 'luxo' "
-        "(one of: 'hip', 'elbow', 'hip_torque', 'elbow_torque'), found 'knee'",
+        "(one of: 'hip', 'elbow', 'hip_torque', 'elbow_torque'), or a phase's gain kp= or "
+        "kd=, found 'knee'",
     ),
     (
         HOP.replace("hip=10 ", "base=10 "),

@@ -562,10 +562,11 @@ def bind_motor_program(
                     f"an actuated joint angle or an actuator of figure '{figure}' "
                     f"(coordinate '{setting.name}' has no actuator; {drivable})",
                 )
-            else:
+            else:  # or a gain: 'Kp=' for 'kp=' read as a joint no figure has
                 raise program.error(
                     setting.name_token,
-                    f"a joint angle or an actuator of figure '{figure}' ({drivable})",
+                    f"a joint angle or an actuator of figure '{figure}' ({drivable}), or a "
+                    "phase's gain kp= or kd=",
                 )
             if a in driven:
                 earlier = driven[a].token
