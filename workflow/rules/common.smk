@@ -51,8 +51,8 @@ def typed_overrides(value, schema):
 
 
 CONFIG_SCHEMA = Path(workflow.current_basedir) / "../schemas/config.schema.yaml"
-for key, value in typed_overrides(dict(config), yaml.safe_load(CONFIG_SCHEMA.read_text())).items():
-    config[key] = value  # --config's strings, typed
+TYPED = typed_overrides(dict(config), yaml.safe_load(CONFIG_SCHEMA.read_text()))
+config.update(TYPED)  # --config's strings, typed
 validate(config, "../schemas/config.schema.yaml")
 
 
@@ -400,17 +400,29 @@ def script_figure(script):
     return None if declared is None else declared.figure
 
 
-def script_group(script):
-    """The controller directory a script draws on: the configured one for the pendulum script,
-    the car's scripts and every script of the car's or Luxo's figure (its object line), else
-    the script's own name."""
+def drives_car(script):
+    """Whether a script is the car's: in car.scripts, or its object line names the car's figure."""
+    return script in config["car"]["scripts"] or script_figure(script) == config["car"]["figure"]
+
+
+def script_group_and_reason(script):
+    """The controller directory a script draws on, and why (for a message): the configured one
+    for the pendulum's scripts, the car's and Luxo's (by their figure), else the script's own
+    name."""
     if script == config["pendulum"]["script"] or script in config["pendulum"]["scripts"]:
-        return config["pendulum"]["group"]
-    if script in config["car"]["scripts"] or script_figure(script) == config["car"]["figure"]:
-        return config["car"]["group"]
+        return (config["pendulum"]["group"],
+                "config pendulum.group: the script is the pendulum's, or in pendulum.scripts")
+    if drives_car(script):
+        return (config["car"]["group"],
+                "config car.group: the script is in car.scripts, or drives the car's figure")
     if script_figure(script) == config["luxo"]["figure"]:
-        return config["luxo"]["group"]
-    return script
+        return config["luxo"]["group"], "config luxo.group: the script animates Luxo's figure"
+    return script, "the script's own name, as for any script not configured otherwise"
+
+
+def script_group(script):
+    """The controller directory a script draws on (``script_group_and_reason``)."""
+    return script_group_and_reason(script)[0]
 
 
 def script_dt(script):
@@ -418,20 +430,9 @@ def script_dt(script):
     car's scripts, else the default."""
     if script_figure(script) == config["luxo"]["figure"]:
         return config["luxo"]["dt"]
-    if script in config["car"]["scripts"] or script_figure(script) == config["car"]["figure"]:
+    if drives_car(script):
         return config["car"]["dt"]
     return config["simulation"]["dt"]
-
-
-def script_group_reason(script):
-    """Why ``script_group`` chose the group it did, for a message."""
-    if script == config["pendulum"]["script"] or script in config["pendulum"]["scripts"]:
-        return "config pendulum.group: the script is the pendulum's, or in pendulum.scripts"
-    if script in config["car"]["scripts"] or script_figure(script) == config["car"]["figure"]:
-        return "config car.group: the script is in car.scripts, or drives the car's figure"
-    if script_figure(script) == config["luxo"]["figure"]:
-        return "config luxo.group: the script animates Luxo's figure"
-    return "the script's own name, as for any script not configured otherwise"
 
 
 def script_inputs(wildcards):
@@ -441,7 +442,7 @@ def script_inputs(wildcards):
     (it named only the missing spec, at '1:1')."""
     path = f"specs/scripts/{wildcards.script}.anim"
     script = parsed_spec(path)
-    group = script_group(wildcards.script)
+    group, reason = script_group_and_reason(wildcards.script)
     names = script.controllers()
     for command in script.commands:
         name = getattr(command, "controller", None)
@@ -450,7 +451,7 @@ def script_inputs(wildcards):
             raise WorkflowError(
                 f"{path}:{command.token.line}: {command.table_token.text} names controller "
                 f"{name}, whose spec {spec} does not exist: the script's controllers come from "
-                f"specs/controllers/{group}/ ({script_group_reason(wildcards.script)})"
+                f"specs/controllers/{group}/ ({reason})"
             )
     figures = {f"results/dynamics/{parsed_spec(f'specs/controllers/{group}/{name}.ssc').figure}.py"
                for name in names}
