@@ -466,17 +466,19 @@ def learning_comparison_figure(results_by_search: Mapping[str, Sequence[str | Pa
         ncols = min(3, len(entries))
         add_legend(figure, entries, ncols=ncols)
         width, height = figure.get_size_inches()
-        styles = {"sense": "sense-based controllers solid", "time": "time-based dashed"}
-        shown = [styles[kind] for kind in ("sense", "time") if kind in drawn_kinds]
-        if len(shown) == 1:  # it said 'time-based dashed' where none was drawn
-            shown = [shown[0].replace("time-based dashed", "time-based controllers dashed")]
-        if len(shown) == 2:
+        if drawn_kinds == {"sense", "time"}:
             title = (
                 "Learning curves for both kinds of motion controller\n"
-                f"BSR searches: {shown[0]}, {shown[1]}"
+                "BSR searches: sense-based controllers solid, time-based dashed"
             )
-        else:
-            title = f"Learning curves of BSR searches\n{shown[0]}"
+        else:  # only the kinds drawn (it said 'time-based dashed' where none was)
+            words = {"-": "solid", "--": "dashed"}  # KIND_LINESTYLE's; any other kind: "-."
+            shown = ", ".join(
+                f"{KIND_TEXT.get(k, k)} controllers "
+                + words.get(KIND_LINESTYLE.get(k, "-."), "dash-dotted")
+                for k in sorted(drawn_kinds)
+            )
+            title = f"Learning curves of BSR searches\n{shown}"
         figure.suptitle(title, y=1 - 0.1 / height, va="top", fontsize=11)
         figure.subplots_adjust(
             top=1 - (SUPTITLE_TOP + TITLE_LINE * 2 + AXES_TITLE) / height,

@@ -197,10 +197,11 @@ def format_state_axes(
         if not axis.period:
             if data is not None and len(data):
                 low, high = min(low, float(data[:, k].min())), max(high, float(data[:, k].max()))
-                for edge in (axis.low, axis.high) if (low, high) != (axis.low, axis.high) else ():
+                if (low, high) != (axis.low, axis.high):
+                    widened.append(axis.name)
                     line = ax.axvline if k == 0 else ax.axhline
-                    line(edge, zorder=2, **edge_style)
-                    widened += [] if axis.name in widened else [axis.name]
+                    for edge in (axis.low, axis.high):
+                        line(edge, zorder=2, **edge_style)
             margin = 0.02 * (high - low)
             low, high = low - margin, high + margin
         limits(low, high)
@@ -481,6 +482,7 @@ def torque_figure(table_path: str | Path, contours: bool = True) -> Figure:
             colorbar = figure.colorbar(mesh, ax=ax, pad=0.02)
             colorbar.set_label(f"{control} (N·m)")
             legend = []
+            format_state_axes(ax, axes)  # the limits first: the contour labels' spacing needs them
             if not finite.all():  # drawn white, they read as 0 N·m
                 ax.pcolormesh(
                     edges[0],
@@ -509,7 +511,6 @@ def torque_figure(table_path: str | Path, contours: bool = True) -> Figure:
                     zorder=2,
                 )
                 lines.set(path_effects=halo)
-                format_state_axes(ax, axes)  # the limits, for the labels' spacing
                 labels = ax.clabel(lines, fmt=lambda v: f"{v:g} s", fontsize=8, inline=False)
                 for text in labels:
                     text.set(path_effects=halo)
@@ -521,7 +522,6 @@ def torque_figure(table_path: str | Path, contours: bool = True) -> Figure:
                     )
                 )
             legend.extend(_mark_table_destinations(ax, table, axes))
-            format_state_axes(ax, axes)
             ax.set_title(
                 f"Controller {name}: {control} table, "
                 f"{' × '.join(str(len(g)) for g in table.axes)} nodes\n"
