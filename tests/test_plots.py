@@ -627,3 +627,101 @@ def test_script_figure_refuses_tables_of_which_none_drives_the_script(
         f"{trajectory}: none of the tables given (Z) is one of the script's controllers (A, D)"
     )
     script_path_figure(trajectory, [other, drawn_tables["A"]])  # one of them is used
+
+
+def test_phase_planes_pair_each_coordinate_with_its_rate():
+    """A 2-D state is one plane; coordinates followed by their rates give a plane each; any
+    other state is refused, naming its variables and units (the car hint for a car's)."""
+    from mosys.plots.pendulum import phase_planes
+    from mosys.plots.style import PlotInputError
+
+    def axes(*units, names=None):
+        names = names or [f"v{i}" for i in range(len(units))]
+        return [StateAxis(n, u, 0.0, 1.0, None) for n, u in zip(names, units, strict=True)]
+
+    assert phase_planes(axes("m", "deg")) == [(0, 1)]  # 2-D: as given, whatever its units
+    assert phase_planes(axes("deg", "deg", "deg/s", "deg/s")) == [(0, 2), (1, 3)]
+    assert phase_planes(axes("deg", "m", "deg/s", "m/s")) == [(0, 2), (1, 3)]
+    for units in [("deg", "deg/s", "deg", "deg/s"), ("deg", "deg", "deg/s"), ("deg",), ()]:
+        with pytest.raises(PlotInputError, match="coordinates followed by their rates"):
+            phase_planes(axes(*units))
+    car = axes("m", "m", "deg", "deg", names=["x", "y", "heading", "steer"])
+    with pytest.raises(PlotInputError) as error:
+        phase_planes(car)
+    assert str(error.value) == (
+        "a state-space path is drawn for a 2-D state, or for coordinates followed by their "
+        "rates (units U then U/s); this state is x, y, heading, steer in m, m, deg, deg "
+        "(a car's runs are drawn by mosys plot car)"
+    )
+
+
+def test_script_path_of_a_four_dimensional_state_draws_a_plane_per_joint(tmp_path):
+    """A double pendulum's script (shoulder, elbow and their rates) is drawn in two panels,
+    each coordinate against its rate, with the controller's destination in each and one title
+    over both; without its table the axes come from the trajectory's units. Until 2026-12-05 it
+    was refused ('a pendulum plot needs a 2-D controller table'), so the pipeline's job that
+    draws a script's path and GIF failed, and the GIF was never made."""
+    names = ("shoulder", "elbow", "shoulder_rate", "elbow_rate")
+    t = DT * np.arange(501)
+    state = np.column_stack([-30 - 60 * t, 20 - 20 * t, -60 + 0 * t, -20 + 0 * t])
+    trajectory = tmp_path / "hang.h5"
+    write_trajectory(
+        trajectory,
+        Trajectory(
+            t=t,
+            state=state,
+            control=np.zeros((len(t), 2)),
+            controller=np.zeros(len(t), dtype=np.int64),
+            state_order=names,
+            control_names=("shoulder_torque", "elbow_torque"),
+            controllers=("H",),
+            attrs={"script": "hang.anim"},
+            motion=None,
+            state_units=("deg", "deg", "deg/s", "deg/s"),
+            control_units=("N*m", "N*m"),
+        ),
+    )
+    angles = np.arange(-180.0, 91.0, 90.0)
+    rates = np.linspace(-200.0, 200.0, 5)
+    shape = (4, 4, 5, 5)
+    table = tmp_path / "H.h5"
+    write_controller_table(
+        table,
+        ControllerTable(
+            state_order=names,
+            control_names=("shoulder_torque", "elbow_torque"),
+            axes=(angles, angles, rates, rates),
+            axis_units=("deg", "deg", "deg/s", "deg/s"),
+            wrap=(True, True, False, False),
+            torque=np.zeros((*shape, 2)),
+            value=np.ones(shape),
+            control_min=np.array([-40.0, -20.0]),
+            control_max=np.array([40.0, 20.0]),
+            effort_weight=np.array([0.01, 0.01]),
+            dest={"shoulder": -90.0, "elbow": 0.0, "shoulder_rate": 0.0, "elbow_rate": 0.0},
+            figure="double_pendulum",
+            attrs={"dt": DT},
+        ),
+    )
+    figure = script_path_figure(trajectory, [table])
+    shoulder, elbow = figure.axes
+    assert (shoulder.get_xlabel(), shoulder.get_ylabel()) == (
+        "shoulder (deg) — cylindrical",
+        "shoulder_rate (deg/s)",
+    )
+    assert elbow.get_ylabel() == "elbow_rate (deg/s)"
+    assert figure.get_suptitle().startswith("State-space path of the animation script hang.anim")
+    assert not shoulder.get_title() and not elbow.get_title()
+    for ax, destination, start in [
+        (shoulder, (-90.0, 0.0), tuple(state[0, [0, 2]])),
+        (elbow, (0.0, 0.0), tuple(state[0, [1, 3]])),
+    ]:
+        texts = {text.get_text(): text.xy for text in ax.texts}
+        assert texts["dH"] == destination  # in this panel's plane
+        assert texts["sH"] == start
+    labels = legend_labels(figure)
+    assert len(labels) == len(set(labels))  # each entry once, not once a panel
+    assert labels[-1] == "end, t = 0.50 s"
+    bare = script_path_figure(trajectory, [])
+    assert [ax.get_ylabel() for ax in bare.axes] == ["shoulder_rate (deg/s)", "elbow_rate (deg/s)"]
+    assert bare.axes[0].get_ylim()[1] >= 500  # the paper's rate scale, as for the pendulum

@@ -39,7 +39,9 @@ from mosys.plots.style import (
     DESTINATION_COLOR,
     GIF_DPI,
     GIF_FPS,
+    MARGIN_TOP,
     SYMBOLS,
+    TITLE_LINE,
     PlotInputError,
     add_legend,
     animation_frames,
@@ -147,12 +149,22 @@ def plot_state_path(ax: Axes, points: np.ndarray, axes: Sequence[StateAxis], **s
 def table_axes(table: ControllerTable, path: str | Path = "") -> tuple[StateAxis, StateAxis]:
     """The two plot axes of a 2-D controller table; PlotInputError for any other dimension."""
     if len(table.state_order) != 2:
-        car = table.figure == "car" or {"heading", "steer"} <= set(table.state_order)
         raise PlotInputError(
             f"{path}: a pendulum plot needs a 2-D controller table, this one has state "
-            f"{', '.join(table.state_order)}"
-            + (" (a car's runs are drawn by mosys plot car)" if car else "")
+            f"{', '.join(table.state_order)}" + _car_hint(table.state_order, table.figure)
         )
+    return state_axes(table)
+
+
+def _car_hint(state_order: Sequence[str], figure: str = "") -> str:
+    if figure == "car" or {"heading", "steer"} <= set(state_order):
+        return " (a car's runs are drawn by mosys plot car)"
+    return ""
+
+
+def state_axes(table: ControllerTable) -> tuple[StateAxis, ...]:
+    """A plot axis for each of the table's state variables, in its state order: the range of
+    its nodes, or one period for a wrap axis."""
     axes = []
     for name, grid, unit, wrap in zip(
         table.state_order, table.axes, table.axis_units, table.wrap, strict=True
@@ -165,20 +177,51 @@ def table_axes(table: ControllerTable, path: str | Path = "") -> tuple[StateAxis
     return tuple(axes)
 
 
-def trajectory_axes(trajectory: Trajectory) -> tuple[StateAxis, StateAxis]:
-    """Plot axes for a pendulum trajectory read without its controller tables: the first state
-    variable an angle in degrees, periodic over 360 (the range of the data: [-180, 180) or
-    [0, 360)); the second a rate in deg/s, over at least [-500, 500] (the paper's scale)."""
-    if trajectory.state.ndim != 2 or trajectory.state.shape[1] != 2:
-        raise PlotInputError(f"a pendulum plot needs a 2-D state, got {trajectory.state_order}")
-    angle, rate = trajectory.state[:, 0], trajectory.state[:, 1]
-    low = -180.0 if angle.min() >= -180.0 and angle.max() < 180.0 else 0.0
-    reach = max(500.0, float(np.abs(rate).max()) * 1.05)
-    names = trajectory.state_order
-    return (
-        StateAxis(names[0], "deg", low, low + 360.0, 360.0),
-        StateAxis(names[1], "deg/s", -reach, reach, None),
+def phase_planes(axes: Sequence[StateAxis]) -> list[tuple[int, int]]:
+    """The pairs of state columns (x, y) a state-space path is drawn in: a 2-D state's one
+    plane; for a state of 2k variables whose last k are the rates of the first k (unit + "/s",
+    the dynamics' order q, q̇: a double pendulum's shoulder, elbow, shoulder_rate, elbow_rate),
+    each coordinate against its rate. PlotInputError for any other state."""
+    count = len(axes)
+    if count == 2:
+        return [(0, 1)]
+    half = count // 2
+    rates = all(axes[i + half].unit == f"{axes[i].unit}/s" for i in range(half))
+    if count and count % 2 == 0 and rates:
+        return [(i, i + half) for i in range(half)]
+    names = [axis.name for axis in axes]
+    raise PlotInputError(
+        "a state-space path is drawn for a 2-D state, or for coordinates followed by their "
+        f"rates (units U then U/s); this state is {', '.join(names)} in "
+        f"{', '.join(axis.unit or '(no unit)' for axis in axes)}" + _car_hint(names)
     )
+
+
+def trajectory_axes(trajectory: Trajectory) -> tuple[StateAxis, ...]:
+    """Plot axes for a trajectory read without its controller tables, by the columns' units
+    (a file without them: a 2-D state read as an angle in deg and its rate in deg/s): an angle
+    (deg) is periodic over 360 (the range of the data: [-180, 180) or [0, 360)); a rate in
+    deg/s spans at least [-500, 500] (the paper's scale); any other column its data."""
+    state, names = trajectory.state, trajectory.state_order
+    units = trajectory.state_units
+    if units is None:
+        if state.ndim != 2 or state.shape[1] != 2:
+            raise PlotInputError(f"a pendulum plot needs a 2-D state, got {trajectory.state_order}")
+        units = ("deg", "deg/s")
+    axes = []
+    for name, unit, column in zip(names, units, state.T, strict=True):
+        if unit == "deg":
+            low = -180.0 if column.min() >= -180.0 and column.max() < 180.0 else 0.0
+            axes.append(StateAxis(name, unit, low, low + 360.0, 360.0))
+        elif unit == "deg/s":
+            reach = max(500.0, float(np.abs(column).max()) * 1.05)
+            axes.append(StateAxis(name, unit, -reach, reach, None))
+        else:
+            low, high = float(column.min()), float(column.max())
+            if high - low < 1e-9:
+                low, high = low - 1.0, high + 1.0
+            axes.append(StateAxis(name, unit, low, high, None))
+    return tuple(axes)
 
 
 def format_state_axes(
@@ -670,8 +713,10 @@ def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | 
     own colour; ``sX`` marks where controller X is invoked (a motor program's start is marked
     with its name) and ``dX`` its destination (read
     from the controller tables in ``table_paths``, matched to the script's controllers by file
-    stem; without them no destinations are drawn, and the axes are the pendulum's: see
-    ``trajectory_axes``; tables of which none drives the script are refused)."""
+    stem; without them no destinations are drawn, and the axes come from the trajectory: see
+    ``trajectory_axes``; tables of which none drives the script are refused). A state of
+    coordinates and their rates (a double pendulum's) is drawn one panel per coordinate, against
+    its rate (``phase_planes``)."""
     trajectory = read_trajectory(trajectory_path)
     if len(trajectory.t) == 0:
         raise PlotInputError(f"{trajectory_path}: the trajectory has no samples")
@@ -683,40 +728,99 @@ def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | 
             f"{trajectory_path}: none of the tables given ({', '.join(tables)}) is one of the "
             f"script's controllers ({', '.join(dict.fromkeys(trajectory.controllers))})"
         )
-    if used:
-        axes = table_axes(tables[used[0]], paths[used[0]])
-        if tuple(a.name for a in axes) != tuple(trajectory.state_order):
-            raise PlotInputError(
-                f"{trajectory_path}: state order {trajectory.state_order} differs from that of "
-                f"its controller {used[0]}, {tuple(a.name for a in axes)}"
-            )
-    else:
-        try:
-            axes = trajectory_axes(trajectory)
-        except PlotInputError as error:
-            raise PlotInputError(f"{trajectory_path}: {error}") from None
-    colors = controller_colors(trajectory.controllers)
-    kinds = _source_kinds(trajectory)
+    where = paths[used[0]] if used else trajectory_path
+    try:
+        axes = state_axes(tables[used[0]]) if used else trajectory_axes(trajectory)
+        planes = phase_planes(axes)
+    except PlotInputError as error:
+        raise PlotInputError(f"{where}: {error}") from None
+    if used and tuple(a.name for a in axes) != tuple(trajectory.state_order):
+        raise PlotInputError(
+            f"{trajectory_path}: state order {trajectory.state_order} differs from that of "
+            f"its controller {used[0]}, {tuple(a.name for a in axes)}"
+        )
     state = trajectory.state.copy()
     for k, axis in enumerate(axes):  # a motor program's stretch keeps the angle unwrapped
         if axis.period:
             state[:, k] = axis.low + np.mod(state[:, k] - axis.low, axis.period)
-    switches = _switches(trajectory)
+    drawing = _ScriptDrawing(
+        trajectory,
+        controller_colors(trajectory.controllers),
+        _source_kinds(trajectory),
+        _switches(trajectory),
+        [tables[name] for name in used],
+        used,
+    )
+    script = str(trajectory.attrs.get("script", Path(trajectory_path).name))
+    programs = sum(name in drawing.motor for _, name in drawing.switches)
+    invoked = counted(len(drawing.switches) - programs, "controller invocation")
+    if programs:
+        invoked += f" and {counted(programs, 'motor program')}"
+    title = (
+        f"State-space path of the animation script {Path(script).name}\n"
+        f"{invoked} over {trajectory.t[-1] - trajectory.t[0]:.2f} s"
+    )
+    columns = min(len(planes), 2)
+    rows = -(-len(planes) // columns)
     with plot_style():
-        figure = new_figure(7.6, 6.4)
-        ax = figure.add_subplot()
-        legend = []
+        figure = new_figure(7.6 if columns == 1 else 6.4 * columns, 1.0 + 5.4 * rows)
+        legend: dict[str, object] = {}
+        panels = []
+        for panel, (x, y) in enumerate(planes):
+            ax = figure.add_subplot(rows, columns, panel + 1)
+            entries, labels, obstacles = drawing.panel(ax, state[:, [x, y]], (axes[x], axes[y]))
+            for handle, label in entries:
+                legend.setdefault(label, handle)
+            panels.append((ax, labels, obstacles))
+        end = legend.pop(END_LABEL.format(trajectory.t[-1]))  # the end last
+        legend[END_LABEL.format(trajectory.t[-1])] = end
+        if len(planes) == 1:
+            panels[0][0].set_title(title)
+        entries = [(handle, label) for label, handle in legend.items()]
+        add_legend(figure, entries, ncols=3 if len(entries) > 4 else 4)
+        if len(planes) > 1:  # one title over the panels, below the figure's top edge
+            height = figure.get_size_inches()[1]
+            figure.suptitle(title, y=1 - MARGIN_TOP / height, va="top")
+            figure.subplots_adjust(top=1 - (MARGIN_TOP + 3 * TITLE_LINE) / height, wspace=0.25)
+        for ax, labels, obstacles in panels:
+            place_labels(figure, ax, labels, obstacles)
+    return figure
+
+
+END_LABEL = "end, t = {:.2f} s"
+END_STYLE = {"marker": "o", "markersize": 5, "color": "black", "markeredgecolor": "white"}
+
+
+@dataclass(frozen=True)
+class _ScriptDrawing:
+    """What every panel of a script's path figure shares: the trajectory, each controller's
+    colour and kind, the invocations (sample index, name) and the tables that drive it."""
+
+    trajectory: Trajectory
+    colors: dict
+    kinds: dict
+    switches: list[tuple[int, str]]
+    tables: list[ControllerTable]
+    used: list[str]
+
+    @property
+    def motor(self) -> set[str]:
+        return {name for name, kind in self.kinds.items() if kind == "motor program"}
+
+    def panel(self, ax: Axes, state: np.ndarray, axes: tuple[StateAxis, StateAxis]):
+        """Draw the path in one plane: ``state`` (N, 2) the two columns in spec units, wrapped
+        into ``axes``. Returns its legend entries, point labels and markers to keep clear."""
+        trajectory, colors, motor = self.trajectory, self.colors, self.motor
         for first, stop, name in _controller_runs(trajectory):
             plot_state_path(
                 ax, state[first:stop], axes, color=colors[name], linewidth=1.8, zorder=3
             )
-        for name in dict.fromkeys(trajectory.controllers):
-            legend.append(
-                (Line2D([], [], color=colors[name], linewidth=2), f"{kinds[name]} {name}")
-            )
+        legend = [
+            (Line2D([], [], color=colors[name], linewidth=2), f"{self.kinds[name]} {name}")
+            for name in dict.fromkeys(trajectory.controllers)
+        ]
         labels, obstacles = [], []
-        motor = {name for name in trajectory.controllers if kinds[name] == "motor program"}
-        for i, name in switches:
+        for i, name in self.switches:
             mark_start(ax, state[i, 0], state[i, 1], colors[name], zorder=6.5)  # over dX
             label = name if name in motor else f"s{name}"  # 'sswing' read as a typo
             labels.append((state[i, 0], state[i, 1], label, colors[name]))
@@ -725,38 +829,22 @@ def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | 
         if motor:
             started += "; P: motor program P started"
         legend.append((Line2D([], [], **start_style("white")), started))
-        for name in used:
-            x, y = destination_point(tables[name], axes)
+        for name, table in zip(self.used, self.tables, strict=True):
+            x, y = destination_point(table, axes)
             if x is None or y is None:
                 continue
             mark_destination(ax, x, y, color=colors[name])
             labels.append((x, y, f"d{name}", colors[name]))
             obstacles.append((x, y, 7.0))
-        if used:
+        if self.used:
             legend.append((destination_handle(), "dX: destination of controller X"))
         legend += format_state_axes(ax, axes, state)
         legend += _shade_breakpoints(ax, trajectory, axes, colors)
-        end_style = {"marker": "o", "markersize": 5, "color": "black", "markeredgecolor": "white"}
-        ax.plot(state[-1, 0], state[-1, 1], zorder=7, **end_style)  # over an sX square there
+        ax.plot(state[-1, 0], state[-1, 1], zorder=7, **END_STYLE)  # over an sX square there
         obstacles.append((state[-1, 0], state[-1, 1], 3.0))
-        legend.append(
-            (
-                Line2D([], [], linestyle="none", **end_style),
-                f"end, t = {trajectory.t[-1]:.2f} s",
-            )
-        )
-        script = str(trajectory.attrs.get("script", Path(trajectory_path).name))
-        programs = sum(name in motor for _, name in switches)
-        invoked = counted(len(switches) - programs, "controller invocation")
-        if programs:
-            invoked += f" and {counted(programs, 'motor program')}"
-        ax.set_title(
-            f"State-space path of the animation script {Path(script).name}\n"
-            f"{invoked} over {trajectory.t[-1] - trajectory.t[0]:.2f} s"
-        )
-        add_legend(figure, legend, ncols=3 if len(legend) > 4 else 4)
-        place_labels(figure, ax, labels, obstacles)
-    return figure
+        end = Line2D([], [], linestyle="none", **END_STYLE)
+        legend.append((end, END_LABEL.format(trajectory.t[-1])))
+        return legend, labels, obstacles
 
 
 def _source_kinds(trajectory: Trajectory) -> dict[str, str]:
