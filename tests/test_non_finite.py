@@ -263,3 +263,19 @@ def test_luxos_contacts_blow_up_at_a_coarse_step(tmp_path, capsys):
     assert "vx=nan m/s" in message
     assert_nothing_written(out)
     assert main([*argv, "--dt", "0.0005"]) == 0
+
+
+def test_a_coordinate_at_an_axis_end_as_the_spec_writes_it_is_inside():
+    """The car's speed axis, ``ssd speed -0.9 0.9 7``, ends at -0.9 + 6 x 0.3, which rounds to
+    0.8999999999999999: a start at 0.9 m/s was 'beyond the table's axes: outside its domain'.
+    Within a billionth of a step of an end a coordinate lies on it; beyond that it is moved and
+    flagged, as before."""
+    axis_min, axis_step = np.array([-0.9]), np.array([0.3])
+    axis_count, wrap = np.array([7], dtype=np.int64), np.zeros(1, dtype=np.bool_)
+    top = axis_min[0] + axis_step[0] * 6
+    assert top < 0.9  # the rounding this is about
+    clamped = np.empty(1)
+    for value, inside in [(0.9, True), (-0.9 - 1e-12, True), (0.9 + 1e-6, False), (-1.0, False)]:
+        state = np.array([value])
+        assert clamp_to_domain(axis_min, axis_step, axis_count, wrap, state, clamped) == inside
+        assert clamped[0] == (top if value > 0 else -0.9)  # moved onto the end either way

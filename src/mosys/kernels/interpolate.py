@@ -18,6 +18,9 @@ WRAP_LIMIT = 2.0**52
 # are products of fractions (and float32 in the DP's exit tables), so a state at 0.8 of a cell
 # sums to 0.7999999999999998, and was refused by a threshold of 0.8 that it meets.
 KNOWN_WEIGHT_ROUNDING = 1e-6
+# A coordinate this far (in grid steps) beyond an axis's end lies on it: the end is computed as
+# the first node plus (n - 1) steps, which rounds away from the number in the spec.
+AXIS_END_ROUNDING = 1e-9
 
 
 @njit(cache=True, inline="always")  # inside the DP's loop over every exit
@@ -41,8 +44,11 @@ def grid_strides(axis_count, out):
 @njit(cache=True)
 def clamp_to_domain(axis_min, axis_step, axis_count, wrap, state, out):
     """Copy ``state`` (d,) into ``out`` (d,), moving each non-wrap coordinate onto the nearest
-    point of its axis range (±inf onto its ends). Returns True when nothing had to move; False
-    too when a coordinate is NaN (copied as is: ``corner_weights`` makes a NaN of it)."""
+    point of its axis range (±inf onto its ends). Returns True when nothing had to move more
+    than ``AXIS_END_ROUNDING`` of a grid step (the last node is ``axis_min`` + (n − 1) ·
+    ``axis_step``, which rounds: the car's speed axis, ``ssd speed -0.9 0.9 7``, ends at
+    0.8999999999999999 m/s, and a start at 0.9 read as beyond it); False too when a coordinate
+    is NaN (copied as is: ``corner_weights`` makes a NaN of it)."""
     unchanged = True
     for k in range(state.shape[0]):
         value = state[k]
@@ -50,12 +56,13 @@ def clamp_to_domain(axis_min, axis_step, axis_count, wrap, state, out):
             unchanged = False
         elif not wrap[k]:
             top = axis_min[k] + axis_step[k] * (axis_count[k] - 1)
+            slack = AXIS_END_ROUNDING * axis_step[k]
             if value < axis_min[k]:
+                unchanged = unchanged and value >= axis_min[k] - slack
                 value = axis_min[k]
-                unchanged = False
             elif value > top:
+                unchanged = unchanged and value <= top + slack
                 value = top
-                unchanged = False
         out[k] = value
     return unchanged
 
