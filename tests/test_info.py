@@ -541,3 +541,16 @@ def test_info_on_a_file_that_is_not_hdf5_gives_no_traceback(tmp_path):
     assert done.stderr == (
         f"mosys: {text}: not an HDF5 file (mosys info reads the .h5 files mosys writes)\n"
     )
+
+
+def test_info_read_into_a_pipe_closed_early_stops_quietly(made):
+    """``mosys info F | head -1``: the reader goes away after one line. The rest is not written,
+    and no 'mosys: [Errno 32] Broken pipe' follows (it did): exit 141, as a Unix tool's."""
+    command = [sys.executable, "-m", "mosys.cli", "info", str(made["composite result"])]
+    with subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE) as process:
+        first = process.stdout.readline()
+        process.stdout.close()  # as head does after its line
+        stderr = process.stderr.read().decode()
+        code = process.wait()
+    assert first.startswith(str(made["composite result"]).encode())
+    assert (code, stderr) == (141, "")

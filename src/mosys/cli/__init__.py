@@ -6,13 +6,16 @@ arguments, checks and handler together (``verb.Verb``); this module assembles th
 parser and runs one.
 
 Exit codes: 0 success; 2 a bad spec or input (a ``file:line:column: expected ..., found ...``
-message, no traceback, no output file) or bad arguments; 1 any other failure.
+message, no traceback, no output file) or bad arguments; 1 any other failure; 128 + the signal
+for a stop by a signal (130 Ctrl-C, 143 SIGTERM, 129 SIGHUP) or by the reader of the output
+closing its pipe (141).
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import select
 import signal
 import sys
 import textwrap
@@ -150,6 +153,14 @@ def main(argv: list[str] | None = None) -> int:
     except (SpecError, SimulationError) as error:
         print(error, file=sys.stderr)  # file:line:column: first, as compilers do
         return 2
+    except BrokenPipeError as error:
+        if not stdout_closed():
+            print(f"mosys: {error}", file=sys.stderr)
+            return 2
+        # the reader of the output went away (mosys info F | head): stop quietly, as a Unix
+        # tool does; nothing left to flush into the closed pipe at exit
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 128 + signal.SIGPIPE
     except (OSError, InputError) as error:  # a missing, unreadable or corrupt input file
         print(f"mosys: {error}", file=sys.stderr)
         return 2
@@ -159,6 +170,17 @@ def main(argv: list[str] | None = None) -> int:
     except Stopped as stop:  # SIGTERM or SIGHUP: whoever sent it knows
         return stop.code
     return 0
+
+
+def stdout_closed() -> bool:
+    """Whether standard output is a pipe whose reader has closed it (poll reports an error on
+    the writing end)."""
+    try:
+        poller = select.poll()
+        poller.register(sys.stdout.fileno(), select.POLLOUT)
+        return any(event & select.POLLERR for _, event in poller.poll(0))
+    except (OSError, ValueError, AttributeError):  # no descriptor, or no poll on this system
+        return False
 
 
 @contextmanager
