@@ -102,6 +102,21 @@ def test_pendulum_specs(name):
     assert [d.name for d in spec.ordered_state(("angle", "omega"))] == ["angle", "omega"]
 
 
+def test_figure_12_as_the_paper_prints_it_parses_as_a_does():
+    """The paper's Figure 12 declares the angle's wrap on a line of its own, ``wrap angle``
+    after ``ssd angle -180 170 36`` (its text runs 'ssd angle -180 170 36 wrap angle torq
+    ...'); DESIGN.md's form puts ``wrap`` at the end of the ssd line. Both make the same spec."""
+    paper = (
+        (PENDULUM / "A.ssc")
+        .read_text()
+        .replace("ssd angle -180 170 36 wrap", "ssd angle -180 170 36\nwrap angle")
+    )
+    assert "wrap angle" in paper
+    assert values(parse_controller_text(paper, "A.ssc")) == values(
+        parse_controller_spec(PENDULUM / "A.ssc")
+    )
+
+
 def test_spec_a_is_figure_12_verbatim():
     assert (PENDULUM / "A.ssc").read_text() == (
         "# controller for a single link\n"
@@ -231,8 +246,8 @@ ERRORS = [
     ),
     (
         replace_line(2, "ssdd omega -500.0 500.0 21"),
-        "x.ssc:2:1: expected one of 'dyn', 'ssd', 'torq', 'dest', 'tol', 'maxiter', 'dt', "
-        "'known_weight', 'obstacle', 'domain', 'hold', 'policy', found 'ssdd'",
+        "x.ssc:2:1: expected one of 'dyn', 'ssd', 'wrap', 'torq', 'dest', 'tol', 'maxiter', "
+        "'dt', 'known_weight', 'obstacle', 'domain', 'hold', 'policy', found 'ssdd'",
     ),
     (
         replace_line(2, "ssd omega -500.0 500.0"),
@@ -269,6 +284,24 @@ ERRORS = [
     (
         replace_line(3, "ssd angle -180 170 36 wrap twice"),
         "x.ssc:3:28: expected end of line, found 'twice'",
+    ),
+    (
+        SpecLines(BASE).insert(4, "wrap theta"),
+        "x.ssc:4:6: expected the name of a state dimension an earlier ssd line declares "
+        "('omega', 'angle'), found 'theta'",
+    ),
+    (
+        SpecLines(BASE).insert(2, "wrap angle"),
+        "x.ssc:2:6: expected the name of a state dimension an earlier ssd line declares "
+        "(none yet), found 'angle'",
+    ),
+    (
+        SpecLines(BASE).insert(4, "wrap"),
+        "x.ssc:4:5: expected a name for the periodic state dimension, found end of line",
+    ),
+    (
+        SpecLines(BASE).insert(4, "wrap angle omega"),
+        "x.ssc:4:12: expected end of line, found 'omega'",
     ),
     (
         replace_line(3, "ssd omega -180 170 36 wrap"),

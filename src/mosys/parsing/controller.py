@@ -4,7 +4,8 @@
 
     dyn link1                          # the figure: specs/figures/link1.fig
     ssd omega -500.0 500.0 21          # state dimension: name min max samples
-    ssd angle -180 170 36 wrap         # 'wrap': periodic dimension (period samples * step)
+    ssd angle -180 170 36 wrap         # 'wrap': periodic dimension (period samples * step);
+                                       # or a line 'wrap angle' after it, as the paper writes it
     torq torque -10.0 10.0 11 0.1      # control: name min max samples K
     dest angle=0 omega=0               # destination state (grid nodes); may be repeated
     tol 1e-6                           # optional: convergence tolerance, s (default 1e-6)
@@ -39,6 +40,7 @@ Values are in spec units: degrees for angles, deg/s for angular rates, metres an
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import math
 from collections.abc import Sequence
@@ -62,6 +64,7 @@ from mosys.parsing.tokens import (
 KEYWORDS = (
     "dyn",
     "ssd",
+    "wrap",
     "torq",
     "dest",
     "tol",
@@ -425,6 +428,22 @@ class _Parser:
             reader.word("'wrap'")
             reader.end()
         self.state.append(StateDimension(name.text, minimum, maximum, samples, wrap, name))
+
+    def line_wrap(self, line: Line) -> None:
+        """``wrap NAME``: the state dimension an earlier ssd line declared is periodic, as the
+        word ``wrap`` at the end of that line says (the paper's Figure 12 writes it so)."""
+        reader = line.reader()
+        token = reader.peek()
+        reader.name("the periodic state dimension")
+        reader.end()
+        assert token is not None
+        for k, dimension in enumerate(self.state):
+            if dimension.name == token.text:
+                self.state[k] = dataclasses.replace(dimension, wrap=True)
+                return
+        declared = ", ".join(f"'{d.name}'" for d in self.state) or "none yet"
+        expected = f"the name of a state dimension an earlier ssd line declares ({declared})"
+        raise self.error(token, expected, token.text)
 
     def line_torq(self, line: Line) -> None:
         reader = line.reader()
