@@ -32,7 +32,7 @@ from mosys.parsing.composite import parse_composite_script
 ROOT = Path(__file__).resolve().parents[1]
 SCRIPT = ROOT / "specs/composite/starman_show.comp"
 PAPER = "1,024 simulations in under a minute (DEC 3000/400)"
-PAPER_SECONDS = 60.0
+PAPER_SECONDS = 60.0  # "under a minute": at most this, so a ratio to it bounds ours from above
 
 
 def tiny_controllers(directory: Path) -> Path:
@@ -77,7 +77,7 @@ def main() -> None:
                     "score before": round(found.guess_score, 3),
                     "score after": round(found.score, 3),
                     "paper": PAPER,
-                    "vs paper": f">{PAPER_SECONDS / wall:.0f}x faster",
+                    "vs paper": f"up to {PAPER_SECONDS / wall:.0f}x faster",
                     "target": "<= 10 s on 2 cores",
                 }
             )
@@ -110,7 +110,7 @@ def main() -> None:
                 "simulations": found.simulations,
                 "seconds": round(process, 2),
                 "paper": PAPER,
-                "vs paper": f">{PAPER_SECONDS / process:.0f}x faster",
+                "vs paper": f"up to {PAPER_SECONDS / process:.0f}x faster",
                 "target": "<= 10 s on 2 cores",
             }
         )
