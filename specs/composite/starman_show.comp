@@ -3,8 +3,8 @@
 # search moves the two switch points to make the total below as large as it can.
 figure starman
 
-# The phases in time order: the BSR search whose best controller runs (results/bsr/NAME/; no
-# seed= so the best seed's), and the user's guessed duration in simulator ticks (dt = 0.01 s).
+# The phases in time order: the BSR search whose best controller runs (results/bsr/NAME/, best
+# seed), the guessed duration in 0.01 s ticks (Table 4's: 159, 90, 100; our cartwheel is slower).
 phase cartwheel controller=starman_cartwheel_robust ticks=215
 phase jump      controller=starman_jump_robust      ticks=100
 phase shuffle   controller=starman_shuffle_robust   ticks=100
