@@ -5,9 +5,10 @@ specs/controllers/car/park.ssc ships.
     python benchmarks/car.py            # all three, warm numba cache (after one filling run)
     python benchmarks/car.py --smoke    # CI: the paper's size only
 
-Writes results/benchmarks/car.{csv,md} (car_smoke.* with --smoke) and prints them. The paper's
-size is park.ssc (its scene, controls and destination) on the paper's steps: 0.5 m in x, 0.25 m
-in y, 15 deg of heading, 15 deg of steer and 0.5 m/s. The 8x grid halves the step of x, y and
+Writes results/benchmarks/car.{csv,md} (car_smoke.* with --smoke) and prints them. The paper
+gives only its table's size (13,250 states) and none of its steps; the paper's size here is
+park.ssc (its scene, controls and destination) on steps chosen to come near it: 0.5 m in x,
+0.25 m in y, 15 deg of heading, 15 deg of steer and 0.5 m/s. The 8x grid halves the step of x, y and
 heading over the same ranges (2n - 1 nodes on each of those axes). dp_s_warm is the DP's time,
 split into its exit transitions and its value iteration (transitions_s_warm,
 value_iteration_s_warm), so that the table shows where the time goes. Each table then runs the
@@ -36,7 +37,7 @@ ROOT = Path(__file__).resolve().parents[1]
 SPEC = ROOT / "specs/controllers/car/park.ssc"
 REFINED_AXES = ("x", "y", "heading")
 PAPER_STATES = 13250
-PAPER_GRID = {  # ssd NAME MIN MAX SAMPLES at the paper's steps, every dest value on a node
+PAPER_GRID = {  # ssd NAME MIN MAX SAMPLES near the paper's 13,250 states, dest on nodes
     "x": "-3.0 6.0 19",
     "y": "0.9 3.65 12",
     "heading": "-30 45 6",
@@ -46,7 +47,7 @@ PAPER_GRID = {  # ssd NAME MIN MAX SAMPLES at the paper's steps, every dest valu
 
 
 def paper_spec(text: str) -> str:
-    """park.ssc on the paper's grid steps (PAPER_GRID)."""
+    """park.ssc on a grid of the paper's size (PAPER_GRID)."""
     for name, axis in PAPER_GRID.items():
         text = re.sub(rf"^ssd {name} .*$", f"ssd {name} {axis}", text, flags=re.M)
     return text
