@@ -19,11 +19,12 @@ from mosys.parsing.bsr import FITNESS_TERMS
 
 PAPER_EVALUATIONS = 40_000
 # §2.1.3: 40,000 sense-based evaluations took 3-6 minutes on a DEC 3000/400 AXP; footnote 6:
-# good time-based controllers in "a few tens of seconds" on the same machine.
+# good time-based controllers are found in "a few tens of seconds" on the same machine, by a
+# serial search of no stated length, so that figure is compared with a whole search of ours.
 PAPER_SECONDS = {"sense": (180.0, 360.0), "time": (20.0, 60.0)}
 PAPER_FIGURE = {
     "sense": "3-6 min per 40,000 evaluations (DEC 3000/400)",
-    "time": "tens of seconds (DEC 3000/400)",
+    "time": "a good controller in a few tens of seconds (DEC 3000/400)",
 }
 
 
@@ -130,6 +131,9 @@ def runs_frame(result_paths: list[str | Path]) -> pd.DataFrame:
         kind = str(setup["kind"])
         seconds_40k = median_ms_per_evaluation(results) * PAPER_EVALUATIONS / 1000.0
         paper_low, paper_high = PAPER_SECONDS[kind]
+        ours = seconds_40k  # the paper's sense-based figure is per 40,000 evaluations
+        if kind == "time":  # its time-based one is per search: against a whole search of ours
+            ours = float(np.median([search_seconds(result) for result in results]))
         steps_per_second = np.median([result.attrs["steps_per_second"] for result in results])
         row = {
             "search": name,
@@ -139,8 +143,7 @@ def runs_frame(result_paths: list[str | Path]) -> pd.DataFrame:
             "40k evaluations (s)": round(seconds_40k, 1),
             "paper": PAPER_FIGURE[kind],
             "speed-up vs paper": (
-                f"{speed_up(paper_low / seconds_40k).removesuffix('x')}-"
-                f"{speed_up(paper_high / seconds_40k)}"
+                f"{speed_up(paper_low / ours).removesuffix('x')}-{speed_up(paper_high / ours)}"
             ),
             **fitness_columns(results),
         }
@@ -160,7 +163,11 @@ def write_bsr_table(result_paths: list[str | Path], csv_path: str, md_path: str)
         "spec's own G; ci: a reduced one). ms per evaluation: wall time of the search (one "
         "thread unless the config gives more), numba's compilation of its kernels left out, "
         "over its evaluations, median over seeds; 40k "
-        "evaluations: that rate times 40,000, against the paper's DEC 3000/400 figures. The "
+        "evaluations: that rate times 40,000. speed-up: the paper's DEC 3000/400 figure over "
+        "ours: for sense-based searches its 3-6 min per 40,000 evaluations over our 40k "
+        "evaluations; for time-based ones, whose figure is a whole search's ('a few tens of "
+        "seconds', footnote 6, no evaluation count), over our whole search, median over "
+        "seeds. The "
         "terms are measured on each seed's best motion from the nominal start; medians over "
         "seeds. contact_distance counts endpoints within 1 mm of the floor at both ends of a "
         "step.\n\n"
