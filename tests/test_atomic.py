@@ -5,6 +5,7 @@ fails, the disk is full or a signal stops it."""
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import os
 import signal
@@ -166,3 +167,95 @@ def test_ctrl_c_is_one_line_and_exit_130(tmp_path, monkeypatch, capsys):
     (tmp_path / "x.h5").write_bytes(b"")
     assert main(["info", str(tmp_path / "x.h5")]) == 130
     assert capsys.readouterr().err == "mosys: interrupted; nothing written\n"
+
+
+@pytest.mark.parametrize("number", [signal.SIGINT, signal.SIGTERM])
+def test_a_stop_whose_exception_a_library_swallowed_still_writes_nothing(
+    pendulum, tmp_path, monkeypatch, capsys, number
+):
+    """numba compiling a kernel calls back through ctypes, which swallows an exception raised
+    there ('Exception ignored on calling ctypes callback function'): a Ctrl-C or SIGTERM
+    arriving then was lost, and the command wrote its outputs and exited 0. The stop is
+    recorded as it arrives, so the command still writes nothing and exits with the signal's
+    code."""
+    import mosys.paper_tables.pendulum as table
+
+    real = table.write_pendulum_table
+
+    def swallowing(*args, **kwargs):
+        with contextlib.suppress(KeyboardInterrupt, Stopped):  # as the ctypes callback does
+            os.kill(os.getpid(), number)
+            time.sleep(5)  # the handler raises at the next instruction
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(table, "write_pendulum_table", swallowing)
+    out = tmp_path / "out"
+    argv = ["pendulum-table", pendulum / "controllers" / "A.h5", "--dynamics",
+            pendulum / "dynamics" / "link1.py", "--csv", out / "t.csv",
+            "--md", out / "t.md"]  # fmt: skip
+    assert main([str(arg) for arg in argv]) == 128 + number
+    assert not out.exists()
+    said = "mosys: interrupted; nothing written\n" if number == signal.SIGINT else ""
+    assert capsys.readouterr().err == said
+
+
+def test_an_error_after_a_stop_is_the_stop(tmp_path, monkeypatch, capsys):
+    """numba stopped while compiling raised RuntimeError('no compiled object yet') and the
+    command died with its traceback, exit 1: after a stop, any error is the stop's."""
+    import mosys.io.info
+
+    def stopped_then_broken(*args, **kwargs):
+        with contextlib.suppress(KeyboardInterrupt):
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(5)
+        raise RuntimeError("no compiled object yet")
+
+    monkeypatch.setattr(mosys.io.info, "describe_file", stopped_then_broken)
+    (tmp_path / "x.h5").write_bytes(b"")
+    assert main(["info", str(tmp_path / "x.h5")]) == 130
+    assert capsys.readouterr().err == "mosys: interrupted; nothing written\n"
+    monkeypatch.setattr(mosys.io.info, "describe_file", lambda *a, **k: 1 / 0)
+    with pytest.raises(ZeroDivisionError):  # without a stop, an error is still a fault
+        main(["info", str(tmp_path / "x.h5")])
+
+
+def test_a_read_only_folder_is_named_not_the_hidden_partial(tmp_path, monkeypatch):
+    """The partial could not be made, and removing it (in the clean-up) raised EROFS, which
+    replaced the message: 'mosys: [Errno 30] Read-only file system: .../.A.h5.123.ab.partial'."""
+    real_open = Path.open
+
+    def read_only(self: Path, *args, **kwargs):
+        raise OSError(errno.EROFS, os.strerror(errno.EROFS), str(self))
+
+    def unlink(self: Path, missing_ok=False):
+        raise OSError(errno.EROFS, os.strerror(errno.EROFS), str(self))
+
+    monkeypatch.setattr(Path, "open", read_only)
+    monkeypatch.setattr(Path, "unlink", unlink)
+    for together in (False, True):
+        held = outputs_together() if together else contextlib.nullcontext()
+        with pytest.raises(InputError) as error, held:
+            write_text_atomically(tmp_path / "a.txt", "text")
+        assert str(error.value) == f"{tmp_path / 'a.txt'}: cannot write it: Read-only file system"
+    monkeypatch.setattr(Path, "open", real_open)
+
+
+def test_a_stop_during_a_kernels_compilation_waits_for_its_end(monkeypatch, capsys):
+    """Raised inside numba's compilation, the exception went through a ctypes callback, which
+    printed 'Exception ignored ...' with a traceback and lost it: a first stop is kept for the
+    compilation's end (``compile_lock`` raises it there), a second stops at once."""
+    from mosys.errors import forget_stops, raise_if_stopped, stop_received
+    from mosys.kernels import compile_lock
+
+    forget_stops()
+    monkeypatch.setattr(compile_lock, "_depth", 1)  # as while a kernel compiles
+    with pytest.raises(KeyboardInterrupt), stop_signals_raise():
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.2)  # the handler has run by now, and raised nothing
+        assert stop_received() == signal.SIGINT
+        assert capsys.readouterr().err == "mosys: stopping when numba's compilation ends\n"
+        with pytest.raises(KeyboardInterrupt):
+            raise_if_stopped()  # what the compilation's end does
+        os.kill(os.getpid(), signal.SIGINT)  # a second Ctrl-C: at once
+        time.sleep(5)
+    forget_stops()

@@ -1,4 +1,7 @@
-"""Errors a user can cause with a bad input file (not a spec: those raise SpecError)."""
+"""Errors a user can cause with a bad input file (not a spec: those raise SpecError), and the
+stop signals a command has received."""
+
+import signal
 
 
 class InputError(ValueError):
@@ -32,3 +35,34 @@ class Stopped(BaseException):
     def __init__(self, number: int):
         super().__init__(f"stopped by signal {number}")
         self.code = 128 + number
+
+
+_stops: list[int] = []  # the stop signals received by the running command, in order
+
+
+def note_stop(number: int) -> None:
+    """Record that the running command was sent stop signal ``number`` (``cli`` does, as the
+    signal arrives): a library that swallows the exception the signal raised (numba compiling
+    through a ctypes callback prints 'Exception ignored' and goes on) cannot make the command
+    finish as if nothing had happened (``raise_if_stopped``)."""
+    _stops.append(number)
+
+
+def forget_stops() -> None:
+    """A new command starts with no stop received."""
+    _stops.clear()
+
+
+def stop_received() -> int | None:
+    """The first stop signal the running command received, or None."""
+    return _stops[0] if _stops else None
+
+
+def raise_if_stopped() -> None:
+    """Raise what the first stop signal received raises (KeyboardInterrupt for SIGINT, else
+    Stopped), if one was: before a command's outputs are renamed into place."""
+    number = stop_received()
+    if number == signal.SIGINT:
+        raise KeyboardInterrupt
+    if number is not None:
+        raise Stopped(number)

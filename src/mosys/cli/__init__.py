@@ -26,7 +26,7 @@ from contextlib import contextmanager
 from mosys import __version__
 from mosys.cli import animation, bsr, composite, dynamics, index, info, paper_tables, plots, ssc
 from mosys.cli.verb import Family, file_options, same_file_problem
-from mosys.errors import Stopped
+from mosys.errors import Stopped, forget_stops, note_stop, stop_received
 
 # In `mosys --help` order: the pipeline's steps, then what is drawn and tabulated from them.
 FAMILIES: tuple[Family, ...] = (
@@ -141,35 +141,52 @@ def main(argv: list[str] | None = None) -> int:
     )
     if problem:
         parser.error(problem)
-    from mosys.errors import InputError, SimulationError
     from mosys.files import command_files
     from mosys.io.atomic import outputs_together
-    from mosys.parsing.tokens import SpecError
 
+    forget_stops()
     try:
         # no output replaces a file the verb read; its outputs appear all together or none
         with stop_signals_raise(), command_files(), outputs_together():
             args.command.handler(args)
-    except (SpecError, SimulationError) as error:
+    except KeyboardInterrupt:
+        return stopped_code(signal.SIGINT)
+    except Stopped as stop:
+        return stopped_code(stop.code - 128)
+    except Exception as error:
+        number = stop_received()
+        if number is not None:  # a library turned the stop into an error of its own (numba,
+            return stopped_code(number)  # stopped while compiling: "no compiled object yet")
+        return error_code(error)
+    return 0
+
+
+def error_code(error: Exception) -> int:
+    """Say what went wrong with a bad input and give exit code 2; any other error is raised
+    again (a traceback, exit 1)."""
+    from mosys.errors import InputError, SimulationError
+    from mosys.parsing.tokens import SpecError
+
+    if isinstance(error, (SpecError, SimulationError)):
         print(error, file=sys.stderr)  # file:line:column: first, as compilers do
         return 2
-    except BrokenPipeError as error:
-        if not stdout_closed():
-            print(f"mosys: {error}", file=sys.stderr)
-            return 2
+    if isinstance(error, BrokenPipeError) and stdout_closed():
         # the reader of the output went away (mosys info F | head): stop quietly, as a Unix
         # tool does; nothing left to flush into the closed pipe at exit
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 128 + signal.SIGPIPE
-    except (OSError, InputError) as error:  # a missing, unreadable or corrupt input file
+    if isinstance(error, (OSError, InputError)):  # a missing, unreadable or corrupt input file
         print(f"mosys: {error}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
+    raise error
+
+
+def stopped_code(number: int) -> int:
+    """The exit code of a command stopped by signal ``number``, nothing written: Ctrl-C says
+    so; SIGTERM and SIGHUP, whose sender knows, stop without a word."""
+    if number == signal.SIGINT:
         print("mosys: interrupted; nothing written", file=sys.stderr)
-        return 128 + signal.SIGINT
-    except Stopped as stop:  # SIGTERM or SIGHUP: whoever sent it knows
-        return stop.code
-    return 0
+    return 128 + number
 
 
 def stdout_closed() -> bool:
@@ -187,16 +204,29 @@ def stdout_closed() -> bool:
 def stop_signals_raise() -> Iterator[None]:
     """Within the block, SIGTERM and SIGHUP (a scheduler or a closed terminal stopping the
     command) raise ``Stopped``, as Ctrl-C raises KeyboardInterrupt, so that the partial outputs
-    are removed on the way out; the handlers before are restored after. Outside the main
-    thread (signals reach only it) the block changes nothing."""
+    are removed on the way out; each is also recorded (``errors.note_stop``), so that one whose
+    exception a library swallows still stops the outputs from being written. The handlers
+    before are restored after. Outside the main thread (signals reach only it) the block
+    changes nothing."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
 
     def stop(number: int, _frame) -> None:
+        first = stop_received() is None
+        note_stop(number)  # kept, should the exception be swallowed on its way out
+        compile_lock = sys.modules.get("mosys.kernels.compile_lock")
+        if first and compile_lock is not None and compile_lock.compiling():
+            # raised inside numba's ctypes callbacks, it would be swallowed with a traceback:
+            # raised when the compilation ends instead; a second signal stops at once
+            print("mosys: stopping when numba's compilation ends", file=sys.stderr, flush=True)
+            return
+        if number == signal.SIGINT:
+            raise KeyboardInterrupt
         raise Stopped(number)
 
-    before = {number: signal.signal(number, stop) for number in (signal.SIGTERM, signal.SIGHUP)}
+    numbers = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+    before = {number: signal.signal(number, stop) for number in numbers}
     try:
         yield
     finally:

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import h5py
 
-from mosys.errors import InputError
+from mosys.errors import InputError, raise_if_stopped
 from mosys.files import output_problem
 
 PARTIAL_NAME_BYTES = 120  # of the final name kept in the partial's: NAME_MAX is 255 bytes
@@ -34,13 +34,15 @@ _held: _Outputs | None = None  # the running command's; None: each write is rena
 def outputs_together() -> Iterator[None]:
     """One command's outputs, all or none: within the block every ``write_atomically`` writes
     its partial file and holds it back; when the block ends they are renamed onto their paths
-    together, and if it raises (a later output failing, a signal made an exception) every
-    partial is removed, and every folder made for them, and no output changes."""
+    together, and if it raises (a later output failing, a signal made an exception), or a
+    stop signal was received (``errors.raise_if_stopped``), every partial is removed, and every
+    folder made for them, and no output changes."""
     global _held
     outer, _held = _held, _Outputs()
     held, renamed = _held, False
     try:
         yield
+        raise_if_stopped()  # a stop whose exception a library swallowed: none are renamed
         for partial, path in held.partials:
             try:
                 os.replace(partial, path)
@@ -49,7 +51,7 @@ def outputs_together() -> Iterator[None]:
         renamed = True
     finally:
         for partial, _ in held.partials:
-            with contextlib.suppress(FileNotFoundError, NotADirectoryError):
+            with contextlib.suppress(OSError):  # never written, or not ours to remove
                 partial.unlink()
         if not renamed:
             _remove_empty(held.folders)
@@ -112,8 +114,8 @@ def write_atomically(
     except OSError as error:  # the partial's name in the system's message means nothing to a user
         raise InputError(f"{path}: cannot write it: {error.strerror or error}") from None
     finally:
-        if not held_back:
-            with contextlib.suppress(FileNotFoundError, NotADirectoryError):
+        if not held_back:  # OSError: never made (a read-only file system refuses even that)
+            with contextlib.suppress(OSError):
                 partial.unlink()
         if not written:
             _remove_empty(made)

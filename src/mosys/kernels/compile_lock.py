@@ -35,10 +35,20 @@ import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
+from mosys.errors import raise_if_stopped
+
 _installed = False
 _cache_only = False
 _deferring = False
 _cold_seconds = 0.0  # this process's time in top-level compilations after cache misses
+_depth = 0  # top-level compilations under the lock in progress; numba's compiler lock guards it
+
+
+def compiling() -> bool:
+    """Whether numba is compiling a kernel that missed its cache: a stop signal's exception
+    raised now would be raised inside numba's ctypes callbacks, which swallow it (the command
+    line defers it to the compilation's end, ``errors.raise_if_stopped``)."""
+    return _depth > 0
 
 
 def _tell_a_person(function: str) -> None:
@@ -173,13 +183,11 @@ def serialize_cold_compilation() -> None:
     probe = MissProbe()
     event.register("numba:compile", probe)
     compile_signature = Dispatcher.compile
-    depth = 0  # top-level compilations under the lock; numba's compiler lock guards it
 
     def compile_once(self: Dispatcher, sig):
-        global _cold_seconds
-        nonlocal depth
+        global _cold_seconds, _depth
         with global_compiler_lock:
-            if depth or isinstance(self._cache, NullCache):
+            if _depth or isinstance(self._cache, NullCache):
                 return compile_signature(self, sig)
             armed, probe.armed = probe.armed, True  # armed: when loading needs another
             try:
@@ -196,13 +204,14 @@ def serialize_cold_compilation() -> None:
             began = time.perf_counter()
             try:
                 with machine_lock(function, wait=not _deferring):
-                    depth += 1
+                    _depth += 1
                     try:  # loads it if another process compiled it while this one waited
                         return compile_signature(self, sig)
                     finally:
-                        depth -= 1
+                        _depth -= 1
             finally:
                 _cold_seconds += time.perf_counter() - began
+                raise_if_stopped()  # a stop the command line deferred while this compiled
 
     compile_once.__doc__ = compile_signature.__doc__
     Dispatcher.compile = compile_once
