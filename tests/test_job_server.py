@@ -364,3 +364,50 @@ def test_the_socket_appears_only_once_it_listens(tmp_path, monkeypatch):
         assert seen == [True]
         assert sorted(p.name for p in tmp_path.iterdir()) == ["server.sock"]
         listener.accept()[0].close()
+
+
+def test_a_stopped_server_waits_for_its_jobs_and_reports_their_codes(server, tmp_path):
+    """Ctrl-C on a build reaches the server too: it left at once, and a job that ended in that
+    moment had nobody to send its code ('the job server ended before job N did', exit 1). Now
+    it takes no more jobs, tells those running to stop and reports each one's code."""
+    sleeper = tmp_path / "sleeper.py"
+    sleeper.write_text("import time\n\ntime.sleep(30)\n")
+    client = subprocess.Popen(
+        [sys.executable, "-m", "mosys.command", "plot", "free-swing", "--dynamics", str(sleeper)]
+        + ["-o", "x.png"],
+        cwd=tmp_path,
+        env={**environment(), "MOSYS_JOB_SERVER": str(server.socket)},
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    deadline = time.monotonic() + 20.0
+    while not server.jobs():
+        assert time.monotonic() < deadline, server.log.read_text()
+        time.sleep(0.02)
+    ((job, _),) = server.jobs()
+    server.process.send_signal(signal.SIGINT)
+    _, stderr = client.communicate(timeout=60)
+    assert client.returncode == 143, stderr  # the job's own code: stopped by SIGTERM
+    assert "ended before" not in stderr
+    assert server.process.wait(timeout=20) == 0
+    assert server.wait_for_end(job) == "ended: exit 143"  # reported by the server itself
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_a_request_is_declined_once_the_package_has_changed(monkeypatch):
+    """A job forks the server, so it runs the code the server imported: a file edited during a
+    build ran as it was, and Snakemake took the output as made by the edited code."""
+    request = {"python": sys.executable, "package": job_server.package_directory(), "env": {}}
+    monkeypatch.setattr(os, "environ", {})
+    monkeypatch.delitem(sys.modules, "numba.np.ufunc.parallel", raising=False)  # this process's
+    stamp = job_server.source_stamp()
+    assert stamp and all(path.endswith(".py") for path, _, _ in stamp)
+    monkeypatch.setattr(job_server, "_started_with", stamp)
+    assert job_server.decline_reason(request) is None
+    path, mtime, size = stamp[3]
+    changed = (*stamp[:3], (path, mtime + 1, size), *stamp[4:])
+    monkeypatch.setattr(job_server, "_started_with", changed)
+    relative = os.path.relpath(path, os.path.dirname(job_server.package_directory()))
+    assert job_server.decline_reason(request) == f"{relative} changed since the server started"
+    monkeypatch.setattr(job_server, "_started_with", stamp[1:])  # a file added since
+    assert "changed since the server started" in job_server.decline_reason(request)

@@ -1,6 +1,7 @@
 # Config validation and the only helpers of the workflow: target lists, the package modules each
 # rule's verb runs, and the specs (read by mosys's own parsers) that decide a rule's inputs.
 import ast
+import contextlib
 import functools
 import importlib.util
 import json
@@ -115,6 +116,7 @@ for _key, _variable in (("memory_gib", "MOSYS_MAX_MEMORY_GIB"), ("steps", "MOSYS
 # Without it (job_server: false, or it fails to start) every job is its own process as before.
 JOB_SERVER = {}
 JOB_SERVER_LOG = Path(".snakemake/log/mosys_job_server.log")
+JOB_SERVER_LOG_BYTES = 1 << 20  # beyond this the log is moved aside (.1) when a server starts
 JOB_SERVER_VARIABLE = "MOSYS_JOB_SERVER"  # a name, so that --lint sees no user setting
 
 
@@ -126,8 +128,13 @@ def start_job_server():
     directory = Path(tempfile.mkdtemp(prefix="mosys-jobs-"))
     socket_path = directory / "socket"
     JOB_SERVER_LOG.parent.mkdir(parents=True, exist_ok=True)
+    # appended to, not truncated: two runs at once (on other targets) each have a server, and
+    # one truncating the log the other writes left it full of NUL bytes
+    with contextlib.suppress(OSError):
+        if JOB_SERVER_LOG.stat().st_size > JOB_SERVER_LOG_BYTES:
+            JOB_SERVER_LOG.replace(JOB_SERVER_LOG.with_suffix(".log.1"))
     try:
-        with open(JOB_SERVER_LOG, "w") as log:
+        with open(JOB_SERVER_LOG, "a") as log:
             process = subprocess.Popen(
                 ["mosys", "job-server", str(socket_path)],
                 stdin=subprocess.DEVNULL,

@@ -15,10 +15,13 @@ itself) when any other of them, the interpreter or the mosys package differs fro
 since the kernels' caches were set up at import. The server never runs a kernel itself: a numba
 thread pool started before a fork would not survive it.
 
-It stops on SIGTERM or SIGINT, when the process that started it exits, after ``--idle``
-seconds without a job, or, once no job runs, when its socket file is removed or replaced; a job
-whose client goes away is sent SIGTERM. A job whose server has gone (killed meanwhile) sends
-its exit code to its client itself.
+It stops on SIGTERM or SIGINT and when the process that started it exits (its running jobs
+are sent SIGTERM and their exit codes reported as they end, for ``STOP_WAIT_S`` at most), after
+``--idle`` seconds without a job, or, once no job runs, when its socket file is removed or
+replaced; a job whose client goes away is sent SIGTERM. A job whose server has gone (killed
+meanwhile) sends its exit code to its client itself. A request is declined when a file of the
+mosys package has changed since the server started (``source_stamp``): a fork would run the
+code as it was, and Snakemake would take its output as made by the code as it is.
 """
 
 from __future__ import annotations
@@ -69,13 +72,35 @@ PRELOAD_TRIES = 3  # tries of a module that needed compiling, one after each job
 POLL_S = 1.0  # how often the server looks for its parent and its idle time
 REQUEST_TIMEOUT_S = 2.0  # a client sends its request as it connects; others wait meanwhile
 SOCKET_PATH_BYTES = 107  # a Unix socket's path, its NUL aside (sockaddr_un)
+STOP_WAIT_S = 10.0  # after a stop signal, how long the server waits for its jobs to end
+
+_started_with: tuple | None = None  # source_stamp() when the server started
+
+
+def source_stamp() -> tuple:
+    """The mosys package's Python files as they are on disk: (path, mtime_ns, size) of each,
+    in order. A job forked from the server runs the code the server imported; a file edited
+    since it started (during a build) must be run from disk, by a process of its own."""
+    root = package_directory()
+    stamp = []
+    for folder, folders, files in os.walk(root):
+        folders[:] = sorted(name for name in folders if name != "__pycache__")
+        for name in sorted(files):
+            if name.endswith(".py"):
+                path = os.path.join(folder, name)
+                with contextlib.suppress(OSError):  # removed meanwhile: the stamp differs
+                    status = os.stat(path)
+                    stamp.append((path, status.st_mtime_ns, status.st_size))
+    return tuple(stamp)
 
 
 def serve(path: str, idle_seconds: float) -> None:
     """Listen on the Unix socket ``path`` (replacing a stale one) and run each request in a
     fork until told to stop, importing ``PRELOADED`` one module at a time while no request
     waits: a job that comes early starts at once and imports what is not loaded yet itself."""
+    global _started_with
     os.close(os.pidfd_open(os.getpid()))  # Linux 5.3 or later: else fail now, not per job
+    _started_with = source_stamp()
     wakeup, woken = socket.socketpair()  # a stop signal wakes the selector at once
     wakeup.setblocking(False)
     signal.set_wakeup_fd(wakeup.fileno(), warn_on_full_buffer=False)
@@ -135,16 +160,30 @@ def _serve_requests(
     selector, listener, parent: int, idle_seconds: float, stopping, path: str, ours
 ) -> None:
     """The server's loop: accept requests and fork their jobs, report each job's exit code to
-    its client, SIGTERM a job whose client went away, preload while idle; until a stop signal,
-    the parent's exit, ``idle_seconds`` without a job, or, once its jobs have ended, its
-    socket's leaving ``path`` (removed or replaced: no client can reach it any more)."""
+    its client, SIGTERM a job whose client went away, preload while idle; until a stop signal
+    or the parent's exit (then, taking no more requests, it SIGTERMs its jobs and reports their
+    codes as they end, for ``STOP_WAIT_S`` at most), ``idle_seconds`` without a job, or, once
+    its jobs have ended, its socket's leaving ``path`` (removed or replaced: no client can
+    reach it any more)."""
     jobs: dict[int, tuple[socket.socket, int]] = {}  # pid -> (its client's connection, pidfd)
     preloads = Preloads(PRELOADED)
     last_activity = time.monotonic()
-    while not stopping and os.getppid() == parent:
-        if not jobs and time.monotonic() - last_activity > idle_seconds:
+    deadline = None  # once told to stop: until when the running jobs may end and be reported
+    while True:
+        if stopping or os.getppid() != parent:
+            if not jobs or (deadline is not None and time.monotonic() > deadline):
+                break
+            if deadline is None:  # take no more jobs; those running are told to stop, and
+                # their codes reach their clients (gone at once, it left them to say 'the job
+                # server ended before job N did', exit 1, for a job stopped by Ctrl-C)
+                selector.unregister(listener)
+                for pid in jobs:
+                    forward(pid, signal.SIGTERM)
+                deadline = time.monotonic() + STOP_WAIT_S
+                preloads.pending.clear()
+        elif not jobs and time.monotonic() - last_activity > idle_seconds:
             break
-        if not jobs and _file_identity(path) != ours:
+        elif not jobs and _file_identity(path) != ours:
             _log(f"{path} is no longer this server's socket: stopping")
             break
         events = selector.select(0.0 if preloads.pending else POLL_S)
@@ -327,9 +366,25 @@ def decline_reason(request: dict) -> str | None:
         imported = name.startswith(NUMBA_PREFIX) and name not in PER_JOB_VARIABLES
         if imported and env.get(name) != os.environ.get(name):
             return f"{name}={env.get(name)!r}, not {os.environ.get(name)!r}"
+    if _started_with is not None:
+        changed = _changed_source(_started_with, source_stamp())
+        if changed:
+            return f"{changed} changed since the server started"
     parallel = sys.modules.get("numba.np.ufunc.parallel")
     if parallel is not None and parallel._is_initialized:
         return "numba's thread pool started in the server: a fork would inherit it broken"
+    return None
+
+
+def _changed_source(before: tuple, now: tuple) -> str | None:
+    """The first of the package's files added, removed or changed between two stamps
+    (``source_stamp``), or None."""
+    if before == now:
+        return None
+    old, new = {path: rest for path, *rest in before}, {path: rest for path, *rest in now}
+    for path in sorted(set(old) | set(new)):
+        if old.get(path) != new.get(path):
+            return os.path.relpath(path, os.path.dirname(package_directory()))
     return None
 
 
