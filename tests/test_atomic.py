@@ -259,3 +259,24 @@ def test_a_stop_during_a_kernels_compilation_waits_for_its_end(monkeypatch, caps
         os.kill(os.getpid(), signal.SIGINT)  # a second Ctrl-C: at once
         time.sleep(5)
     forget_stops()
+
+
+def test_a_partial_left_by_a_killed_writer_goes_with_the_next_write(tmp_path):
+    """A writer killed outright (SIGKILL) cannot remove its partial file: one stayed beside a
+    plot after a rebuild. The next write of that output removes the partials of writers that
+    no longer run; a running writer's, and another output's, stay."""
+    import subprocess
+    import sys
+
+    dead = int(subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                              capture_output=True, text=True, check=True).stdout)  # fmt: skip
+    path = tmp_path / "C_portrait.png"
+    abandoned = tmp_path / f".C_portrait.png.{dead}.0123abcd.partial"
+    running = tmp_path / f".C_portrait.png.{os.getppid()}.89abcdef.partial"
+    other = tmp_path / f".C_portrait.png.5.{dead}.0123abcd.partial"  # C_portrait.png.5's
+    for partial in (abandoned, running, other):
+        partial.write_bytes(b"half a plot")
+    write_text_atomically(path, "a whole plot")
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        [path.name, running.name, other.name]
+    )

@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
 import secrets
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from glob import escape as glob_escape
 from pathlib import Path
 
 import h5py
@@ -16,6 +18,7 @@ from mosys.errors import InputError, raise_if_stopped
 from mosys.files import output_problem
 
 PARTIAL_NAME_BYTES = 120  # of the final name kept in the partial's: NAME_MAX is 255 bytes
+_PARTIAL_TAIL = re.compile(r"\.(\d+)\.[0-9a-f]{8}\.partial")  # what follows .NAME: PID, RANDOM
 
 
 @dataclass
@@ -98,6 +101,7 @@ def write_atomically(
     name = path.name.encode("utf-8", "surrogateescape")[:PARTIAL_NAME_BYTES]
     short = name.decode("utf-8", "ignore")
     partial = path.with_name(f".{short}.{os.getpid()}.{secrets.token_hex(4)}.partial")
+    _remove_abandoned_partials(path.with_name(f".{short}"))
     made = _missing_folders(path.parent.absolute())
     held_back = False  # the partial handed to ``outputs_together``, which renames or removes it
     written = False
@@ -119,6 +123,30 @@ def write_atomically(
                 partial.unlink()
         if not written:
             _remove_empty(made)
+
+
+def _remove_abandoned_partials(stem: Path) -> None:
+    """Remove the partial files ``STEM.PID.RANDOM.partial`` of writers that no longer run: a
+    process killed outright (SIGKILL, a crash) cannot remove its own, and they stayed beside
+    the output for good (a 2 MB one beside the car's table). A partial whose writer runs, or
+    may (a process of another user), is left alone."""
+    with contextlib.suppress(OSError):
+        for candidate in stem.parent.glob(f"{glob_escape(stem.name)}.*.*.partial"):
+            own = _PARTIAL_TAIL.fullmatch(candidate.name[len(stem.name) :])
+            pid = int(own.group(1)) if own else os.getpid()  # another output's, if no match
+            if pid != os.getpid() and not _process_runs(pid):
+                with contextlib.suppress(OSError):
+                    candidate.unlink()
+
+
+def _process_runs(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # another user's: it runs
+        return True
+    return True
 
 
 def write_hdf5_atomically(path: str | Path, fill: Callable[[h5py.File], None]) -> None:
