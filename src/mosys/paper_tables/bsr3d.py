@@ -32,7 +32,8 @@ from mosys.paper_tables.bsr import (
 # §4.1: "One evaluation of a motion controller for Rex requires 1,000 time steps of simulation,
 # and about 0.3 seconds of elapsed time on a Digital 3000/400 AXP workstation. An acceptable
 # controller had therefore been found in just under five hours", after "rapid progress ...
-# through the first 50,000 evaluations". The paper gives no other 3-D timing.
+# through the first 50,000 evaluations". Its other 3-D timings are not figures: §5's "can still
+# take hours", and §4.2's sense-based controllers "took longer to find" (Figure 7).
 PAPER_MS_PER_1000_STEPS = 300.0
 PAPER_FIGURE = "Rex: 300 ms per 1,000 steps (DEC 3000/400)"
 SPEED_UP = "speed-up vs paper (300 ms / ours)"
