@@ -208,15 +208,15 @@ def test_signals_reach_the_job_and_a_job_whose_client_dies_is_stopped(server, tm
     assert not (tmp_path / "x.png").exists()
 
 
-def test_a_job_reports_its_own_exit_code_when_the_server_is_killed(server, tmp_path):
-    """The job is the server's fork and outlives it; its client used to exit 1 ("the job
-    server ended before job N did") although the job went on and ended with its own code."""
-    sleeper = tmp_path / "sleeper.py"
-    sleeper.write_text("import time\n\ntime.sleep(2)\n")  # then it is no dynamics module: exit 2
+def served_sleeper(server: Server, directory: Path, seconds: float) -> subprocess.Popen:
+    """A served job (``plot free-swing``) whose dynamics module sleeps ``seconds`` as it is
+    loaded, then is found to be none (exit 2), once the server has started it; its client."""
+    sleeper = directory / "sleeper.py"
+    sleeper.write_text(f"import time\n\ntime.sleep({seconds})\n")
     client = subprocess.Popen(
         [sys.executable, "-m", "mosys.command", "plot", "free-swing", "--dynamics", str(sleeper)]
         + ["-o", "x.png"],
-        cwd=tmp_path,
+        cwd=directory,
         env={**environment(), "MOSYS_JOB_SERVER": str(server.socket)},
         stderr=subprocess.PIPE,
         text=True,
@@ -225,6 +225,13 @@ def test_a_job_reports_its_own_exit_code_when_the_server_is_killed(server, tmp_p
     while not server.jobs():
         assert time.monotonic() < deadline, server.log.read_text()
         time.sleep(0.02)
+    return client
+
+
+def test_a_job_reports_its_own_exit_code_when_the_server_is_killed(server, tmp_path):
+    """The job is the server's fork and outlives it; its client used to exit 1 ("the job
+    server ended before job N did") although the job went on and ended with its own code."""
+    client = served_sleeper(server, tmp_path, 2)  # then it is no dynamics module: exit 2
     server.process.kill()
     server.process.wait(timeout=20)
     _, stderr = client.communicate(timeout=60)
@@ -370,20 +377,7 @@ def test_a_stopped_server_waits_for_its_jobs_and_reports_their_codes(server, tmp
     """Ctrl-C on a build reaches the server too: it left at once, and a job that ended in that
     moment had nobody to send its code ('the job server ended before job N did', exit 1). Now
     it takes no more jobs, tells those running to stop and reports each one's code."""
-    sleeper = tmp_path / "sleeper.py"
-    sleeper.write_text("import time\n\ntime.sleep(30)\n")
-    client = subprocess.Popen(
-        [sys.executable, "-m", "mosys.command", "plot", "free-swing", "--dynamics", str(sleeper)]
-        + ["-o", "x.png"],
-        cwd=tmp_path,
-        env={**environment(), "MOSYS_JOB_SERVER": str(server.socket)},
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    deadline = time.monotonic() + 20.0
-    while not server.jobs():
-        assert time.monotonic() < deadline, server.log.read_text()
-        time.sleep(0.02)
+    client = served_sleeper(server, tmp_path, 30)
     ((job, _),) = server.jobs()
     server.process.send_signal(signal.SIGINT)
     _, stderr = client.communicate(timeout=60)
