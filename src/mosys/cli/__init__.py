@@ -158,6 +158,8 @@ def main(argv: list[str] | None = None) -> int:
         if number is not None:  # a library turned the stop into an error of its own (numba,
             return stopped_code(number)  # stopped while compiling: "no compiled object yet")
         return error_code(error)
+    finally:
+        forget_stops()  # the stops were this command's (a caller may run another)
     return 0
 
 
