@@ -725,3 +725,19 @@ def test_script_path_of_a_four_dimensional_state_draws_a_plane_per_joint(tmp_pat
     bare = script_path_figure(trajectory, [])
     assert [ax.get_ylabel() for ax in bare.axes] == ["shoulder_rate (deg/s)", "elbow_rate (deg/s)"]
     assert bare.axes[0].get_ylim()[1] >= 500  # the paper's rate scale, as for the pendulum
+
+
+def test_a_wide_rate_axis_is_not_ticked_every_100_degrees_per_second():
+    """The paper's ±500 deg/s takes a tick every 100; a backflip's ±3,200 took 64, a black
+    smear down the axis (Luxo's script path): wide ranges keep matplotlib's own step."""
+    from matplotlib.figure import Figure
+
+    for reach, most in [(500.0, 11), (3200.0, 12)]:
+        ax = Figure().add_subplot()
+        axes = (
+            StateAxis("angle", "deg", -180.0, 180.0, 360.0),
+            StateAxis("omega", "deg/s", -reach, reach, None),
+        )
+        format_state_axes(ax, axes)
+        ticks = [t for t in ax.get_yticks() if -reach * 1.02 <= t <= reach * 1.02]
+        assert 5 <= len(ticks) <= most, ticks

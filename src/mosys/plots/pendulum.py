@@ -61,6 +61,7 @@ from mosys.plots.style import (
 PORTRAIT_STARTS = 8  # start states per portrait
 PORTRAIT_SECONDS = 3.0  # s simulated from each start
 UNKNOWN_COLOR = "0.55"  # a node without a cost-to-go on the torque map
+MAX_TICKED_SPAN = {"deg": 720.0, "deg/s": 1500.0}  # widest axes ticked every 60 deg, 100 deg/s
 LABEL_GAP_INCHES = 0.45  # contour labels at least this far apart and from the destination
 CYCLE_SECONDS = (3.0, 5.0)  # s: a periodic destination's cycle is drawn over this window
 # pale tints of the basins of a table with several destinations, one per destination in order
@@ -248,9 +249,11 @@ def format_state_axes(
             margin = 0.02 * (high - low)
             low, high = low - margin, high + margin
         limits(low, high)
-        if axis.unit == "deg":
+        # the paper's ticks where they make a dozen or so; wider ranges (a backflip's 3,000
+        # deg/s) keep matplotlib's, which choose their own step
+        if axis.unit == "deg" and high - low <= MAX_TICKED_SPAN["deg"]:
             ticker.set_major_locator(MultipleLocator(60.0 if high - low > 200 else 30.0))
-        elif axis.unit == "deg/s" and high - low >= 500:
+        elif axis.unit == "deg/s" and 500 <= high - low <= MAX_TICKED_SPAN["deg/s"]:
             ticker.set_major_locator(MultipleLocator(100.0))
     labels = [axis_label(a.name, a.unit) + (" — cylindrical" if a.period else "") for a in axes]
     ax.set_xlabel(labels[0])
