@@ -18,7 +18,11 @@ from matplotlib.contour import ContourSet
 from PIL import Image
 
 from mosys.cli import main
-from mosys.io.controller_table import ControllerTable, write_controller_table
+from mosys.io.controller_table import (
+    ControllerTable,
+    read_controller_table,
+    write_controller_table,
+)
 from mosys.io.trajectory import FigureMotion, Trajectory, read_trajectory, write_trajectory
 from mosys.parsing.controller import parse_controller_spec
 from mosys.plots.controls import controls_figure
@@ -35,7 +39,7 @@ from mosys.plots.pendulum import (
     torque_figure,
     write_script_gif,
 )
-from mosys.plots.style import controller_colors
+from mosys.plots.style import PlotInputError, controller_colors
 from mosys.ssc.generate import generate_controller
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -725,6 +729,31 @@ def test_script_path_of_a_four_dimensional_state_draws_a_plane_per_joint(tmp_pat
     bare = script_path_figure(trajectory, [])
     assert [ax.get_ylabel() for ax in bare.axes] == ["shoulder_rate (deg/s)", "elbow_rate (deg/s)"]
     assert bare.axes[0].get_ylim()[1] >= 500  # the paper's rate scale, as for the pendulum
+    # a table of some of the figure's variables (Luxo's landing table: four of ten) draws on
+    # the trajectory's axes, its destination in the panels whose variables it names
+    for names_, dest in [(("elbow", "elbow_rate"), 10.0), (("wrist", "wrist_rate"), None)]:
+        part = tmp_path / "partial" / "H.h5"
+        part.parent.mkdir(exist_ok=True)
+        write_controller_table(
+            part,
+            dataclasses.replace(
+                read_controller_table(table),
+                state_order=names_,
+                axes=(angles, rates),
+                axis_units=("deg", "deg/s"),
+                wrap=(True, False),
+                torque=np.zeros((4, 5, 2)),
+                value=np.ones((4, 5)),
+                dest={names_[0]: 0.0, names_[1]: 0.0},
+            ),
+        )
+        if dest is None:
+            with pytest.raises(PlotInputError, match="differs from that of its controller H"):
+                script_path_figure(trajectory, [part])
+            continue
+        shoulder, elbow = script_path_figure(trajectory, [part]).axes
+        assert "dH" not in {t.get_text() for t in shoulder.texts}
+        assert {t.get_text(): t.xy for t in elbow.texts}["dH"] == (0.0, 0.0)
 
 
 def test_a_wide_rate_axis_is_not_ticked_every_100_degrees_per_second():

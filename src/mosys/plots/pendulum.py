@@ -731,17 +731,11 @@ def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | 
             f"{trajectory_path}: none of the tables given ({', '.join(tables)}) is one of the "
             f"script's controllers ({', '.join(dict.fromkeys(trajectory.controllers))})"
         )
-    where = paths[used[0]] if used else trajectory_path
+    axes, where = trajectory_plot_axes(trajectory, trajectory_path, tables, used, paths)
     try:
-        axes = state_axes(tables[used[0]]) if used else trajectory_axes(trajectory)
         planes = phase_planes(axes)
     except PlotInputError as error:
         raise PlotInputError(f"{where}: {error}") from None
-    if used and tuple(a.name for a in axes) != tuple(trajectory.state_order):
-        raise PlotInputError(
-            f"{trajectory_path}: state order {trajectory.state_order} differs from that of "
-            f"its controller {used[0]}, {tuple(a.name for a in axes)}"
-        )
     state = trajectory.state.copy()
     for k, axis in enumerate(axes):  # a motor program's stretch keeps the angle unwrapped
         if axis.period:
@@ -788,6 +782,29 @@ def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | 
         for ax, labels, obstacles in panels:
             place_labels(figure, ax, labels, obstacles)
     return figure
+
+
+def trajectory_plot_axes(trajectory: Trajectory, trajectory_path, tables, used, paths):
+    """The plot axes of a script's state, and the file they come from: its first controller's
+    table's, where the trajectory's state is that table's; the trajectory's own
+    (``trajectory_axes``) where it has no table, or where it is the figure's whole state of which
+    the table covers some variables (a script with motor programs: Luxo's landing table covers
+    four of his ten). Any other state order is refused."""
+    if not used:
+        try:
+            return trajectory_axes(trajectory), trajectory_path
+        except PlotInputError as error:
+            raise PlotInputError(f"{trajectory_path}: {error}") from None
+    table_axes = state_axes(tables[used[0]])
+    names = tuple(axis.name for axis in table_axes)
+    if names == tuple(trajectory.state_order):
+        return table_axes, paths[used[0]]
+    if set(names) <= set(trajectory.state_order) and trajectory.state_units is not None:
+        return trajectory_axes(trajectory), trajectory_path
+    raise PlotInputError(
+        f"{trajectory_path}: state order {trajectory.state_order} differs from that of its "
+        f"controller {used[0]}, {names}"
+    )
 
 
 END_LABEL = "end, t = {:.2f} s"
