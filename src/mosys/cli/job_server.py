@@ -180,14 +180,14 @@ def _serve_requests(
                 for pid in jobs:
                     forward(pid, signal.SIGTERM)
                 deadline = time.monotonic() + STOP_WAIT_S
-                preloads.pending.clear()
         elif not jobs and time.monotonic() - last_activity > idle_seconds:
             break
         elif not jobs and _file_identity(path) != ours:
             _log(f"{path} is no longer this server's socket: stopping")
             break
-        events = selector.select(0.0 if preloads.pending else POLL_S)
-        if not events and preloads.pending:
+        preloading = bool(preloads.pending) and deadline is None  # not once told to stop
+        events = selector.select(0.0 if preloading else POLL_S)
+        if not events and preloading:
             if not preloads.import_next() and not preloads.warming_up:
                 preloads.warming_up = True
                 with contextlib.suppress(OSError):  # no fork: the jobs compile it all
