@@ -434,6 +434,6 @@ def test_cli_rejects_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture) ->
 
 
 def test_counts_read_as_words():
-    from mosys.plots.style import seeds_text
+    from mosys.plots.style import counted
 
-    assert [seeds_text(n) for n in (1, 2)] == ["1 seed", "2 seeds"]  # "1 seeds" in a title
+    assert [counted(n, "seed") for n in (1, 2)] == ["1 seed", "2 seeds"]  # "1 seeds" in a title

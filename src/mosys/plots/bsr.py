@@ -53,6 +53,7 @@ from mosys.plots.style import (
     check_animation_options,
     choose_interval,
     controller_colors,
+    counted,
     draw_pose,
     draw_terrain,
     fit_aspect,
@@ -64,7 +65,6 @@ from mosys.plots.style import (
     save_figure,
     scene_figure,
     scene_limits,
-    seeds_text,
     spread_labels,
     write_real_time_gif,
 )
@@ -302,7 +302,7 @@ def learning_figure(results: Sequence[str | Path]) -> Figure:
     figure_name = first.attrs.get("figure", "")
     title = (
         f"BSR search {name}: {KIND_TEXT.get(kind, kind)} controller"
-        f"{f' for {figure_name}' if figure_name else ''}, {seeds_text(len(loaded))}\n"
+        f"{f' for {figure_name}' if figure_name else ''}, {counted(len(loaded), 'seed')}\n"
         + wrapped(
             f"best fitness found so far by each seed; {fitness_formula(first.fitness_weights)}"
         )
@@ -440,7 +440,7 @@ def learning_comparison_figure(results_by_search: Mapping[str, Sequence[str | Pa
             entries.append(
                 (
                     (Patch(color=colors[name], alpha=BAND_ALPHA * 1.6), Line2D([], [], **style)),
-                    f"{name} ({KIND_TEXT.get(kind, kind)}, {seeds_text(len(loaded))})",
+                    f"{name} ({KIND_TEXT.get(kind, kind)}, {counted(len(loaded), 'seed')})",
                 )
             )
         for ax in (raw, scaled):

@@ -86,6 +86,7 @@ from mosys.plots.style import (
     check_animation_options,
     choose_interval,
     controller_colors,
+    counted,
     draw_pose,
     fit_aspect,
     frame_samples,
@@ -97,7 +98,6 @@ from mosys.plots.style import (
     samples_to_the_end,
     save_figure,
     scene_figure,
-    seeds_text,
     spread_labels,
     text_color,
     write_real_time_gif,
@@ -836,7 +836,8 @@ def learning_kinds_figure(
     figures = sorted({str(r.attrs.get("figure", "")) for _, _, rs in kinds for r in rs} - {""})
     formulas = {fitness_formula(results[0].fitness_weights) for _, _, results in kinds}
     versus = " vs ".join(
-        f"{KIND_TEXT[kind]} {name} ({seeds_text(len(results))})" for kind, name, results in kinds
+        f"{KIND_TEXT[kind]} {name} ({counted(len(results), 'seed')})"
+        for kind, name, results in kinds
     )
     if len(formulas) == 1:
         fitness = formulas.pop()
@@ -872,7 +873,7 @@ def learning_kinds_figure(
             entries.append(
                 (
                     Line2D([], [], color=color, linewidth=MEDIAN_WIDTH, linestyle=style),
-                    f"{name} ({KIND_TEXT[kind]}): median over {seeds_text(len(results))}",
+                    f"{name} ({KIND_TEXT[kind]}): median over {counted(len(results), 'seed')}",
                 )
             )
             entries.append(

@@ -143,11 +143,6 @@ def counted(number: int, noun: str) -> str:
     return f"{number} {noun}{'' if number == 1 else 's'}"
 
 
-def seeds_text(count: int) -> str:
-    """``1 seed``, ``3 seeds``."""
-    return counted(count, "seed")
-
-
 def minus_signs(text: str) -> str:
     """A true minus sign for hyphens in numbers."""
     return text.replace("-", "−")
