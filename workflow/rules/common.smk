@@ -52,9 +52,8 @@ def typed_overrides(value, schema):
 
 
 CONFIG_SCHEMA = Path(workflow.current_basedir) / "../schemas/config.schema.yaml"
-TYPED = typed_overrides(dict(config), yaml.safe_load(CONFIG_SCHEMA.read_text()))
-config.update(TYPED)  # --config's strings, typed
-validate(config, "../schemas/config.schema.yaml")
+config.update(typed_overrides(dict(config), yaml.safe_load(CONFIG_SCHEMA.read_text())))
+validate(config, str(CONFIG_SCHEMA))  # --config's strings typed first
 
 
 def configured_specs():
