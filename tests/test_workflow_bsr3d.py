@@ -48,6 +48,7 @@ def test_bsr3d_all_builds_every_search_plot_and_the_table(built):
     for name in SEARCHES:
         assert len(results(built, name)) == 2
         assert f"results/bsr/{name}/seed1.h5" in listed
+        assert (built / "results/plots/bsr3d" / name / "learning.png").stat().st_size > 10_000
     for motion in ("cujo", "rex", "bob", "bob_time"):
         for plot in ("filmstrip.png", "motion.gif", "rest.png"):
             assert (built / "results/plots/bsr3d" / motion / plot).stat().st_size > 10_000
@@ -121,6 +122,7 @@ def test_editing_the_turn_reruns_the_turn_and_the_second_walk_not_the_first(buil
     assert jobs == {
         "bsr_search": 4,
         "bsr3d_motion_plots": 1,
+        "bsr3d_search_learning": 2,
         "bsr3d_runs_table": 1,
         "bsr3d_targets_table": 1,
         "bsr3d_all": 1,

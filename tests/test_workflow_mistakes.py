@@ -126,6 +126,44 @@ def test_a_script_of_the_cars_figure_draws_on_the_cars_controllers(work):
     assert "--dt 0.01 " in output  # the car's step
 
 
+def test_a_chain_line_naming_no_search_stops_the_dag_at_that_line(work):
+    """It stopped at the missing spec's line 1 (``specs/bsr/rex_wlak.bsr:1:1: expected an
+    existing spec file``), a file the user never wrote."""
+    spec = work / "specs/bsr/my_turn.bsr"
+    text = (work / "specs/bsr/rex_turn.bsr").read_text(encoding="utf-8")
+    line = next(n for n, row in enumerate(text.splitlines(), 1) if row.startswith("chain "))
+    spec.write_text(text.replace("chain rex_walk", "chain rex_wlak"), encoding="utf-8")
+    try:
+        code, output = dry_run(work, "results/bsr/my_turn/seed1.h5")
+    finally:
+        spec.unlink()
+    assert code != 0
+    assert (
+        f"specs/bsr/my_turn.bsr:{line}:7: expected the name of a search in specs/bsr/ to "
+        "continue, found 'rex_wlak' (specs/bsr/rex_wlak.bsr does not exist)"
+    ) in output
+
+
+def test_a_3d_search_of_your_own_is_drawn_without_registering_it(work):
+    """A motion's plots for a search the config does not name: the search and the searches
+    its chain lines continue, in order (it was a KeyError); its seeds' learning curves."""
+    code, output = dry_run(work, "results/plots/bsr3d/rex_turn/filmstrip.png")
+    assert code == 0, output
+    plot = next(line for line in output.splitlines() if "mosys plot bsr3d " in line)
+    walk = plot.index("results/bsr/rex_walk/seed1.h5")
+    assert walk < plot.index("results/bsr/rex_turn/seed1.h5")
+    assert "rex_walk_again" not in plot
+    code, output = dry_run(work, "results/plots/bsr3d/bob_walk/learning.png")
+    assert code == 0, output
+    assert "mosys plot bsr3d-seeds results/bsr/bob_walk/seed1.h5" in output
+    code, output = dry_run(work, "results/plots/bsr3d/nosuch/filmstrip.png")
+    assert code != 0
+    assert (
+        "results/plots/bsr3d/nosuch/: expected a motion of config bsr3d.motions (cujo, rex, "
+        "bob, bob_time) or a search spec, found 'nosuch' (specs/bsr/nosuch.bsr does not exist)"
+    ) in output
+
+
 def test_a_malformed_spec_stops_the_dag_with_its_location(work):
     spec = work / "specs/scripts/pendulum_catch.anim"
     text = spec.read_text(encoding="utf-8")

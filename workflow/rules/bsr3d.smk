@@ -1,6 +1,7 @@
 # 3-D BSR figures (the 1995 paper's section 4): their searches run by bsr.smk's bsr_search (a
 # search that continues another waits for its results); here their drawings (a filmstrip, a GIF
-# and the figure at rest per motion, Figures 7 and 8) and the 3-D runs table.
+# and the figure at rest per motion, each search's seeds' learning curves, Figures 7 and 8) and
+# the 3-D runs table.
 
 rule bsr3d_motion_plots:
     input:
@@ -46,6 +47,21 @@ rule bsr3d_seeds:
         "results/logs/plots/bsr3d/seeds.log",
     benchmark:
         "results/benchmarks/plots/bsr3d/seeds.tsv"
+    threads: 1
+    shell:
+        "mosys plot bsr3d-seeds {input.results} -o {output} > {log} 2>&1"
+
+
+rule bsr3d_search_learning:
+    input:
+        results=bsr_seed_results,
+        code=code_inputs("mosys.cli.plots", "mosys.plots.bsr3d"),  # mosys plot bsr3d-seeds
+    output:
+        report("results/plots/bsr3d/{name}/learning.png", caption="../report/bsr3d_learning.rst", category="1995 paper: 3-D figures", subcategory="{name}"),
+    log:
+        "results/logs/plots/bsr3d/{name}_learning.log",
+    benchmark:
+        "results/benchmarks/plots/bsr3d/{name}_learning.tsv"
     threads: 1
     shell:
         "mosys plot bsr3d-seeds {input.results} -o {output} > {log} 2>&1"

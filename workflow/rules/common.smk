@@ -562,8 +562,20 @@ def bsr_seeds(name):
 
 
 def bsr_chain(name):
-    """The search a 3-D search continues (its 'chain' line), or None."""
-    return parsed_spec(f"specs/bsr/{name}.bsr").chain or None
+    """The search a 3-D search continues (its 'chain' line), or None. A chain line naming no
+    spec stops the DAG at that line (not at the missing file's line 1)."""
+    from mosys.parsing.tokens import location
+
+    spec = parsed_spec(f"specs/bsr/{name}.bsr")
+    if not spec.chain:
+        return None
+    if not Path(f"specs/bsr/{spec.chain}.bsr").is_file():
+        raise WorkflowError(
+            f"{location(spec.path, spec.tokens['chain'])}: expected the name of a search in"
+            f" specs/bsr/ to continue, found {spec.chain!r} (specs/bsr/{spec.chain}.bsr does"
+            " not exist)"
+        )
+    return spec.chain
 
 
 def bsr_chain_results(wildcards):
@@ -630,9 +642,32 @@ def bsr3d_results(*names):
             for name in (names or config["bsr3d"]["searches"]) for seed in bsr_seeds(name)]
 
 
+def bsr3d_motion_searches(motion):
+    """The chain of searches a 3-D motion draws, in order: a motion of config bsr3d.motions, or
+    else a search of its own (specs/bsr/MOTION.bsr) with the searches its 'chain' lines
+    continue, so that a user's spec needs no registering."""
+    motions = config["bsr3d"]["motions"]
+    if motion in motions:
+        return motions[motion]
+    if not Path(f"specs/bsr/{motion}.bsr").is_file():
+        raise WorkflowError(
+            f"results/plots/bsr3d/{motion}/: expected a motion of config bsr3d.motions"
+            f" ({', '.join(motions)}) or a search spec, found {motion!r}"
+            f" (specs/bsr/{motion}.bsr does not exist)"
+        )
+    chain = [motion]
+    while (continued := bsr_chain(chain[0])) is not None:
+        if continued in chain:
+            raise WorkflowError(
+                f"specs/bsr/{chain[0]}.bsr: its chain lines loop ({' -> '.join([continued, *chain])})"
+            )
+        chain.insert(0, continued)
+    return chain
+
+
 def bsr3d_motion_results(wildcards):
     """The result files of a 3-D motion's chain of searches, in order."""
-    return bsr3d_results(*config["bsr3d"]["motions"][wildcards.motion])
+    return bsr3d_results(*bsr3d_motion_searches(wildcards.motion))
 
 
 def bsr3d_table_targets():
@@ -650,8 +685,9 @@ def bsr3d_target_roles(wildcards):
 def bsr3d_targets():
     plots = [f"results/plots/bsr3d/{motion}/{plot}" for motion in config["bsr3d"]["motions"]
              for plot in ("filmstrip.png", "motion.gif", "rest.png")]
+    learning = [f"results/plots/bsr3d/{name}/learning.png" for name in config["bsr3d"]["searches"]]
     figures = ["results/plots/bsr3d/learning_kinds.png", "results/plots/bsr3d/seeds.png"]
-    return bsr3d_results() + plots + figures + bsr3d_table_targets()
+    return bsr3d_results() + plots + learning + figures + bsr3d_table_targets()
 
 
 def composite_searches(name):
