@@ -4,6 +4,8 @@ starts, and determinism whatever the threads."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numba
 import numpy as np
 import pytest
@@ -54,6 +56,52 @@ def test_a_3d_spec_names_what_its_figure_has(text, message):
     with pytest.raises(SpecError) as error:
         setup(text)
     assert str(error.value).startswith(message)
+
+
+@pytest.mark.parametrize(
+    "start, message",
+    [
+        ("head=20", "test.bsr:6:15: expected an angle of head within its range, -15 to 15 deg, "),
+        ("head_turn=5", "test.bsr:6:15: expected head_turn at its fixed angle, 0 deg, found "),
+    ],
+)
+def test_a_start_angle_outside_its_joints_range_is_refused(start, message):
+    """It was clipped to the range without a word (a 60 deg start of a 25 deg leg stood at 25)."""
+    with pytest.raises(SpecError) as error:
+        setup(SPEC.replace("spine=0", f"spine=0 {start}"))
+    assert str(error.value).startswith(message), str(error.value)
+    setup(SPEC.replace("spine=0", "spine=0 head=15 head_turn=0"))  # the ends are in it
+
+
+@pytest.mark.parametrize(
+    "dropped, fitness, message",
+    [
+        (
+            "feet ",
+            "foot_steps=0.2",
+            "test.bsr:7:40: expected a term of a figure with feet for foot_steps (a 'feet' line "
+            "in its .fig; 'cujo' has none), found 'foot_steps=0.2'",
+        ),
+        (
+            "terrain ",
+            "",
+            "test.bsr:1:8: expected a figure on a floor for a BSR search (a 'terrain floor' "
+            "line: the fitness terms and senses measure the figure against the ground; 'cujo' "
+            "has none and would fall for ever), found 'cujo'",
+        ),
+    ],
+)
+def test_a_search_needing_what_its_figure_lacks_is_refused(tmp_path, dropped, fitness, message):
+    """Feet terms of a figure without feet were silently 0, and a figure with no floor fell
+    for ever, both with exit 0."""
+    text = Path("specs/figures/cujo.fig").read_text(encoding="utf-8")
+    kept = [line for line in text.splitlines() if not line.startswith(dropped)]
+    (tmp_path / "cujo.fig").write_text("\n".join(kept) + "\n", encoding="utf-8")
+    figure = load_bsr_figure3d(tmp_path, "test.bsr", Token("cujo", 1, 8))
+    spec = SPEC.replace("fall=-5", f"fall=-5 {fitness}".rstrip())
+    with pytest.raises(SpecError) as error:
+        bind_search3d(parse_bsr_text(spec, "test.bsr"), figure)
+    assert str(error.value) == message
 
 
 def test_a_new_sense_rule_contains_a_point_of_the_parents_sense_trajectory():

@@ -383,11 +383,8 @@ ERRORS_3D = {
     SPATIAL + "heading a\nlimit b swing_lower=3 swing_upper=-3\n": "bad.fig:6:35: expected a "
     "number >= swing_lower (3) for swing_upper (degrees), found '-3'",
     PLANAR + "rod c length=1 mass=1\nfree a\nball b on=a\nhinge c on=a\nheading a\n"
-    "limit c lower=0 upper=0 stiffness=5\n": "bad.fig:8:23: expected a number > lower (0) for "
-    "upper (degrees), found '0'",
-    PLANAR + "rod c length=1 mass=1\nfree a\nball b on=a\nhinge c on=a\nheading a\n"
-    "limit c lower=-5 upper=5\n": "bad.fig:8:25: expected 'stiffness=' (N·m/rad), found end of "
-    "line",
+    "limit c lower=5 upper=0\n": "bad.fig:8:23: expected a number >= lower (5) for upper "
+    "(degrees), found '0'",
     PLANAR + "rod c length=1 mass=1\nfree a\nball b on=a\nhinge c on=a\nheading a\n"
     "limit c lower=-5 upper=5 swing_lower=0 stiffness=5\n": "bad.fig:8:26: expected one of "
     "'lower=', 'upper=', 'stiffness=', 'damping=', found 'swing_lower=0'",
@@ -399,6 +396,18 @@ ERRORS_3D = {
     SPATIAL + "heading a\nhinge a on=b splay=5\n": "bad.fig:6:14: expected one of 'on=', 'at=', "
     "'offset=', 'angle=', 'rate=', 'actuator=', found 'splay=5'",
 }
+
+
+def test_a_hinge_limit_in_a_3d_figure_is_a_bare_range_that_may_fix_its_angle() -> None:
+    """As a ball's: it needed a stiffness, which the kinematic 3-D joints never use, and could
+    not fix the angle (lower == upper), so a rigid hinge had to be written as a ball."""
+    hinged = PLANAR + "rod c length=1 mass=1\nfree a\nball b on=a\nhinge c on=a\nheading a\n"
+    fixed = parse_figure_text(hinged + "limit c lower=20 upper=20\n", "fixed.fig")
+    (limit,) = fixed.limits
+    assert (limit.lower, limit.upper, limit.stiffness) == (math.radians(20), math.radians(20), 0)
+    assert parse_figure_text(render_figure_spec(fixed), "fixed.fig") == fixed
+    ranged = parse_figure_text(hinged + "limit c lower=-5 upper=5 stiffness=5\n", "ranged.fig")
+    assert ranged.limits[0].stiffness == 5.0  # kept, not used
 
 
 @pytest.mark.parametrize("text", list(ERRORS_3D))

@@ -172,6 +172,11 @@ ERRORS = {
     "1 (the length of 'a') for at (m along the parent), found '1.5'",
     ROD + "free a\nlimit a lower=-10 stiffness=5\n": "bad.fig:3:7: expected a rod with a 'pin' "
     "or 'hinge' joint (a free root has no limit), found 'a'",
+    # the free root's message, not "expected 'stiffness='" first (adding one only led to it)
+    ROD + "free a\nlimit a lower=-10 upper=10\n": "bad.fig:3:7: expected a rod with a 'pin' "
+    "or 'hinge' joint (a free root has no limit), found 'a'",
+    ROD + "pin a\nlimit a lower=-10 upper=10\n": "bad.fig:3:27: expected 'stiffness=' "
+    "(N·m/rad), found end of line",
     ROD + "pin a\nlimit a lower=10 upper=-10 stiffness=5\n": "bad.fig:3:24: expected a number "
     "> lower (10) for upper (degrees), found '-10'",
     "gravity 9.81\ngravity 1.6\n" + ROD + "pin a\n": "bad.fig:2:1: expected one 'gravity' line "

@@ -70,6 +70,8 @@ CREEP_LOG_TAU = 0.2
 CREEP_CENTER = 0.1
 CREEP_LOG_SIDE = 0.1
 CREEP_LOG_SEGMENT = 0.2
+# deg: a start angle this close outside its joint's range is on it (the range is kept in rad)
+ANGLE_ROUNDING_DEG = 1e-9
 
 
 class Simulation(Protocol):
@@ -201,6 +203,14 @@ def bind_names(spec: BsrSpec, figure, term_names: tuple[str, ...]) -> BoundNames
             f"its weight and its speed of fall; '{figure.figure.name}' has gravity "
             f"{figure.gravity:g})",
         )
+    if math.isnan(figure.floor):  # no floor: every fitness term and sense reads the ground
+        raise SpecError.at(
+            spec.path,
+            spec.tokens["figure"],
+            f"a figure on a floor for a BSR search (a 'terrain floor' line: the fitness terms "
+            f"and senses measure the figure against the ground; '{figure.figure.name}' has "
+            "none and would fall for ever)",
+        )
     for term in spec.weights:
         if term not in term_names:
             raise SpecError.at(
@@ -226,7 +236,16 @@ def bind_names(spec: BsrSpec, figure, term_names: tuple[str, ...]) -> BoundNames
         elif kind == "angle":
             root_angle = math.radians(value)
         else:
-            joints[figure.joint_names.index(name)] = math.radians(value)
+            joint = figure.joint_names.index(name)
+            low, high = np.degrees([figure.joint_min[joint], figure.joint_max[joint]])
+            if not low - ANGLE_ROUNDING_DEG <= value <= high + ANGLE_ROUNDING_DEG:
+                allowed = (
+                    f"{name} at its fixed angle, {low:g} deg"
+                    if low == high
+                    else f"an angle of {name} within its range, {low:g} to {high:g} deg"
+                )
+                raise SpecError.at(spec.path, spec.tokens[f"start.{name}"], allowed)
+            joints[joint] = math.radians(value)
     fall = []
     for i, endpoint in enumerate(spec.fall):
         name = f"{endpoint.rod}.{endpoint.end}"

@@ -39,6 +39,7 @@ from mosys.parsing.bsr import FITNESS_TERMS_3D, BsrSpec
 from mosys.parsing.tokens import SpecError
 
 ENRICH_ROUNDS = 3  # §4.2: rounds of the relevance mutation that enrich the first population
+FEET_TERMS = ("feet_distance", "foot_steps")  # the fitness terms that measure the feet
 
 
 @dataclass(frozen=True)
@@ -187,6 +188,14 @@ def bind_search3d(
             spec.path, spec.tokens["perturb"], "no 'perturb' line for a 3-D figure (not built)"
         )
     names = bind_names(spec, figure, FITNESS_TERMS_3D)
+    for term in FEET_TERMS:
+        if spec.weights.get(term, 0.0) != 0.0 and not figure.feet:
+            raise SpecError.at(
+                spec.path,
+                spec.tokens[f"fitness.{term}"],
+                f"a term of a figure with feet for {term} (a 'feet' line in its .fig; "
+                f"'{figure.figure.name}' has none)",
+            )
     endpoints = [tuple(row) for row in figure.endpoints.tolist()]
     feet = np.array([endpoints.index(tuple(foot)) for foot in figure.feet], np.int64)
     height = standing_height(figure)

@@ -25,9 +25,10 @@ Ry(ψ)``) and may use three more keywords and two more ``free`` options::
 A ball joint sits where a hinge would (``at=`` defaults to the parent's length) and has two
 angles, θ (``angle=``, default name the rod's) and ψ (``swing=``, default ``ROD_swing``), their
 rates (``rate=``, ``swing_rate=``) named ``NAME_rate`` by default, ``offset``/``splay`` 0 by
-default, no actuator; its ``limit`` may fix an angle (lower == upper) and needs no
-``stiffness``. A ``hinge`` in a 3-D figure is a joint whose ψ is fixed at 0 (named
-``ROD_swing``, a name no other coordinate may take); its ``limit`` is a planar one.
+default, no actuator. A ``hinge`` in a 3-D figure is a joint whose ψ is fixed at 0 (named
+``ROD_swing``, a name no other coordinate may take). Every limit of a 3-D figure (a ball's or
+a hinge's) is a bare range: it may fix an angle (lower == upper) and needs no ``stiffness``
+(the 3-D BSR simulator's joints are kinematic; one given is kept and not used).
 """
 
 from __future__ import annotations
@@ -428,6 +429,9 @@ class _RawLimit:
     damping: float
     swing_lower: float
     swing_upper: float
+    # (line, column) where a planar figure's limit lacks its 'stiffness=' (reported once the
+    # rod is known to have a joint that takes a limit at all)
+    stiffness_missing_at: tuple[int, int] | None = None
 
 
 @dataclass
@@ -788,10 +792,12 @@ class _Parser:
                 [", ".join(f"'{key}='" for key in bound_keys[:-1]), f"'{bound_keys[-1]}='"]
             )
             raise SpecError(self.path, line.number, line.end_column, f"{expected} (degrees)", None)
-        if not ball:  # a ball joint's limit may be a bare range (the BSR simulator's)
-            self.required(line, found, "stiffness", "N·m/rad")
-        lower, upper = self.bounds(found, "lower", "upper", ball)
-        swing_lower, swing_upper = self.bounds(found, "swing_lower", "swing_upper", ball)
+        # a 3-D figure's limit (a ball's or a hinge's) is a bare range, which may fix its angle:
+        # the 3-D BSR simulator's joints are kinematic, and no spring acts
+        kinematic = self.dimensions == 3
+        missing = None if kinematic or "stiffness" in found else (line.number, line.end_column)
+        lower, upper = self.bounds(found, "lower", "upper", kinematic)
+        swing_lower, swing_upper = self.bounds(found, "swing_lower", "swing_upper", kinematic)
         stiffness = 0.0
         if "stiffness" in found:
             stiffness = self.number(found["stiffness"], "stiffness", "stiffness (N·m/rad)", ">0")
@@ -799,7 +805,7 @@ class _Parser:
         if "damping" in found:
             damping = self.number(found["damping"], "damping", "damping (N·m·s/rad)", ">=0")
         self.limits.append(
-            _RawLimit(rod, lower, upper, stiffness, damping, swing_lower, swing_upper)
+            _RawLimit(rod, lower, upper, stiffness, damping, swing_lower, swing_upper, missing)
         )
 
     def bounds(
@@ -1047,6 +1053,8 @@ class _Parser:
             raise self.error(
                 raw.rod, "a rod with a 'pin' or 'hinge' joint (a free root has no limit)"
             )
+        if raw.stiffness_missing_at is not None:
+            raise SpecError(self.path, *raw.stiffness_missing_at, "'stiffness=' (N·m/rad)", None)
         for other in self.limits:
             if other is raw:
                 break
