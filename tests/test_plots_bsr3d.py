@@ -25,6 +25,7 @@ import mosys.plots.bsr3d as bsr3d
 from mosys.cli import main
 from mosys.io.bsr_result import BsrController, BsrResult, read_bsr_result, write_bsr_result
 from mosys.io.trajectory import FigureMotion
+from mosys.plots.bsr import TITLE_WIDTH
 from mosys.plots.bsr3d import (
     FRONT,
     SIDE,
@@ -481,6 +482,28 @@ def test_learning_kinds_figure(kinds: dict[str, list[Path]]) -> None:
     logged = learning_kinds_figure(kinds["time"], [], log_x=True)
     assert logged.axes[0].get_xscale() == "log"
     assert logged.axes[0].get_xlabel() == "controller evaluations (count, log scale)"
+
+
+def test_learning_kinds_title_fits_two_long_fitness_functions(
+    kinds: dict[str, list[Path]], tmp_path: Path
+) -> None:
+    """Two searches' fitness functions side by side on one line ran off both edges."""
+    weights = {
+        "distance": 1, "feet_distance": 1, "sideways": -1, "fall": -100,
+        "heading_deviation": -0.02, "min_height": 2, "foot_steps": 0.2,
+    }  # fmt: skip
+    sense = []
+    for path in kinds["sense"]:
+        result = read_bsr_result(path)
+        attrs = {**result.attrs, "fitness_weights": json.dumps(weights)}
+        sense.append(tmp_path / path.name)
+        write_bsr_result(sense[-1], dataclasses.replace(result, attrs=attrs))
+    title = learning_kinds_figure(kinds["time"], sense).get_suptitle()
+    lines = title.splitlines()
+    assert lines[2] == "dog_time: fitness = 1·distance − 1·sideways"
+    assert lines[3].startswith("dog_sense: fitness = 1·distance + 1·feet_distance")
+    assert len(lines) == 5 and "0.2·foot_steps" in lines[4]
+    assert max(map(len, lines)) <= TITLE_WIDTH
 
 
 def test_learning_kinds_errors(kinds: dict[str, list[Path]], chain: dict[str, list[Path]]) -> None:

@@ -14,6 +14,8 @@ from mosys.cli.verb import (
     whole_number_problem,
 )
 
+COMPILE_NOTE_S = 1.0  # s: a search that spent this long compiling says so in its last line
+
 
 def _bsr_search_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("spec", help="the search spec (.bsr)")
@@ -55,9 +57,15 @@ def _bsr_search(args: argparse.Namespace) -> None:
         args.threads,
         args.chain,
     )
+    compiling = (
+        f"; {outcome.compile_seconds:.1f} s of it compiling numba's kernels, once per machine"
+        if outcome.compile_seconds >= COMPILE_NOTE_S
+        else ""
+    )
     print(
         f"{args.output}: best fitness {outcome.fitness:.3f} after {outcome.evaluations[-1]} "
-        f"evaluations in {outcome.wall_seconds:.1f} s ({outcome.steps_per_second:.3g} steps/s)"
+        f"evaluations in {outcome.wall_seconds:.1f} s ({outcome.steps_per_second:.3g} steps/s"
+        f"{compiling})"
     )
 
 

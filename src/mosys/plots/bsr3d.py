@@ -840,14 +840,15 @@ def learning_kinds_figure(
         for kind, name, results in kinds
     )
     if len(formulas) == 1:
-        fitness = formulas.pop()
-    else:
-        fitness = "; ".join(
-            f"{name}: {fitness_formula(results[0].fitness_weights)}" for _, name, results in kinds
+        fitness = wrapped(formulas.pop())
+    else:  # each search's on lines of its own: side by side they ran off the figure
+        fitness = "\n".join(
+            wrapped(f"{name}: {fitness_formula(results[0].fitness_weights)}")
+            for _, name, results in kinds
         )
     title = (
         "Learning curves for both kinds of motion controller"
-        f"{': ' + ', '.join(figures) if figures else ''}\n{versus}\n{fitness}"
+        f"{': ' + ', '.join(figures) if figures else ''}\n{wrapped(versus)}\n{fitness}"
     )
     entries: list[tuple[object, str]] = []
     ends = []  # (colour, evaluations, median) at each median curve's end
