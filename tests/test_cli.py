@@ -282,6 +282,10 @@ def usage_error(message: str) -> str:
             "usage: mosys compile [-h] -o OUTPUT spec\n"
             "mosys compile: error: the following arguments are required: -o/--output\n",
         ),
+        (  # the verb's usage: the top level's named no verb
+            ["info", "a.h5", "b.h5"],
+            "usage: mosys info [-h] file\nmosys info: error: unrecognized arguments: b.h5\n",
+        ),
     ],
 )
 def test_bad_arguments(tmp_path, monkeypatch, capsys, argv, stderr):

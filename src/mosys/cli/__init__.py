@@ -106,7 +106,9 @@ def build_parser() -> argparse.ArgumentParser:
                 groups[group] = verbs.add_parser(group).add_subparsers(dest="kind", required=True)
             subparser = (groups[group] if group else verbs).add_parser(name, help=verb.summary)
             verb.add_arguments(subparser)
-            subparser.set_defaults(command=verb, file_options=file_options(subparser))
+            subparser.set_defaults(
+                command=verb, file_options=file_options(subparser), verb_parser=subparser
+            )
     return parser
 
 
@@ -133,7 +135,9 @@ def environment_problem() -> str | None:
 def main(argv: list[str] | None = None) -> int:
     """Run the verb ``argv`` names (None: this command line's); its exit code."""
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args, unknown = parser.parse_known_args(argv)
+    if unknown:  # the verb's usage, not the top level's (which names no verb)
+        args.verb_parser.error(f"unrecognized arguments: {' '.join(unknown)}")
     problem = (
         args.command.check(args)
         or same_file_problem(args, args.file_options)
