@@ -215,3 +215,23 @@ def test_final_spin_is_the_bodys_rate_at_the_end():
     measured = outcome.terms[FITNESS_TERMS_3D.index("final_spin")]
     assert measured == pytest.approx(np.degrees(np.linalg.norm(rate)), rel=1e-9)
     assert measured > 1.0  # a run of a random controller ends moving
+
+
+def test_a_heading_rod_standing_upright_at_the_start_is_refused(tmp_path):
+    """The heading is the heading rod's horizontal direction: of an upright rod it was
+    rounding, and a search weighed its deviation (21 deg of noise) without a word."""
+    text = Path("specs/figures/cujo.fig").read_text(encoding="utf-8")
+    (tmp_path / "cujo.fig").write_text(
+        text.replace("heading spine offset=0", "heading front_left offset=0"), encoding="utf-8"
+    )
+    figure = load_bsr_figure3d(tmp_path, "test.bsr", Token("cujo", 1, 8))
+    splayed = SPEC.replace("spine=0", "spine=0 front_left_swing=5")  # 15 deg from upright
+    bind_search3d(parse_bsr_text(splayed, "test.bsr"), figure)
+    with pytest.raises(SpecError) as error:
+        upright = SPEC.replace("spine=0", "spine=0 front_left_swing=-5")  # 5 deg
+        bind_search3d(parse_bsr_text(upright, "test.bsr"), figure)
+    assert str(error.value) == (
+        "test.bsr:1:8: expected a figure whose heading rod lies nearer the horizontal at the "
+        "start ('front_left', its 'heading' line's rod, is 5.0 deg from upright in the start "
+        "pose, and its horizontal direction is the heading), found 'cujo'"
+    )

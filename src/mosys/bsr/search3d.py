@@ -28,7 +28,7 @@ from mosys.bsr.search import (
     describe_values,
     population_arrays,
 )
-from mosys.bsr.start3d import standing_state
+from mosys.bsr.start3d import pose_at_rest, standing_state
 from mosys.errors import InputError
 from mosys.io.bsr_result import BsrController
 from mosys.io.contracts import open_contract
@@ -40,6 +40,9 @@ from mosys.parsing.tokens import SpecError
 
 ENRICH_ROUNDS = 3  # §4.2: rounds of the relevance mutation that enrich the first population
 FEET_TERMS = ("feet_distance", "foot_steps")  # the fitness terms that measure the feet
+# the least horizontal part of the heading rod's length at the start (sin 5.7°): nearer upright,
+# its horizontal direction, the heading, is rounding, and so are the terms that measure it
+HEADING_MIN_HORIZONTAL = 0.1
 
 
 @dataclass(frozen=True)
@@ -174,6 +177,27 @@ def standing_height(figure: BsrFigure3D, root_angle: float = 0.0) -> float:
     return float(standing_state(figure, root_angle, np.zeros(len(figure.joint_names)))[CY])
 
 
+def _check_heading_rod(
+    spec: BsrSpec, figure: BsrFigure3D, root_angle: float, angles: np.ndarray
+) -> None:
+    """Raise SpecError at the spec's ``figure`` word if the heading rod stands within
+    asin(HEADING_MIN_HORIZONTAL) of upright in the start pose (root_angle rad about the world
+    z axis, angles (J,) rad): its horizontal direction is then no heading."""
+    rod_ends, _ = pose_at_rest(figure, angles)
+    dx, dy, dz = rod_ends[figure.heading_rod, 1] - rod_ends[figure.heading_rod, 0]
+    along = math.cos(root_angle) * dx - math.sin(root_angle) * dy
+    horizontal = math.hypot(along, dz) / math.sqrt(dx * dx + dy * dy + dz * dz)
+    if horizontal < HEADING_MIN_HORIZONTAL:
+        rod = figure.figure.rods[figure.heading_rod].name
+        raise SpecError.at(
+            spec.path,
+            spec.tokens["figure"],
+            f"a figure whose heading rod lies nearer the horizontal at the start ('{rod}', "
+            f"its 'heading' line's rod, is {math.degrees(math.asin(horizontal)):.1f} deg from "
+            "upright in the start pose, and its horizontal direction is the heading)",
+        )
+
+
 def bind_search3d(
     spec: BsrSpec,
     figure: BsrFigure3D,
@@ -211,6 +235,7 @@ def bind_search3d(
         filter_time=spec.sense_filter,
     )
     if chain is None:
+        _check_heading_rod(spec, figure, names.root_angle, names.joints)
         start = standing_state(figure, names.root_angle, names.joints, names.x)
         start_force = np.zeros(figure.endpoints.shape[0])
     else:

@@ -15,17 +15,19 @@ def state_size(figure: BsrFigure3D) -> int:
     return JOINTS + 2 * len(figure.joint_names)
 
 
-def end_offsets(figure: BsrFigure3D, angles: np.ndarray) -> np.ndarray:
-    """(E, 3) each distinct endpoint's offset from the centre of mass in the body frame, m, in
-    the pose ``angles`` (J,) rad."""
+def pose_at_rest(figure: BsrFigure3D, angles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The figure in the pose ``angles`` (J,) rad, in its body frame about its centre of mass:
+    each rod's proximal and distal end (N, 2, 3) m, and each distinct endpoint's offset (E, 3)
+    m."""
     n_rods = figure.parent.shape[0]
+    rod_ends = np.empty((n_rods, 2, 3))
     offsets = np.empty((figure.endpoints.shape[0], 3))
     arrays = figure.arrays
     body_frame(
         *arrays[:9],
         np.asarray(angles, np.float64),
         np.zeros(len(figure.joint_names)),
-        np.empty((n_rods, 2, 3)),
+        rod_ends,
         offsets,
         np.empty_like(offsets),
         np.empty((n_rods, 3, 3)),
@@ -33,7 +35,7 @@ def end_offsets(figure: BsrFigure3D, angles: np.ndarray) -> np.ndarray:
         np.empty((3, 3)),
         np.empty(3),
     )
-    return offsets
+    return rod_ends, offsets
 
 
 def standing_state(
@@ -47,7 +49,7 @@ def standing_state(
     state = np.zeros(state_size(figure))
     angles = np.clip(np.asarray(angles, np.float64), figure.joint_min, figure.joint_max)
     state[JOINTS : JOINTS + n_angles] = angles
-    offsets = end_offsets(figure, angles)
+    _, offsets = pose_at_rest(figure, angles)
     heights = math.sin(root_angle) * offsets[:, 0] + math.cos(root_angle) * offsets[:, 1]
     floor = 0.0 if math.isnan(figure.floor) else figure.floor
     state[CX] = x
