@@ -235,3 +235,21 @@ def test_a_heading_rod_standing_upright_at_the_start_is_refused(tmp_path):
         "start ('front_left', its 'heading' line's rod, is 5.0 deg from upright in the start "
         "pose, and its horizontal direction is the heading), found 'cujo'"
     )
+
+
+def test_a_figure_lying_flat_is_refused_not_divided_by(tmp_path):
+    """Its standing centre of mass is on the floor: the senses' scales divided by that height
+    and the search died of ZeroDivisionError, exit 1, with a traceback."""
+    (tmp_path / "flat.fig").write_text(
+        "rod a length=0.6 mass=3\nrod b length=0.6 mass=3\nfree a\nball b on=a\n"
+        "limit b lower=-30 upper=30 swing_lower=-30 swing_upper=30\nheading a\nterrain floor\n",
+        encoding="utf-8",
+    )
+    figure = load_bsr_figure3d(tmp_path, "test.bsr", Token("flat", 1, 8))
+    spec = SPEC.replace("figure cujo", "figure flat").replace("spine=0", "a=0")
+    with pytest.raises(SpecError) as error:
+        bind_search3d(parse_bsr_text(spec, "test.bsr"), figure)
+    assert str(error.value) == (
+        "test.bsr:1:8: expected a figure whose centre of mass stands above the floor at rest "
+        "(every angle 0; 'flat' lies flat, its centre of mass 0 m up), found 'flat'"
+    )

@@ -277,8 +277,8 @@ def test_bsr_search_exits_2_when_a_3d_figure_blows_up(tmp_path: Path) -> None:
         done,
         f"{spec}:3:1: the figure's state became non-finite at t = 1e+298 s (seed 1, generation "
         "0): "
-        "cm_x=-inf m, cm_y=nan m, cm_z=inf m, cm_vx=-3.08359e+291 m/s, cm_vy=-8.417e+292 m/s,"
-        " cm_vz=4.68199e+294 m/s, q_w=1, q_x=0.000146768, q_y=-3.6913e-05, q_z=-5.7647e-05, "
+        "cm_x=-inf m, cm_y=-inf m, cm_z=inf m, cm_vx=-3.08359e+291 m/s, cm_vy=-8.417e+292 m/s,"
+        " cm_vz=4.68199e+294 m/s, q_w=nan, q_x=nan, q_y=nan, q_z=nan, "
         "L_x=-1.30589e+295 kg·m²/s, L_y=1.84741e+288 kg·m²/s, L_z=-4.73087e+292 kg·m²/s, "
         "head=0.00726047 deg, head_turn=0 deg, tail=-0.291395 deg, tail_swing=0 deg, "
         "front_left=-0.115567 deg, front_left_swing=-0.0156968 deg, front_right=0.201265 deg, "

@@ -223,6 +223,13 @@ def bind_search3d(
     endpoints = [tuple(row) for row in figure.endpoints.tolist()]
     feet = np.array([endpoints.index(tuple(foot)) for foot in figure.feet], np.int64)
     height = standing_height(figure)
+    if not height > 0.0:  # the senses' and the fall's scale
+        raise SpecError.at(
+            spec.path,
+            spec.tokens["figure"],
+            f"a figure whose centre of mass stands above the floor at rest (every angle 0; "
+            f"'{figure.figure.name}' lies flat, its centre of mass {height:g} m up)",
+        )
     speed = math.sqrt(figure.gravity * height)
     task = Task(
         falls=names.fall_endpoints,
