@@ -534,6 +534,26 @@ def _mix_shares(weight, active, count, mixing, stored):
         weight[i] /= total
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def cholesky_in_place(system, n, scale):
+    """The Cholesky factor L of the symmetric positive definite system[:n, :n] (its lower
+    triangle read), into that lower triangle; False where a pivot is at most 1e-12 of ``scale``
+    (the largest entry): singular, the factor unfinished."""
+    for k in range(n):
+        for c in range(k):
+            total = system[k, c]
+            for p in range(c):
+                total -= system[k, p] * system[c, p]
+            system[k, c] = total / system[c, c]
+        total = system[k, k]
+        for p in range(k):
+            total -= system[k, p] * system[k, p]
+        if not total > 1e-12 * scale:
+            return False
+        system[k, k] = math.sqrt(total)
+    return True
+
+
 @njit(cache=True, error_model="numpy")
 def _normal_block(u, r, active, count, responses, system, compliance, pairs):
     """The set-up of ``_shared_friction`` at the active contacts: A⁻¹ into system[:n, :n], N0 =
@@ -575,18 +595,8 @@ def _normal_block(u, r, active, count, responses, system, compliance, pairs):
                 pairs[i, j, 7] = r[i, 2] * k[0, 2] - r[i, 0] * k[2, 2]
                 pairs[i, j, 8] = r[i, 2] * twist_x - r[i, 0] * twist_z
         row += 1
-    for k in range(n):
-        for c in range(k):
-            total = system[k, c]
-            for p in range(c):
-                total -= system[k, p] * system[c, p]
-            system[k, c] = total / system[c, c]
-        total = system[k, k]
-        for p in range(k):
-            total -= system[k, p] * system[k, p]
-        if not total > 1e-12 * scale_a:
-            return -1.0
-        system[k, k] = math.sqrt(total)
+    if not cholesky_in_place(system, n, scale_a):
+        return -1.0
     for k in range(n):  # L⁻¹, row by row (a row's entries of L are used left to right)
         diagonal = 1.0 / system[k, k]
         for c in range(k):
@@ -916,21 +926,7 @@ def frictionless_impulses(u, count, responses, impulse, system, compliance):
                         column += 1
                 system[row, MAX_CONTACTS] = -u[i, 1]
                 row += 1
-            singular = False
-            for k in range(n):
-                for c in range(k):
-                    total = system[k, c]
-                    for q in range(c):
-                        total -= system[k, q] * system[c, q]
-                    system[k, c] = total / system[c, c]
-                total = system[k, k]
-                for q in range(k):
-                    total -= system[k, q] * system[k, q]
-                if not total > 1e-12 * scale:
-                    singular = True
-                    break
-                system[k, k] = math.sqrt(total)
-            if singular:
+            if not cholesky_in_place(system, n, scale):
                 continue
             for k in range(n):  # L y = b, then Lᵀ x = y
                 total = system[k, MAX_CONTACTS]
