@@ -151,6 +151,31 @@ def test_two_contacts_share_friction_in_the_ratio_of_their_normal_impulses():
     assert abs(weights @ after[:, 0]) < 1e-9
 
 
+@pytest.mark.parametrize(
+    ("u", "r", "pushing"),
+    [
+        ([[-0.79, -0.27], [-0.24, -0.45]], [[0.25, -0.21], [0.59, -0.31]], [True, True]),
+        ([[-0.43, -0.37], [-0.37, -0.15]], [[0.75, -0.54], [0.47, -0.51]], [True, False]),
+    ],
+)
+def test_where_no_impulses_of_the_friction_rule_push_the_normal_ones_alone_hold(u, r, pushing):
+    """Two sinking points whose shared friction needs a pulling normal impulse and neither of
+    which can be stopped dead alone (one in six random pairs): the floor gave no impulse, and
+    the figure sank, was lifted out by its position and kept a fall's velocity. Now normal
+    impulses alone (no friction for the step), which leave neither point sinking."""
+    u, r = np.array(u), np.array(r)
+    inverse_mass, inverse_inertia = 1 / 20.0, 1 / 2.0
+    impulse = np.zeros((2, 2))
+    contact_impulses(u, r, 2, inverse_mass, inverse_inertia, impulse)
+    assert (impulse[:, 1] > 0).tolist() == pushing
+    np.testing.assert_array_equal(impulse[:, 0], 0.0)
+    for i in range(2):
+        after = u[i, 1] + sum(
+            (inverse_mass + r[i, 0] * r[j, 0] * inverse_inertia) * impulse[j, 1] for j in range(2)
+        )
+        assert after == pytest.approx(0.0, abs=1e-12) if pushing[i] else after >= 0.0
+
+
 def test_a_contact_that_is_leaving_gets_no_impulse():
     impulse = np.ones((2, 2))
     contact_impulses(

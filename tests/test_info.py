@@ -445,7 +445,7 @@ def test_info_of_each_other_kind(made, capsys):
     assert section(out, "search:")[1] == (
         "  sense-based controller, 10 rules, joints: arm_a, arm_b, leg_a, leg_b"
     )
-    assert "  /best/figure_motion: 151 samples, t 0 … 1.5 s, 2-D, 5 rods (torso, arm_a, " in out
+    assert "  /best/figure_motion: 251 samples, t 0 … 2.5 s, 2-D, 5 rods (torso, arm_a, " in out
 
     out = info_of(made["composite result"], capsys)
     refined = section(out, "phases, refined (phases):")

@@ -162,7 +162,7 @@ def test_composite_ticks_are_limited(tmp_path, composite_workspace, capsys):
     message = last_line(capsys)
     assert message.startswith(
         f"{script}:9:59: expected at most 10,000,000 integration steps per run, found "
-        "100,000,000,214 (the phases' 100,000,000,214 ticks to the end of this one)"
+        "100,000,000,229 (the phases' 100,000,000,229 ticks to the end of this one)"
     )
     assert_nothing_written(out)
 
@@ -181,7 +181,7 @@ def test_composite_ticks_past_int64_together_are_limited_and_counted_exactly(
     assert main([*argv, "-o", str(out)]) == 2
     assert last_line(capsys).startswith(
         f"{script}:9:59: expected at most 10,000,000 integration steps per run, found "
-        f"9.22e+18 (the phases' {215 + 2**63 - 1:,} ticks to the end of this one)"
+        f"9.22e+18 (the phases' {230 + 2**63 - 1:,} ticks to the end of this one)"
     )
     assert_nothing_written(out)
 

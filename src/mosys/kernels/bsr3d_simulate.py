@@ -24,7 +24,9 @@ fixed point over the weights: each iteration a symmetric positive definite solve
 block inverted once; Anderson mixing of the weights, where the plain iteration would take two to
 five times as many, except for two contacts with no z in their offsets from the centre of mass
 or their velocities, which iterate plainly as the 2-D rule does). Contacts whose normal impulse
-would pull are dropped one at a time. An endpoint that still ends the step below the floor lifts
+would pull are dropped one at a time, then each is tried alone, stopped dead; where no set of
+the friction rule pushes, the normal impulses alone (no friction for that step) stop the
+sinking ones. An endpoint that still ends the step below the floor lifts
 the figure out of it, and an endpoint alone on the floor is stopped and held where it stood, as
 in 2-D.
 
@@ -532,6 +534,26 @@ def _mix_shares(weight, active, count, mixing, stored):
         weight[i] /= total
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def cholesky_in_place(system, n, scale):
+    """The Cholesky factor L of the symmetric positive definite system[:n, :n] (its lower
+    triangle read), into that lower triangle; False where a pivot is at most 1e-12 of ``scale``
+    (the largest entry): singular, the factor unfinished."""
+    for k in range(n):
+        for c in range(k):
+            total = system[k, c]
+            for p in range(c):
+                total -= system[k, p] * system[c, p]
+            system[k, c] = total / system[c, c]
+        total = system[k, k]
+        for p in range(k):
+            total -= system[k, p] * system[k, p]
+        if not total > 1e-12 * scale:
+            return False
+        system[k, k] = math.sqrt(total)
+    return True
+
+
 @njit(cache=True, error_model="numpy")
 def _normal_block(u, r, active, count, responses, system, compliance, pairs):
     """The set-up of ``_shared_friction`` at the active contacts: A⁻¹ into system[:n, :n], N0 =
@@ -573,18 +595,8 @@ def _normal_block(u, r, active, count, responses, system, compliance, pairs):
                 pairs[i, j, 7] = r[i, 2] * k[0, 2] - r[i, 0] * k[2, 2]
                 pairs[i, j, 8] = r[i, 2] * twist_x - r[i, 0] * twist_z
         row += 1
-    for k in range(n):
-        for c in range(k):
-            total = system[k, c]
-            for p in range(c):
-                total -= system[k, p] * system[c, p]
-            system[k, c] = total / system[c, c]
-        total = system[k, k]
-        for p in range(k):
-            total -= system[k, p] * system[k, p]
-        if not total > 1e-12 * scale_a:
-            return -1.0
-        system[k, k] = math.sqrt(total)
+    if not cholesky_in_place(system, n, scale_a):
+        return -1.0
     for k in range(n):  # L⁻¹, row by row (a row's entries of L are used left to right)
         diagonal = 1.0 / system[k, k]
         for c in range(k):
@@ -880,6 +892,75 @@ def _twist_too_strong(impulse, active, count):
     return False
 
 
+@njit(cache=True, error_model="numpy")
+def frictionless_impulses(u, count, responses, impulse, system, compliance):
+    """Normal impulses alone (count,) N s into impulse[:, 1] (its x and z 0), the floor's last
+    resort when no impulse set of the friction rule pushes: the contacts that push stop
+    sinking, and none of the others sinks after them (non-penetration with no friction; for a
+    positive definite normal block exactly one such set). The sets are tried largest first;
+    ``compliance`` (s/kg) is added to each contact's own normal response in sets of three or
+    more (as ``contact_impulses`` does: a rigid body leaves their split undecided). u (count, 3),
+    responses (M, M, 3, 3); system (M + 4, M + 4): work space. Returns whether a set was
+    found (else the impulses are 0)."""
+    impulse[:count, :] = 0.0
+    for size in range(count, 0, -1):
+        for members in range(1, 1 << count):
+            n = 0
+            for i in range(count):
+                n += (members >> i) & 1
+            if n != size:
+                continue
+            added = compliance if n >= 3 else 0.0
+            # A_S's Cholesky factor in system[:n, :n], the solution in column M
+            scale = 0.0
+            row = 0
+            for i in range(count):
+                if not (members >> i) & 1:
+                    continue
+                column = 0
+                for j in range(count):
+                    if (members >> j) & 1:
+                        value = responses[i, j, 1, 1] + (added if i == j else 0.0)
+                        system[row, column] = value
+                        scale = max(scale, abs(value))
+                        column += 1
+                system[row, MAX_CONTACTS] = -u[i, 1]
+                row += 1
+            if not cholesky_in_place(system, n, scale):
+                continue
+            for k in range(n):  # L y = b, then Lᵀ x = y
+                total = system[k, MAX_CONTACTS]
+                for q in range(k):
+                    total -= system[k, q] * system[q, MAX_CONTACTS]
+                system[k, MAX_CONTACTS] = total / system[k, k]
+            pushing = True
+            for k in range(n - 1, -1, -1):
+                total = system[k, MAX_CONTACTS]
+                for q in range(k + 1, n):
+                    total -= system[q, k] * system[q, MAX_CONTACTS]
+                system[k, MAX_CONTACTS] = total / system[k, k]
+                pushing = pushing and system[k, MAX_CONTACTS] > 0.0
+            if not pushing:
+                continue
+            row = 0
+            for i in range(count):
+                if (members >> i) & 1:
+                    impulse[i, 1] = system[row, MAX_CONTACTS]
+                    row += 1
+            holding = True
+            for i in range(count):
+                if (members >> i) & 1:
+                    continue
+                uy = u[i, 1]
+                for j in range(count):
+                    uy += responses[i, j, 1, 1] * impulse[j, 1]
+                holding = holding and uy >= -1e-9
+            if holding:
+                return True
+            impulse[:count, 1] = 0.0
+    return False
+
+
 @njit(cache=True, inline="always", error_model="numpy")
 def contact_impulses(
     u,
@@ -902,7 +983,8 @@ def contact_impulses(
     together, with shared friction, dropping the one whose normal impulse would pull most and
     trying again while two or more are left; then each sinking one alone, the fastest first,
     stopped dead. The first set whose normal impulses push and after which no other touching
-    point sinks is kept; none, no impulse (the 2-D rule for two, carried to any number).
+    point sinks is kept; none, the normal impulses alone (``frictionless_impulses``), as the
+    2-D rule does for two.
     responses (M, M, 3, 3), system (M + 4, M + 4), mixing (3, M, M), shares (3, M), pairs (M, M,
     9), spins (M, 3, 3): work space.
     chosen (count,): the points' endpoint numbers; end_share (E,): each endpoint's share of the
@@ -964,7 +1046,7 @@ def contact_impulses(
             if u[i, 1] < 0.0 and not tried[i] and (first < 0 or u[i, 1] < u[first, 1]):
                 first = i
         if first < 0:
-            return
+            break
         tried[first] = 1.0
         px, py, pz = stop_dead(u, responses, first)
         if py <= 0.0:
@@ -977,6 +1059,10 @@ def contact_impulses(
         if _others_hold(u, count, responses, impulse, active):
             return
         impulse[first, :] = 0.0
+    # no set pushes under the friction rule: without friction, rather than no impulse (the
+    # figure would sink, be lifted out by its position alone and gather a fall's velocity)
+    compliance = COMPLIANCE * (responses[0, 0, 0, 0] + responses[0, 0, 1, 1])
+    frictionless_impulses(u, count, responses, impulse, system, compliance)
 
 
 class StepWork(NamedTuple):

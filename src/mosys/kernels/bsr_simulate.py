@@ -314,11 +314,48 @@ def _two_contacts(u, r, inverse_mass, inverse_inertia, impulse):
 
 
 @njit(cache=True)
+def _frictionless(u, r, count, inverse_mass, inverse_inertia, impulse):
+    """Normal impulses alone into impulse[:, 1] (x 0): the floor's last resort when no set of
+    the friction rule pushes. Both points stop sinking if both then push; else the one whose
+    impulse alone stops it sinking and leaves the other not sinking (non-penetration with no
+    friction: for a positive definite normal block exactly one such set)."""
+    if count == 2:
+        a00 = _response(r[0, 0], r[0, 1], r[0, 0], r[0, 1], inverse_mass, inverse_inertia)[3]
+        a01 = _response(r[0, 0], r[0, 1], r[1, 0], r[1, 1], inverse_mass, inverse_inertia)[3]
+        a11 = _response(r[1, 0], r[1, 1], r[1, 0], r[1, 1], inverse_mass, inverse_inertia)[3]
+        determinant = a00 * a11 - a01 * a01
+        if determinant > 1e-12 * max(a00, a11) ** 2:
+            normal0 = (-u[0, 1] * a11 + u[1, 1] * a01) / determinant
+            normal1 = (-u[1, 1] * a00 + u[0, 1] * a01) / determinant
+            if normal0 > 0.0 and normal1 > 0.0:
+                impulse[0, 1] = normal0
+                impulse[1, 1] = normal1
+                return
+    for i in range(count):
+        if u[i, 1] >= 0.0:
+            continue
+        own = _response(r[i, 0], r[i, 1], r[i, 0], r[i, 1], inverse_mass, inverse_inertia)[3]
+        normal = -u[i, 1] / own
+        if count == 2:
+            other = 1 - i
+            cross = _response(
+                r[other, 0], r[other, 1], r[i, 0], r[i, 1], inverse_mass, inverse_inertia
+            )[3]
+            if u[other, 1] + cross * normal < -1e-9:
+                continue
+        impulse[i, 1] = normal
+        return
+
+
+@njit(cache=True)
 def contact_impulses(u, r, count, inverse_mass, inverse_inertia, impulse):
     """The ground's impulses on ``count`` (0, 1 or 2) touching endpoints: u (2, 2) their
     velocities m/s, r (2, 2) their offsets from the centre of mass m; fills impulse (2, 2) N s.
     Tries both endpoints together, then each alone (the one sinking faster first), keeping the
-    first set whose normal impulses push and whose other endpoint does not sink."""
+    first set whose normal impulses push and whose other endpoint does not sink; where none
+    does, the normal impulses alone (``_frictionless``: no friction for that step), rather than
+    none (the figure would sink, be lifted out by its position alone and gather a fall's
+    velocity, until one step's impulse threw it)."""
     impulse[:, :] = 0.0
     if count == 0:
         return
@@ -346,6 +383,7 @@ def contact_impulses(u, r, count, inverse_mass, inverse_inertia, impulse):
         impulse[i, 0] = px
         impulse[i, 1] = py
         return
+    _frictionless(u, r, count, inverse_mass, inverse_inertia, impulse)
 
 
 @njit(cache=True)
