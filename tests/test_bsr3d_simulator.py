@@ -391,7 +391,8 @@ def test_a_figure_in_a_vertical_plane_moves_as_the_2d_simulator_moves_it():
 def contact_case(u, r, inverse_mass=1 / 42.1, spin_inertia=(3.0, 4.0, 2.5), world_inverse=None):
     """The impulses (count, 3) the floor gives points with velocities u and offsets r (count,
     3) from the centre of mass of a body of that mass and (diagonal) inertia (or inverse world
-    inertia tensor (3, 3)), and the points' velocities after them."""
+    inertia tensor (3, 3)), the points' velocities after them, and whether the impulses follow
+    the friction rule (False: the floor's frictionless last resort)."""
     count = len(u)
     m = sim.MAX_CONTACTS
     uu, rr = np.zeros((m, 3)), np.zeros((m, 3))
@@ -400,7 +401,7 @@ def contact_case(u, r, inverse_mass=1 / 42.1, spin_inertia=(3.0, 4.0, 2.5), worl
         world_inverse = np.diag(1.0 / np.asarray(spin_inertia))
     impulse = np.zeros((m, 3))
     responses = np.zeros((m, m, 3, 3))
-    sim.contact_impulses(
+    frictional = sim.contact_impulses(
         uu,
         rr,
         count,
@@ -420,13 +421,14 @@ def contact_case(u, r, inverse_mass=1 / 42.1, spin_inertia=(3.0, 4.0, 2.5), worl
     for i in range(count):
         for j in range(count):
             after[i] += responses[i, j] @ impulse[j]
-    return impulse[:count], after
+    return impulse[:count], after, frictional
 
 
 def test_several_contacts_share_friction_in_the_ratio_of_their_normal_impulses():
     u = [[0.3, -0.5, 0.1], [0.2, -0.4, -0.2], [0.25, -0.6, 0.05]]
     r = [[0.4, -0.6, 0.3], [0.4, -0.6, -0.3], [-0.5, -0.6, 0.0]]
-    impulse, after = contact_case(np.array(u), np.array(r))
+    impulse, after, frictional = contact_case(np.array(u), np.array(r))
+    assert frictional
     normal = impulse[:, 1]
     assert (normal > 0).all()
     # none sinks (but for the compliance that splits three contacts' load: 1e-6 of a response)
@@ -447,10 +449,24 @@ def test_where_no_impulses_of_the_friction_rule_push_the_floor_still_holds_the_f
     u = np.array([[0.0, -0.0971, 0.379], [0.0, -0.0971, -0.379]])
     r = np.array([[0.0, -0.6944, -0.098], [0.0, -0.6944, 0.198]])
     world_inverse = np.array([[0.671, 0.0, 0.0], [0.0, 4.2194, -0.32167], [0.0, -0.32167, 0.827]])
-    impulse, after = contact_case(u, r, 1 / 18.0, world_inverse=world_inverse)
+    impulse, after, frictional = contact_case(u, r, 1 / 18.0, world_inverse=world_inverse)
+    assert not frictional
     assert (impulse[:, 1] > 0.5).all()
     np.testing.assert_array_equal(impulse[:, [0, 2]], 0.0)
     np.testing.assert_allclose(after[:, 1], 0.0, atol=1e-12)
+
+
+def test_a_lone_point_that_stopping_dead_would_pull_is_stopped_horizontally_and_rises():
+    """A lone point sliding fast whose full stop would tip the body up off it: the horizontal
+    stop alone (no frictionless push, which the step's pin then turned into a hidden sliding
+    velocity), after which it slides no more and does not sink."""
+    u = np.array([[-3.0, -0.05, 1.0]])
+    r = np.array([[0.6, -0.3, 0.2]])
+    impulse, after, frictional = contact_case(u, r, 1 / 20.0, spin_inertia=(2.0, 2.0, 2.0))
+    assert frictional
+    assert impulse[0, 1] == 0.0 and np.abs(impulse[0, [0, 2]]).max() > 1.0
+    np.testing.assert_allclose(after[0, [0, 2]], 0.0, atol=1e-12)
+    assert after[0, 1] >= 0.0
 
 
 def test_a_figure_spreading_its_legs_is_held_by_the_floor_at_every_step():
@@ -483,7 +499,7 @@ def test_a_contact_that_barely_touches_does_not_make_friction_explode():
     ones (a search once found the 4,000 N s this used to give and flew off at 25 m/s)."""
     u = np.array([[0.0363, -0.1048, 0.018], [-0.0275, -0.095, -0.0347]])
     r = np.array([[-0.0835, -0.6633, -0.1592], [-0.0234, -0.6632, 0.2383]])
-    impulse, after = contact_case(u, r)
+    impulse, after, _ = contact_case(u, r)
     assert np.abs(impulse).max() < 10.0
     assert np.abs(after).max() < 0.2
 

@@ -31,8 +31,8 @@ ROOT = Path(__file__).resolve().parents[1]
 SPECS = ROOT / "specs"
 SHOW = SPECS / "composite" / "starman_show.comp"
 PHASE_LINES = (  # the phase lines of starman_show.comp as written, and their durations
-    ("phase cartwheel controller=starman_cartwheel_robust ticks=230", 230),
-    ("phase jump      controller=starman_jump_robust      ticks=100", 100),
+    ("phase cartwheel controller=starman_cartwheel_robust ticks=215", 215),
+    ("phase jump      controller=starman_jump_robust      ticks=150", 150),
     ("phase shuffle   controller=starman_shuffle_robust   ticks=100", 100),
 )
 
@@ -92,10 +92,10 @@ def slider_click(slider, ticks: int) -> None:
 @pytest.mark.slow
 def test_the_editor_starts_from_the_scripts_durations(at_guess):
     editor = at_guess
-    expected = editor.session.score([230, 100, 100])
-    assert editor.ticks.tolist() == [230, 100, 100]
-    assert [slider.val for slider in editor.sliders] == [230, 100, 100]
-    assert [slider.valmax for slider in editor.sliders] == [690, 430, 430]  # 3x, or the total
+    expected = editor.session.score([215, 150, 100])
+    assert editor.ticks.tolist() == [215, 150, 100]
+    assert [slider.val for slider in editor.sliders] == [215, 150, 100]
+    assert [slider.valmax for slider in editor.sliders] == [645, 465, 465]  # 3x, or the total
     assert editor.scored.total == expected.total
     assert editor.total_text.get_text() == f"total {score_text(expected.total)}"
     assert editor.status_text.get_text() == f"the durations in {editor.script_path}"
@@ -109,9 +109,9 @@ def test_moving_a_slider_reruns_the_motion_and_redraws_it(at_guess):
 
     slider_click(editor.sliders[0], 120)  # the cartwheel stops after 1.2 s instead of 2.15 s
 
-    assert editor.ticks.tolist() == [120, 100, 100]
+    assert editor.ticks.tolist() == [120, 150, 100]
     assert editor.sliders[0].val == 120
-    expected = editor.session.score([120, 100, 100])  # what the pipeline's session makes of it
+    expected = editor.session.score([120, 150, 100])  # what the pipeline's session makes of it
     motion = expected.motion
     assert editor.scored.total == expected.total
     assert editor.scored.scores == expected.scores
@@ -156,18 +156,18 @@ def test_each_phase_is_drawn_in_its_colour(at_guess):
 def test_set_duration_moves_the_slider_and_refuses_what_no_slider_gives(at_guess):
     editor = at_guess
     editor.set_duration(2, 150.0)  # a slider gives floats
-    assert editor.ticks.tolist() == [230, 100, 150]
+    assert editor.ticks.tolist() == [215, 150, 150]
     assert editor.sliders[2].val == 150
-    assert editor.scored.total == editor.session.total([230, 100, 150])
+    assert editor.scored.total == editor.session.total([215, 150, 150])
     for k, ticks, message in (
         (0, 0, "phase cartwheel: a duration is a whole number of ticks >= 1, got 0"),
         (1, 12.5, "phase jump: a duration is a whole number of ticks >= 1, got 12.5"),
-        (2, 431, "phase shuffle: at most 430 ticks (its slider's end), got 431"),
+        (2, 466, "phase shuffle: at most 465 ticks (its slider's end), got 466"),
     ):
         with pytest.raises(ValueError) as error:
             editor.set_duration(k, ticks)
         assert str(error.value) == message
-    assert editor.ticks.tolist() == [230, 100, 150]  # unchanged
+    assert editor.ticks.tolist() == [215, 150, 150]  # unchanged
     with pytest.raises(IndexError):
         editor.set_duration(3, 10)
 
@@ -178,18 +178,18 @@ def test_a_slider_moved_past_the_limits_goes_back_and_says_why(at_guess, monkeyp
     past it: the move is refused in the status line (not raised into the GUI loop) and the
     slider and motion stay where they were."""
     editor = at_guess
-    monkeypatch.setenv("MOSYS_MAX_STEPS", "600")  # the guess, 430 ticks, fits
+    monkeypatch.setenv("MOSYS_MAX_STEPS", "600")  # the guess, 465 ticks, fits
     scored = editor.scored
-    slider_click(editor.sliders[0], 500)  # 700 ticks in all
-    assert editor.ticks.tolist() == [230, 100, 100]
-    assert editor.sliders[0].val == 230
+    slider_click(editor.sliders[0], 500)  # 750 ticks in all
+    assert editor.ticks.tolist() == [215, 150, 100]
+    assert editor.sliders[0].val == 215
     assert editor.scored is scored
     assert editor.status_text.get_text() == (
-        "not run: expected at most 600 integration steps per run, found 700 (the phases' 700 "
+        "not run: expected at most 600 integration steps per run, found 750 (the phases' 750 "
         'ticks to the end of this one); raise MOSYS_MAX_STEPS to allow it (README, "Limits")'
     )
-    slider_click(editor.sliders[0], 300)  # 500 ticks: runs
-    assert editor.ticks.tolist() == [300, 100, 100]
+    slider_click(editor.sliders[0], 300)  # 550 ticks: runs
+    assert editor.ticks.tolist() == [300, 150, 100]
     assert editor.status_text.get_text().startswith("unsaved")
 
 
@@ -198,8 +198,8 @@ def test_reset_returns_to_the_start(at_guess):
     editor = at_guess
     editor.set_durations([10, 20, 30])
     click(editor.reset_button.ax)
-    assert editor.ticks.tolist() == [230, 100, 100]
-    assert [slider.val for slider in editor.sliders] == [230, 100, 100]
+    assert editor.ticks.tolist() == [215, 150, 100]
+    assert [slider.val for slider in editor.sliders] == [215, 150, 100]
     assert editor.status_text.get_text() == f"the durations in {editor.script_path}"
 
 
@@ -402,7 +402,7 @@ def test_run_editor_refuses_a_guess_past_the_limits_before_its_window(
     import mosys.editor.concatenation as concatenation
     from mosys.limits import LimitError
 
-    text = composite_workspace.script.read_text().replace("ticks=100\n", "ticks=99999999999\n", 1)
+    text = composite_workspace.script.read_text().replace("ticks=150\n", "ticks=99999999999\n", 1)
     script = copied_script(composite_workspace, tmp_path, text)
     monkeypatch.setattr(concatenation, "interactive_backend", lambda: "tkagg")
     figures = plt.get_fignums()
@@ -410,7 +410,7 @@ def test_run_editor_refuses_a_guess_past_the_limits_before_its_window(
         run_editor(script, composite_workspace.bsr_results, SPECS / "figures", SPECS / "bsr")
     assert str(error.value).startswith(
         f"{script}:9:59: expected at most 10,000,000 integration steps per run, found "
-        "100,000,000,229 (the phases' 100,000,000,229 ticks to the end of this one)"
+        "100,000,000,214 (the phases' 100,000,000,214 ticks to the end of this one)"
     )
     assert plt.get_fignums() == figures
 

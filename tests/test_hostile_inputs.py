@@ -432,7 +432,8 @@ def test_a_composite_score_dividing_by_zero_is_written_plainly(
     nan."""
     script = tmp_path / "show.comp"
     text = composite_workspace.script.read_text()
-    old = "score jump      = max_t(min_i(y_i(t))) * (dtime ?= 100)"
+    old = "score jump      = max_t(min_i(y_i(t))) * (dtime ?= 150)"
+    assert old in text
     script.write_text(text.replace(old, f"score jump      = {expression}"))
     out = tmp_path / "show.h5"
     argv = ["composite", str(script), "--bsr-results", str(composite_workspace.bsr_results)]

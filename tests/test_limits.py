@@ -155,14 +155,14 @@ def test_composite_ticks_are_limited(tmp_path, composite_workspace, capsys):
     """The issue's ticks=99999999999 (745 GiB)."""
     script = tmp_path / "starman_show.comp"
     text = composite_workspace.script.read_text()
-    script.write_text(text.replace("ticks=100\n", "ticks=99999999999\n", 1))
+    script.write_text(text.replace("ticks=150\n", "ticks=99999999999\n", 1))
     out = tmp_path / "show.h5"
     argv = ["composite", str(script), "--bsr-results", str(composite_workspace.bsr_results)]
     assert main([*argv, "-o", str(out)]) == 2
     message = last_line(capsys)
     assert message.startswith(
         f"{script}:9:59: expected at most 10,000,000 integration steps per run, found "
-        "100,000,000,229 (the phases' 100,000,000,229 ticks to the end of this one)"
+        "100,000,000,214 (the phases' 100,000,000,214 ticks to the end of this one)"
     )
     assert_nothing_written(out)
 
@@ -175,13 +175,13 @@ def test_composite_ticks_past_int64_together_are_limited_and_counted_exactly(
     of ticks past int64 before the parser bounded them)."""
     script = tmp_path / "starman_show.comp"
     text = composite_workspace.script.read_text()
-    script.write_text(text.replace("ticks=100\n", f"ticks={2**63 - 1}\n", 1))
+    script.write_text(text.replace("ticks=150\n", f"ticks={2**63 - 1}\n", 1))
     out = tmp_path / "show.h5"
     argv = ["composite", str(script), "--bsr-results", str(composite_workspace.bsr_results)]
     assert main([*argv, "-o", str(out)]) == 2
     assert last_line(capsys).startswith(
         f"{script}:9:59: expected at most 10,000,000 integration steps per run, found "
-        f"9.22e+18 (the phases' {230 + 2**63 - 1:,} ticks to the end of this one)"
+        f"9.22e+18 (the phases' {215 + 2**63 - 1:,} ticks to the end of this one)"
     )
     assert_nothing_written(out)
 

@@ -563,9 +563,9 @@ def test_no_lone_contact_slides_in_any_motion_the_pipeline_built(composite_built
 def test_editing_the_script_reruns_only_the_transition_search(composite_built):
     script = composite_built / "specs/composite/starman_show.comp"
     text = script.read_text()
-    jump = "controller=starman_jump_robust      ticks=100"
+    jump = "controller=starman_jump_robust      ticks=150"
     assert jump in text
-    with edited_spec(script, text.replace(jump, jump.replace("ticks=100", "ticks=105"))):
+    with edited_spec(script, text.replace(jump, jump.replace("ticks=150", "ticks=155"))):
         jobs = planned_jobs(
             composite_built, "results/composite_all", "--configfile", "config/ci.yaml"
         )

@@ -866,6 +866,18 @@ def stop_dead(u, responses, i):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def stop_horizontally(u, responses, i):
+    """The horizontal impulse (x, 0, z) that stops contact i's horizontal velocity (u[i] (3,))
+    alone, from the x-z block of its own response responses[i, i] (3, 3): the lone contact's
+    stop where stopping dead would pull (the point then does not sink)."""
+    k = responses[i, i]
+    det = k[0, 0] * k[2, 2] - k[0, 2] * k[2, 0]
+    px = (-u[i, 0] * k[2, 2] + u[i, 2] * k[0, 2]) / det
+    pz = (-u[i, 2] * k[0, 0] + u[i, 0] * k[2, 0]) / det
+    return px, 0.0, pz
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def _others_hold(u, count, responses, impulse, members):
     """True if no touching point outside ``members`` ((count,) 1.0 for a member) sinks after
     the impulses (count, 3)."""
@@ -983,8 +995,10 @@ def contact_impulses(
     together, with shared friction, dropping the one whose normal impulse would pull most and
     trying again while two or more are left; then each sinking one alone, the fastest first,
     stopped dead. The first set whose normal impulses push and after which no other touching
-    point sinks is kept; none, the normal impulses alone (``frictionless_impulses``), as the
-    2-D rule does for two.
+    point sinks is kept. A lone point that stopping dead would pull is stopped horizontally
+    alone (``stop_horizontally``; it then rises). Two or more of which no set pushes take
+    normal impulses alone (``frictionless_impulses``), as the 2-D rule does for two. Returns
+    whether the impulses follow the friction rule (False: the frictionless ones).
     responses (M, M, 3, 3), system (M + 4, M + 4), mixing (3, M, M), shares (3, M), pairs (M, M,
     9), spins (M, 3, 3): work space.
     chosen (count,): the points' endpoint numbers; end_share (E,): each endpoint's share of the
@@ -1002,7 +1016,7 @@ def contact_impulses(
         active[i] = 1.0 if u[i, 1] < 0.0 else 0.0
         n += int(active[i])
     if n == 0:
-        return
+        return True
     for j in range(count):
         spin_per_impulse(r, j, world_inverse, spins)
     for i in range(count):
@@ -1028,7 +1042,7 @@ def contact_impulses(
         if worst == -1 and _others_hold(u, count, responses, impulse, active):
             for i in range(count):
                 end_share[chosen[i]] = weight[i]
-            return
+            return True
         if worst < 0:
             # still singular, unsettled, or another point would sink: drop the one sinking
             # slowest
@@ -1050,6 +1064,11 @@ def contact_impulses(
         tried[first] = 1.0
         px, py, pz = stop_dead(u, responses, first)
         if py <= 0.0:
+            if count == 1:
+                # stopping dead would pull: the horizontal stop alone, after which it rises
+                # (the lone-contact rule, as in 2-D)
+                impulse[0, 0], _, impulse[0, 2] = stop_horizontally(u, responses, 0)
+                return True
             continue
         impulse[first, 0] = px
         impulse[first, 1] = py
@@ -1057,12 +1076,13 @@ def contact_impulses(
         active[:count] = 0.0
         active[first] = 1.0
         if _others_hold(u, count, responses, impulse, active):
-            return
+            return True
         impulse[first, :] = 0.0
     # no set pushes under the friction rule: without friction, rather than no impulse (the
     # figure would sink, be lifted out by its position alone and gather a fall's velocity)
     compliance = COMPLIANCE * (responses[0, 0, 0, 0] + responses[0, 0, 1, 1])
     frictionless_impulses(u, count, responses, impulse, system, compliance)
+    return False
 
 
 class StepWork(NamedTuple):
@@ -1286,6 +1306,7 @@ def step_motion(figure, state, dt, work, total_mass, place_rods):
     end_force[:] = 0.0
     pushing = 0
     pinned = -1
+    frictional = True
     if not math.isnan(floor):
         # the endpoints (at most M, the lowest) that would end the step within the contact
         # tolerance of the floor (speculative contacts, as in 2-D)
@@ -1328,7 +1349,7 @@ def step_motion(figure, state, dt, work, total_mass, place_rods):
             # the velocity that would take the point exactly to the floor counts as zero
             u[i, 1] = uy + max(state[CY] + ry - floor, 0.0) / dt
             u[i, 2] = uz
-        contact_impulses(
+        frictional = contact_impulses(
             u,
             r,
             count,
@@ -1345,7 +1366,8 @@ def step_motion(figure, state, dt, work, total_mass, place_rods):
             spins,
         )
         for i in range(count):
-            if impulse[i, 1] > 0.0:
+            # a frictionless push pins nothing (its points may slide)
+            if frictional and impulse[i, 1] > 0.0:
                 pushing += 1
                 pinned = chosen[i]
             state[VX] += impulse[i, 0] / total_mass
@@ -1395,6 +1417,12 @@ def step_motion(figure, state, dt, work, total_mass, place_rods):
             state[CY] += floor - lowest_y  # no sinking: lift the figure out of the floor
             next_lowest += floor - lowest_y
             lowest_y = floor
+        elif not frictional and end_force[bottom] > 0.0:
+            # the lowest endpoint took a frictionless push: it pushed, so it touches (as a
+            # pinned one does), and ends the step on the floor rather than skimming above it
+            next_lowest -= lowest_y - floor
+            state[CY] -= lowest_y - floor
+            lowest_y = floor
         alone = lowest_y - floor <= CONTACT_TOLERANCE < next_lowest - floor
         if alone and not (pushing == 1 and pinned == bottom):
             # one endpoint down does not slide, however it came to be alone on the floor (as in
@@ -1419,12 +1447,7 @@ def step_motion(figure, state, dt, work, total_mass, place_rods):
             response(r, 0, 0, inverse_mass, spins, responses)
             px, py, pz = stop_dead(u, responses, 0)
             if py <= 0.0:
-                # horizontal only: solve the x-z block for zero horizontal velocity
-                k = responses[0, 0]
-                det = k[0, 0] * k[2, 2] - k[0, 2] * k[2, 0]
-                px = (-ux * k[2, 2] + uz * k[0, 2]) / det
-                pz = (-uz * k[0, 0] + ux * k[2, 0]) / det
-                py = 0.0
+                px, py, pz = stop_horizontally(u, responses, 0)
             state[VX] += px * inverse_mass
             state[VY] += py * inverse_mass
             state[VZ] += pz * inverse_mass

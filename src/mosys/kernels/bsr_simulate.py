@@ -314,35 +314,30 @@ def _two_contacts(u, r, inverse_mass, inverse_inertia, impulse):
 
 
 @njit(cache=True)
-def _frictionless(u, r, count, inverse_mass, inverse_inertia, impulse):
-    """Normal impulses alone into impulse[:, 1] (x 0): the floor's last resort when no set of
-    the friction rule pushes. Both points stop sinking if both then push; else the one whose
-    impulse alone stops it sinking and leaves the other not sinking (non-penetration with no
-    friction: for a positive definite normal block exactly one such set)."""
-    if count == 2:
-        a00 = _response(r[0, 0], r[0, 1], r[0, 0], r[0, 1], inverse_mass, inverse_inertia)[3]
-        a01 = _response(r[0, 0], r[0, 1], r[1, 0], r[1, 1], inverse_mass, inverse_inertia)[3]
-        a11 = _response(r[1, 0], r[1, 1], r[1, 0], r[1, 1], inverse_mass, inverse_inertia)[3]
-        determinant = a00 * a11 - a01 * a01
-        if determinant > 1e-12 * max(a00, a11) ** 2:
-            normal0 = (-u[0, 1] * a11 + u[1, 1] * a01) / determinant
-            normal1 = (-u[1, 1] * a00 + u[0, 1] * a01) / determinant
-            if normal0 > 0.0 and normal1 > 0.0:
-                impulse[0, 1] = normal0
-                impulse[1, 1] = normal1
-                return
-    for i in range(count):
+def _frictionless(u, r, inverse_mass, inverse_inertia, impulse):
+    """Normal impulses alone into impulse[:, 1] (x 0) at two points: the floor's last resort
+    when no set of the friction rule pushes. Both points stop sinking if both then push; else
+    the one whose impulse alone stops it sinking and leaves the other not sinking
+    (non-penetration with no friction: for a positive definite normal block exactly one such
+    set)."""
+    a00 = _response(r[0, 0], r[0, 1], r[0, 0], r[0, 1], inverse_mass, inverse_inertia)[3]
+    a01 = _response(r[0, 0], r[0, 1], r[1, 0], r[1, 1], inverse_mass, inverse_inertia)[3]
+    a11 = _response(r[1, 0], r[1, 1], r[1, 0], r[1, 1], inverse_mass, inverse_inertia)[3]
+    determinant = a00 * a11 - a01 * a01
+    if determinant > 1e-12 * max(a00, a11) ** 2:
+        normal0 = (-u[0, 1] * a11 + u[1, 1] * a01) / determinant
+        normal1 = (-u[1, 1] * a00 + u[0, 1] * a01) / determinant
+        if normal0 > 0.0 and normal1 > 0.0:
+            impulse[0, 1] = normal0
+            impulse[1, 1] = normal1
+            return
+    for i in range(2):
         if u[i, 1] >= 0.0:
             continue
-        own = _response(r[i, 0], r[i, 1], r[i, 0], r[i, 1], inverse_mass, inverse_inertia)[3]
+        own = a00 if i == 0 else a11
         normal = -u[i, 1] / own
-        if count == 2:
-            other = 1 - i
-            cross = _response(
-                r[other, 0], r[other, 1], r[i, 0], r[i, 1], inverse_mass, inverse_inertia
-            )[3]
-            if u[other, 1] + cross * normal < -1e-9:
-                continue
+        if u[1 - i, 1] + a01 * normal < -1e-9:
+            continue
         impulse[i, 1] = normal
         return
 
@@ -352,16 +347,18 @@ def contact_impulses(u, r, count, inverse_mass, inverse_inertia, impulse):
     """The ground's impulses on ``count`` (0, 1 or 2) touching endpoints: u (2, 2) their
     velocities m/s, r (2, 2) their offsets from the centre of mass m; fills impulse (2, 2) N s.
     Tries both endpoints together, then each alone (the one sinking faster first), keeping the
-    first set whose normal impulses push and whose other endpoint does not sink; where none
-    does, the normal impulses alone (``_frictionless``: no friction for that step), rather than
-    none (the figure would sink, be lifted out by its position alone and gather a fall's
-    velocity, until one step's impulse threw it)."""
+    first set whose normal impulses push and whose other endpoint does not sink. A lone point
+    that stopping dead would pull is stopped horizontally alone (it then rises: the lone-contact
+    rule). Two points of which no set pushes take normal impulses alone (``_frictionless``: no
+    friction for that step) rather than none (the figure would sink, be lifted out by its
+    position alone and gather a fall's velocity, until one step's impulse threw it).
+    Returns whether the impulses follow the friction rule (False: the frictionless ones)."""
     impulse[:, :] = 0.0
     if count == 0:
-        return
+        return True
     if count == 2 and u[0, 1] < 0.0 and u[1, 1] < 0.0:
         if _two_contacts(u, r, inverse_mass, inverse_inertia, impulse):
-            return
+            return True
         impulse[:, :] = 0.0
     first = 0
     if count == 2 and u[1, 1] < u[0, 1]:
@@ -372,6 +369,14 @@ def contact_impulses(u, r, count, inverse_mass, inverse_inertia, impulse):
             continue
         px, py = _single_contact(u[i, 0], u[i, 1], r[i, 0], r[i, 1], inverse_mass, inverse_inertia)
         if py <= 0.0:
+            if count == 1:
+                # stopping dead would pull: the horizontal stop alone, after which it rises
+                # (its vertical velocity is the full stop's Schur complement times -py, >= 0)
+                kxx = _response(r[0, 0], r[0, 1], r[0, 0], r[0, 1], inverse_mass, inverse_inertia)[
+                    0
+                ]
+                impulse[0, 0] = -u[0, 0] / kxx
+                return True
             continue
         if count == 2:
             other = 1 - i
@@ -382,8 +387,11 @@ def contact_impulses(u, r, count, inverse_mass, inverse_inertia, impulse):
                 continue
         impulse[i, 0] = px
         impulse[i, 1] = py
-        return
-    _frictionless(u, r, count, inverse_mass, inverse_inertia, impulse)
+        return True
+    if count == 2:
+        _frictionless(u, r, inverse_mass, inverse_inertia, impulse)
+        return False
+    return True
 
 
 @njit(cache=True)
@@ -464,6 +472,7 @@ def step(
     pushing = 0
     pinned = 0
     pinned_x = 0.0
+    frictional = True
     if not math.isnan(floor):
         # the (at most two) endpoints that would end the step lowest, if within the contact
         # tolerance of the floor (speculative contacts: a point still above the floor may come
@@ -503,9 +512,10 @@ def step(
             gap = max(state[CY] + ry - floor, 0.0)
             u[count, 1] = uy + gap / dt
             count += 1
-        contact_impulses(u, r, count, 1.0 / total_mass, 1.0 / total_inertia, impulse)
+        frictional = contact_impulses(u, r, count, 1.0 / total_mass, 1.0 / total_inertia, impulse)
         for i in range(count):
-            if impulse[i, 1] > 0.0:
+            # a frictionless push pins nothing (its points may slide)
+            if frictional and impulse[i, 1] > 0.0:
                 pushing += 1
                 pinned = chosen0 if i == 0 else chosen1
                 pinned_x = entry[pinned, 0]
@@ -540,6 +550,12 @@ def step(
         if lowest < floor:
             state[CY] += floor - lowest  # no sinking: lift the figure out of the floor
             next_lowest += floor - lowest
+            lowest = floor
+        elif not frictional and end_force[bottom] > 0.0:
+            # the lowest endpoint took a frictionless push: it pushed, so it touches (as a
+            # pinned one does), and ends the step on the floor rather than skimming above it
+            next_lowest -= lowest - floor
+            state[CY] -= lowest - floor
             lowest = floor
         alone = lowest - floor <= CONTACT_TOLERANCE < next_lowest - floor
         if alone and not (pushing == 1 and pinned == bottom):
