@@ -130,7 +130,7 @@ def test_moving_a_slider_reruns_the_motion_and_redraws_it(at_guess):
     # the scores shown are the session's for these durations
     assert editor.total_text.get_text() == f"total {score_text(expected.total)}" != text_before
     for k, name in enumerate(("cartwheel", "jump", "shuffle")):
-        seconds = f"{[1.2, 1.0, 1.0][k]:.2f} s"
+        seconds = f"{[1.2, 1.5, 1.0][k]:.2f} s"
         assert editor.phase_texts[k].get_text() == (
             f"{seconds}   score {score_text(expected.scores[name])}"
         )
@@ -180,12 +180,12 @@ def test_a_slider_moved_past_the_limits_goes_back_and_says_why(at_guess, monkeyp
     editor = at_guess
     monkeypatch.setenv("MOSYS_MAX_STEPS", "600")  # the guess, 465 ticks, fits
     scored = editor.scored
-    slider_click(editor.sliders[0], 500)  # 750 ticks in all
+    slider_click(editor.sliders[0], 500)  # 650 ticks to the jump's end
     assert editor.ticks.tolist() == [215, 150, 100]
     assert editor.sliders[0].val == 215
     assert editor.scored is scored
     assert editor.status_text.get_text() == (
-        "not run: expected at most 600 integration steps per run, found 750 (the phases' 750 "
+        "not run: expected at most 600 integration steps per run, found 650 (the phases' 650 "
         'ticks to the end of this one); raise MOSYS_MAX_STEPS to allow it (README, "Limits")'
     )
     slider_click(editor.sliders[0], 300)  # 550 ticks: runs

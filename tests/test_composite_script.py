@@ -49,10 +49,10 @@ EXAMPLE = """\
 # starman_show: the 1995 paper's Table 4, a cartwheel, a jump and a shuffle
 figure starman
 phase cartwheel controller=starman_cartwheel_robust ticks=215
-phase jump controller=starman_jump_robust ticks=100
+phase jump controller=starman_jump_robust ticks=150
 phase shuffle controller=starman_shuffle_robust ticks=100
 score cartwheel = dcm_x * (dtime ?= 215)
-score jump = max_t(min_i(y_i(t))) * (dtime ?= 100)
+score jump = max_t(min_i(y_i(t))) * (dtime ?= 150)
 score shuffle = dcm_x * (dtime ?= 100)
 total = (1.0 + cartwheel) * (1.0 + jump) * (1.0 + shuffle)
 search q=16 g=16 h=4 seed=1
@@ -89,8 +89,8 @@ TABLE_4 = CompositeScript(
         Phase(
             "jump",
             "starman_jump_robust",
-            Binary("*", Call("max_t", Call("min_i", Name("y_i"))), held(100.0)),
-            ticks=100,
+            Binary("*", Call("max_t", Call("min_i", Name("y_i"))), held(150.0)),
+            ticks=150,
         ),
         Phase(
             "shuffle", "starman_shuffle_robust", Binary("*", Name("dcm_x"), held(100.0)), ticks=100
@@ -114,7 +114,7 @@ def test_table_4():
     assert script == TABLE_4
     assert script.spec_sha256 == EXAMPLE_SHA256
     assert (script.name, script.phase_names) == ("starman_show", ("cartwheel", "jump", "shuffle"))
-    assert script.guessed_ticks == (215, 100, 100)
+    assert script.guessed_ticks == (215, 150, 100)
     assert script.search.simulations == 1024
     assert script.tokens == {
         "figure": Token("starman", 2, 8),
@@ -123,7 +123,7 @@ def test_table_4():
         "phase.cartwheel.ticks": Token("215", 3, 59),
         "phase.jump": Token("jump", 4, 7),
         "phase.jump.controller": Token("starman_jump_robust", 4, 23),
-        "phase.jump.ticks": Token("100", 4, 49),
+        "phase.jump.ticks": Token("150", 4, 49),
         "phase.shuffle": Token("shuffle", 5, 7),
         "phase.shuffle.controller": Token("starman_shuffle_robust", 5, 26),
         "phase.shuffle.ticks": Token("100", 5, 55),
@@ -132,7 +132,7 @@ def test_table_4():
         "score.shuffle": Token("shuffle", 8, 7),
         "total": Token("total", 9, 1),
     }
-    # every node keeps its token: 'score jump = max_t(min_i(y_i(t))) * (dtime ?= 100)'
+    # every node keeps its token: 'score jump = max_t(min_i(y_i(t))) * (dtime ?= 150)'
     jump = script.phases[1].score
     assert jump.token == Token("*", 7, 35)
     assert jump.left.token == Token("max_t", 7, 14)
@@ -140,7 +140,7 @@ def test_table_4():
     assert jump.left.argument.argument.token == Token("y_i", 7, 26)
     assert jump.right.token == Token("?=", 7, 44)
     assert jump.right.left.token == Token("dtime", 7, 38)
-    assert jump.right.right.token == Token("100", 7, 47)
+    assert jump.right.right.token == Token("150", 7, 47)
     assert script.total.right.left.token == Token("1.0", 9, 45)
     assert script.phases[0].token == Token("cartwheel", 3, 7)
 
@@ -166,10 +166,10 @@ def test_render_table_4():
     assert text == (
         "figure starman\n"
         "phase cartwheel controller=starman_cartwheel_robust ticks=215\n"
-        "phase jump controller=starman_jump_robust ticks=100\n"
+        "phase jump controller=starman_jump_robust ticks=150\n"
         "phase shuffle controller=starman_shuffle_robust ticks=100\n"
         "score cartwheel = dcm_x * (dtime ?= 215)\n"
-        "score jump = max_t(min_i(y_i)) * (dtime ?= 100)\n"
+        "score jump = max_t(min_i(y_i)) * (dtime ?= 150)\n"
         "score shuffle = dcm_x * (dtime ?= 100)\n"
         "total = (1 + cartwheel) * (1 + jump) * (1 + shuffle)\n"
         "search q=16 g=16 h=4 seed=1\n"
@@ -256,13 +256,13 @@ def test_falloff_width_is_20_percent_of_the_target():
 def test_table_4_scores():
     cartwheel = PhaseMotion(np.array(COM), np.array(ENDS), 215)
     shuffle = PhaseMotion(np.array(COM) + [0.0, 0.0], np.array(ENDS), 120)
-    jump = PhaseMotion(np.array(COM), np.array(ENDS), 100)
+    jump = PhaseMotion(np.array(COM), np.array(ENDS), 150)
     scores, total = score_script(
         TABLE_4, {"cartwheel": cartwheel, "jump": jump, "shuffle": shuffle}
     )
     expected = {
         "cartwheel": 2.0,  # dcm_x = 2 at exactly 215 ticks
-        "jump": 0.3,  # the lowest endpoint rises to 0.3 m, exactly 100 ticks
+        "jump": 0.3,  # the lowest endpoint rises to 0.3 m, exactly 150 ticks
         "shuffle": 2.0 * math.exp(-1.0),  # 120 ticks, one w = 20 ticks off 100
     }
     assert list(scores) == ["cartwheel", "jump", "shuffle"]

@@ -4,7 +4,7 @@
 figure starman
 
 # The phases in time order: the BSR search whose best controller runs (results/bsr/NAME/, best
-# seed), the guessed duration in 0.01 s ticks (Table 4's: 159, 90, 100; our cartwheel is slower).
+# seed), the guessed duration in 0.01 s ticks (Table 4's: 159, 90, 100; ours are longer).
 phase cartwheel controller=starman_cartwheel_robust ticks=215
 phase jump      controller=starman_jump_robust      ticks=150
 phase shuffle   controller=starman_shuffle_robust   ticks=100

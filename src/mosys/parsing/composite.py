@@ -7,10 +7,10 @@ the transition-point search of Figure 5 tunes the phase durations to maximise th
     # starman_show: the 1995 paper's Table 4, a cartwheel, a jump and a shuffle
     figure starman
     phase cartwheel controller=starman_cartwheel_robust ticks=215
-    phase jump controller=starman_jump_robust ticks=100
+    phase jump controller=starman_jump_robust ticks=150
     phase shuffle controller=starman_shuffle_robust ticks=100
     score cartwheel = dcm_x * (dtime ?= 215)
-    score jump = max_t(min_i(y_i(t))) * (dtime ?= 100)
+    score jump = max_t(min_i(y_i(t))) * (dtime ?= 150)
     score shuffle = dcm_x * (dtime ?= 100)
     total = (1.0 + cartwheel) * (1.0 + jump) * (1.0 + shuffle)
     search q=16 g=16 h=4 seed=1
