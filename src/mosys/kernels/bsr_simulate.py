@@ -372,9 +372,8 @@ def contact_impulses(u, r, count, inverse_mass, inverse_inertia, impulse):
             if count == 1:
                 # stopping dead would pull: the horizontal stop alone, after which it rises
                 # (its vertical velocity is the full stop's Schur complement times -py, >= 0)
-                kxx = _response(r[0, 0], r[0, 1], r[0, 0], r[0, 1], inverse_mass, inverse_inertia)[
-                    0
-                ]
+                rx, ry = r[0, 0], r[0, 1]
+                kxx = _response(rx, ry, rx, ry, inverse_mass, inverse_inertia)[0]
                 impulse[0, 0] = -u[0, 0] / kxx
                 return True
             continue
