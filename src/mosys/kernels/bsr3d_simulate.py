@@ -905,21 +905,23 @@ def _twist_too_strong(impulse, active, count):
 
 
 @njit(cache=True, error_model="numpy")
-def frictionless_impulses(u, count, responses, impulse, system, compliance):
+def frictionless_impulses(u, count, responses, impulse, system, compliance, members):
     """Normal impulses alone (count,) N s into impulse[:, 1] (its x and z 0), the floor's last
     resort when no impulse set of the friction rule pushes: the contacts that push stop
     sinking, and none of the others sinks after them (non-penetration with no friction; for a
     positive definite normal block exactly one such set). The sets are tried largest first;
     ``compliance`` (s/kg) is added to each contact's own normal response in sets of three or
     more (as ``contact_impulses`` does: a rigid body leaves their split undecided). u (count, 3),
-    responses (M, M, 3, 3); system (M + 4, M + 4): work space. Returns whether a set was
-    found (else the impulses are 0)."""
+    responses (M, M, 3, 3); system (M + 4, M + 4), members (M,): work space. Returns whether
+    a set was found (else the impulses are 0)."""
     impulse[:count, :] = 0.0
     for size in range(count, 0, -1):
-        for members in range(1, 1 << count):
+        for subset in range(1, 1 << count):
             n = 0
             for i in range(count):
-                n += (members >> i) & 1
+                bit = (subset >> i) & 1
+                members[i] = bit
+                n += bit
             if n != size:
                 continue
             added = compliance if n >= 3 else 0.0
@@ -927,11 +929,11 @@ def frictionless_impulses(u, count, responses, impulse, system, compliance):
             scale = 0.0
             row = 0
             for i in range(count):
-                if not (members >> i) & 1:
+                if not members[i]:
                     continue
                 column = 0
                 for j in range(count):
-                    if (members >> j) & 1:
+                    if members[j]:
                         value = responses[i, j, 1, 1] + (added if i == j else 0.0)
                         system[row, column] = value
                         scale = max(scale, abs(value))
@@ -956,18 +958,10 @@ def frictionless_impulses(u, count, responses, impulse, system, compliance):
                 continue
             row = 0
             for i in range(count):
-                if (members >> i) & 1:
+                if members[i]:
                     impulse[i, 1] = system[row, MAX_CONTACTS]
                     row += 1
-            holding = True
-            for i in range(count):
-                if (members >> i) & 1:
-                    continue
-                uy = u[i, 1]
-                for j in range(count):
-                    uy += responses[i, j, 1, 1] * impulse[j, 1]
-                holding = holding and uy >= -1e-9
-            if holding:
+            if _others_hold(u, count, responses, impulse, members):
                 return True
             impulse[:count, 1] = 0.0
     return False
@@ -1081,7 +1075,7 @@ def contact_impulses(
     # no set pushes under the friction rule: without friction, rather than no impulse (the
     # figure would sink, be lifted out by its position alone and gather a fall's velocity)
     compliance = COMPLIANCE * (responses[0, 0, 0, 0] + responses[0, 0, 1, 1])
-    frictionless_impulses(u, count, responses, impulse, system, compliance)
+    frictionless_impulses(u, count, responses, impulse, system, compliance, active)
     return False
 
 

@@ -264,6 +264,14 @@ def _single_contact(ux, uy, rx, ry, inverse_mass, inverse_inertia):
 
 
 @njit(cache=True)
+def _horizontal_stop(ux, rx, ry, inverse_mass, inverse_inertia):
+    """The horizontal impulse N s that stops one contact point's horizontal velocity ux m/s
+    alone (offset rx, ry m from the centre of mass): the lone contact's stop where stopping it
+    dead would pull (the point then does not sink)."""
+    return -ux / _response(rx, ry, rx, ry, inverse_mass, inverse_inertia)[0]
+
+
+@njit(cache=True)
 def _two_contacts(u, r, inverse_mass, inverse_inertia, impulse):
     """Impulses (2, 2) at two contact points with velocities u (2, 2) and offsets r (2, 2):
     both stop sinking, tangential impulses in the ratio of the normal ones, and the
@@ -372,9 +380,9 @@ def contact_impulses(u, r, count, inverse_mass, inverse_inertia, impulse):
             if count == 1:
                 # stopping dead would pull: the horizontal stop alone, after which it rises
                 # (its vertical velocity is the full stop's Schur complement times -py, >= 0)
-                rx, ry = r[0, 0], r[0, 1]
-                kxx = _response(rx, ry, rx, ry, inverse_mass, inverse_inertia)[0]
-                impulse[0, 0] = -u[0, 0] / kxx
+                impulse[0, 0] = _horizontal_stop(
+                    u[0, 0], r[0, 0], r[0, 1], inverse_mass, inverse_inertia
+                )
                 return True
             continue
         if count == 2:
@@ -571,7 +579,7 @@ def step(
             inverse_inertia = 1.0 / total_inertia
             px, py = _single_contact(ux, uy, rx, ry, inverse_mass, inverse_inertia)
             if py <= 0.0:
-                px = -ux / _response(rx, ry, rx, ry, inverse_mass, inverse_inertia)[0]
+                px = _horizontal_stop(ux, rx, ry, inverse_mass, inverse_inertia)
                 py = 0.0
             state[VX] += px * inverse_mass
             state[VY] += py * inverse_mass
