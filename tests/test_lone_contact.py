@@ -10,6 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from mosys.bsr.lone_contact import (
+    CONTACT_HEIGHT,
     MAX_EXCURSION,
     MIN_DURATION,
     LoneContact,
@@ -18,6 +19,7 @@ from mosys.bsr.lone_contact import (
     sliding,
 )
 from mosys.errors import InputError
+from mosys.kernels.bsr_simulate import CONTACT_TOLERANCE
 
 DT = 1e-3  # s
 T = np.arange(201) * DT  # 0.2 s
@@ -76,6 +78,7 @@ def test_a_foot_hovering_five_millimetres_up_is_not_down():
 def test_down_is_the_simulators_contact_tolerance(height, found):
     """Within 1 mm a sliding foot is a lone contact that slides; above it, it is in the air for
     the simulator (no force on it), as a CI-budget cartwheel's hand hovering 1.8 mm up was."""
+    assert CONTACT_HEIGHT == CONTACT_TOLERANCE
     motion = figure(foot(0.02 * T / T[-1], height), foot(0.3, UP))
     assert len(sliding(lone_contacts(T, motion))) == found
 

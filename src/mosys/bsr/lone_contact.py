@@ -24,12 +24,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from mosys.errors import InputError
-from mosys.kernels.bsr_simulate import CONTACT_TOLERANCE
 
 # m: an endpoint at most this far above the floor is down: the simulators' own contact
-# tolerance (an endpoint higher is in the air for them, and every endpoint the floor pushes
-# ends its step exactly on the floor)
-CONTACT_HEIGHT = CONTACT_TOLERANCE
+# tolerance, kernels.bsr_simulate.CONTACT_TOLERANCE (an endpoint higher is in the air for them,
+# and every endpoint the floor pushes ends its step exactly on the floor). A literal, so that
+# reading a file (``mosys info``) does not load numba; tests/test_lone_contact.py holds the two
+# equal.
+CONTACT_HEIGHT = 1e-3
 STILL_SPEED = 1e-2  # m/s: ... if it also moves vertically slower than this
 CLEAR_HEIGHT = 1e-2  # m: every other endpoint at least this far above the floor
 MIN_DURATION = 20e-3  # s: the shortest stretch that counts as a lone contact
