@@ -14,6 +14,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import assert_png
+from hypothesis import given
+from hypothesis import strategies as st
 from matplotlib.collections import LineCollection, PolyCollection
 from PIL import Image
 
@@ -289,6 +291,37 @@ def test_learning_figure(searches: dict[str, list[Path]]) -> None:
     assert label_y[2] - label_y[1] > 0  # the tied seeds' labels moved apart
     with pytest.raises(PlotInputError, match="more than one search"):
         learning_figure([*searches["star_sense"], *searches["star_time"]])
+
+
+def test_finals_range_zooms_only_where_the_finals_lie_close() -> None:
+    # Bob's five finals on a scale from -52: a range of their own, padded
+    low, high = bsr.finals_range(np.array([3.22, 3.25, 3.33, 3.36, 3.89]), -52.0, 6.0)
+    assert high - low == pytest.approx(max(0.67 * (1 + 2 * bsr.FINALS_PAD), 0.04 * 58.0))
+    assert (low + high) / 2 == pytest.approx((3.22 + 3.89) / 2)
+    # spread over most of the curves' range: the curves' own scale
+    assert bsr.finals_range(np.array([15.0, 46.0]), 12.0, 48.0) is None
+    # all equal: the least span, about them
+    low, high = bsr.finals_range(np.array([2.0, 2.0]), 0.0, 10.0)
+    assert (low, high) == pytest.approx((2.0 - 5 * bsr.FINALS_LEAST, 2.0 + 5 * bsr.FINALS_LEAST))
+    assert bsr.finals_range(np.array([np.nan]), 0.0, 1.0) is None
+    assert bsr.finals_range(np.array([1.0]), 1.0, 1.0) is None
+
+
+@given(
+    st.lists(st.floats(-1e3, 1e3), min_size=1, max_size=12),
+    st.floats(-1e3, 1e3),
+    st.floats(1e-3, 2e3),
+)
+def test_finals_range_holds_every_final(values: list[float], low: float, size: float) -> None:
+    """Whatever the finals, the zoomed range holds them all, is no narrower than FINALS_LEAST
+    and no wider than FINALS_ZOOM of the curves' range."""
+    finals = np.clip(np.array(values), low, low + size)
+    zoom = bsr.finals_range(finals, low, low + size)
+    if zoom is not None:
+        rounding = 8 * math.ulp(abs(low) + size)  # the range's ends are rounded numbers
+        assert zoom[0] <= finals.min() and finals.max() <= zoom[1]
+        assert bsr.FINALS_LEAST * size - rounding <= zoom[1] - zoom[0]
+        assert zoom[1] - zoom[0] <= bsr.FINALS_ZOOM * size + rounding
 
 
 def test_learning_plot_writes_a_png(searches: dict[str, list[Path]], tmp_path: Path) -> None:

@@ -524,7 +524,7 @@ def test_learning_kinds_errors(kinds: dict[str, list[Path]], chain: dict[str, li
 
 
 def test_seeds_figure_is_figure_8(kinds: dict[str, list[Path]], tmp_path: Path) -> None:
-    figure = seeds_figure(kinds["sense"])
+    figure = seeds_figure(kinds["sense"])  # one search: its learning figure
     curves, finals = figure.axes
     assert figure.get_suptitle().startswith(
         "BSR search dog_sense: sense-based controller for cujo, 3 seeds\n"
@@ -544,6 +544,70 @@ def test_seeds_figure_is_figure_8(kinds: dict[str, list[Path]], tmp_path: Path) 
     kinds_png = tmp_path / "kinds.png"
     plot_learning_kinds(kinds["time"], kinds["sense"], kinds_png)
     assert_png(kinds_png, least_width=800)
+
+
+def test_seeds_figure_of_both_kinds(kinds: dict[str, list[Path]], tmp_path: Path) -> None:
+    """Figure 8 with the other kind's seeds beside (Bob's walk, sense- and time-based): every
+    seed's curve in its kind's style, and a column of final best fitness per kind, sense-based
+    first, each named with its median below it and marked by a black bar."""
+    figure = seeds_figure([*kinds["time"], *kinds["sense"]])
+    curves, finals = figure.axes
+    assert figure.get_suptitle() == (
+        "Variability in search-algorithm performance: cujo\n"
+        "sense-based dog_sense (3 seeds) vs time-based dog_time (4 seeds)\n"
+        "fitness = 1·distance − 1·sideways"
+    )
+    assert [line.get_label() for line in curves.lines] == [
+        *(f"dog_sense seed {seed}" for seed in (1, 2, 3)),
+        *(f"dog_time seed {seed}" for seed in (1, 2, 3, 4)),
+    ]
+    assert {line.get_linestyle() for line in curves.lines[:3]} == {"-"}
+    assert {line.get_linestyle() for line in curves.lines[3:]} == {"--"}
+    assert [tick.get_text() for tick in finals.get_xticklabels()] == [
+        "sense-based\nmedian 2.00",
+        "time-based\nmedian 2.75",
+    ]
+    assert [text.get_text() for text in finals.texts] == [
+        "seed 1: 2.00",
+        "seed 2: 1.20",
+        "seed 3: 2.60",
+        "seed 1: 3.00",
+        "seed 2: 2.50",
+        "seed 3: 3.40",
+        "seed 4: 2.00",
+    ]
+    dots = [line for line in finals.lines if line.get_marker() == "o"]
+    sense_x, time_x = dots[0].get_xdata()[0], dots[-1].get_xdata()[0]
+    assert sense_x < 0.5 < time_x  # a column each
+    medians = [line for line in finals.lines if line.get_color() == "k"]
+    assert [line.get_ydata()[0] for line in medians] == pytest.approx([2.0, 2.75])
+    out = tmp_path / "both.png"
+    plot_seeds([*kinds["sense"], *kinds["time"]], out)
+    assert_png(out, least_width=800)
+    other = write_learning(tmp_path, "dog_sense_again", "sense", {1: 1.0})
+    with pytest.raises(PlotInputError) as error:
+        seeds_figure([*kinds["sense"], *kinds["time"], *other])
+    assert "more than one search" in str(error.value)
+
+
+def test_close_finals_get_a_scale_of_their_own(tmp_path: Path) -> None:
+    """Seeds that end close together after a long climb (Bob's five between 3.2 and 3.9 after
+    starting at -50) are drawn on the finals panel's own scale, its range shaded behind the
+    curves; seeds spread over the curves' range keep the curves' scale."""
+    close = write_learning(tmp_path, "dog_close", "time", {1: 10.0, 2: 10.4, 3: 9.8})
+    figure = seeds_figure(close)
+    curves, finals = figure.axes
+    low, high = finals.get_ylim()
+    assert 9.0 < low < 9.8 and 10.4 < high < 11.0
+    assert finals.get_title() == "final best fitness\n(the shaded band, enlarged)"
+    (band,) = curves.patches
+    assert band.get_y() == pytest.approx(low) and band.get_height() == pytest.approx(high - low)
+    assert curves.get_ylim()[0] < 1.0  # the curves keep their whole range
+    spread = seeds_figure(write_learning(tmp_path, "dog_spread", "time", {1: 1.0, 2: 10.0}))
+    curves, finals = spread.axes
+    assert finals.get_ylim() == curves.get_ylim()
+    assert finals.get_title() == "final best fitness"
+    assert not curves.patches
 
 
 # --------------------------------------------------------------------------- a figure at rest

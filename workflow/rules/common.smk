@@ -86,7 +86,7 @@ def configured_specs():
         ("bsr3d.searches", bsr3d["searches"]),
         ("bsr3d.full_budget", bsr3d["full_budget"]),
         ("bsr3d.kinds", list(bsr3d["kinds"].values())),
-        ("bsr3d.variability", [bsr3d["variability"]]),
+        ("bsr3d.variability", list(bsr3d["variability"].values())),
         ("composite.robustness", [*composite["robustness"], *composite["robustness"].values()]),
     ]
     searches += [(f"bsr3d.motions.{motion}", chain) for motion, chain in bsr3d["motions"].items()]

@@ -291,7 +291,12 @@ def _bsr3d_kinds(args: argparse.Namespace) -> None:
 
 
 def _bsr3d_seeds_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("results", nargs="+", help="all seed files of one search (.h5)")
+    parser.add_argument(
+        "results",
+        nargs="+",
+        help="all seed files of one search, or of a sense-based and a time-based search of one "
+        "problem, drawn side by side (.h5)",
+    )
     parser.add_argument("-o", "--output", required=True, type=OutputPath(*PLOT), help="PNG")
 
 

@@ -21,9 +21,11 @@ from __future__ import annotations
 import math
 import textwrap
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.cm import ScalarMappable
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
@@ -84,6 +86,11 @@ TERMS = {
 LEARNING_WIDTH, LEARNING_HEIGHT = 9.5, 5.4  # inches
 TITLE_WIDTH = 110  # characters of a title line at the learning figures' width
 FINALS_WIDTH = 1.9  # inches: the panel of each seed's final best fitness
+FINALS_PAD = 0.15  # of the finals' span, above and below them where the panel zooms
+FINALS_LEAST = 0.04  # of the curves' y range: the closest the finals panel zooms
+FINALS_ZOOM = 0.5  # the panel zooms where its range is at most this share of the curves'
+FINALS_TICKS = 0.4  # inches right of the finals panel for its own scale's tick labels
+ZOOM_COLOR = "#ebebeb"  # the zoomed range, shaded behind the curves and the finals panel
 CURVE_WIDTH = 1.5  # pt
 COMPARISON_WIDTH, COMPARISON_HEIGHT = 12.5, 5.6  # inches
 BAND_ALPHA = 0.16  # the min..max band of a search's seeds
@@ -279,9 +286,10 @@ def plot_learning(results: Sequence[str | Path], path: str | Path) -> None:
 def learning_figure(results: Sequence[str | Path]) -> Figure:
     """Figure 8 ("Variability in search-algorithm performance") for one search: the best
     fitness so far against the number of controller evaluations, one line per seed, and in a
-    narrow panel beside it each seed's final best fitness marked with its seed number. The
-    title names the search, the controller kind and the fitness function. The figure may be
-    2-D or 3-D. PlotInputError if the files are not all of one search."""
+    narrow panel beside it each seed's final best fitness marked with its seed number, on a
+    scale of its own where the finals lie close together (``draw_finals``). The title names
+    the search, the controller kind and the fitness function. The figure may be 2-D or 3-D.
+    PlotInputError if the files are not all of one search."""
     if not results:
         raise PlotInputError("plot_learning: no BSR result files given")
     loaded = sorted(  # the curves do not depend on the figure's dimensions: 2-D or 3-D
@@ -309,12 +317,7 @@ def learning_figure(results: Sequence[str | Path]) -> Figure:
     )
     with plot_style():
         figure = new_figure(LEARNING_WIDTH, LEARNING_HEIGHT)
-        curves, finals = figure.subplots(
-            1,
-            2,
-            sharey=True,
-            gridspec_kw={"width_ratios": [LEARNING_WIDTH - FINALS_WIDTH - 1.5, FINALS_WIDTH]},
-        )
+        curves, finals = learning_axes(figure, FINALS_WIDTH)
         right_end = max(int(r.evaluations[-1]) for r, _ in loaded)
         for (result, _), seed in zip(loaded, seeds, strict=True):
             evaluations = np.append(result.evaluations, right_end)
@@ -332,34 +335,114 @@ def learning_figure(results: Sequence[str | Path]) -> Figure:
         curves.set_xlabel("controller evaluations (count)")
         curves.set_ylabel("best fitness so far (Σ weight × term)")
         curves.set_title("learning curve of each seed", fontsize=10)
-        finals.set_title("final best fitness", fontsize=10)
-        finals.set_xlim(0, 1)
-        finals.set_xticks([])
-        finals.grid(False, axis="x")
-        finals.tick_params(axis="y", labelleft=False, length=0)
-        final_values = np.array([r.best_fitness[-1] for r, _ in loaded])
-        low, high = curves.get_ylim()
         _layout_learning(figure, title)
-        height = finals.get_position().height * figure.get_size_inches()[1]
-        gap = (high - low) * (11.5 / 72) / height  # a label's height, data units
-        labels = spread_labels(final_values, gap, low + gap / 2, high - gap / 2)
+        final_values = np.array([r.best_fitness[-1] for r, _ in loaded])
         decimals = shared_decimals(final_values)
-        for value, label_y, seed in zip(final_values, labels, seeds, strict=True):
-            color = colors[str(seed)]
-            finals.plot(
-                0.12, value, "o", color=color, markersize=6, markeredgecolor="black", mew=0.6
-            )
-            finals.plot([0.12, 0.3], [value, label_y], color=color, linewidth=0.8)
-            finals.text(
-                0.32,
-                label_y,
-                f"seed {seed}: {minus_signs(f'{value:.{decimals}f}')}",
-                va="center",
-                ha="left",
-                fontsize=8.5,
-            )
-        finals.set_ylim(low, high)
+        column = FinalsColumn(
+            "",
+            final_values,
+            [
+                f"seed {seed}: {minus_signs(f'{value:.{decimals}f}')}"
+                for seed, value in zip(seeds, final_values, strict=True)
+            ],
+            [colors[str(seed)] for seed in seeds],
+        )
+        draw_finals(curves, finals, [column])
     return figure
+
+
+def learning_axes(figure: Figure, finals_width: float) -> tuple[Axes, Axes]:
+    """The learning curves' axes and, ``finals_width`` inches wide to their right, the final
+    best fitness panel's."""
+    curves, finals = figure.subplots(
+        1,
+        2,
+        gridspec_kw={"width_ratios": [LEARNING_WIDTH - finals_width - 1.5, finals_width]},
+    )
+    return curves, finals
+
+
+@dataclass(frozen=True)
+class FinalsColumn:
+    """One search's seeds in the final best fitness panel: ``heading`` above the column ("" for
+    none), each seed's final best fitness ``values`` (S,), the text beside its dot ``labels``
+    (S,) and its colour ``colors`` (S,)."""
+
+    heading: str
+    values: np.ndarray
+    labels: list[str]
+    colors: list
+
+
+def finals_range(values: np.ndarray, low: float, high: float) -> tuple[float, float] | None:
+    """The final best fitness panel's own y range (data units) where ``values`` lie close
+    together on the curves' axis (low, high): their span padded by FINALS_PAD of it on each
+    side and at least FINALS_LEAST of (high - low), so that the seeds' differences can be read
+    (Bob's five finals, 3.2 to 3.9, were one blot on a scale from -50); None where that range
+    would be more than FINALS_ZOOM of the curves' (the panel keeps the curves' scale)."""
+    finite = values[np.isfinite(values)]
+    if finite.size == 0 or not high > low:
+        return None
+    smallest, largest = float(finite.min()), float(finite.max())
+    span = max((largest - smallest) * (1 + 2 * FINALS_PAD), FINALS_LEAST * (high - low))
+    if span > FINALS_ZOOM * (high - low):
+        return None
+    middle = 0.5 * (smallest + largest)
+    return middle - span / 2, middle + span / 2
+
+
+def draw_finals(curves: Axes, finals: Axes, columns: Sequence[FinalsColumn]) -> None:
+    """Each column's seeds as dots at their final best fitness, labelled, side by side in
+    ``finals`` (after the curves are drawn and the figure laid out), each column's heading
+    below it and, where there are several, its median as a black bar. Where the finals lie
+    close together (``finals_range``) the panel has a scale of its own, its ticks on the right,
+    and the range it shows is shaded on ``curves``."""
+    low, high = curves.get_ylim()
+    values = np.concatenate([column.values for column in columns])
+    zoom = finals_range(values, low, high)
+    shown_low, shown_high = zoom if zoom is not None else (low, high)
+    finals.set_xlim(0, 1)
+    width = 1.0 / len(columns)
+    if any(column.heading for column in columns):  # each column named below it
+        finals.set_xticks(
+            [(k + 0.5) * width for k in range(len(columns))],
+            [column.heading for column in columns],
+            fontsize=9,
+        )
+        finals.tick_params(axis="x", length=0)
+    else:
+        finals.set_xticks([])
+    finals.grid(False, axis="x")
+    if zoom is None:
+        finals.tick_params(axis="y", labelleft=False, length=0)
+        finals.set_title("final best fitness", fontsize=10)
+    else:
+        figure = finals.figure
+        right = figure.subplotpars.right - FINALS_TICKS / figure.get_size_inches()[0]
+        figure.subplots_adjust(right=right)
+        finals.yaxis.tick_right()
+        finals.tick_params(axis="y", labelsize=8.5)
+        finals.set_title("final best fitness\n(the shaded band, enlarged)", fontsize=10)
+        curves.axhspan(*zoom, color=ZOOM_COLOR, zorder=0, linewidth=0)
+        curves.set_ylim(low, high)
+        finals.set_facecolor(ZOOM_COLOR)
+    height = finals.get_position().height * finals.figure.get_size_inches()[1]
+    gap = (shown_high - shown_low) * (11.5 / 72) / height  # a label's height, data units
+    for k, column in enumerate(columns):
+        dot, text = k * width + 0.12 * width, k * width + 0.32 * width
+        labels = spread_labels(column.values, gap, shown_low + gap / 2, shown_high - gap / 2)
+        for value, label_y, label, color in zip(
+            column.values, labels, column.labels, column.colors, strict=True
+        ):
+            finals.plot(
+                dot, value, "o", color=color, markersize=6, markeredgecolor="black", mew=0.6
+            )
+            finals.plot([dot, text - 0.02 * width], [value, label_y], color=color, linewidth=0.8)
+            finals.text(text, label_y, label, va="center", ha="left", fontsize=8.5)
+        if len(columns) > 1:  # each column's median, a short black bar across its dots
+            median = float(np.median(column.values))
+            finals.plot([dot - 0.08 * width, dot + 0.08 * width], [median, median], "k-", lw=1.6)
+    finals.set_ylim(shown_low, shown_high)
 
 
 def shared_decimals(values: np.ndarray, digits: int = 3) -> int:

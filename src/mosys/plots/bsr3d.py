@@ -50,20 +50,25 @@ from mosys.io.bsr_result import BsrResult
 from mosys.io.trajectory import FigureMotion
 from mosys.plots.bsr import (
     CURVE_WIDTH,
+    FINALS_WIDTH,
     FOLLOW_POSES,
     KIND_LINESTYLE,
     KIND_TEXT,
     LEARNING_HEIGHT,
     LEARNING_WIDTH,
     TERMS,
+    FinalsColumn,
     best_result_path,
     curves_on_grid,
+    draw_finals,
     fitness_formula,
     group_by_search,
+    learning_axes,
     learning_figure,
     read_result,
     root_attrs,
     search_name,
+    shared_decimals,
     terms_text,
     wrapped,
 )
@@ -833,23 +838,7 @@ def learning_kinds_figure(
     last = max(int(r.evaluations[-1]) for _, _, results in kinds for r in results)
     if log_x and first <= 0:
         raise PlotInputError("plot_learning_kinds: a log axis needs evaluations above 0")
-    figures = sorted({str(r.attrs.get("figure", "")) for _, _, rs in kinds for r in rs} - {""})
-    formulas = {fitness_formula(results[0].fitness_weights) for _, _, results in kinds}
-    versus = " vs ".join(
-        f"{KIND_TEXT[kind]} {name} ({counted(len(results), 'seed')})"
-        for kind, name, results in kinds
-    )
-    if len(formulas) == 1:
-        fitness = wrapped(formulas.pop())
-    else:  # each search's on lines of its own: side by side they ran off the figure
-        fitness = "\n".join(
-            wrapped(f"{name}: {fitness_formula(results[0].fitness_weights)}")
-            for _, name, results in kinds
-        )
-    title = (
-        "Learning curves for both kinds of motion controller"
-        f"{': ' + ', '.join(figures) if figures else ''}\n{wrapped(versus)}\n{fitness}"
-    )
+    title = _kinds_title("Learning curves for both kinds of motion controller", kinds)
     entries: list[tuple[object, str]] = []
     ends = []  # (colour, evaluations, median) at each median curve's end
     with plot_style():
@@ -893,15 +882,44 @@ def learning_kinds_figure(
         ax.xaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))
         ax.set_xlabel(f"controller evaluations (count{', log scale' if log_x else ''})")
         ax.set_ylabel("best fitness so far (Σ weight × term)")
-        add_legend(figure, entries, ncols=2, fontsize=LEGEND_SIZE)
-        width, height = figure.get_size_inches()
-        figure.suptitle(title, y=1 - 0.1 / height, va="top", fontsize=10.5)
-        figure.subplots_adjust(
-            top=1 - (MARGIN_TOP + 0.1 + TITLE_LINE * (title.count("\n") + 1)) / height,
-            left=(MARGIN_LEFT + 0.1) / width,
-            right=1 - (MARGIN_RIGHT + 0.3) / width,
-        )
+        _lay_out_kinds(figure, entries, title, above=0.1, right=0.3)
     return figure
+
+
+def _lay_out_kinds(
+    figure: Figure, entries: list[tuple[object, str]], title: str, above: float, right: float
+) -> None:
+    """The kinds' legend below the axes, ``title`` above them and the margins: ``above`` inches
+    more between the title and the axes, ``right`` more at their right."""
+    add_legend(figure, entries, ncols=2, fontsize=LEGEND_SIZE)
+    width, height = figure.get_size_inches()
+    figure.suptitle(title, y=1 - 0.1 / height, va="top", fontsize=10.5)
+    figure.subplots_adjust(
+        top=1 - (MARGIN_TOP + above + TITLE_LINE * (title.count("\n") + 1)) / height,
+        left=(MARGIN_LEFT + 0.1) / width,
+        right=1 - (MARGIN_RIGHT + right) / width,
+        wspace=0.05,
+    )
+
+
+def _kinds_title(heading: str, kinds: Sequence[tuple[str, str, list[BsrResult]]]) -> str:
+    """A figure title: ``heading`` and the figures drawn, then each (kind, search, results) as
+    'time-based NAME (N seeds)' joined by 'vs', then the fitness function (each search's on a
+    line of its own where they differ: side by side they ran off the figure)."""
+    figures = sorted({str(r.attrs.get("figure", "")) for _, _, rs in kinds for r in rs} - {""})
+    formulas = {fitness_formula(results[0].fitness_weights) for _, _, results in kinds}
+    versus = " vs ".join(
+        f"{KIND_TEXT[kind]} {name} ({counted(len(results), 'seed')})"
+        for kind, name, results in kinds
+    )
+    if len(formulas) == 1:
+        fitness = wrapped(formulas.pop())
+    else:
+        fitness = "\n".join(
+            wrapped(f"{name}: {fitness_formula(results[0].fitness_weights)}")
+            for _, name, results in kinds
+        )
+    return f"{heading}{': ' + ', '.join(figures) if figures else ''}\n{wrapped(versus)}\n{fitness}"
 
 
 def plot_seeds(results: Sequence[str | Path], path: str | Path) -> None:
@@ -912,11 +930,67 @@ def plot_seeds(results: Sequence[str | Path], path: str | Path) -> None:
 
 def seeds_figure(results: Sequence[str | Path]) -> Figure:
     """Figure 8 ("Variability in search-algorithm performance"): the seeds of one search (Bob's
-    sense-based walk), each its own learning curve, and beside them each seed's final best
-    fitness, as ``mosys.plots.bsr.learning_figure`` draws them for 2-D and 3-D figures alike."""
+    sense-based walk), or of two searches of the two kinds on one problem (Bob's walk, sense-
+    and time-based: the paper's finding is that the sense-based one is the better for Bob, and
+    that its runs vary). One search: ``mosys.plots.bsr.learning_figure``. Two: each seed's
+    learning curve in its kind's colour (sense-based solid, time-based dashed), and beside them
+    each seed's final best fitness, a column per kind, on a scale of their own where they lie
+    close together (``draw_finals``). PlotInputError when no file is given, or the files are of
+    more than one search of a kind or more than two searches."""
     if not results:
         raise PlotInputError("plot_seeds: no BSR result files given")
-    return learning_figure(results)
+    by_kind: dict[str, list[Path]] = {}
+    for path in results:
+        by_kind.setdefault(str(root_attrs(path).get("controller_kind", "")), []).append(Path(path))
+    if len(by_kind) == 1:
+        return learning_figure(results)
+    unknown = sorted(set(by_kind) - set(KIND_TEXT))
+    if unknown:
+        raise PlotInputError(f"plot_seeds: results of an unknown controller kind {unknown[0]!r}")
+    kinds = [(kind, *_load_kind(by_kind[kind], kind)) for kind in ("sense", "time")]
+    title = _kinds_title("Variability in search-algorithm performance", kinds)
+    entries: list[tuple[object, str]] = []
+    columns = []
+    with plot_style():
+        figure = new_figure(LEARNING_WIDTH, LEARNING_HEIGHT)
+        curves, finals = learning_axes(figure, 2 * FINALS_WIDTH - 0.7)
+        right_end = max(int(r.evaluations[-1]) for _, _, rs in kinds for r in rs)
+        for kind, name, kind_results in kinds:
+            color, style = KIND_COLORS[kind], KIND_LINESTYLE[kind]
+            for result in kind_results:
+                curves.step(
+                    np.append(result.evaluations, right_end),
+                    np.append(result.best_fitness, result.best_fitness[-1]),
+                    where="post",
+                    color=color,
+                    linewidth=CURVE_WIDTH,
+                    linestyle=style,
+                    label=f"{name} seed {int(result.attrs['seed'])}",
+                )
+            entries.append(
+                (
+                    Line2D([], [], color=color, linewidth=CURVE_WIDTH, linestyle=style),
+                    f"{name} ({KIND_TEXT[kind]}): each seed",
+                )
+            )
+            values = np.array([r.best_fitness[-1] for r in kind_results])
+            decimals = shared_decimals(values)
+            labels = [
+                f"seed {int(r.attrs['seed'])}: {minus_signs(f'{v:.{decimals}f}')}"
+                for r, v in zip(kind_results, values, strict=True)
+            ]
+            median = minus_signs(f"{np.median(values):.{decimals}f}")
+            heading = f"{KIND_TEXT[kind]}\nmedian {median}"
+            columns.append(FinalsColumn(heading, values, labels, [color] * len(values)))
+        curves.set_xlim(0, right_end * 1.01 if right_end > 0 else 1)
+        curves.xaxis.get_major_locator().set_params(integer=True)  # whole counts
+        curves.xaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))
+        curves.set_xlabel("controller evaluations (count)")
+        curves.set_ylabel("best fitness so far (Σ weight × term)")
+        curves.set_title("learning curve of each seed", fontsize=10)
+        _lay_out_kinds(figure, entries, title, above=0.3, right=0.0)
+        draw_finals(curves, finals, columns)
+    return figure
 
 
 # --------------------------------------------------------------------------- a figure at rest
