@@ -364,7 +364,7 @@ def learning_axes(figure: Figure, finals_width: float) -> tuple[Axes, Axes]:
 
 @dataclass(frozen=True)
 class FinalsColumn:
-    """One search's seeds in the final best fitness panel: ``heading`` above the column ("" for
+    """One search's seeds in the final best fitness panel: ``heading`` below the column ("" for
     none), each seed's final best fitness ``values`` (S,), the text beside its dot ``labels``
     (S,) and its colour ``colors`` (S,)."""
 
