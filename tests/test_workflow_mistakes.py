@@ -57,6 +57,15 @@ def test_numbers_given_with_config_are_numbers(work):
             "2.5 is not of type 'integer'",
         ),
         ("car:\n  start_grid:\n    heading: []\n", "[] should be non-empty"),
+        (
+            "bsr3d:\n  variability: {time: nope}\n",
+            "config bsr3d.variability: 'nope' names no spec",
+        ),
+        (
+            "bsr3d:\n  variability: {sense: null, time: null}\n",
+            "config bsr3d.variability: a search of at least one kind (sense or time), found none",
+        ),
+        ("bsr3d:\n  variability: bob_walk\n", "'bob_walk' is not of type 'object'"),
     ],
 )
 def test_a_config_naming_no_spec_or_an_impossible_grid_is_refused_before_anything_runs(

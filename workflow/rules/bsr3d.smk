@@ -39,7 +39,7 @@ rule bsr3d_learning_kinds:
 
 rule bsr3d_seeds:
     input:
-        results=bsr3d_results(*config["bsr3d"]["variability"].values()),
+        results=bsr3d_results(*variability_searches()),
         code=code_inputs("mosys.cli.plots", "mosys.plots.bsr3d"),  # mosys plot bsr3d-seeds
     output:
         report("results/plots/bsr3d/seeds.png", caption="../report/bsr3d_seeds.rst", category="1995 paper: 3-D figures", subcategory="Figures 7 and 8"),

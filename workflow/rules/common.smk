@@ -56,6 +56,11 @@ config.update(typed_overrides(dict(config), yaml.safe_load(CONFIG_SCHEMA.read_te
 validate(config, str(CONFIG_SCHEMA))  # --config's strings typed first
 
 
+def variability_searches():
+    """The searches Figure 8 draws (config bsr3d.variability: a kind set to null is left out)."""
+    return [name for name in config["bsr3d"]["variability"].values() if name]
+
+
 def configured_specs():
     """(config key, spec file) for every spec the config names."""
     pendulum, car, luxo = config["pendulum"], config["car"], config["luxo"]
@@ -86,7 +91,7 @@ def configured_specs():
         ("bsr3d.searches", bsr3d["searches"]),
         ("bsr3d.full_budget", bsr3d["full_budget"]),
         ("bsr3d.kinds", list(bsr3d["kinds"].values())),
-        ("bsr3d.variability", list(bsr3d["variability"].values())),
+        ("bsr3d.variability", variability_searches()),
         ("composite.robustness", [*composite["robustness"], *composite["robustness"].values()]),
     ]
     searches += [(f"bsr3d.motions.{motion}", chain) for motion, chain in bsr3d["motions"].items()]
@@ -103,6 +108,8 @@ def configured_specs():
 for _key, _spec in configured_specs():
     if not Path(_spec).is_file():
         raise WorkflowError(f"config {_key}: {Path(_spec).stem!r} names no spec ({_spec} does not exist)")
+if not variability_searches():
+    raise WorkflowError("config bsr3d.variability: a search of at least one kind (sense or time), found none")
 
 # The limits on one job's memory and steps (README, "Limits"), for every job this run starts.
 for _key, _variable in (("memory_gib", "MOSYS_MAX_MEMORY_GIB"), ("steps", "MOSYS_MAX_STEPS")):
