@@ -20,7 +20,7 @@ from mosys.cli import main
 from mosys.errors import InputError
 from mosys.io.car_scene import controller_table_scene
 from mosys.io.controller_table import write_controller_table
-from mosys.io.start_grid import read_start_grid, write_start_grid
+from mosys.io.start_grid import OUTSIDE_DOMAIN, read_start_grid, write_start_grid
 from mosys.kernels.geometry import (
     first_colliding_sample,
     grown_polygon,
@@ -224,12 +224,20 @@ def test_a_start_grid_runs_the_starts_that_can_park_and_excludes_the_others(
             [-1.0, 1.5, 5.0, 0.0, 0.0],
             [0.0, 0.6, 0.0, 0.0, 0.0],  # the body overlaps the curb
             [0.0, 2.7, 0.0, 0.0, 0.0],  # the reference point is outside the domain
+            [2.8, 0.6, 0.0, 0.0, 0.0],  # the body overlaps the curb and the front car
         ]
     )
     one = evaluate_starts(small, starts, 10.0, DT, threads=1)
     shown = capsys.readouterr().err  # progress: the runs done, and the starts not run
-    assert "starts: done, 2 runs in " in shown and "(2 starts that cannot park not run)" in shown
-    assert one.excluded.tolist() == ["", "", NOT_FREE, NOT_FREE]
+    assert "starts: done, 2 runs in " in shown and "(3 starts that cannot park not run)" in shown
+    assert one.excluded.tolist() == ["", "", NOT_FREE, NOT_FREE, NOT_FREE]
+    assert one.excluded_detail.tolist() == [
+        "",
+        "",
+        "overlaps curb",
+        OUTSIDE_DOMAIN,
+        "overlaps curb and front",
+    ]
     assert not one.parked[2:].any() and not one.collided[2:].any()
     assert np.isnan(one.parking_seconds[2:]).all() and np.isnan(one.path_length[2:]).all()
     assert np.isfinite(one.path_length[:2]).all() and np.all(one.path_length[:2] > 0)
@@ -243,6 +251,7 @@ def test_a_start_grid_runs_the_starts_that_can_park_and_excludes_the_others(
     write_start_grid(tmp_path / "grid.h5", one)
     back = read_start_grid(tmp_path / "grid.h5")
     assert back.excluded.tolist() == one.excluded.tolist()
+    assert back.excluded_detail.tolist() == one.excluded_detail.tolist()
     np.testing.assert_array_equal(back.cost_to_go, one.cost_to_go)
     np.testing.assert_array_equal(back.consistency, one.consistency)
     assert one.arrival_cost_to_go is None and back.arrival_cost_to_go is None

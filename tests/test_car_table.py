@@ -14,7 +14,7 @@ import pandas as pd
 import pytest
 
 from mosys.io.controller_table import ControllerTable, write_controller_table
-from mosys.io.start_grid import StartGrid, write_start_grid
+from mosys.io.start_grid import OUTSIDE_DOMAIN, StartGrid, write_start_grid
 from mosys.io.trajectory import Trajectory, write_trajectory
 from mosys.paper_tables.car import start_grid_columns, write_car_table
 from mosys.ssc.parking import NO_WAY, NOT_FREE, TOLERANCE
@@ -48,6 +48,7 @@ GRID_COLUMNS = {
     "grid_starts": 10,
     "grid_counted": 7,
     "grid_excluded_not_free": 2,
+    "grid_excluded_not_free_why": "",  # a grid without the details (a file before 2026-12-06)
     "grid_excluded_no_path": 1,
     "grid_parked": 4,
     "grid_success_rate": 0.571,  # 4 of the 7 counted starts, not of all 10
@@ -83,6 +84,20 @@ def test_start_grid_columns_against_the_whole_arrival_box():
         "arrival_consistency_p90": 1.2,  # 1.0 + 0.8 × (1.25 - 1.0)
         "arrival_consistency_within_25pct": 0.75,  # 0.8, 1.25 and 1.0 of the four
     }
+
+
+def test_the_starts_that_are_not_free_are_counted_by_why():
+    """Commonest first, ties by name; the other starts' details are not counted."""
+    grid = start_grid()
+    details = ["overlaps curb", "overlaps curb and front_car", OUTSIDE_DOMAIN]
+    grid = dataclasses.replace(
+        grid,
+        excluded=np.array([""] * 4 + [NOT_FREE] * 5 + [NO_WAY], dtype=object),
+        excluded_detail=np.array([""] * 4 + [details[0]] * 2 + details + [""], dtype=object),
+    )
+    assert start_grid_columns(grid)["grid_excluded_not_free_why"] == (
+        "overlaps curb: 3; overlaps curb and front_car: 1; reference point outside the domain: 1"
+    )
 
 
 def test_start_grid_columns_when_no_start_parks():

@@ -39,6 +39,15 @@ STRING = h5py.string_dtype()
 
 NOT_FREE = "start pose overlaps an obstacle or lies outside the domain"  # why a start is
 NO_WAY = "no collision-free path to the destination (pose search)"  # excluded (``excluded``)
+OUTSIDE_DOMAIN = "reference point outside the domain"  # what makes a NOT_FREE pose so
+# (``excluded_detail``), else ``overlap_detail``'s text
+
+
+def overlap_detail(obstacles: list[str]) -> str:
+    """The ``excluded_detail`` of a start pose whose body overlaps the named obstacles."""
+    return "overlaps " + " and ".join(obstacles)
+
+
 CONSISTENCY_BAND = 0.25  # consistent: |parking time / cost-to-go - 1| <= this (within 25 %)
 NOTHING_S = 1e-9  # a parking time and cost-to-go both under this are both none: consistent
 
@@ -69,7 +78,9 @@ def consistency_summary(ratios: np.ndarray) -> tuple[float, float, float]:
 class StartGrid:
     """Start states (n, d) spec units in ``state_order`` and their outcomes. state_units: the
     spec unit of each column (``start``'s ``units``); None: the car's (parsing.vehicle) for its
-    variables, and a file without them reads as None."""
+    variables, and a file without them reads as None. excluded_detail: (n,) str, what makes a
+    ``NOT_FREE`` start so (``OUTSIDE_DOMAIN`` or ``overlap_detail``), "" for the others; None
+    for a file without it (before 2026-12-06)."""
 
     start: np.ndarray
     state_order: tuple[str, ...]
@@ -82,6 +93,7 @@ class StartGrid:
     attrs: dict
     state_units: tuple[str, ...] | None = None
     arrival_cost_to_go: np.ndarray | None = None
+    excluded_detail: np.ndarray | None = None
 
     @property
     def counted(self) -> np.ndarray:
@@ -136,6 +148,9 @@ def write_start_grid(path: str | Path, grid: StartGrid) -> None:
         if grid.arrival_cost_to_go is not None:
             arrival = np.asarray(grid.arrival_cost_to_go, float)
             create_with_unit(h5, "arrival_cost_to_go", arrival, "s")
+        if grid.excluded_detail is not None:
+            detail = np.asarray(grid.excluded_detail, dtype=object)
+            create_with_unit(h5, "excluded_detail", detail, TEXT, dtype=STRING)
         h5.attrs["state_order"] = list(grid.state_order)
         for key, value in grid.attrs.items():
             h5.attrs[key] = value
@@ -189,4 +204,7 @@ def read_start_grid(path: str | Path) -> StartGrid:
             attrs={k: h5.attrs[k] for k in h5.attrs if k != "state_order"},
             state_units=column_units(h5["start"]),
             arrival_cost_to_go=h5["arrival_cost_to_go"][()] if "arrival_cost_to_go" in h5 else None,
+            excluded_detail=h5["excluded_detail"].asstr()[()].astype(object)
+            if "excluded_detail" in h5
+            else None,
         )

@@ -42,6 +42,7 @@ def start_grid_columns(grid: StartGrid) -> dict:
         "grid_starts": int(grid.start.shape[0]),
         "grid_counted": int(grid.counted.sum()),
         "grid_excluded_not_free": int(np.sum(grid.excluded == NOT_FREE)),
+        "grid_excluded_not_free_why": not_free_breakdown(grid),
         "grid_excluded_no_path": int(np.sum(grid.excluded == NO_WAY)),
         "grid_parked": int(parked.sum()),
         "grid_success_rate": round(grid.success_rate, 3),
@@ -52,6 +53,19 @@ def start_grid_columns(grid: StartGrid) -> dict:
         **consistency_columns("consistency", grid.consistency if parked.any() else None),
         **consistency_columns("arrival_consistency", arrival if parked.any() else None),
     }
+
+
+def not_free_breakdown(grid: StartGrid) -> str:
+    """The ``NOT_FREE`` starts counted by what makes them so (``StartGrid.excluded_detail``),
+    commonest first, e.g. 'overlaps curb: 515; reference point outside the domain: 420'; "" for
+    a grid without the details or with no such start."""
+    if grid.excluded_detail is None:
+        return ""
+    details, counts = np.unique(
+        grid.excluded_detail[grid.excluded == NOT_FREE].astype(str), return_counts=True
+    )
+    order = sorted(range(len(details)), key=lambda k: (-counts[k], details[k]))
+    return "; ".join(f"{details[k]}: {counts[k]}" for k in order)
 
 
 def consistency_columns(prefix: str, ratios: np.ndarray | None) -> dict:
@@ -127,7 +141,9 @@ def write_car_table(
         f"(|speed| <= {tolerance['speed_m_s']} m/s) to the end of the run, with no collision "
         "at any instant. Start grid: a start that cannot park at all is excluded, and the "
         "success rate counts only the others (grid_counted): grid_excluded_not_free, the start "
-        "pose overlaps an obstacle or lies outside the domain; grid_excluded_no_path, a search "
+        "pose overlaps an obstacle or lies outside the domain (grid_excluded_not_free_why: how "
+        "many starts lie outside the domain and how many overlap which obstacles); "
+        "grid_excluded_no_path, a search "
         "over poses (the steer's largest angle, forward and back) finds no collision-free path "
         "to the destination. Consistency: parking time / the table's cost-to-go at the start, "
         "for each counted start that parked; its median, 90th percentile and the share within "

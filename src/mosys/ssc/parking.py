@@ -15,8 +15,14 @@ import numpy as np
 from mosys.errors import InputError
 from mosys.io.car_scene import CarScene, car_scene_attributes, controller_table_scene
 from mosys.io.progress import Progress
-from mosys.io.start_grid import NO_WAY, NOT_FREE, StartGrid
-from mosys.kernels.geometry import first_colliding_sample, pack_polygons
+from mosys.io.start_grid import NO_WAY, NOT_FREE, OUTSIDE_DOMAIN, StartGrid, overlap_detail
+from mosys.kernels.geometry import (
+    first_colliding_sample,
+    pack_polygons,
+    place_outline,
+    point_in_polygon,
+    polygons_overlap,
+)
 from mosys.limits import check_job
 from mosys.ssc.controller import Controller
 
@@ -107,6 +113,32 @@ def classify_starts(controller: Controller, starts: np.ndarray) -> tuple[np.ndar
     return reason.astype(object), reach.path_length
 
 
+def not_free_details(
+    scene: CarScene, starts: np.ndarray, order: tuple[str, ...], excluded: np.ndarray
+) -> np.ndarray:
+    """What makes each ``NOT_FREE`` start (n, d) in ``order``, spec units, so: (n,) str,
+    ``OUTSIDE_DOMAIN`` where the reference point lies outside the scene's domain, else
+    ``overlap_detail`` of every obstacle the body overlaps there (the tests of
+    ``geometry.pose_is_free_at``, one by one); "" for the other starts."""
+    detail = np.full(len(starts), "", dtype=object)
+    body = np.empty_like(scene.body_outline)
+    columns = [order.index(name) for name in ("x", "y", "heading")]
+    for i in np.flatnonzero(excluded == NOT_FREE):
+        x, y, heading = starts[i, columns]
+        if scene.domain.shape[0] > 0 and not point_in_polygon(x, y, scene.domain):
+            detail[i] = OUTSIDE_DOMAIN
+            continue
+        place_outline(scene.body_outline, x, y, math.radians(heading), body)
+        detail[i] = overlap_detail(
+            [
+                name
+                for name, polygon in zip(scene.obstacle_names, scene.obstacles, strict=True)
+                if polygons_overlap(body, polygon)
+            ]
+        )
+    return detail
+
+
 def evaluate_starts(
     controller: Controller,
     starts: np.ndarray,
@@ -159,6 +191,7 @@ def evaluate_starts(
         collided=np.array([o.collision_index >= 0 for o in runs], dtype=np.bool_),
         parking_seconds=np.array([o.parking_seconds for o in runs]),
         excluded=excluded,
+        excluded_detail=not_free_details(scene, starts, controller.state_order, excluded),
         cost_to_go=np.array([controller.cost_to_go(start) for start in starts]),
         path_length=path_length,
         arrival_cost_to_go=None
