@@ -4,6 +4,7 @@ starts, and determinism whatever the threads."""
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numba
@@ -121,12 +122,25 @@ def test_a_new_sense_rule_contains_a_point_of_the_parents_sense_trajectory():
 
 
 @pytest.mark.slow  # a minute and more: a whole sense-based search
-def test_a_sense_based_search_enriches_its_first_population_with_three_rounds():
+def test_a_sense_based_search_enriches_a_first_set_and_keeps_its_best():
+    """§4.2: three rounds of the relevance mutation enrich "the first set of 100 motion
+    controllers"; the best C of them go on (here a first set of 8 for C = 4, to be quick)."""
     spec = SPEC.replace("controller time rules=3 period=0.4", "controller sense rules=3")
-    outcome = run_search(setup(spec), 1)
-    # C controllers, three rounds of C more, then C per generation
-    assert list(outcome.evaluations) == [16, 20, 24, 28]
-    assert setup(SPEC).enrich_rounds == 0
+    sense = setup(spec)
+    assert (sense.enrich_rounds, sense.first_set, sense.first_size) == (3, 100, 100)
+    assert (setup(SPEC).enrich_rounds, setup(SPEC).first_size) == (0, 4)  # time-based: C
+    outcome = run_search(dataclasses.replace(sense, first_set=8), 1)
+    # 8 controllers, three rounds of 8 more, then C = 4 per generation
+    assert list(outcome.evaluations) == [32, 36, 40, 44]
+
+
+def test_the_first_set_keeps_its_best_controllers_in_order():
+    population = _Population(setup(), np.random.default_rng(5), size=6)
+    population.fitness[:] = [0.5, 3.0, -1.0, 2.0, 3.0, 0.0]
+    kept = population.take(np.argsort(-population.fitness, kind="stable")[:3])
+    assert kept.fitness.tolist() == [3.0, 3.0, 2.0]  # ties keep their order: 1, then 4
+    np.testing.assert_array_equal(kept.target, population.target[[1, 4, 3]])
+    np.testing.assert_array_equal(kept.senses, population.senses[[1, 4, 3]])
 
 
 def test_a_search_gives_the_same_result_on_one_thread_and_two():
@@ -215,6 +229,20 @@ def test_final_spin_is_the_bodys_rate_at_the_end():
     measured = outcome.terms[FITNESS_TERMS_3D.index("final_spin")]
     assert measured == pytest.approx(np.degrees(np.linalg.norm(rate)), rel=1e-9)
     assert measured > 1.0  # a run of a random controller ends moving
+
+
+def test_net_rotation_is_the_size_of_the_heading_change():
+    """``net_rotation`` (footnote 10's net rotation about the vertical) is |heading_change|,
+    whichever way the figure turned."""
+    from mosys.parsing.bsr import FITNESS_TERMS_3D
+
+    turns = []
+    for seed in (1, 2, 3):
+        terms = run_search(setup(), seed).terms
+        turned = terms[FITNESS_TERMS_3D.index("heading_change")]
+        assert terms[FITNESS_TERMS_3D.index("net_rotation")] == abs(turned)
+        turns.append(turned)
+    assert all(t != 0.0 for t in turns)  # random controllers turn: the term is not all 0
 
 
 def test_a_heading_rod_standing_upright_at_the_start_is_refused(tmp_path):

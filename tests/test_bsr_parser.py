@@ -167,7 +167,7 @@ KEYWORDS = (
 TERMS = (
     "'distance=', 'max_height=', 'contact_distance=', 'rotations=', 'fall=', 'sideways=', "
     "'heading_change=', 'heading_deviation=', 'feet_distance=', 'foot_steps=', 'min_height=', "
-    "'heading_sine=', 'final_spin='"
+    "'heading_sine=', 'final_spin=', 'net_rotation='"
 )
 FALL_LINE = (
     "a 'fall' line naming the endpoints whose ground contact the fall term measures "

@@ -19,8 +19,8 @@ The same search drives 2-D and 3-D figures: a ``SearchSetup`` carries the simula
 evaluates a population and records a run (``PlanarSimulation`` here, the 3-D one in
 ``mosys.bsr.search3d``), and how new sense rules are made relevant: 2-D shares a corner with
 the sense trajectory; 3-D (§4.2) contains a point of it (the point uniformly inside the box, at
-most 0.98 of the half-side from the centre), and the first population is enriched by three
-rounds of that mutation before the search begins.
+most 0.98 of the half-side from the centre), and a first set of 100 controllers (§4.2) is
+enriched by three rounds of that mutation before the search begins, its best C going on.
 
 A run whose figure's state blows up (NaN, inf or beyond ±``kernels.soundness.STATE_LIMIT``: the
 kernels stop there) aborts the search with ``NonFiniteStateError`` at the spec's ``simulate``
@@ -97,8 +97,9 @@ class Simulation(Protocol):
 class SearchSetup:
     """A spec bound to its figure: the nominal start pose (root angle rad, joints (J,) rad, x
     m), the fall endpoints' indices, the term weights in the order of the simulation's terms,
-    the budget, the simulation, the relevance heuristic (``RELEVANCE``) and how many rounds of
-    it enrich the first population."""
+    the budget, the simulation, the relevance heuristic (``RELEVANCE``), how many rounds of it
+    enrich the first population, and how many controllers that first population has
+    (``first_set``; 0: C) before the best C of them are kept."""
 
     spec: BsrSpec
     figure: BsrFigure
@@ -111,6 +112,12 @@ class SearchSetup:
     simulation: Simulation
     relevance: str = "corner"
     enrich_rounds: int = 0
+    first_set: int = 0
+
+    @property
+    def first_size(self) -> int:
+        """The first population's size: ``first_set``, or C where that is larger (or 0)."""
+        return max(self.spec.controllers, self.first_set)
 
     @classmethod
     def bound(
@@ -123,7 +130,8 @@ class SearchSetup:
         **search,
     ) -> SearchSetup:
         """The set-up of a spec whose names ``bind_names`` looked up in its figure (2-D or 3-D);
-        ``generations`` overrides the spec's G; ``search``: ``relevance``, ``enrich_rounds``."""
+        ``generations`` overrides the spec's G; ``search``: ``relevance``, ``enrich_rounds``,
+        ``first_set``."""
         return cls(
             spec=spec,
             figure=figure,
@@ -287,24 +295,27 @@ def searched_variables(setup: SearchSetup) -> int:
 
 def search_memory_bytes(setup: SearchSetup, record_step_bytes: int) -> float:
     """About the memory a search takes, bytes: two populations (the controllers and their
-    mutants), each controller's rules (targets, tau, boxes) and the senses of its last run (steps
-    + 1, V) float64 (``_Population``), and one recorded run of ``record_step_bytes`` per step."""
+    mutants; or the first population, where it is larger), each controller's rules (targets,
+    tau, boxes) and the senses of its last run (steps + 1, V) float64 (``_Population``), and one
+    recorded run of ``record_step_bytes`` per step."""
     spec, figure = setup.spec, setup.figure
     senses = len(figure.sense_names)
     rules = 8.0 * spec.rules * (len(figure.joint_names) + 3 + 2 * senses)
     per_controller = rules + 8.0 * (spec.steps + 1) * senses
-    return 2.0 * spec.controllers * per_controller + float(spec.steps) * record_step_bytes
+    populations = max(2 * spec.controllers, setup.first_size)
+    return float(populations) * per_controller + float(spec.steps) * record_step_bytes
 
 
 class _Population:
-    """C controllers as stacked arrays (what ``run_population`` takes), their fitness and the
-    sense trajectory of each one's last run (for the relevance heuristic)."""
+    """C controllers (or ``size``) as stacked arrays (what ``run_population`` takes), their
+    fitness and the sense trajectory of each one's last run (for the relevance heuristic)."""
 
     ARRAYS = ("target", "tau", "center", "side", "segment", "senses", "fitness")
 
-    def __init__(self, setup: SearchSetup, rng: np.random.Generator):
+    def __init__(self, setup: SearchSetup, rng: np.random.Generator, size: int | None = None):
         spec, figure = setup.spec, setup.figure
-        c, r, j, v = spec.controllers, spec.rules, len(figure.joint_names), 0
+        c = spec.controllers if size is None else size
+        r, j, v = spec.rules, len(figure.joint_names), 0
         if spec.kind == "sense":
             v = len(figure.sense_names)
         self.setup = setup
@@ -404,6 +415,14 @@ class _Population:
         for name in _Population.ARRAYS:
             setattr(twin, name, getattr(self, name).copy())
         return twin
+
+    def take(self, keep: np.ndarray) -> _Population:
+        """A population of the controllers ``keep`` (K,) of this one, in that order."""
+        kept = _Population.__new__(_Population)
+        kept.setup = self.setup
+        for name in _Population.ARRAYS:
+            setattr(kept, name, getattr(self, name)[keep].copy())
+        return kept
 
     def copy_from(self, other: _Population, k_to: int, k_from: int) -> None:
         for name in _Population.ARRAYS:
@@ -551,7 +570,7 @@ class PlanarSimulation:
 def _evaluate(setup: SearchSetup, population: _Population, rng: np.random.Generator):
     """PlanarSimulation.evaluate."""
     spec, figure = setup.spec, setup.figure
-    c = spec.controllers
+    c = population.target.shape[0]  # C, or the first population's size
     if spec.perturbation.any:
         starts = np.stack(
             [
@@ -604,7 +623,8 @@ def run_search(setup: SearchSetup, seed: int, label: str = "search") -> SearchOu
     rng = np.random.default_rng(seed)
     compiled = cold_compilation_seconds()
     began = time.perf_counter()
-    current = _Population(setup, rng)
+    first_size = setup.first_size
+    current = _Population(setup, rng, first_size)
     first = f"seed {seed}, generation 0"
     # silent unless slow (many rules): a line at most every second, and no closing line
     starting = Progress(f"{label}: first population", 1 + setup.enrich_rounds, "rounds")
@@ -612,15 +632,17 @@ def run_search(setup: SearchSetup, seed: int, label: str = "search") -> SearchOu
     starting.update(1)
     for round_ in range(setup.enrich_rounds):
         # §4.2: rounds of the relevance-heuristic mutation enrich the first population
-        for k in range(c):
+        for k in range(first_size):
             current.draw_rule(k, int(rng.integers(spec.rules)), rng, current.senses[k])
         current.fitness[:] = _evaluated(setup, current, rng, first)
         starting.update(2 + round_)
+    if first_size > c:  # §4.2's "first set of 100": the best C go on
+        current = current.take(np.argsort(-current.fitness, kind="stable")[:c])
     mutant = current.copy()
     best_k = int(np.argmax(current.fitness))
     best = current.controller(best_k)
     best_fitness = float(current.fitness[best_k])
-    evaluations = [c * (1 + setup.enrich_rounds)]
+    evaluations = [first_size * (1 + setup.enrich_rounds)]
     curve = [best_fitness]
     progress = Progress(label, setup.generations, "generations")
     for generation in range(1, setup.generations + 1):
@@ -645,7 +667,7 @@ def run_search(setup: SearchSetup, seed: int, label: str = "search") -> SearchOu
             half = c // 2
             for worse, better in zip(order[c - half :], order[:half], strict=True):
                 current.copy_from(current, int(worse), int(better))
-        evaluations.append(c * (generation + 1 + setup.enrich_rounds))
+        evaluations.append(evaluations[0] + c * generation)
         curve.append(best_fitness)
         progress.update(generation, f"best fitness {best_fitness:.3f}")
     progress.finish(f"best fitness {best_fitness:.3f}")

@@ -39,6 +39,7 @@ from mosys.parsing.bsr import FITNESS_TERMS_3D, BsrSpec
 from mosys.parsing.tokens import SpecError
 
 ENRICH_ROUNDS = 3  # §4.2: rounds of the relevance mutation that enrich the first population
+FIRST_SET = 100  # §4.2: "the first set of 100 motion controllers" they enrich; the best C go on
 FEET_TERMS = ("feet_distance", "foot_steps")  # the fitness terms that measure the feet
 # the least horizontal part of the heading rod's length at the start (sin 5.7°): nearer upright,
 # its horizontal direction, the heading, is rounding, and so are the terms that measure it
@@ -115,7 +116,7 @@ class SpatialSimulation:
 
     def evaluate(self, setup: SearchSetup, population, rng: np.random.Generator) -> np.ndarray:
         spec = setup.spec
-        c = spec.controllers
+        c = population.target.shape[0]  # C, or the first population's size
         starts = np.repeat(self.start[None, :], c, axis=0)
         rules = np.zeros((c, spec.steps + 1), np.int64)
         terms = np.zeros((c, len(FITNESS_TERMS_3D)))
@@ -264,4 +265,5 @@ def bind_search3d(
         SpatialSimulation(task, start, start_force),
         relevance="contain",
         enrich_rounds=ENRICH_ROUNDS if spec.kind == "sense" else 0,
+        first_set=FIRST_SET if spec.kind == "sense" else 0,
     )

@@ -26,7 +26,8 @@ least ``STEP_LIFT``) of a foot other than the one that touched down last; ``min_
 lowest com height, m; ``heading_sine`` the sine of the heading change (1: a quarter turn to the
 left, whatever the turns before it: a turn that a spin does not beat); ``final_spin`` the body's
 angular speed at the end, deg/s (a run that ends toppling or spinning pays for it: the next
-search of a chain starts there).
+search of a chain starts there); ``net_rotation`` |heading change|, deg (footnote 10's "net
+rotation about the vertical axis", whichever way).
 
 A run stops where the state is not sound (``kernels.soundness.state_is_sound``), as the 2-D
 one does: checked before every step and after the last, it returns ``blown_up(step)`` (< 0);
@@ -85,8 +86,9 @@ from mosys.kernels.soundness import state_is_sound
     MIN_HEIGHT,
     HEADING_SINE,
     FINAL_SPIN,
-) = range(11)
-TERM_COUNT = 11
+    NET_ROTATION,
+) = range(12)
+TERM_COUNT = 12
 PHYSICAL_SENSES = 10  # height, velocity (3), angular velocity (3), up (3)
 STEP_LIFT = 0.01  # m: a foot that comes down counts as a step if it rose this high since it left
 
@@ -302,6 +304,7 @@ def tally_terms(state, work, task, tally, steps, terms_out):
     terms_out[FOOT_STEPS] = counts[STEPS_TAKEN]
     terms_out[MIN_HEIGHT] = sums[LOWEST]
     terms_out[HEADING_SINE] = math.sin(turned)
+    terms_out[NET_ROTATION] = abs(math.degrees(turned))
     # the body's rate at the end: I⁻¹ (L - h) in the world (the deformation's own spin h)
     world_inverse = work.matrices[3]
     conjugate(rotation, work.matrices[2], world_inverse)

@@ -53,6 +53,7 @@ FITNESS_TERMS_3D = (
     "min_height",
     "heading_sine",
     "final_spin",
+    "net_rotation",
 )
 DEFAULT_FALL_BELOW = 0.5  # 3-D: fallen below this fraction of the standing com height
 DEFAULT_SENSE_FILTER = 0.05  # s: 3-D sense-based: the physical senses' low-pass time constant

@@ -120,6 +120,7 @@ TERMS_3D = {
     "min_height": ("min height", "m", ".2f"),
     "heading_sine": ("sin(heading change)", "", "+.2f"),
     "final_spin": ("final spin", "deg/s", ".0f"),
+    "net_rotation": ("net rotation", "deg", ".1f"),
     **TERMS,
 }
 MAX_POSES = 500  # a filmstrip drawing more is a grey smear: an --interval that short is refused
