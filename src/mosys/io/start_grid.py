@@ -39,17 +39,15 @@ STRING = h5py.string_dtype()
 
 NOT_FREE = "start pose overlaps an obstacle or lies outside the domain"  # why a start is
 NO_WAY = "no collision-free path to the destination (pose search)"  # excluded (``excluded``)
-OUTSIDE_DOMAIN = "reference point outside the domain"  # what makes a NOT_FREE pose so
-# (``excluded_detail``), else ``overlap_detail``'s text
+OUTSIDE_DOMAIN = "reference point outside the domain"  # a NOT_FREE start's ``excluded_detail``
+CONSISTENCY_BAND = 0.25  # consistent: |parking time / cost-to-go - 1| <= this (within 25 %)
+NOTHING_S = 1e-9  # a parking time and cost-to-go both under this are both none: consistent
 
 
 def overlap_detail(obstacles: list[str]) -> str:
-    """The ``excluded_detail`` of a start pose whose body overlaps the named obstacles."""
-    return "overlaps " + " and ".join(obstacles)
-
-
-CONSISTENCY_BAND = 0.25  # consistent: |parking time / cost-to-go - 1| <= this (within 25 %)
-NOTHING_S = 1e-9  # a parking time and cost-to-go both under this are both none: consistent
+    """The ``excluded_detail`` of a start pose whose body overlaps the named obstacles (none:
+    ``NOT_FREE`` itself, which the pose search's freedom test and this one should not allow)."""
+    return "overlaps " + " and ".join(obstacles) if obstacles else NOT_FREE
 
 
 def consistency_ratios(parking_seconds: np.ndarray, cost_to_go: np.ndarray) -> np.ndarray:
