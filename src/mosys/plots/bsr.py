@@ -320,35 +320,48 @@ def learning_figure(results: Sequence[str | Path]) -> Figure:
         curves, finals = learning_axes(figure, FINALS_WIDTH)
         right_end = max(int(r.evaluations[-1]) for r, _ in loaded)
         for (result, _), seed in zip(loaded, seeds, strict=True):
-            evaluations = np.append(result.evaluations, right_end)
-            best = np.append(result.best_fitness, result.best_fitness[-1])
-            curves.step(
-                evaluations,
-                best,
-                where="post",
-                color=colors[str(seed)],
-                linewidth=CURVE_WIDTH,
-                label=f"seed {seed}",
+            draw_seed_curve(
+                curves, result, right_end, color=colors[str(seed)], label=f"seed {seed}"
             )
-        curves.set_xlim(0, right_end * 1.01 if right_end > 0 else 1)
-        _thousands(curves.xaxis)
-        curves.set_xlabel("controller evaluations (count)")
-        curves.set_ylabel("best fitness so far (Σ weight × term)")
-        curves.set_title("learning curve of each seed", fontsize=10)
+        label_learning_curves(curves, right_end)
         _layout_learning(figure, title)
         final_values = np.array([r.best_fitness[-1] for r, _ in loaded])
-        decimals = shared_decimals(final_values)
-        column = FinalsColumn(
-            "",
-            final_values,
-            [
-                f"seed {seed}: {minus_signs(f'{value:.{decimals}f}')}"
-                for seed, value in zip(seeds, final_values, strict=True)
-            ],
-            [colors[str(seed)] for seed in seeds],
-        )
+        labels = seed_labels(seeds, final_values)
+        column = FinalsColumn("", final_values, labels, [colors[str(seed)] for seed in seeds])
         draw_finals(curves, finals, [column])
     return figure
+
+
+def draw_seed_curve(curves: Axes, result: BsrResult, right_end: int, **style) -> None:
+    """One seed's best fitness so far against evaluations, a step line held at its last value
+    out to ``right_end`` evaluations (the longest seed's), drawn with ``style``."""
+    curves.step(
+        np.append(result.evaluations, right_end),
+        np.append(result.best_fitness, result.best_fitness[-1]),
+        where="post",
+        linewidth=CURVE_WIDTH,
+        **style,
+    )
+
+
+def label_learning_curves(curves: Axes, right_end: int) -> None:
+    """The learning curves' panel: evaluations from 0 to ``right_end`` in whole thousands-
+    separated counts, its axis labels and its title."""
+    curves.set_xlim(0, right_end * 1.01 if right_end > 0 else 1)
+    _thousands(curves.xaxis)
+    curves.set_xlabel("controller evaluations (count)")
+    curves.set_ylabel("best fitness so far (Σ weight × term)")
+    curves.set_title("learning curve of each seed", fontsize=10)
+
+
+def seed_labels(seeds: Sequence[int], values: np.ndarray) -> list[str]:
+    """'seed K: value' for each seed's final best fitness, all with the same decimals
+    (``shared_decimals``)."""
+    decimals = shared_decimals(values)
+    return [
+        f"seed {seed}: {minus_signs(f'{value:.{decimals}f}')}"
+        for seed, value in zip(seeds, values, strict=True)
+    ]
 
 
 def learning_axes(figure: Figure, finals_width: float) -> tuple[Axes, Axes]:
@@ -395,8 +408,9 @@ def draw_finals(curves: Axes, finals: Axes, columns: Sequence[FinalsColumn]) -> 
     """Each column's seeds as dots at their final best fitness, labelled, side by side in
     ``finals`` (after the curves are drawn and the figure laid out), each column's heading
     below it and, where there are several, its median as a black bar. Where the finals lie
-    close together (``finals_range``) the panel has a scale of its own, its ticks on the right,
-    and the range it shows is shaded on ``curves``."""
+    close together (``finals_range``) the panel has a scale of its own, its ticks on the right
+    (the figure's right margin widened for them), and the range it shows is shaded on
+    ``curves``."""
     low, high = curves.get_ylim()
     values = np.concatenate([column.values for column in columns])
     zoom = finals_range(values, low, high)

@@ -61,13 +61,16 @@ from mosys.plots.bsr import (
     best_result_path,
     curves_on_grid,
     draw_finals,
+    draw_seed_curve,
     fitness_formula,
     group_by_search,
+    label_learning_curves,
     learning_axes,
     learning_figure,
     read_result,
     root_attrs,
     search_name,
+    seed_labels,
     shared_decimals,
     terms_text,
     wrapped,
@@ -958,15 +961,15 @@ def seeds_figure(results: Sequence[str | Path]) -> Figure:
         right_end = max(int(r.evaluations[-1]) for _, _, rs in kinds for r in rs)
         for kind, name, kind_results in kinds:
             color, style = KIND_COLORS[kind], KIND_LINESTYLE[kind]
-            for result in kind_results:
-                curves.step(
-                    np.append(result.evaluations, right_end),
-                    np.append(result.best_fitness, result.best_fitness[-1]),
-                    where="post",
+            seeds = [int(result.attrs["seed"]) for result in kind_results]
+            for result, seed in zip(kind_results, seeds, strict=True):
+                draw_seed_curve(
+                    curves,
+                    result,
+                    right_end,
                     color=color,
-                    linewidth=CURVE_WIDTH,
                     linestyle=style,
-                    label=f"{name} seed {int(result.attrs['seed'])}",
+                    label=f"{name} seed {seed}",
                 )
             entries.append(
                 (
@@ -975,20 +978,11 @@ def seeds_figure(results: Sequence[str | Path]) -> Figure:
                 )
             )
             values = np.array([r.best_fitness[-1] for r in kind_results])
-            decimals = shared_decimals(values)
-            labels = [
-                f"seed {int(r.attrs['seed'])}: {minus_signs(f'{v:.{decimals}f}')}"
-                for r, v in zip(kind_results, values, strict=True)
-            ]
-            median = minus_signs(f"{np.median(values):.{decimals}f}")
+            median = minus_signs(f"{np.median(values):.{shared_decimals(values)}f}")
             heading = f"{KIND_TEXT[kind]}\nmedian {median}"
+            labels = seed_labels(seeds, values)
             columns.append(FinalsColumn(heading, values, labels, [color] * len(values)))
-        curves.set_xlim(0, right_end * 1.01 if right_end > 0 else 1)
-        curves.xaxis.get_major_locator().set_params(integer=True)  # whole counts
-        curves.xaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))
-        curves.set_xlabel("controller evaluations (count)")
-        curves.set_ylabel("best fitness so far (Σ weight × term)")
-        curves.set_title("learning curve of each seed", fontsize=10)
+        label_learning_curves(curves, right_end)
         _lay_out_kinds(figure, entries, title, above=0.3, right=0.0)
         draw_finals(curves, finals, columns)
     return figure
