@@ -21,7 +21,13 @@ from matplotlib.patches import Polygon
 from PIL import Image
 
 import mosys.plots.car as car
-from mosys.io.start_grid import NO_WAY, NOT_FREE, consistency_ratios, consistency_summary
+from mosys.io.start_grid import (
+    NO_WAY,
+    NOT_FREE,
+    OUTSIDE_DOMAIN,
+    consistency_ratios,
+    consistency_summary,
+)
 from mosys.io.trajectory import Trajectory, write_trajectory
 from mosys.kernels.geometry import first_colliding_sample, pack_polygons
 from mosys.plots.car import (
@@ -531,6 +537,42 @@ def test_excluded_starts_have_their_own_markers_and_are_not_counted(tmp_path):
     assert figure.get_suptitle().startswith(HEADLINE)
 
 
+def test_starts_that_are_not_free_are_drawn_by_what_they_overlap(tmp_path):
+    """A grid that says what makes each start not free (``excluded_detail``): a + per detail,
+    each its own colour and legend entry, the overlaps in alphabetical order, then the starts
+    off the domain; the rate and the other markers as before."""
+    path = write_start_grid(tmp_path / "grid.h5", headings=(0.0, 90.0, 180.0))
+    with h5py.File(path, "a") as h5:
+        excluded = h5["excluded"].asstr()[()]
+        detail = np.full(len(excluded), "", dtype=object)
+        not_free = np.flatnonzero(excluded == NOT_FREE)
+        detail[not_free] = [OUTSIDE_DOMAIN, "overlaps front car", "overlaps curb and front car"]
+        h5.create_dataset("excluded_detail", data=detail, dtype=h5py.string_dtype())
+    figure = success_map_figure(path)
+    labels = [
+        "cannot park: start overlaps curb and front car",
+        "cannot park: start overlaps front car",
+        "cannot park: start’s reference point outside the domain",
+    ]
+    assert legend_labels(figure) == MAP_LEGEND[:3] + labels + MAP_LEGEND[4:]
+    by_gid = {}
+    for ax in figure.axes[:3]:
+        by_gid.update({c.get_gid(): c for c in ax.collections if isinstance(c, PathCollection)})
+    colors = [by_gid[label].get_facecolor()[0] for label in labels]
+    for first, second in ((0, 1), (0, 2), (1, 2)):
+        assert not same_color(colors[first], colors[second])
+    assert same_color(colors[0], car.NOT_FREE_COLOR)
+    panels = figure.axes[:3]  # headings 0°, 90°, 180°: the detail of each one's start at (6, 1)
+    for ax, label in zip(panels, [labels[2], labels[1], labels[0]], strict=True):
+        np.testing.assert_array_equal(markers(ax)[label], [[6, 1]])
+    (legend,) = figure.legends
+    handles = dict(zip(legend_labels(figure), legend.legend_handles, strict=True))
+    assert {handles[label].get_marker() for label in labels} == {"+"}
+    assert figure.get_suptitle().startswith(
+        "Controller park: parks from 3 of 18 starts (16.7 %); 6 more cannot park at all"
+    )
+
+
 def test_only_the_exclusion_reasons_present_are_in_the_legend(tmp_path):
     path = write_start_grid(tmp_path / "grid.h5")
     with h5py.File(path, "a") as h5:
@@ -813,6 +855,18 @@ def test_a_start_grid_with_bad_exclusions(tmp_path):
     with h5py.File(path, "a") as h5:
         del h5["excluded"]
         h5.create_dataset("excluded", data=excluded.astype(object), dtype=h5py.string_dtype())
+        h5["excluded_detail"] = np.zeros(8)
+    with pytest.raises(PlotInputError) as error:
+        read_start_grid(path)
+    assert str(error.value) == f"{path}: /excluded_detail must hold strings (h5py.string_dtype())"
+    with h5py.File(path, "a") as h5:
+        del h5["excluded_detail"]
+        h5.create_dataset("excluded_detail", data=["overlaps curb"] * 7, dtype=h5py.string_dtype())
+    with pytest.raises(PlotInputError) as error:
+        read_start_grid(path)
+    assert str(error.value) == f"{path}: /excluded_detail has shape (7,), expected (8,)"
+    with h5py.File(path, "a") as h5:
+        del h5["excluded_detail"]
         h5["collided"][7] = True
     with pytest.raises(PlotInputError) as error:
         read_start_grid(path)

@@ -179,9 +179,18 @@ DATASETS = (
 )
 
 
+def _texts(h5: h5py.File, name: str, path: str | Path) -> np.ndarray:
+    """The dataset ``name`` (n,) as Python strings; InputError if it does not hold strings."""
+    try:
+        return h5[name].asstr()[()].astype(object)
+    except TypeError:  # h5py: asstr() of a dataset that does not hold strings
+        raise InputError(f"{path}: /{name} must hold strings (h5py.string_dtype())") from None
+
+
 def read_start_grid(path: str | Path) -> StartGrid:
     """Read a start grid written by ``write_start_grid``; InputError naming the file and the
-    datasets (or ``state_order``) it lacks, or that it cannot be read (``contracts.open_hdf5``)."""
+    datasets (or ``state_order``) it lacks, a text dataset that does not hold strings, or that
+    it cannot be read (``contracts.open_hdf5``)."""
     with open_hdf5(path) as h5:
         for kind, names, present in (
             ("datasets", DATASETS, h5),
@@ -196,13 +205,13 @@ def read_start_grid(path: str | Path) -> StartGrid:
             parked=h5["parked"][()],
             collided=h5["collided"][()],
             parking_seconds=h5["parking_seconds"][()],
-            excluded=h5["excluded"].asstr()[()].astype(object),
+            excluded=_texts(h5, "excluded", path),
             cost_to_go=h5["cost_to_go"][()],
             path_length=h5["path_length"][()],
             attrs={k: h5.attrs[k] for k in h5.attrs if k != "state_order"},
             state_units=column_units(h5["start"]),
             arrival_cost_to_go=h5["arrival_cost_to_go"][()] if "arrival_cost_to_go" in h5 else None,
-            excluded_detail=h5["excluded_detail"].asstr()[()].astype(object)
-            if "excluded_detail" in h5
-            else None,
+            excluded_detail=(
+                _texts(h5, "excluded_detail", path) if "excluded_detail" in h5 else None
+            ),
         )

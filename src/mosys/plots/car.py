@@ -40,6 +40,7 @@ from mosys.io.start_grid import (
     DATASETS,
     NO_WAY,
     NOT_FREE,
+    OUTSIDE_DOMAIN,
     StartGrid,
     consistency_summary,
 )
@@ -103,6 +104,8 @@ PARKING_TIMES = LinearSegmentedColormap.from_list(
     "parking_times", matplotlib.colormaps["Greens"](np.linspace(0.35, 1.0, 256))
 )
 NOT_FREE_COLOR, NO_WAY_COLOR = "0.2", "0.3"  # the markers of the starts that cannot park
+# a NOT_FREE start's + by what makes it so (the start grid's excluded_detail), in turn
+NOT_FREE_DETAIL_COLORS = (NOT_FREE_COLOR, "#2c6fbb", "#8e44ad", "#a6611a", "#018571")
 MARKER_DIAMETER_RANGE = (3.5, 7.5)  # pt, a start-grid map's markers
 MAP_LEGEND_COLUMNS = 3
 CONSISTENCY_BIN = 0.05  # width of a consistency histogram bin
@@ -313,16 +316,15 @@ def read_start_grid(path: str | Path) -> DrawnStartGrid:
     excluded start that was run."""
     try:
         grid = read_start_grid_file(path)
-    except InputError as error:  # a dataset or state_order is missing
+    except InputError as error:  # a dataset or state_order missing, texts that are not strings
         raise PlotInputError(str(error)) from None
-    except TypeError:  # h5py: asstr() of a dataset that does not hold strings
-        raise PlotInputError(f"{path}: /excluded must hold strings (h5py.string_dtype())") from None
     attrs = grid.attrs
     _missing(path, "start grid (root attributes)", GRID_ATTRS, attrs)
     start = np.asarray(grid.start, dtype=np.float64)
     per_start = {name: np.asarray(getattr(grid, name)) for name in DATASETS[1:]}
-    if grid.arrival_cost_to_go is not None:
-        per_start["arrival_cost_to_go"] = np.asarray(grid.arrival_cost_to_go)
+    for name in ("arrival_cost_to_go", "excluded_detail"):  # optional
+        if getattr(grid, name) is not None:
+            per_start[name] = np.asarray(getattr(grid, name))
     state_order = grid.state_order
     _columns(path, state_order, ("x", "y"))
     if start.ndim != 2 or start.shape[1] != len(state_order) or len(start) == 0:
@@ -980,7 +982,9 @@ def success_map_figure(start_grid_path: str | Path) -> Figure:
     each start's reference point (x, y) a marker: a green disc where it parked (coloured by the
     parking time, colour bar in s), a red × where it hit an obstacle, an orange square where it
     did not park within the simulated time; and for a start that cannot park at all (excluded,
-    not run) a grey + where the start pose is not free (``NOT_FREE``), a hollow grey diamond
+    not run) a + where the start pose is not free (``NOT_FREE``; one colour per obstacle or set
+    of obstacles it overlaps, and for a reference point off the domain, where the grid says
+    which: ``excluded_detail``, else grey), a hollow grey diamond
     where the pose search found no path to the destination (``NO_WAY``). Markers are sized to
     the grid's spacing on the page. Starts that differ in any other variable (heading, steer,
     speed) get one panel per distinct combination: a table of panels when two vary (rows
@@ -1021,11 +1025,7 @@ def success_map_figure(start_grid_path: str | Path) -> Figure:
             TIMED_OUT,
             counted & ~parked & ~grid.collided,
         ),
-        *(
-            (label, marker, grid.excluded == reason)
-            for reason, (label, marker) in EXCLUSIONS.items()
-            if np.any(grid.excluded == reason)
-        ),
+        *_exclusion_kinds(grid),
     ]
     legend = [(marker.handle(), label) for label, marker, _ in kinds]
     legend.append(
@@ -1072,6 +1072,36 @@ def success_map_figure(start_grid_path: str | Path) -> Figure:
         _suptitle(layout.figure, f"{headline}\n{details}")
         add_legend(layout.figure, legend, ncols=MAP_LEGEND_COLUMNS)
     return layout.figure
+
+
+def _exclusion_kinds(grid: StartGrid) -> list[tuple[str, _Marker, np.ndarray]]:
+    """The start-grid map's kinds of starts that cannot park, (legend text, marker, which
+    starts (n,) bool), each reason present once; the ``NOT_FREE`` starts of a grid that says
+    what makes them so (``excluded_detail``) a kind per detail instead, each a + of its own
+    colour (NOT_FREE_DETAIL_COLORS in turn: the overlaps in alphabetical order, then
+    ``OUTSIDE_DOMAIN``)."""
+    kinds = []
+    for reason, (label, marker) in EXCLUSIONS.items():
+        which = grid.excluded == reason
+        if not which.any():
+            continue
+        if reason != NOT_FREE or grid.excluded_detail is None:
+            kinds.append((label, marker, which))
+            continue
+        details = grid.excluded_detail.astype(str)
+        present = sorted(set(details[which]), key=lambda text: (text == OUTSIDE_DOMAIN, text))
+        for k, detail in enumerate(present):
+            color = NOT_FREE_DETAIL_COLORS[k % len(NOT_FREE_DETAIL_COLORS)]
+            kinds.append(
+                (
+                    f"cannot park: start{'’s' if detail == OUTSIDE_DOMAIN else ''} {detail}"
+                    if detail
+                    else label,
+                    replace(marker, face=color, edge=color),
+                    which & (details == detail),
+                )
+            )
+    return kinds
 
 
 def plot_consistency(start_grid_path: str | Path, out_path: str | Path) -> None:
