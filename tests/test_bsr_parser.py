@@ -542,8 +542,8 @@ def test_a_spec_naming_a_figure_unfit_for_bsr_is_refused_at_its_figure_line(tmp_
     with pytest.raises(SpecError) as error:
         load_rod_figure(figures, "x.bsr", token)
     assert str(error.value) == (
-        f"x.bsr:4:8: expected a BSR figure ({figures / 'link1.fig'}:11:5: expected a 'free' "
-        "root (BSR figures fly and fall), found 'link'), found 'link1'"
+        f"x.bsr:4:8: expected a BSR figure, found 'link1' ({figures / 'link1.fig'}:11:5: "
+        "expected a 'free' root, as BSR figures fly and fall, found 'link')"
     )
 
 

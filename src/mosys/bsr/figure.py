@@ -178,7 +178,7 @@ def check_bsr_figure(figure: Figure) -> Joint:
     floor (or no terrain); returns the root's joint, raises SpecError at the offending line."""
     root = figure.root
     if root.kind != "free":
-        raise SpecError.at(figure.path, root.token, "a 'free' root (BSR figures fly and fall)")
+        raise SpecError.at(figure.path, root.token, "a 'free' root, as BSR figures fly and fall")
     if figure.rods[0].name != root.rod:
         raise SpecError.at(figure.path, figure.rods[0].token, f"the root rod '{root.rod}' first")
     if figure.terrain.kind not in ("none", "floor"):
@@ -200,7 +200,7 @@ def load_rod_figure(figures_dir: str | Path, spec_path: str, token: Token) -> Fi
     try:
         check_bsr_figure(parsed)
     except SpecError as error:  # a sound figure, but not one for BSR: the spec chose it
-        raise SpecError.at(spec_path, token, f"a BSR figure ({error})") from None
+        raise SpecError.at(spec_path, token, "a BSR figure", str(error)) from None
     return parsed
 
 

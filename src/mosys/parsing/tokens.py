@@ -48,9 +48,19 @@ def shortened_words(text: str) -> str:
 class SpecError(Exception):
     """A spec that does not parse: names the file, the 1-based line and column, what the grammar
     expected there and what it found (``None`` for the end of the line, ``END_OF_FILE``,
-    ``NO_FILE`` for a file that is not there: 'found end of line' read as a parse error)."""
+    ``NO_FILE`` for a file that is not there: 'found end of line' read as a parse error), and
+    optionally ``why`` what was found will not do, in brackets after it (another file's error
+    that the word brought about)."""
 
-    def __init__(self, path: str, line: int, column: int, expected: str, found: str | None):
+    def __init__(
+        self,
+        path: str,
+        line: int,
+        column: int,
+        expected: str,
+        found: str | None,
+        why: str | None = None,
+    ):
         self.path = str(path)
         self.line = line
         self.column = column
@@ -58,14 +68,14 @@ class SpecError(Exception):
         self.found = found
         special = {None: "end of line", END_OF_FILE: "end of file", NO_FILE: "no such file"}
         shown = special.get(found) or shown_text(found)
-        super().__init__(
-            f"{self.path}:{line}:{column}: expected {shortened_words(expected)}, found {shown}"
-        )
+        where = f"{self.path}:{line}:{column}"
+        message = f"{where}: expected {shortened_words(expected)}, found {shown}"
+        super().__init__(message if why is None else f"{message} ({why})")
 
     @classmethod
-    def at(cls, path: str, token: Token, expected: str) -> SpecError:
+    def at(cls, path: str, token: Token, expected: str, why: str | None = None) -> SpecError:
         """The error at ``token`` of the spec ``path``, having found the token's text."""
-        return cls(path, token.line, token.column, expected, token.text)
+        return cls(path, token.line, token.column, expected, token.text, why)
 
 
 @dataclass(frozen=True)
