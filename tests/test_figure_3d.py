@@ -615,8 +615,8 @@ heading a
 terrain floor
 """
 BINDING_ERRORS = {
-    BINDING.replace("free a", "pin a"): "bad.fig:4:5: expected a 'free' root (BSR figures fly "
-    "and fall), found 'a'",
+    BINDING.replace("free a", "pin a"): "bad.fig:4:5: expected a 'free' root, as BSR figures fly "
+    "and fall, found 'a'",
     BINDING.replace(
         "rod a length=1 mass=1\nrod b length=1 mass=1\n",
         "rod b length=1 mass=1\nrod a length=1 mass=1\n",
