@@ -554,6 +554,28 @@ def cholesky_in_place(system, n, scale):
     return True
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def normal_responses(active, count, responses, compliance, system):
+    """A: the active contacts' (``active`` (count,), nonzero for one) normal (y) velocity
+    responses to one another's normal impulses (from ``responses`` (M, M, 3, 3)), with
+    ``compliance`` (s/kg) added to its diagonal, into system[:n, :n] in the contacts' order;
+    returns its largest entry (the scale its pivots are judged by)."""
+    scale = 0.0
+    row = 0
+    for i in range(count):
+        if not active[i]:
+            continue
+        column = 0
+        for j in range(count):
+            if active[j]:
+                value = responses[i, j, 1, 1] + (compliance if i == j else 0.0)
+                system[row, column] = value
+                scale = max(scale, abs(value))
+                column += 1
+        row += 1
+    return scale
+
+
 @njit(cache=True, error_model="numpy")
 def _normal_block(u, r, active, count, responses, system, compliance, pairs):
     """The set-up of ``_shared_friction`` at the active contacts: A⁻¹ into system[:n, :n], N0 =
@@ -566,19 +588,11 @@ def _normal_block(u, r, active, count, responses, system, compliance, pairs):
         if active[i]:
             n += 1
     rhs = MAX_CONTACTS + 3  # the right-hand sides' and solutions' column
-    # A; then L in place of A, then A⁻¹ (both triangles) in place of L, and N0 = A⁻¹ (-u_y)
-    scale_a = 0.0
-    row = 0
     for i in range(count):
         if not active[i]:
             continue
-        column = 0
         for j in range(count):
             if active[j]:
-                value = responses[i, j, 1, 1] + (compliance if i == j else 0.0)
-                system[row, column] = value
-                scale_a = max(scale_a, abs(value))
-                column += 1
                 # B's and D's terms of the pair: the normal (y) response at i and the slide
                 # (x, z) and twist response at i (the twist's velocity r_z v_x - r_x v_z) to a
                 # slide x, a slide z and a twist at j (a twist's impulse (r_z, 0, -r_x))
@@ -594,7 +608,8 @@ def _normal_block(u, r, active, count, responses, system, compliance, pairs):
                 pairs[i, j, 6] = r[i, 2] * k[0, 0] - r[i, 0] * k[2, 0]
                 pairs[i, j, 7] = r[i, 2] * k[0, 2] - r[i, 0] * k[2, 2]
                 pairs[i, j, 8] = r[i, 2] * twist_x - r[i, 0] * twist_z
-        row += 1
+    # A; then L in place of A, then A⁻¹ (both triangles) in place of L, and N0 = A⁻¹ (-u_y)
+    scale_a = normal_responses(active, count, responses, compliance, system)
     if not cholesky_in_place(system, n, scale_a):
         return -1.0
     for k in range(n):  # L⁻¹, row by row (a row's entries of L are used left to right)
@@ -926,20 +941,12 @@ def frictionless_impulses(u, count, responses, impulse, system, compliance, memb
                 continue
             added = compliance if n >= 3 else 0.0
             # A_S's Cholesky factor in system[:n, :n], the solution in column M
-            scale = 0.0
+            scale = normal_responses(members, count, responses, added, system)
             row = 0
             for i in range(count):
-                if not members[i]:
-                    continue
-                column = 0
-                for j in range(count):
-                    if members[j]:
-                        value = responses[i, j, 1, 1] + (added if i == j else 0.0)
-                        system[row, column] = value
-                        scale = max(scale, abs(value))
-                        column += 1
-                system[row, MAX_CONTACTS] = -u[i, 1]
-                row += 1
+                if members[i]:
+                    system[row, MAX_CONTACTS] = -u[i, 1]
+                    row += 1
             if not cholesky_in_place(system, n, scale):
                 continue
             for k in range(n):  # L y = b, then Lᵀ x = y
