@@ -42,7 +42,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from mosys.kernels.bsr_simulate import CONTACT_TOLERANCE, deform_joints
+from mosys.kernels.bsr_simulate import CONTACT_TOLERANCE, deform_joints, lowest_on_floor
 
 CX, CY, CZ, VX, VY, VZ = 0, 1, 2, 3, 4, 5
 QW = 6  # quaternion w, x, y, z
@@ -1403,28 +1403,21 @@ def step_motion(figure, state, dt, work, total_mass, place_rods):
         state[CY] = floor - y
         state[CZ] = entry[pinned, 2] - z
     if not math.isnan(floor):
-        lowest_y = np.inf
+        lowest = np.inf
         next_lowest = np.inf
         bottom = -1
         for e in range(n_ends):
             y = endpoint_position(state, rotation, end_offset, e)[1]
-            if y < lowest_y:
-                next_lowest = lowest_y
-                lowest_y = y
+            if y < lowest:
+                next_lowest = lowest
+                lowest = y
                 bottom = e
             elif y < next_lowest:
                 next_lowest = y
-        if lowest_y < floor:
-            state[CY] += floor - lowest_y  # no sinking: lift the figure out of the floor
-            next_lowest += floor - lowest_y
-            lowest_y = floor
-        elif not frictional and end_force[bottom] > 0.0:
-            # the lowest endpoint took a frictionless push: it pushed, so it touches (as a
-            # pinned one does), and ends the step on the floor rather than skimming above it
-            next_lowest -= lowest_y - floor
-            state[CY] -= lowest_y - floor
-            lowest_y = floor
-        alone = lowest_y - floor <= CONTACT_TOLERANCE < next_lowest - floor
+        lift, alone = lowest_on_floor(
+            lowest, next_lowest, floor, not frictional and end_force[bottom] > 0.0
+        )
+        state[CY] += lift
         if alone and not (pushing == 1 and pinned == bottom):
             # one endpoint down does not slide, however it came to be alone on the floor (as in
             # 2-D): stopped dead if that pushes, else horizontally, and held where it stood

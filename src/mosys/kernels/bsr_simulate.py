@@ -179,6 +179,22 @@ def figure_body_frame(figure, theta, theta_rate, rod_ends, end_offset, end_veloc
 
 
 @njit(cache=True, inline="always")
+def lowest_on_floor(lowest, next_lowest, floor, pushed):
+    """After a step, the figure's lift (m, up) that puts its lowest endpoint (height lowest, m;
+    the next lowest at next_lowest) on the floor (height floor): where it sank into the floor
+    (no sinking), or where it took a frictionless push (``pushed``: it pushed, so it touches, as
+    a pinned one does, and ends the step on the floor rather than skimming above it); else 0.
+    And whether that endpoint is then alone on the floor (within CONTACT_TOLERANCE of it, the
+    next beyond). 2-D and 3-D alike."""
+    lift = 0.0
+    if lowest < floor or pushed:
+        lift = floor - lowest
+        next_lowest += lift
+        lowest = floor
+    return lift, lowest - floor <= CONTACT_TOLERANCE < next_lowest - floor
+
+
+@njit(cache=True, inline="always")
 def endpoint_position(state, cos_phi, sin_phi, end_offset, e):
     """World (x, y) of endpoint e, m, from its offset from the centre of mass in the body frame
     (end_offset (E, 2)) and the body's orientation (cos_phi, sin_phi)."""
@@ -554,17 +570,10 @@ def step(
                 bottom = e
             elif y < next_lowest:
                 next_lowest = y
-        if lowest < floor:
-            state[CY] += floor - lowest  # no sinking: lift the figure out of the floor
-            next_lowest += floor - lowest
-            lowest = floor
-        elif not frictional and end_force[bottom] > 0.0:
-            # the lowest endpoint took a frictionless push: it pushed, so it touches (as a
-            # pinned one does), and ends the step on the floor rather than skimming above it
-            next_lowest -= lowest - floor
-            state[CY] -= lowest - floor
-            lowest = floor
-        alone = lowest - floor <= CONTACT_TOLERANCE < next_lowest - floor
+        lift, alone = lowest_on_floor(
+            lowest, next_lowest, floor, not frictional and end_force[bottom] > 0.0
+        )
+        state[CY] += lift
         if alone and not (pushing == 1 and pinned == bottom):
             # one endpoint down does not slide, however it came to be alone on the floor (the
             # lift above, a stop that would have pulled it down, a deformation that lifts it
