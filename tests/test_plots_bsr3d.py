@@ -31,7 +31,9 @@ from mosys.plots.bsr3d import (
     SIDE,
     TOP,
     Camera,
+    camera_text,
     chain_paths,
+    choose_camera,
     figure_at_rest_figure,
     filmstrip_figure,
     floor_cells,
@@ -278,6 +280,24 @@ def test_every_camera_is_a_rotation_with_a_level_right_axis(
     assert np.linalg.norm(seen) == pytest.approx(np.linalg.norm(point), abs=1e-9)
 
 
+def test_a_motion_is_seen_from_where_its_poses_spread_out() -> None:
+    """A walk straight forward from the default view; a walk away from it (-z, after a left
+    turn) from as far round as the views go; an L of both from between; a figure standing
+    still, or moving less than a tenth of its size, from the default (the first of equals)."""
+    forward = np.array([[0.6 * k, 0.5, 0.0] for k in range(6)])
+    away = np.array([[0.0, 0.5, -0.6 * k] for k in range(6)])
+    turned = np.concatenate([forward, forward[-1] + away[1:] * [1.0, 0.0, 1.0]])
+    assert choose_camera(forward, 2.0) == Camera(30.0)
+    assert choose_camera(away, 2.0) == Camera(60.0)
+    assert choose_camera(turned, 2.0) == Camera(45.0)  # both walks alike: halfway
+    assert choose_camera(np.repeat(forward[:1], 4, axis=0), 2.0) == Camera(30.0)
+    assert choose_camera(away * 0.1, 20.0) == Camera(30.0)
+    assert camera_text(Camera(45.0)) == (
+        "seen from its front right (45° round from its right side), 30° above the floor"
+    )
+    assert camera_text(Camera(0.0, 0.0)) == "seen from its right side, 0° above the floor"
+
+
 def test_floor_squares_are_nice_and_aligned_to_the_world() -> None:
     points = np.array([[0.0, 0.3, 0.0], [1.0, 0.5, -1.0]])
     cell, x_edges, z_edges = floor_cells(points, margin=0.1, size=1.0)
@@ -363,9 +383,20 @@ def test_filmstrip_draws_the_chain_as_one_motion(chain: dict[str, list[Path]]) -
         "poses every 0.5 s from 0 s to 6 s, coloured by search, light → dark, with their "
         "shadows; the centre of mass's path on the floor (■ start, ● hand-over)",
     ]
-    assert "floor squares 0.25 m; seen from its front right, 30° above the floor" in (
-        figure.get_suptitle()
-    )
+    # the chain turns left and walks on, away from the default view: seen from further round
+    assert figure.get_suptitle().splitlines()[2:] == [
+        "arrows: the heading at the start of each search and at the end; floor squares 0.25 m",
+        "seen from its front right (45° round from its right side), 30° above the floor",
+    ]
+    size = bsr3d.pose_size(joined.motion.endpoints)
+    posed = joined.motion.com[bsr3d.samples_to_the_end(joined.motion.t, 0.5)]
+    camera = choose_camera(posed, size)
+    assert camera == Camera(45.0)
+    # the whole floor, as that camera sees it, lies within the picture
+    edges = floor_cells(joined.motion.endpoints, bsr3d.FLOOR_MARGIN * size, size)[1:]
+    corners = project(bsr3d._floor_corners(*edges), camera)
+    for axis, limits in enumerate((scene.get_xlim(), scene.get_ylim())):
+        assert limits[0] < corners[:, axis].min() and corners[:, axis].max() < limits[1]
     # the poses: one stick figure every 0.5 s, coloured by search, light to dark
     poses = [c for c in scene.collections if isinstance(c, LineCollection) and c.get_path_effects()]
     assert len(poses) == 13
@@ -380,8 +411,8 @@ def test_filmstrip_draws_the_chain_as_one_motion(chain: dict[str, list[Path]]) -
     for before, after in zip(paths, paths[1:], strict=False):
         np.testing.assert_allclose(before.get_xydata()[-1], after.get_xydata()[0])
     floor_com = joined.motion.com * [1.0, 0.0, 1.0]
-    np.testing.assert_allclose(paths[0].get_xydata()[0], project(floor_com[0])[:2])
-    np.testing.assert_allclose(paths[-1].get_xydata()[-1], project(floor_com[-1])[:2])
+    np.testing.assert_allclose(paths[0].get_xydata()[0], project(floor_com[0], camera)[:2])
+    np.testing.assert_allclose(paths[-1].get_xydata()[-1], project(floor_com[-1], camera)[:2])
     # the floor, the heading arrows, the legend and the colour bar of time
     (floor,) = [c for c in scene.collections if isinstance(c, PolyCollection)]
     size = bsr3d.pose_size(joined.motion.endpoints)
@@ -402,7 +433,7 @@ def test_filmstrip_draws_the_chain_as_one_motion(chain: dict[str, list[Path]]) -
     assert [text.get_text() for text in key.texts if text.get_text()] == ["x", "y", "z"]
     arrows = [text for text in key.texts if getattr(text, "arrow_patch", None)]
     tips = np.array([arrow.xy for arrow in arrows])  # each world axis as the camera sees it
-    np.testing.assert_allclose(tips, project(np.eye(3))[:, :2])
+    np.testing.assert_allclose(tips, project(np.eye(3), camera)[:, :2])
 
 
 def test_filmstrip_of_one_search_chooses_its_poses(
@@ -621,7 +652,9 @@ def test_figure_at_rest(tmp_path: Path) -> None:
         "Cujo at rest (t = 0 s): 7 rods, 7 kg, heading rod spine\n"
         "▲ the rod ends it walks on; the heading rod is drawn thicker"
     )
-    assert main_view.get_title() == "seen from its front right, 30° above the floor"
+    assert main_view.get_title() == (
+        "seen from its front right (30° round from its right side), 30° above the floor"
+    )
     names = [text.get_text() for text in main_view.texts]
     assert sorted(names[:-1]) == sorted(ROD_NAMES) and names[-1] == "floor squares 0.25 m"
     assert [ax.get_title() for ax in (side, front, top)] == [

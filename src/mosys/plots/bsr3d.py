@@ -4,7 +4,7 @@ Figures": Figures 15 to 17, and Figures 7 and 8 for 3-D searches), drawn from se
 
 - ``plot_filmstrip``: Figures 15 to 17 (Cujo bounding, Rex's walk-turn-walk, Bob walking), the
   best motion of one search, or of a chain of searches drawn as one motion, as stick figures at
-  regular times over a checkered floor, seen by one fixed camera (``VIEW``).
+  regular times over a checkered floor, seen by one camera (``choose_camera``).
 - ``write_motion_gif``: the same motion animated, the same camera.
 - ``plot_learning_kinds``: Figure 7 ("Learning curves for both kinds of motion controller"),
   a time-based and a sense-based search of one problem, every seed and the median of each.
@@ -21,7 +21,9 @@ t = 0) is drawn at its distances along the picture plane's right and up axes (``
 that one metre is as long wherever it is, the floor's squares all alike and the view can pan.
 ``VIEW`` looks from the figure's right (+z) side, turned CAMERA_AZIMUTH towards its front
 (+x) and CAMERA_ELEVATION above the floor: walking forward runs left to right, a left turn heads
-away from the camera, a right turn towards it.
+away from the camera, a right turn towards it. A motion's filmstrip and animation turn the
+camera further towards the front where that spreads the poses out (``choose_camera``: a walk
+that turns left and walks on, as Rex's, whose second walk would pile its poses up).
 
 A chain (Rex's walk, then his turn from where the walk ends, then his walk again) is given as
 its files in order, one per search, each search's ``chain`` attribute naming the one before it
@@ -133,6 +135,7 @@ CHAIN_TOLERANCE = 1e-3  # m: a continuing search's first pose is its predecessor
 # the camera
 CAMERA_AZIMUTH = 30.0  # deg from the figure's right side (+z) towards its front (+x)
 CAMERA_ELEVATION = 30.0  # deg above the floor
+CAMERA_AZIMUTHS = tuple(np.arange(CAMERA_AZIMUTH, 61.0, 5.0))  # deg: a motion's camera's choice
 
 
 @dataclass(frozen=True)
@@ -154,7 +157,7 @@ class Camera:
         return np.array([right, np.cross(toward, right), toward])
 
 
-VIEW = Camera()  # the filmstrips' and animations' camera
+VIEW = Camera()  # the rest poses' camera, and a straight walk's (``choose_camera``)
 SIDE, FRONT, TOP = Camera(0.0, 0.0), Camera(90.0, 0.0), Camera(0.0, 90.0)
 
 
@@ -163,6 +166,25 @@ def project(points: np.ndarray, camera: Camera = VIEW) -> np.ndarray:
     along the picture's right axis (u, m), along its up axis (v, m) and towards the camera
     (depth, m; nearer is larger)."""
     return np.asarray(points, dtype=np.float64) @ camera.basis().T
+
+
+def choose_camera(com: np.ndarray, size: float) -> Camera:
+    """The camera of a filmstrip and its animation: the one among CAMERA_AZIMUTHS (front right
+    views, CAMERA_ELEVATION above the floor) that draws the filmstrip's poses furthest apart.
+    com (k, 3) m: the poses' centres of mass in order; size m: the figure's (``pose_size``).
+    Each consecutive pair's distance on the picture counts by its logarithm, taken between 0.1
+    and 1 times the size (poses a size apart no longer overlap, and a figure standing still
+    overlaps itself from anywhere), and the largest sum wins, the first of equals: a walk
+    straight forward is seen from CAMERA_AZIMUTH, and one that turns away from the camera,
+    which piles its poses up there, from further round (Rex's second walk, from 45°)."""
+    best, best_score = VIEW, -math.inf
+    for azimuth in CAMERA_AZIMUTHS:
+        camera = Camera(float(azimuth))
+        gaps = np.linalg.norm(np.diff(project(com, camera)[:, :2], axis=0), axis=1)
+        score = float(np.log(np.clip(gaps, 0.1 * size, size)).sum())
+        if score > best_score + 1e-9:
+            best, best_score = camera, score
+    return best
 
 
 # --------------------------------------------------------------------------- reading a chain
@@ -465,8 +487,10 @@ def camera_text(camera: Camera) -> str:
     if camera.elevation >= 90:
         return "seen from above"
     side = {0.0: "its right side", 90.0: "its front"}.get(camera.azimuth)
-    if side is None:
-        side = "its front right" if 0 < camera.azimuth < 90 else f"azimuth {camera.azimuth:g}°"
+    if side is None and 0 < camera.azimuth < 90:
+        side = f"its front right ({camera.azimuth:g}° round from its right side)"
+    elif side is None:
+        side = f"azimuth {camera.azimuth:g}°"
     return f"seen from {side}, {camera.elevation:g}° above the floor"
 
 
@@ -547,8 +571,18 @@ def plot_filmstrip(
         save_figure(filmstrip_figure(result_paths, interval), path)
 
 
+def default_interval(chain: ChainMotion) -> float:
+    """A filmstrip's interval between poses, s, where none is given: a round one
+    (``choose_interval``) giving about ``pose_count`` poses."""
+    count = pose_count(chain)
+    duration = float(chain.motion.t[-1] - chain.motion.t[0])
+    return choose_interval(duration, (max(count - 2, 2), count + 2))
+
+
 def filmstrip_figure(
-    result_paths: Sequence[str | Path], interval: float | None = None, camera: Camera = VIEW
+    result_paths: Sequence[str | Path],
+    interval: float | None = None,
+    camera: Camera | None = None,
 ) -> Figure:
     """Figures 15 to 17: the best motion of a 3-D search, or of a chain of them in order
     (``join_chain``) drawn as one, seen by ``camera``: the figure's rods (lines with round
@@ -560,14 +594,14 @@ def filmstrip_figure(
     a dot at each hand-over, an arrow of the heading at each search's start and at the end,
     over a checkered floor covering the motion (its squares' side in the subtitle), a key of
     the world axes in the corner. The title names the figure and the searches; the legend
-    gives each search's controller, seed, time span, fitness and measured terms."""
+    gives each search's controller, seed, time span, fitness and measured terms. camera None:
+    ``choose_camera`` for the poses drawn."""
     chain = join_chain(result_paths)
     motion = chain.motion
     t = motion.t
     duration = float(t[-1] - t[0])
     if interval is None:
-        count = pose_count(chain)
-        interval = choose_interval(duration, (max(count - 2, 2), count + 2))
+        interval = default_interval(chain)
     if not interval > 0:
         raise ValueError(f"interval must be a positive number of seconds, got {interval!r}")
     if duration / interval > MAX_POSES:  # before a time is listed for each pose
@@ -578,8 +612,12 @@ def filmstrip_figure(
     samples = samples_to_the_end(t, interval)
     poses = motion.endpoints[samples]
     size = pose_size(motion.endpoints)
+    if camera is None:
+        camera = choose_camera(motion.com[samples], size)
     cell, x_edges, z_edges = floor_cells(motion.endpoints, FLOOR_MARGIN * size, size)
-    seen = project(np.concatenate([poses.reshape(-1, 3), _floor_corners(x_edges, z_edges)]))
+    seen = project(
+        np.concatenate([poses.reshape(-1, 3), _floor_corners(x_edges, z_edges)]), camera
+    )
     limits = fit_aspect(
         np.array([seen[:, :2].min(axis=0) - VIEW_PADDING, seen[:, :2].max(axis=0) + VIEW_PADDING])
     )
@@ -596,7 +634,7 @@ def filmstrip_figure(
         "the centre of mass's path on the floor "
         f"{'(■ start, ● hand-over)' if chained else '(■ its start)'}\n"
         f"arrows: the heading at the start{' of each search' if chained else ''} and at the "
-        f"end; floor squares {cell:g} m; {camera_text(camera)}"
+        f"end; floor squares {cell:g} m\n{camera_text(camera)}"
     )
     legend_rows = sum(label.count("\n") + 1 for _, label in entries)
     norm = Normalize(0.0, duration if duration > 0 else 1.0)
@@ -653,7 +691,7 @@ def write_motion_gif(
     path: str | Path,
     fps: int = GIF_FPS,
     max_frames: int = GIF_MAX_FRAMES,
-    camera: Camera = VIEW,
+    camera: Camera | None = None,
 ) -> None:
     """An animated GIF of the best motion of a 3-D search, or of a chain of them in order
     (``join_chain``), seen by ``camera`` as in ``filmstrip_figure``: the checkered floor, the
@@ -663,16 +701,21 @@ def write_motion_gif(
     (``frame_samples``: every 40 ms by default, the step widened to keep to ``max_frames``
     frames), played in real time; the last frame held; loops. A motion ranging wider or taller
     than FOLLOW_POSES times the figure's size is followed by a view that pans
-    (``mosys.plots.style.pan``). Written atomically."""
+    (``mosys.plots.style.pan``). Written atomically. camera None: the filmstrip's
+    (``choose_camera`` for the poses of ``default_interval``)."""
     check_animation_options(fps, max_frames)
     chain = join_chain(result_paths)
     motion = chain.motion
     t, endpoints = motion.t, motion.endpoints
     samples, step = frame_samples(t, int(fps), int(max_frames))
     size = pose_size(endpoints)
+    if camera is None:
+        posed = samples_to_the_end(t, default_interval(chain))
+        camera = choose_camera(motion.com[posed], size)
     cell, x_edges, z_edges = floor_cells(endpoints, FLOOR_MARGIN * size, size)
     seen = project(endpoints[samples], camera)  # (frames, rods, 2, 3)
-    points = np.concatenate([seen.reshape(-1, 3), project(_floor_corners(x_edges, z_edges))])
+    corners = project(_floor_corners(x_edges, z_edges), camera)
+    points = np.concatenate([seen.reshape(-1, 3), corners])
     limits = fit_aspect(
         np.array([points[:, :2].min(axis=0), points[:, :2].max(axis=0)]) + [[-0.1], [0.1]]
     )
