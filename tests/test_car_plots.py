@@ -832,45 +832,56 @@ def test_a_start_grid_with_a_wrong_shaped_new_dataset(tmp_path, name):
     assert not (tmp_path / "x.png").exists()
 
 
+def refusal(path: Path, change) -> str:
+    """The PlotInputError message of reading the start grid ``path`` after ``change``(h5)."""
+    with h5py.File(path, "a") as h5:
+        change(h5)
+    with pytest.raises(PlotInputError) as error:
+        read_start_grid(path)
+    return str(error.value)
+
+
+def replace_texts(h5, name: str, texts) -> None:
+    """The text dataset ``name`` of an open start grid, made ``texts`` (replaced if there)."""
+    if name in h5:
+        del h5[name]
+    h5.create_dataset(name, data=np.asarray(texts, dtype=object), dtype=h5py.string_dtype())
+
+
 def test_a_start_grid_with_bad_exclusions(tmp_path):
     path = write_start_grid(tmp_path / "grid.h5")
-    with h5py.File(path, "a") as h5:
+    with h5py.File(path) as h5:
         excluded = h5["excluded"].asstr()[()]
-        del h5["excluded"]
-        h5["excluded"] = np.zeros(8)
-    with pytest.raises(PlotInputError) as error:
-        read_start_grid(path)
-    assert str(error.value) == f"{path}: /excluded must hold strings (h5py.string_dtype())"
-    with h5py.File(path, "a") as h5:
-        del h5["excluded"]
-        guessed = excluded.astype(object)
-        guessed[6] = "looks blocked"
-        h5.create_dataset("excluded", data=guessed, dtype=h5py.string_dtype())
-    with pytest.raises(PlotInputError) as error:
-        read_start_grid(path)
-    assert str(error.value) == (
+    guessed = excluded.astype(object)
+    guessed[6] = "looks blocked"
+
+    def numbers(name):
+        def change(h5):
+            del h5[name]
+            h5[name] = np.zeros(8)
+
+        return change
+
+    strings = "must hold strings (h5py.string_dtype())"
+    assert refusal(path, numbers("excluded")) == f"{path}: /excluded {strings}"
+    assert refusal(path, lambda h5: replace_texts(h5, "excluded", guessed)) == (
         f"{path}: start 6 is excluded for an unknown reason 'looks blocked' (known: "
         f"{NOT_FREE!r}, {NO_WAY!r})"
     )
+    replace = {"excluded": excluded, "excluded_detail": [""] * 8}
     with h5py.File(path, "a") as h5:
-        del h5["excluded"]
-        h5.create_dataset("excluded", data=excluded.astype(object), dtype=h5py.string_dtype())
-        h5["excluded_detail"] = np.zeros(8)
-    with pytest.raises(PlotInputError) as error:
-        read_start_grid(path)
-    assert str(error.value) == f"{path}: /excluded_detail must hold strings (h5py.string_dtype())"
-    with h5py.File(path, "a") as h5:
-        del h5["excluded_detail"]
-        h5.create_dataset("excluded_detail", data=["overlaps curb"] * 7, dtype=h5py.string_dtype())
-    with pytest.raises(PlotInputError) as error:
-        read_start_grid(path)
-    assert str(error.value) == f"{path}: /excluded_detail has shape (7,), expected (8,)"
-    with h5py.File(path, "a") as h5:
-        del h5["excluded_detail"]
+        for name, texts in replace.items():
+            replace_texts(h5, name, texts)
+    assert refusal(path, numbers("excluded_detail")) == f"{path}: /excluded_detail {strings}"
+    assert refusal(path, lambda h5: replace_texts(h5, "excluded_detail", [""] * 7)) == (
+        f"{path}: /excluded_detail has shape (7,), expected (8,)"
+    )
+
+    def collide(h5):
+        replace_texts(h5, "excluded_detail", [""] * 8)
         h5["collided"][7] = True
-    with pytest.raises(PlotInputError) as error:
-        read_start_grid(path)
-    assert str(error.value) == (
+
+    assert refusal(path, collide) == (
         f"{path}: start 7 is excluded ({NO_WAY}) but has an outcome: parked False, collided True"
     )
 

@@ -615,9 +615,7 @@ def filmstrip_figure(
     if camera is None:
         camera = choose_camera(motion.com[samples], size)
     cell, x_edges, z_edges = floor_cells(motion.endpoints, FLOOR_MARGIN * size, size)
-    seen = project(
-        np.concatenate([poses.reshape(-1, 3), _floor_corners(x_edges, z_edges)]), camera
-    )
+    seen = project(np.concatenate([poses.reshape(-1, 3), _floor_corners(x_edges, z_edges)]), camera)
     limits = fit_aspect(
         np.array([seen[:, :2].min(axis=0) - VIEW_PADDING, seen[:, :2].max(axis=0) + VIEW_PADDING])
     )
