@@ -639,7 +639,12 @@ def filmstrip_figure(
     shades = pose_colors(chain)
     with plot_style():
         figure, ax, bar = scene_figure(
-            limits, SCENE_WIDTH, title.count("\n") + 1, legend_rows, colorbar=True
+            limits,
+            SCENE_WIDTH,
+            title.count("\n") + 1,
+            legend_rows,
+            colorbar=True,
+            axes_drawn=False,
         )
         ax.set_axis_off()
         height = figure.get_size_inches()[1]
@@ -733,7 +738,7 @@ def write_motion_gif(
     )
     with plot_style():
         figure, ax, _ = scene_figure(
-            limits, GIF_WIDTH, title.count("\n") + 1, legend_rows=0, dpi=GIF_DPI
+            limits, GIF_WIDTH, title.count("\n") + 1, 0, dpi=GIF_DPI, axes_drawn=False
         )
         ax.set_axis_off()
         figure.suptitle(title, y=1 - 0.08 / figure.get_size_inches()[1], va="top", fontsize=8)

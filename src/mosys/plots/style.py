@@ -280,6 +280,7 @@ POSE_TIMES = LinearSegmentedColormap.from_list(  # poses, light (start) to dark 
     "pose_times", matplotlib.colormaps["YlGnBu"](np.linspace(0.3, 1.0, 256))
 )
 COLORBAR_SPACE = 1.05  # inches right of a scene for its colour bar and label
+BARE_MARGIN = 0.15  # inches below a scene drawn without axes (no axis label to make room for)
 
 
 def draw_terrain(ax: Axes, terrain: list, bottom: float) -> None:
@@ -302,15 +303,19 @@ def scene_figure(
     legend_rows: int,
     colorbar: bool = False,
     dpi: float | None = None,
+    axes_drawn: bool = True,
 ) -> tuple[Figure, Axes, Axes | None]:
     """A figure with one equal-aspect panel ``width`` inches wide showing ``limits``
     [[xmin, ymin], [xmax, ymax]] (m), sized in inches so that its box has their aspect: room
-    above for ``header_lines`` lines of title, below for the axis label and a legend of
+    above for ``header_lines`` lines of title, below for the axis label (``axes_drawn``; a
+    picture without axes, such as the 3-D views, False: only BARE_MARGIN) and a legend of
     ``legend_rows`` rows, on the right for a colour bar (the returned third axes, else None)."""
     (x0, y0), (x1, y1) = limits
     height = width * (y1 - y0) / (x1 - x0)
     top = MARGIN_TOP + TITLE_LINE * header_lines + 0.1
-    bottom = MARGIN_BOTTOM + (LEGEND_ROW * (legend_rows + 1) if legend_rows else 0.0)
+    bottom = (MARGIN_BOTTOM if axes_drawn else BARE_MARGIN) + (
+        LEGEND_ROW * (legend_rows + 1) if legend_rows else 0.0
+    )
     right = MARGIN_RIGHT + (COLORBAR_SPACE if colorbar else 0.0)
     fig_width = MARGIN_LEFT + width + right
     fig_height = top + height + bottom
