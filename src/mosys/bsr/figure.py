@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Protocol
 
 import numpy as np
 
@@ -150,8 +151,26 @@ def bsr_figure(figure: Figure) -> BsrFigure:
     )
 
 
+class RodFigure(Protocol):
+    """What ``rod_figure_motion`` reads of a BSR figure, 2-D (BsrFigure) or 3-D (BsrFigure3D):
+    the parsed figure, its rods' masses (kg), lengths (m), centres of mass and inertias, and
+    gravity (m/s²)."""
+
+    figure: Figure
+    mass: np.ndarray
+    length: np.ndarray
+    com: np.ndarray
+    inertia: np.ndarray
+    gravity: float
+
+
 def rod_figure_motion(
-    bsr_figure, rod_ends: np.ndarray, com: np.ndarray, dt: float, contact: str, **three_d
+    bsr_figure: RodFigure,
+    rod_ends: np.ndarray,
+    com: np.ndarray,
+    dt: float,
+    contact: str,
+    **three_d: object,
 ) -> FigureMotion:
     """A BSR figure's run (``bsr_figure`` a BsrFigure or a BsrFigure3D: its parsed ``figure``
     and its rods' ``mass``, ``length``, ``com``, ``inertia``) as the ``figure_motion``

@@ -37,7 +37,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
@@ -60,6 +60,9 @@ from mosys.kernels.compile_lock import cold_compilation_seconds
 from mosys.kernels.soundness import steps_before_blow_up, unsoundness
 from mosys.parsing.bsr import FITNESS_TERMS, BsrSpec
 from mosys.parsing.tokens import SpecError, Token, location
+
+if TYPE_CHECKING:  # the 3-D figure, for an annotation only
+    from mosys.bsr.figure3d import BsrFigure3D
 
 CORNER_INSIDE = 0.98  # a re-initialised box's corner: this fraction of the half-side out
 RELEVANCE = ("corner", "contain")
@@ -198,7 +201,9 @@ class BoundNames:
     weights: np.ndarray
 
 
-def bind_names(spec: BsrSpec, figure, term_names: tuple[str, ...]) -> BoundNames:
+def bind_names(
+    spec: BsrSpec, figure: BsrFigure | BsrFigure3D, term_names: tuple[str, ...]
+) -> BoundNames:
     """Look the spec's start coordinates, fall endpoints and fitness terms up in the figure (a
     2-D or 3-D BSR figure: its ``root_angle``, ``root_x``, ``joint_names``, ``endpoint_names``)
     and ``term_names``; a name it lacks raises SpecError at its word, and so does a figure

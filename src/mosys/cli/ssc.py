@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+from typing import TYPE_CHECKING
 
 from mosys.cli.verb import (
     HDF5,
@@ -16,6 +17,11 @@ from mosys.cli.verb import (
     positive_number_problem,
     whole_number_problem,
 )
+
+if TYPE_CHECKING:  # for the annotations only: the command loads these when a verb runs
+    import numpy as np
+
+    from mosys.io.controller_table import ControllerTable
 
 
 def _dp_arguments(parser: argparse.ArgumentParser) -> None:
@@ -139,7 +145,7 @@ def _starts(args: argparse.Namespace) -> None:
     write_start_grid(args.output, grid)
 
 
-def off_table_problem(table, values: dict) -> None:
+def off_table_problem(table: ControllerTable, values: dict[str, np.ndarray]) -> None:
     """InputError for a start heading or steer outside the table's axis (one that does not
     wrap): a start off the table was run and counted as a failure without a word."""
     from mosys.errors import InputError

@@ -16,6 +16,7 @@ from collections.abc import Sequence
 
 import h5py
 import numpy as np
+from numpy.typing import ArrayLike
 
 DIMENSIONLESS = "1"
 INDEX = "index"
@@ -25,12 +26,12 @@ SPEC = "spec"
 MIXED = "mixed"
 
 
-def string_attr(value) -> str:
+def string_attr(value: object) -> str:
     """A string attribute as read by h5py (str or bytes)."""
     return value.decode() if isinstance(value, bytes) else str(value)
 
 
-def string_tuple(values) -> tuple[str, ...]:
+def string_tuple(values: object) -> tuple[str, ...]:
     """A string-list attribute as read by h5py (str, bytes or an array of either) as a tuple."""
     return tuple(string_attr(v) for v in np.atleast_1d(values))
 
@@ -65,7 +66,9 @@ def column_units(dataset: h5py.Dataset) -> tuple[str, ...] | None:
     return string_tuple(dataset.attrs["units"]) if "units" in dataset.attrs else None
 
 
-def create_with_unit(group: h5py.Group, name: str, data, unit: str, **options) -> h5py.Dataset:
+def create_with_unit(
+    group: h5py.Group, name: str, data: ArrayLike, unit: str, **options: object
+) -> h5py.Dataset:
     """``group.create_dataset(name, data=data, **options)`` with its ``unit``."""
     dataset = group.create_dataset(name, data=data, **options)
     set_unit(dataset, unit)

@@ -332,7 +332,7 @@ def learning_figure(results: Sequence[str | Path]) -> Figure:
     return figure
 
 
-def draw_seed_curve(curves: Axes, result: BsrResult, right_end: int, **style) -> None:
+def draw_seed_curve(curves: Axes, result: BsrResult, right_end: int, **style: object) -> None:
     """One seed's best fitness so far against evaluations, a step line held at its last value
     out to ``right_end`` evaluations (the longest seed's), drawn with ``style``."""
     curves.step(

@@ -31,6 +31,7 @@ from matplotlib.lines import Line2D
 from matplotlib.markers import MarkerStyle
 from matplotlib.patches import Patch, Polygon
 from matplotlib.ticker import MaxNLocator
+from numpy.typing import ArrayLike
 
 from mosys.errors import InputError
 from mosys.io.attributes import string_attr
@@ -407,7 +408,9 @@ def outcome_text(trajectory: CarTrajectory) -> str:
     return f"FAILED: not parked in {trajectory.simulated_seconds:g} s"
 
 
-def place_outline(outline: np.ndarray, x, y, heading) -> np.ndarray:
+def place_outline(
+    outline: np.ndarray, x: ArrayLike, y: ArrayLike, heading: ArrayLike
+) -> np.ndarray:
     """An outline (V, 2) m in the car's frame placed at poses x, y (m), heading (deg), scalars
     or (K,) arrays: (V, 2) or (K, V, 2) m in the world frame."""
     x, y = np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64)

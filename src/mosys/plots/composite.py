@@ -27,6 +27,7 @@ from matplotlib.collections import LineCollection
 from matplotlib.colors import to_rgba
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
+from matplotlib.typing import ColorType
 
 from mosys.errors import InputError
 from mosys.io.composite_result import CompositeMotion, CompositeResult, read_composite_result
@@ -211,7 +212,7 @@ def phase_colors(phases: Sequence[Mapping]) -> list[tuple[float, float, float, f
     return [colors[str(phase["name"])] for phase in phases]
 
 
-def shade(color, fraction: float) -> tuple[float, float, float, float]:
+def shade(color: ColorType, fraction: float) -> tuple[float, float, float, float]:
     """``color`` for a pose ``fraction`` (0..1) of the way through its phase: mixed LIGHTEST
     with white at 0, pure at 1."""
     rgba = np.array(to_rgba(color))

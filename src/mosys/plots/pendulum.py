@@ -31,6 +31,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Rectangle
 from matplotlib.ticker import MultipleLocator
 from matplotlib.transforms import Bbox
+from matplotlib.typing import ColorType
 
 from mosys.io.attributes import string_tuple
 from mosys.io.controller_table import ControllerTable, read_controller_table
@@ -137,7 +138,9 @@ def cylinder_pieces(points: np.ndarray, axes: Sequence[StateAxis]) -> list[np.nd
     return pieces
 
 
-def plot_state_path(ax: Axes, points: np.ndarray, axes: Sequence[StateAxis], **style) -> None:
+def plot_state_path(
+    ax: Axes, points: np.ndarray, axes: Sequence[StateAxis], **style: object
+) -> None:
     """Plot a path on cylindrical axes; ``label`` (if any) goes on the first piece only."""
     for piece in cylinder_pieces(points, axes):
         ax.plot(piece[:, 0], piece[:, 1], **style)
@@ -645,7 +648,12 @@ LABEL_OFFSETS = ((6, 6), (6, -16), (-26, 6), (-26, -16), (10, -5), (-30, -5), (-
 """Candidate places (points from the anchor) of a point label, in order of preference."""
 
 
-def place_labels(figure, ax: Axes, labels, obstacles) -> None:
+def place_labels(
+    figure: Figure,
+    ax: Axes,
+    labels: Sequence[tuple[float, float, str, ColorType]],
+    obstacles: Sequence[tuple[float, float, float]],
+) -> None:
     """Annotate points without letting labels overlap each other or the markers: each label,
     in turn, takes the first of ``LABEL_OFFSETS`` whose text box meets nothing already placed
     and stays inside the axes (else the one with the least overlap). ``labels``: (x, y, text,
@@ -784,7 +792,13 @@ def script_path_figure(trajectory_path: str | Path, table_paths: Sequence[str | 
     return figure
 
 
-def trajectory_plot_axes(trajectory: Trajectory, trajectory_path, tables, used, paths):
+def trajectory_plot_axes(
+    trajectory: Trajectory,
+    trajectory_path: str | Path,
+    tables: dict[str, ControllerTable],
+    used: Sequence[str],
+    paths: dict[str, str | Path],
+) -> tuple[tuple[StateAxis, ...], str | Path]:
     """The plot axes of a script's state, and the file they come from: its first controller's
     table's, where the trajectory's state is that table's; the trajectory's own
     (``trajectory_axes``) where it has no table, or where it is the figure's whole state of which
@@ -916,7 +930,7 @@ def _shade_breakpoints(
     return entries
 
 
-def write_script_gif(trajectory_path: str | Path, out_path: str | Path, fps: int = GIF_FPS):
+def write_script_gif(trajectory_path: str | Path, out_path: str | Path, fps: int = GIF_FPS) -> None:
     """An animated GIF of the figure moving through the script, drawn only from the
     trajectory's ``figure_motion`` group: rods as thick lines coloured by the active controller,
     the pivot (rod 0's proximal end), the centre of mass and the terrain; fixed, equal-aspect

@@ -28,6 +28,7 @@ from matplotlib.legend_handler import HandlerTuple
 from matplotlib.lines import Line2D
 from matplotlib.patches import Polygon
 from matplotlib.text import Text
+from matplotlib.typing import ColorType
 
 from mosys.errors import InputError
 from mosys.io.atomic import write_atomically
@@ -125,7 +126,7 @@ def save_figure(figure: Figure, path: str | Path) -> None:
 TEXT_LUMINANCE = 0.18  # text on white at most this luminant: contrast about 4.5 : 1
 
 
-def text_color(color) -> tuple[float, float, float]:
+def text_color(color: ColorType) -> tuple[float, float, float]:
     """``color`` darkened, if it must be, until text in it reads on white: its relative
     luminance (WCAG) at most TEXT_LUMINANCE (a contrast of about 4.5 : 1). Pale colours of a
     20-colour cycle (tab20's light halves) drew names hard to read."""
@@ -160,7 +161,9 @@ def controller_colors(names: Sequence[str]) -> dict[str, tuple[float, float, flo
     return {name: palette(k % palette.N) for k, name in enumerate(names)}
 
 
-def mark_destination(axes: Axes, x: float, y: float, color=DESTINATION_COLOR, size=11.0) -> None:
+def mark_destination(
+    axes: Axes, x: float, y: float, color: ColorType = DESTINATION_COLOR, size: float = 11.0
+) -> None:
     """The papers' destination marker: an encircled X at (x, y), drawn above the paths on a white
     halo so that it reads on any background."""
     for marker, scale in (("o", 1.0), ("x", 0.62)):
@@ -187,7 +190,9 @@ def mark_destination(axes: Axes, x: float, y: float, color=DESTINATION_COLOR, si
         )
 
 
-def destination_handle(color=DESTINATION_COLOR, size: float = 11.0) -> tuple[Line2D, Line2D]:
+def destination_handle(
+    color: ColorType = DESTINATION_COLOR, size: float = 11.0
+) -> tuple[Line2D, Line2D]:
     """A legend handle for ``mark_destination`` (draw it with ``LEGEND_HANDLERS``)."""
     return tuple(
         Line2D(
@@ -204,12 +209,14 @@ def destination_handle(color=DESTINATION_COLOR, size: float = 11.0) -> tuple[Lin
     )
 
 
-def mark_start(axes: Axes, x: float, y: float, color, size: float = 6.0, zorder=5.0) -> None:
+def mark_start(
+    axes: Axes, x: float, y: float, color: ColorType, size: float = 6.0, zorder: float = 5.0
+) -> None:
     """The papers' start marker: a small filled square."""
     axes.plot(x, y, **start_style(color, size), zorder=zorder)
 
 
-def start_style(color, size: float = 6.0) -> dict:
+def start_style(color: ColorType, size: float = 6.0) -> dict:
     """Line2D keywords of the start marker."""
     return {
         "marker": "s",
@@ -222,7 +229,10 @@ def start_style(color, size: float = 6.0) -> dict:
 
 
 def add_legend(
-    figure: Figure, entries: Sequence[tuple[object, str]], ncols: int = 3, fontsize=None
+    figure: Figure,
+    entries: Sequence[tuple[object, str]],
+    ncols: int = 3,
+    fontsize: float | str | None = None,
 ) -> None:
     """The figure's legend from (handle, label) pairs, below the axes so that it hides no data
     (the margins are set here, see ``arrange``); a tuple handle draws its parts overlaid."""
@@ -402,7 +412,7 @@ JOINT_SIZE = 3.4  # pt, the round marker at each rod end
 OUTLINE = "0.2"  # the thin outline that keeps light poses visible on white
 
 
-def draw_pose(ax: Axes, pose: np.ndarray, color, zorder: float) -> None:
+def draw_pose(ax: Axes, pose: np.ndarray, color: ColorType, zorder: float) -> None:
     """One pose (rods, 2, 2) m: rods as lines with round ends, outlined thinly."""
     outline = [patheffects.withStroke(linewidth=ROD_WIDTH + 1.0, foreground=OUTLINE)]
     rods = LineCollection(
@@ -478,7 +488,7 @@ GIF_FPS = 25  # frames per second of motion time: a frame every 40 ms
 GIF_MAX_FRAMES = 150  # a longer motion gets a wider step (``frame_samples``)
 
 
-def check_animation_options(fps, max_frames) -> None:
+def check_animation_options(fps: object, max_frames: object) -> None:
     """ValueError unless ``fps`` is a positive whole number and ``max_frames`` one >= 2."""
     if not (isinstance(fps, int | np.integer) and fps > 0):
         raise ValueError(f"fps must be a positive whole number, got {fps!r}")
