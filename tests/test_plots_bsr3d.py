@@ -747,6 +747,35 @@ def test_cli_rejects_bad_input(
             main(arguments)
         assert exit_.value.code == 2
     assert "plot bsr3d-kinds: give --time and/or --sense result files" in capsys.readouterr().err
+    files = [str(path) for path in chain_files(chain)]
+    for option, value, message in (
+        ("--azimuth", "200", "--azimuth must be between -180 and 180 deg, got 200.0"),
+        ("--elevation", "-5", "--elevation must be between 0 and 90 deg, got -5.0"),
+        ("--elevation", "nan", "--elevation must be between 0 and 90 deg, got nan"),
+    ):
+        with pytest.raises(SystemExit) as exit_:
+            main(["plot", "bsr3d", *files, "--filmstrip", str(out), option, value])
+        assert exit_.value.code == 2
+        assert f"plot bsr3d: {message}" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_the_camera_can_be_given(
+    chain: dict[str, list[Path]], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """--azimuth and --elevation: the camera as given; --elevation alone: the azimuth still
+    chosen (the chain turns away from the default view: 45°), at that height."""
+    drawn = []
+    monkeypatch.setattr(bsr3d, "save_figure", lambda figure, path: drawn.append(figure))
+    files = [str(path) for path in chain_files(chain)]
+    out = str(tmp_path / "strip.png")
+    for options, seen in (
+        (["--azimuth", "0", "--elevation", "90"], "seen from above"),
+        (["--azimuth", "10"], "seen from its front right (10° round from its right side), 30° "),
+        (["--elevation", "60"], "seen from its front right (45° round from its right side), 60° "),
+    ):
+        assert main(["plot", "bsr3d", *files, "--filmstrip", out, *options]) == 0
+        assert drawn.pop().get_suptitle().splitlines()[-1].startswith(seen)
 
 
 def test_text_colour_reads_on_white() -> None:

@@ -242,6 +242,15 @@ def _bsr3d_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--interval", type=float, help="seconds between the filmstrip's poses (default: chosen)"
     )
+    parser.add_argument(
+        "--azimuth",
+        type=float,
+        help="the filmstrip's and GIF's camera, deg round from the figure's right side towards "
+        "its front (-180 to 180; default: chosen, 30 to 60)",
+    )
+    parser.add_argument(
+        "--elevation", type=float, help="the camera's height, deg above the floor (0 to 90; 30)"
+    )
 
 
 def _bsr3d_check(args: argparse.Namespace) -> str | None:
@@ -249,6 +258,10 @@ def _bsr3d_check(args: argparse.Namespace) -> str | None:
         return "plot bsr3d: give --filmstrip, --gif and/or --rest"
     if args.interval is not None and not 0 < args.interval < float("inf"):
         return f"plot bsr3d: --interval must be a positive number of seconds, got {args.interval}"
+    if args.azimuth is not None and not -180 <= args.azimuth <= 180:
+        return f"plot bsr3d: --azimuth must be between -180 and 180 deg, got {args.azimuth}"
+    if args.elevation is not None and not 0 <= args.elevation <= 90:
+        return f"plot bsr3d: --elevation must be between 0 and 90 deg, got {args.elevation}"
     return None
 
 
@@ -257,10 +270,12 @@ def _bsr3d(args: argparse.Namespace) -> None:
 
     # one file per search: the last search's best seed, before it the seeds it continues
     chain = bsr3d.chain_paths(args.results)
+    elevation = bsr3d.CAMERA_ELEVATION if args.elevation is None else args.elevation
+    camera = None if args.azimuth is None else bsr3d.Camera(args.azimuth, elevation)
     if args.filmstrip:
-        bsr3d.plot_filmstrip(chain, args.filmstrip, args.interval)
+        bsr3d.plot_filmstrip(chain, args.filmstrip, args.interval, camera, elevation)
     if args.gif:
-        bsr3d.write_motion_gif(chain, args.gif)
+        bsr3d.write_motion_gif(chain, args.gif, camera=camera, elevation=elevation)
     if args.rest:
         bsr3d.plot_result_at_rest(chain[0], args.rest)
 

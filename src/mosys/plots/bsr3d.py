@@ -168,7 +168,7 @@ def project(points: np.ndarray, camera: Camera = VIEW) -> np.ndarray:
     return np.asarray(points, dtype=np.float64) @ camera.basis().T
 
 
-def choose_camera(com: np.ndarray, size: float) -> Camera:
+def choose_camera(com: np.ndarray, size: float, elevation: float = CAMERA_ELEVATION) -> Camera:
     """The camera of a filmstrip and its animation: the one among CAMERA_AZIMUTHS (front right
     views, CAMERA_ELEVATION above the floor) that draws the filmstrip's poses furthest apart.
     com (k, 3) m: the poses' centres of mass in order; size m: the figure's (``pose_size``).
@@ -176,10 +176,11 @@ def choose_camera(com: np.ndarray, size: float) -> Camera:
     and 1 times the size (poses a size apart no longer overlap, and a figure standing still
     overlaps itself from anywhere), and the largest sum wins, the first of equals: a walk
     straight forward is seen from CAMERA_AZIMUTH, and one that turns away from the camera,
-    which piles its poses up there, from further round (Rex's second walk, from 45°)."""
-    best, best_score = VIEW, -math.inf
+    which piles its poses up there, from further round (Rex's second walk, from 50°). Every
+    view is ``elevation`` deg above the floor."""
+    best, best_score = Camera(CAMERA_AZIMUTH, elevation), -math.inf
     for azimuth in CAMERA_AZIMUTHS:
-        camera = Camera(float(azimuth))
+        camera = Camera(float(azimuth), elevation)
         gaps = np.linalg.norm(np.diff(project(com, camera)[:, :2], axis=0), axis=1)
         score = float(np.log(np.clip(gaps, 0.1 * size, size)).sum())
         if score > best_score + 1e-9:
@@ -564,11 +565,15 @@ def _arrow(ax: Axes, base: np.ndarray, heading: float, length: float, camera: Ca
 
 
 def plot_filmstrip(
-    result_paths: Sequence[str | Path], path: str | Path, interval: float | None = None
+    result_paths: Sequence[str | Path],
+    path: str | Path,
+    interval: float | None = None,
+    camera: Camera | None = None,
+    elevation: float = CAMERA_ELEVATION,
 ) -> None:
     """Write ``filmstrip_figure`` as a PNG to ``path``."""
     with plot_style():
-        save_figure(filmstrip_figure(result_paths, interval), path)
+        save_figure(filmstrip_figure(result_paths, interval, camera, elevation), path)
 
 
 def default_interval(chain: ChainMotion) -> float:
@@ -583,6 +588,7 @@ def filmstrip_figure(
     result_paths: Sequence[str | Path],
     interval: float | None = None,
     camera: Camera | None = None,
+    elevation: float = CAMERA_ELEVATION,
 ) -> Figure:
     """Figures 15 to 17: the best motion of a 3-D search, or of a chain of them in order
     (``join_chain``) drawn as one, seen by ``camera``: the figure's rods (lines with round
@@ -595,7 +601,7 @@ def filmstrip_figure(
     over a checkered floor covering the motion (its squares' side in the subtitle), a key of
     the world axes in the corner. The title names the figure and the searches; the legend
     gives each search's controller, seed, time span, fitness and measured terms. camera None:
-    ``choose_camera`` for the poses drawn."""
+    ``choose_camera`` for the poses drawn, ``elevation`` deg above the floor."""
     chain = join_chain(result_paths)
     motion = chain.motion
     t = motion.t
@@ -613,7 +619,7 @@ def filmstrip_figure(
     poses = motion.endpoints[samples]
     size = pose_size(motion.endpoints)
     if camera is None:
-        camera = choose_camera(motion.com[samples], size)
+        camera = choose_camera(motion.com[samples], size, elevation)
     cell, x_edges, z_edges = floor_cells(motion.endpoints, FLOOR_MARGIN * size, size)
     seen = project(np.concatenate([poses.reshape(-1, 3), _floor_corners(x_edges, z_edges)]), camera)
     limits = fit_aspect(
@@ -695,6 +701,7 @@ def write_motion_gif(
     fps: int = GIF_FPS,
     max_frames: int = GIF_MAX_FRAMES,
     camera: Camera | None = None,
+    elevation: float = CAMERA_ELEVATION,
 ) -> None:
     """An animated GIF of the best motion of a 3-D search, or of a chain of them in order
     (``join_chain``), seen by ``camera`` as in ``filmstrip_figure``: the checkered floor, the
@@ -705,7 +712,7 @@ def write_motion_gif(
     frames), played in real time; the last frame held; loops. A motion ranging wider or taller
     than FOLLOW_POSES times the figure's size is followed by a view that pans
     (``mosys.plots.style.pan``). Written atomically. camera None: the filmstrip's
-    (``choose_camera`` for the poses of ``default_interval``)."""
+    (``choose_camera`` for the poses of ``default_interval``, ``elevation`` deg up)."""
     check_animation_options(fps, max_frames)
     chain = join_chain(result_paths)
     motion = chain.motion
@@ -714,7 +721,7 @@ def write_motion_gif(
     size = pose_size(endpoints)
     if camera is None:
         posed = samples_to_the_end(t, default_interval(chain))
-        camera = choose_camera(motion.com[posed], size)
+        camera = choose_camera(motion.com[posed], size, elevation)
     cell, x_edges, z_edges = floor_cells(endpoints, FLOOR_MARGIN * size, size)
     seen = project(endpoints[samples], camera)  # (frames, rods, 2, 3)
     corners = project(_floor_corners(x_edges, z_edges), camera)
