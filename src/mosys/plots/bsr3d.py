@@ -170,7 +170,7 @@ def project(points: np.ndarray, camera: Camera = VIEW) -> np.ndarray:
 
 def choose_camera(com: np.ndarray, size: float, elevation: float = CAMERA_ELEVATION) -> Camera:
     """The camera of a filmstrip and its animation: the one among CAMERA_AZIMUTHS (front right
-    views, CAMERA_ELEVATION above the floor) that draws the filmstrip's poses furthest apart.
+    views) that draws the filmstrip's poses furthest apart.
     com (k, 3) m: the poses' centres of mass in order; size m: the figure's (``pose_size``).
     Each consecutive pair's distance on the picture counts by its logarithm, taken between 0.1
     and 1 times the size (poses a size apart no longer overlap, and a figure standing still
