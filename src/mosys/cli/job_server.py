@@ -211,8 +211,9 @@ def _serve_requests(
                 _, status = os.waitpid(pid, 0)
                 code = os.waitstatus_to_exitcode(status)  # -N: killed by signal N
                 code = code if code >= 0 else 128 - code
-                _send_line(connection, f"exit {code}")
+                # logged first: a client that has its code finds the job's end in the log
                 _log(f"job {pid} ended: exit {code}")
+                _send_line(connection, f"exit {code}")
                 selector.unregister(pidfd)
                 os.close(pidfd)
                 with contextlib.suppress(KeyError):  # unless its client hung up before
