@@ -415,14 +415,11 @@ class _Population:
 
     def copy(self) -> _Population:
         """An independent copy (its arrays are new)."""
-        twin = _Population.__new__(_Population)
-        twin.setup = self.setup
-        for name in _Population.ARRAYS:
-            setattr(twin, name, getattr(self, name).copy())
-        return twin
+        return self.take(slice(None))
 
-    def take(self, keep: np.ndarray) -> _Population:
-        """A population of the controllers ``keep`` (K,) of this one, in that order."""
+    def take(self, keep: np.ndarray | slice) -> _Population:
+        """A population of the controllers ``keep`` (K,) of this one, in that order (a slice:
+        those it selects); its arrays are new."""
         kept = _Population.__new__(_Population)
         kept.setup = self.setup
         for name in _Population.ARRAYS:
