@@ -5,22 +5,33 @@ friction: a lone contact does not slide; ``mosys.bsr.lone_contact``)."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import NamedTuple
 
 import h5py
 import numpy as np
 
-from mosys.bsr.lone_contact import MAX_EXCURSION, lone_contacts, sliding
+from mosys.bsr.lone_contact import lone_contacts, sliding
 from mosys.io.contracts import open_hdf5
 from mosys.io.trajectory import read_figure_motion
 
 
-def rule_lines(path: str | Path) -> list[str]:
-    """A line for each BSR motion in the file (a ``figure_motion`` group made by a BSR
-    simulator over a flat floor: a search's best motion, a composite's before and after): its
-    group, its deepest rod end below the floor (mm) and its lone contacts, how many of them
-    slid MAX_EXCURSION or more; none for a file without such a motion. Raises InputError for a
-    file that cannot be read (``open_hdf5``)."""
-    lines = []
+class RulesMeasured(NamedTuple):
+    """The rules measured on one BSR motion: its group in the file, its deepest rod end below
+    the floor (m, >= 0), its lone contacts and how many of them slid
+    ``lone_contact.MAX_EXCURSION`` or more."""
+
+    group: str
+    depth: float
+    lone_contacts: int
+    sliding: int
+
+
+def measure_rules(path: str | Path) -> list[RulesMeasured]:
+    """The rules measured on each BSR motion in the file (a ``figure_motion`` group made by a
+    BSR simulator over a flat floor: a search's best motion, a composite's before and after);
+    none for a file without such a motion. Raises InputError for a file that cannot be read
+    (``open_hdf5``)."""
+    measured = []
     with open_hdf5(path) as h5:
         groups: list[str] = []
         h5.visititems(
@@ -38,11 +49,5 @@ def rule_lines(path: str | Path) -> list[str]:
             height = floor.pop()
             depth = max(0.0, height - float(np.min(motion.endpoints[..., 1])))
             contacts = lone_contacts(motion.t, motion.endpoints, height)
-            slid = sliding(contacts)
-            noun = "lone contact" if len(contacts) == 1 else "lone contacts"
-            lines.append(
-                f"  /{name}: deepest rod end {1000 * depth:.2f} mm below the floor; "
-                f"{len(contacts)} {noun}, {len(slid)} of them sliding "
-                f"{MAX_EXCURSION * 1000:g} mm or more"
-            )
-    return lines
+            measured.append(RulesMeasured(name, depth, len(contacts), len(sliding(contacts))))
+    return measured

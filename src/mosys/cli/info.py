@@ -12,14 +12,21 @@ def _info_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _info(args: argparse.Namespace) -> None:
-    from mosys.bsr.physics_check import rule_lines
+    from mosys.bsr.lone_contact import MAX_EXCURSION
+    from mosys.bsr.physics_check import measure_rules
     from mosys.io.info import describe_file
+    from mosys.plots.style import counted
 
     print(describe_file(args.file), end="")
-    lines = rule_lines(args.file)
-    if lines:
+    measured = measure_rules(args.file)
+    if measured:
         print("\nthe paper's rules (README, 'The simulator'), measured:")
-        print("\n".join(lines))
+    for rules in measured:
+        print(
+            f"  /{rules.group}: deepest rod end {1000 * rules.depth:.2f} mm below the floor; "
+            f"{counted(rules.lone_contacts, 'lone contact')}, {rules.sliding} of them sliding "
+            f"{MAX_EXCURSION * 1000:g} mm or more"
+        )
 
 
 FAMILY = Family(
