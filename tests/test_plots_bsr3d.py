@@ -515,6 +515,38 @@ def test_learning_kinds_figure(kinds: dict[str, list[Path]]) -> None:
     assert logged.axes[0].get_xlabel() == "controller evaluations (count, log scale)"
 
 
+def test_learning_kinds_cuts_off_a_first_population_far_below(
+    kinds: dict[str, list[Path]], tmp_path: Path
+) -> None:
+    """Rex's first population's -7.7 (60 of 60,000 evaluations, then 0.8 and up) squeezed the
+    curves into the top of the plot: such a start is cut off and the cut noted."""
+    low_start = []
+    for path in kinds["time"]:
+        result = read_bsr_result(path)
+        best = result.best_fitness.copy()
+        best[:2] = -40.0  # the first two records (100 and 113 evaluations) far below
+        low_start.append(tmp_path / path.name)
+        write_bsr_result(low_start[-1], dataclasses.replace(result, best_fitness=best))
+    results = [read_bsr_result(path) for path in low_start + kinds["sense"]]
+    cut = bsr3d.cut_start(results, 150_000)
+    # the curves rise: the lowest kept is the lowest held at 1 % of the axis, 1,500 evaluations
+    kept = min(float(r.best_fitness[r.evaluations <= 1_500][-1]) for r in results)
+    assert cut == bsr3d.CutStart(
+        low=pytest.approx(kept - bsr3d.EARLY_PAD * (3.4 - kept)), evaluations=113, lowest=-40.0
+    )
+    (ax,) = learning_kinds_figure(low_start, kinds["sense"]).axes
+    assert ax.get_ylim()[0] == pytest.approx(cut.low)
+    assert [text.get_text() for text in ax.texts] == [
+        "↓ below the axis: the best of the first 113 evaluations, down to −40",
+        "2.75",  # the final medians
+        "2",
+    ]
+    # a start that stays within half the range is drawn whole, as is any start on a log axis
+    assert bsr3d.cut_start([read_bsr_result(p) for p in kinds["sense"]], 150_000) is None
+    (logged,) = learning_kinds_figure(low_start, [], log_x=True).axes
+    assert logged.get_ylim()[0] < -40 and len(logged.texts) == 1
+
+
 def test_learning_kinds_title_fits_two_long_fitness_functions(
     kinds: dict[str, list[Path]], tmp_path: Path
 ) -> None:
