@@ -9,6 +9,7 @@ are checked through their matplotlib artists."""
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import json
 import math
 from pathlib import Path
@@ -720,6 +721,35 @@ def test_figure_at_rest(tmp_path: Path) -> None:
         "plot_figure_at_rest: needs a 3-D figure's motion, endpoints (N, rods, 2, 3); got "
         "dimensions 2, endpoints (201, 7, 2, 2)"
     )
+
+
+def test_rest_layout_puts_a_long_figures_small_views_under_it() -> None:
+    """A long, low figure (Rex, Cujo) in the column layout's narrow oblique view left wide blank
+    bands above and below it: its small views go in a row under a view as wide as the figure;
+    a tall one (Bob) keeps them in a column beside it."""
+
+    def inside(box, size) -> bool:
+        left, bottom, width, height = box
+        return left >= 0 and bottom >= 0 and left + width <= size[0] and bottom + height <= size[1]
+
+    low = bsr3d.rest_layout(np.array([2.6, 1.0]), title_lines=2)
+    tall = bsr3d.rest_layout(np.array([1.0, 1.6]), title_lines=2)
+    for layout in (low, tall):
+        assert all(inside(box, layout.size) for box in (layout.main, *layout.small))
+    assert low.size[0] == tall.size[0]
+    assert low.size[1] < tall.size[1]  # the blank bands gone
+    assert low.main[2] > tall.main[2]  # a wider oblique view
+    main_bottom = low.main[1]
+    assert all(box[1] + box[3] + bsr3d.REST_SMALL_LABELS <= main_bottom + 1e-9 for box in low.small)
+    lefts = [box[0] for box in low.small]
+    assert lefts == sorted(lefts) and all(  # side by side, apart
+        right[0] - (left[0] + left[2]) >= bsr3d.REST_SMALL_LEFT
+        for left, right in itertools.pairwise(low.small)
+    )
+    main_right = tall.main[0] + tall.main[2]
+    assert all(box[0] >= main_right for box in tall.small)  # the column beside it
+    tops = [box[1] for box in tall.small]
+    assert tops == sorted(tops, reverse=True)  # side view, front view, top view down the page
 
 
 # --------------------------------------------------------------------------- the command line

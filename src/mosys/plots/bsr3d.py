@@ -1110,10 +1110,72 @@ REST_PAD = 1.2  # inches of the oblique view's height above and below its drawin
 REST_SMALL = 1.75  # inches: the small views' side
 REST_SMALL_GAP = 0.8  # inches above each small view: its title and the x label of the one above
 REST_SMALL_LEFT = 0.75  # inches left of the small views: their y labels
+REST_SMALL_LABELS = 0.45  # inches above a small view for its title, below it for its x label
+REST_MAIN_TITLE = 0.3  # inches above the oblique view, where it is as wide as the figure
 LABEL_COLUMN = 1.3  # inches left and right of the oblique view's drawing for the rod names
 LABEL_SIZE = 9.0  # pt
 LABEL_GAP = 0.2  # inches between two rod names' middles
 FOOT_MARKER = "^"
+
+
+@dataclass(frozen=True)
+class RestLayout:
+    """Where ``figure_at_rest_figure`` puts its views, in inches: the figure's ``size`` (width,
+    height), the oblique view's box ``main`` and the small views' ``small`` (side, front, top),
+    each (left, bottom, width, height) from the figure's bottom left corner."""
+
+    size: tuple[float, float]
+    main: tuple[float, float, float, float]
+    small: tuple[tuple[float, float, float, float], ...]
+
+
+def rest_layout(span: np.ndarray, title_lines: int) -> RestLayout:
+    """The views of a figure at rest whose oblique drawing (floor included) spans ``span``
+    (width, height, any unit) under a title of ``title_lines`` lines. The small views stand in
+    a column right of the oblique view or, where that leaves less blank, in a row under it, the
+    oblique view then as wide as the figure: a long, low figure (Rex, Cujo) drawn in the
+    column's narrow view left wide empty bands above and below it; a tall one (Bob) keeps the
+    column."""
+    top = MARGIN_TOP + 0.1 + TITLE_LINE * title_lines
+    main_width, most = REST_MAIN
+    width = 0.2 + main_width + REST_SMALL_LEFT + REST_SMALL + MARGIN_RIGHT + 0.1
+    small_row = REST_SMALL + 2 * REST_SMALL_LABELS  # inches: a small view, its title and labels
+
+    def main_height(view_width: float) -> float:  # as tall as the drawing needs at that width
+        return min(most, span[1] / span[0] * (view_width - 2 * LABEL_COLUMN) + REST_PAD)
+
+    column_room = max(most, 3 * (REST_SMALL + REST_SMALL_GAP))  # inches under the title
+    row_width = width - 0.2 - MARGIN_RIGHT
+    row_main = main_height(row_width)
+    if REST_MAIN_TITLE + row_main + small_row < column_room + MARGIN_BOTTOM:
+        height = top + REST_MAIN_TITLE + row_main + small_row
+        slot = row_width / len(REST_VIEWS)
+        small = tuple(
+            (0.2 + k * slot + REST_SMALL_LEFT, REST_SMALL_LABELS, REST_SMALL, REST_SMALL)
+            for k in range(len(REST_VIEWS))
+        )
+        main = (0.2, small_row, row_width, row_main)
+        return RestLayout((width, height), main, small)
+    height = top + column_room + MARGIN_BOTTOM
+    column_main = main_height(main_width)  # centred in the room
+    main = (0.2, MARGIN_BOTTOM + (column_room - column_main) / 2, main_width, column_main)
+    left = 0.2 + main_width + REST_SMALL_LEFT
+    small = tuple(
+        (
+            left,
+            height - top - (k + 1) * (REST_SMALL + REST_SMALL_GAP) + 0.45,
+            REST_SMALL,
+            REST_SMALL,
+        )
+        for k in range(len(REST_VIEWS))
+    )
+    return RestLayout((width, height), main, small)
+
+
+def _figure_box(box: tuple[float, float, float, float], size: tuple[float, float]) -> tuple:
+    """``box`` (left, bottom, width, height) inches as fractions of a figure of ``size``."""
+    width, height = size
+    return (box[0] / width, box[1] / height, box[2] / width, box[3] / height)
 
 
 def plot_figure_at_rest(motion: FigureMotion, path: str | Path, name: str = "") -> None:
@@ -1149,36 +1211,19 @@ def figure_at_rest_figure(motion: FigureMotion, name: str = "") -> Figure:
     size = pose_size(pose[None])
     floor = floor_cells(pose, FLOOR_MARGIN * size, size)
     drawn = project(np.concatenate([pose.reshape(-1, 3), _floor_corners(*floor[1:])]))
-    span = np.ptp(drawn[:, :2], axis=0)
-    top = MARGIN_TOP + 0.1 + TITLE_LINE * 2
-    main_width, most = REST_MAIN
-    width = 0.2 + main_width + REST_SMALL_LEFT + REST_SMALL + MARGIN_RIGHT + 0.1
-    room = max(most, 3 * (REST_SMALL + REST_SMALL_GAP))  # inches under the title
-    height = top + room + MARGIN_BOTTOM
-    # the oblique view as tall as its drawing needs at the width it has, centred in the room
-    main_height = min(most, span[1] / span[0] * (main_width - 2 * LABEL_COLUMN) + REST_PAD)
+    layout = rest_layout(np.ptp(drawn[:, :2], axis=0), title.count("\n") + 1)
+    width, height = layout.size
     with plot_style():
         figure = new_figure(width, height)
         figure.suptitle(title, y=1 - 0.1 / height, va="top", fontsize=11)
-        main = figure.add_axes(
-            (
-                0.2 / width,
-                (MARGIN_BOTTOM + (room - main_height) / 2) / height,
-                main_width / width,
-                main_height / height,
-            )
-        )
+        main = figure.add_axes(_figure_box(layout.main, layout.size))
         _draw_rest_oblique(main, motion, pose, colors, floor)
         main.set_title(camera_text(VIEW), fontsize=10)
         seen = {view: project(pose, camera)[..., :2].reshape(-1, 2) for view, camera in REST_VIEWS}
         half = 0.55 * max(float(np.ptp(points, axis=0).max()) for points in seen.values())
         half = max(half, 0.05)  # m: every small view spans twice this, to one scale
-        for k, (view, camera) in enumerate(REST_VIEWS):
-            bottom = height - top - (k + 1) * (REST_SMALL + REST_SMALL_GAP) + 0.45
-            left = 0.2 + main_width + REST_SMALL_LEFT
-            ax = figure.add_axes(
-                (left / width, bottom / height, REST_SMALL / width, REST_SMALL / height)
-            )
+        for (view, camera), box in zip(REST_VIEWS, layout.small, strict=True):
+            ax = figure.add_axes(_figure_box(box, layout.size))
             middle = (seen[view].min(axis=0) + seen[view].max(axis=0)) / 2
             if view != "top":  # the floor at the bottom of the view, a little of it showing
                 middle[1] = max(middle[1], 0.9 * half)
