@@ -23,33 +23,44 @@ from matplotlib.collections import LineCollection, PolyCollection
 from PIL import Image
 
 import mosys.plots.bsr3d as bsr3d
+import mosys.plots.bsr3d_learning as bsr3d_learning
+import mosys.plots.figure_at_rest as figure_at_rest
+import mosys.plots.scene3d as scene3d
 from mosys.cli import main
 from mosys.io.bsr_result import BsrController, BsrResult, read_bsr_result, write_bsr_result
 from mosys.io.trajectory import FigureMotion
-from mosys.plots.bsr import TITLE_WIDTH
+from mosys.plots.bsr import TITLE_WIDTH, curves_on_grid
 from mosys.plots.bsr3d import (
+    chain_paths,
+    filmstrip_figure,
+    headings,
+    join_chain,
+    plot_filmstrip,
+    write_motion_gif,
+)
+from mosys.plots.bsr3d_learning import (
+    learning_kinds_figure,
+    plot_learning_kinds,
+    plot_seeds,
+    seeds_figure,
+)
+from mosys.plots.figure_at_rest import figure_at_rest_figure, plot_figure_at_rest
+from mosys.plots.scene3d import (
     FRONT,
     SIDE,
     TOP,
     Camera,
     camera_text,
-    chain_paths,
     choose_camera,
-    figure_at_rest_figure,
-    filmstrip_figure,
     floor_cells,
-    headings,
-    join_chain,
-    learning_kinds_figure,
-    plot_figure_at_rest,
-    plot_filmstrip,
-    plot_learning_kinds,
-    plot_seeds,
     project,
-    seeds_figure,
-    write_motion_gif,
 )
-from mosys.plots.style import PlotInputError, frame_samples
+from mosys.plots.style import (
+    PlotInputError,
+    controller_colors,
+    frame_samples,
+    samples_to_the_end,
+)
 
 DT = 0.01  # s between samples
 SEGMENT = 2.0  # s: each search's motion
@@ -389,13 +400,13 @@ def test_filmstrip_draws_the_chain_as_one_motion(chain: dict[str, list[Path]]) -
         "arrows: the heading at the start of each search and at the end; floor squares 0.25 m",
         "seen from its front right (45° round from its right side), 30° above the floor",
     ]
-    size = bsr3d.pose_size(joined.motion.endpoints)
-    posed = joined.motion.com[bsr3d.samples_to_the_end(joined.motion.t, 0.5)]
+    size = scene3d.pose_size(joined.motion.endpoints)
+    posed = joined.motion.com[samples_to_the_end(joined.motion.t, 0.5)]
     camera = choose_camera(posed, size)
     assert camera == Camera(45.0)
     # the whole floor, as that camera sees it, lies within the picture
-    edges = floor_cells(joined.motion.endpoints, bsr3d.FLOOR_MARGIN * size, size)[1:]
-    corners = project(bsr3d._floor_corners(*edges), camera)
+    edges = floor_cells(joined.motion.endpoints, scene3d.FLOOR_MARGIN * size, size)[1:]
+    corners = project(scene3d.floor_corners(*edges), camera)
     for axis, limits in enumerate((scene.get_xlim(), scene.get_ylim())):
         assert limits[0] < corners[:, axis].min() and corners[:, axis].max() < limits[1]
     # the poses: one stick figure every 0.5 s, coloured by search, light to dark
@@ -416,8 +427,8 @@ def test_filmstrip_draws_the_chain_as_one_motion(chain: dict[str, list[Path]]) -
     np.testing.assert_allclose(paths[-1].get_xydata()[-1], project(floor_com[-1], camera)[:2])
     # the floor, the heading arrows, the legend and the colour bar of time
     (floor,) = [c for c in scene.collections if isinstance(c, PolyCollection)]
-    size = bsr3d.pose_size(joined.motion.endpoints)
-    _, x_edges, z_edges = floor_cells(joined.motion.endpoints, bsr3d.FLOOR_MARGIN * size, size)
+    size = scene3d.pose_size(joined.motion.endpoints)
+    _, x_edges, z_edges = floor_cells(joined.motion.endpoints, scene3d.FLOOR_MARGIN * size, size)
     assert len(floor.get_paths()) == (len(x_edges) - 1) * (len(z_edges) - 1)
     assert len(scene.texts) == 4  # the heading at each search's start and at the end
     (legend,) = figure.legends
@@ -446,7 +457,7 @@ def test_filmstrip_of_one_search_chooses_its_poses(
     assert "(■ its start)" in title and "hand-over" not in title
     poses = [c for c in figure.axes[0].collections if c.get_path_effects()]
     # 1 m covered by a figure 1.19 m long: 1 + 3 / 1.19 poses, so the fewest, about 6
-    assert bsr3d.pose_size(read_bsr_result(chain["dog_walk"][0]).motion.endpoints) == (
+    assert scene3d.pose_size(read_bsr_result(chain["dog_walk"][0]).motion.endpoints) == (
         pytest.approx(math.hypot(0.95, 0.7, 0.12), abs=0.01)
     )
     assert bsr3d.pose_count(join_chain(chain["dog_walk"][:1])) == bsr3d.POSE_COUNT[0] == 6
@@ -488,12 +499,12 @@ def test_learning_kinds_figure(kinds: dict[str, list[Path]]) -> None:
     assert ax.get_xlabel() == "controller evaluations (count)"
     assert ax.get_ylabel() == "best fitness so far (Σ weight × term)"
     assert ax.get_xscale() == "linear"
-    faint = [line for line in ax.lines if line.get_alpha() == bsr3d.SEED_ALPHA]
-    bold = [line for line in ax.lines if line.get_linewidth() == bsr3d.MEDIAN_WIDTH]
+    faint = [line for line in ax.lines if line.get_alpha() == bsr3d_learning.SEED_ALPHA]
+    bold = [line for line in ax.lines if line.get_linewidth() == bsr3d_learning.MEDIAN_WIDTH]
     assert len(faint) == 7
     assert [line.get_linestyle() for line in bold] == ["--", "-"]  # time dashed, sense solid
     results = [read_bsr_result(path) for path in kinds["sense"]]
-    grid, values = bsr3d.curves_on_grid(results)
+    grid, values = curves_on_grid(results)
     np.testing.assert_allclose(bold[1].get_ydata(), np.nanmedian(values, axis=0))
     assert [text.get_text() for text in ax.texts] == ["2.75", "2"]  # the final medians
     # both beyond the longest curve's end, apart: a shorter curve's label sat on the other
@@ -529,11 +540,13 @@ def test_learning_kinds_cuts_off_a_first_population_far_below(
         low_start.append(tmp_path / path.name)
         write_bsr_result(low_start[-1], dataclasses.replace(result, best_fitness=best))
     results = [read_bsr_result(path) for path in low_start + kinds["sense"]]
-    cut = bsr3d.cut_start(results, 150_000)
+    cut = bsr3d_learning.cut_start(results, 150_000)
     # the curves rise: the lowest kept is the lowest held at 1 % of the axis, 1,500 evaluations
     kept = min(float(r.best_fitness[r.evaluations <= 1_500][-1]) for r in results)
-    assert cut == bsr3d.CutStart(
-        low=pytest.approx(kept - bsr3d.EARLY_PAD * (3.4 - kept)), evaluations=113, lowest=-40.0
+    assert cut == bsr3d_learning.CutStart(
+        low=pytest.approx(kept - bsr3d_learning.EARLY_PAD * (3.4 - kept)),
+        evaluations=113,
+        lowest=-40.0,
     )
     (ax,) = learning_kinds_figure(low_start, kinds["sense"]).axes
     assert ax.get_ylim()[0] == pytest.approx(cut.low)
@@ -543,7 +556,7 @@ def test_learning_kinds_cuts_off_a_first_population_far_below(
         "2",
     ]
     # a start that stays within half the range is drawn whole, as is any start on a log axis
-    assert bsr3d.cut_start([read_bsr_result(p) for p in kinds["sense"]], 150_000) is None
+    assert bsr3d_learning.cut_start([read_bsr_result(p) for p in kinds["sense"]], 150_000) is None
     (logged,) = learning_kinds_figure(low_start, [], log_x=True).axes
     assert logged.get_ylim()[0] < -40 and len(logged.texts) == 1
 
@@ -703,11 +716,11 @@ def test_figure_at_rest(tmp_path: Path) -> None:
     spans = {round(np.ptp(ax.get_xlim()), 9) for ax in (side, front, top)}
     assert len(spans) == 1  # one scale
     for ax in (main_view, side, front, top):
-        feet = [line for line in ax.lines if line.get_marker() == bsr3d.FOOT_MARKER]
+        feet = [line for line in ax.lines if line.get_marker() == figure_at_rest.FOOT_MARKER]
         assert len(feet) == 4
         rods = [line for line in ax.lines if line.get_marker() == "o"]
         widest = max(rods, key=lambda line: line.get_linewidth())
-        assert widest.get_color() == bsr3d.controller_colors(list(ROD_NAMES))["spine"]
+        assert widest.get_color() == controller_colors(list(ROD_NAMES))["spine"]
     # the side view shows the spine from hip to shoulder at 0.5 m
     spine = [line for line in side.lines if line.get_marker() == "o"]
     assert any(np.allclose(line.get_xydata(), [[-0.3, 0.5], [0.3, 0.5]]) for line in spine)
@@ -732,18 +745,21 @@ def test_rest_layout_puts_a_long_figures_small_views_under_it() -> None:
         left, bottom, width, height = box
         return left >= 0 and bottom >= 0 and left + width <= size[0] and bottom + height <= size[1]
 
-    low = bsr3d.rest_layout(np.array([2.6, 1.0]), title_lines=2)
-    tall = bsr3d.rest_layout(np.array([1.0, 1.6]), title_lines=2)
+    low = figure_at_rest.rest_layout(np.array([2.6, 1.0]), title_lines=2)
+    tall = figure_at_rest.rest_layout(np.array([1.0, 1.6]), title_lines=2)
     for layout in (low, tall):
         assert all(inside(box, layout.size) for box in (layout.main, *layout.small))
     assert low.size[0] == tall.size[0]
     assert low.size[1] < tall.size[1]  # the blank bands gone
     assert low.main[2] > tall.main[2]  # a wider oblique view
     main_bottom = low.main[1]
-    assert all(box[1] + box[3] + bsr3d.REST_SMALL_LABELS <= main_bottom + 1e-9 for box in low.small)
+    assert all(
+        box[1] + box[3] + figure_at_rest.REST_SMALL_LABELS <= main_bottom + 1e-9
+        for box in low.small
+    )
     lefts = [box[0] for box in low.small]
     assert lefts == sorted(lefts) and all(  # side by side, apart
-        right[0] - (left[0] + left[2]) >= bsr3d.REST_SMALL_LEFT
+        right[0] - (left[0] + left[2]) >= figure_at_rest.REST_SMALL_LEFT
         for left, right in itertools.pairwise(low.small)
     )
     main_right = tall.main[0] + tall.main[2]

@@ -6,7 +6,7 @@
 rule bsr3d_motion_plots:
     input:
         results=bsr3d_motion_results,
-        code=code_inputs("mosys.cli.plots", "mosys.plots.bsr3d"),  # mosys plot bsr3d
+        code=code_inputs("mosys.cli.plots", "mosys.plots.bsr3d", "mosys.plots.figure_at_rest"),  # mosys plot bsr3d
     output:
         filmstrip=report("results/plots/bsr3d/{motion}/filmstrip.png", caption="../report/bsr3d_filmstrip.rst", category="1995 paper: 3-D figures", subcategory="{motion}"),
         gif=report("results/plots/bsr3d/{motion}/motion.gif", caption="../report/bsr3d_gif.rst", category="1995 paper: 3-D figures", subcategory="{motion}"),
@@ -25,7 +25,7 @@ rule bsr3d_learning_kinds:
     input:
         time=bsr3d_results(config["bsr3d"]["kinds"]["time"]),
         sense=bsr3d_results(config["bsr3d"]["kinds"]["sense"]),
-        code=code_inputs("mosys.cli.plots", "mosys.plots.bsr3d"),  # mosys plot bsr3d-kinds
+        code=code_inputs("mosys.cli.plots", "mosys.plots.bsr3d_learning"),  # mosys plot bsr3d-kinds
     output:
         report("results/plots/bsr3d/learning_kinds.png", caption="../report/bsr3d_kinds.rst", category="1995 paper: 3-D figures", subcategory="Figures 7 and 8"),
     log:
@@ -40,7 +40,7 @@ rule bsr3d_learning_kinds:
 rule bsr3d_seeds:
     input:
         results=bsr3d_results(*variability_searches()),
-        code=code_inputs("mosys.cli.plots", "mosys.plots.bsr3d"),  # mosys plot bsr3d-seeds
+        code=code_inputs("mosys.cli.plots", "mosys.plots.bsr3d_learning"),  # mosys plot bsr3d-seeds
     output:
         report("results/plots/bsr3d/seeds.png", caption="../report/bsr3d_seeds.rst", category="1995 paper: 3-D figures", subcategory="Figures 7 and 8"),
     log:
@@ -55,7 +55,7 @@ rule bsr3d_seeds:
 rule bsr3d_search_learning:
     input:
         results=bsr_seed_results,
-        code=code_inputs("mosys.cli.plots", "mosys.plots.bsr3d"),  # mosys plot bsr3d-seeds
+        code=code_inputs("mosys.cli.plots", "mosys.plots.bsr3d_learning"),  # mosys plot bsr3d-seeds
     output:
         report("results/plots/bsr3d/{name}/learning.png", caption="../report/bsr3d_learning.rst", category="1995 paper: 3-D figures", subcategory="{name}"),
     log:

@@ -266,18 +266,18 @@ def _bsr3d_check(args: argparse.Namespace) -> str | None:
 
 
 def _bsr3d(args: argparse.Namespace) -> None:
-    from mosys.plots import bsr3d
+    from mosys.plots import bsr3d, figure_at_rest, scene3d
 
     # one file per search: the last search's best seed, before it the seeds it continues
     chain = bsr3d.chain_paths(args.results)
-    elevation = bsr3d.CAMERA_ELEVATION if args.elevation is None else args.elevation
-    camera = None if args.azimuth is None else bsr3d.Camera(args.azimuth, elevation)
+    elevation = scene3d.CAMERA_ELEVATION if args.elevation is None else args.elevation
+    camera = None if args.azimuth is None else scene3d.Camera(args.azimuth, elevation)
     if args.filmstrip:
         bsr3d.plot_filmstrip(chain, args.filmstrip, args.interval, camera, elevation)
     if args.gif:
         bsr3d.write_motion_gif(chain, args.gif, camera=camera, elevation=elevation)
     if args.rest:
-        bsr3d.plot_result_at_rest(chain[0], args.rest)
+        figure_at_rest.plot_result_at_rest(chain[0], args.rest)
 
 
 def _bsr3d_kinds_arguments(parser: argparse.ArgumentParser) -> None:
@@ -300,9 +300,9 @@ def _bsr3d_kinds_check(args: argparse.Namespace) -> str | None:
 
 
 def _bsr3d_kinds(args: argparse.Namespace) -> None:
-    from mosys.plots import bsr3d
+    from mosys.plots import bsr3d_learning
 
-    bsr3d.plot_learning_kinds(args.time, args.sense, args.output, log_x=args.log_x)
+    bsr3d_learning.plot_learning_kinds(args.time, args.sense, args.output, log_x=args.log_x)
 
 
 def _bsr3d_seeds_arguments(parser: argparse.ArgumentParser) -> None:
@@ -316,9 +316,9 @@ def _bsr3d_seeds_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _bsr3d_seeds(args: argparse.Namespace) -> None:
-    from mosys.plots import bsr3d
+    from mosys.plots import bsr3d_learning
 
-    bsr3d.plot_seeds(args.results, args.output)
+    bsr3d_learning.plot_seeds(args.results, args.output)
 
 
 def _composite_arguments(parser: argparse.ArgumentParser) -> None:

@@ -77,6 +77,7 @@ def new_figure(width: float, height: float) -> Figure:
 # Margins, inches: room for tick labels and an axis label (left, bottom), one title line (top).
 MARGIN_LEFT, MARGIN_RIGHT, MARGIN_BOTTOM, MARGIN_TOP = 0.8, 0.25, 0.55, 0.2
 TITLE_LINE = 0.22  # inches per title line
+LEGEND_SIZE = 8.5  # pt: a legend of many entries (the 3-D plots')
 LEGEND_ROW = 0.21  # inches per legend row, and once more for the legend's frame
 
 
