@@ -635,6 +635,16 @@ SEARCHES = {"bsr_search", "composite_search"}
             {"composite_search", "composite_plots", "composite_table"},
             SIMULATION | {"bsr_search", "bsr_plots", "composite_robustness_table"},
         ),
+        (  # the 3-D plots, one module a job: the figure at rest only with the motion plots
+            "plots/figure_at_rest.py",
+            {"bsr3d_motion_plots"},
+            SIMULATION | SEARCHES | {"bsr3d_learning_kinds", "bsr3d_seeds", "bsr_plots"},
+        ),
+        (  # and Figures 7 and 8 without the filmstrips
+            "plots/bsr3d_learning.py",
+            {"bsr3d_learning_kinds", "bsr3d_seeds", "bsr3d_search_learning"},
+            SIMULATION | SEARCHES | {"bsr3d_motion_plots", "bsr_plots"},
+        ),
         (  # a verb family's CLI module: its own verbs' rules (and theirs downstream), not the
             # modules its handlers import
             "cli/ssc.py",
