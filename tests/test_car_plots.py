@@ -20,7 +20,8 @@ from matplotlib.colors import same_color
 from matplotlib.patches import Polygon
 from PIL import Image
 
-import mosys.plots.car as car
+import mosys.plots.car_scene as car_scene
+import mosys.plots.car_starts as car_starts
 from mosys.io.start_grid import (
     NO_WAY,
     NOT_FREE,
@@ -31,22 +32,22 @@ from mosys.io.start_grid import (
 from mosys.io.trajectory import Trajectory, write_trajectory
 from mosys.kernels.geometry import first_colliding_sample, pack_polygons
 from mosys.plots.car import (
-    FAILURE_COLOR,
-    OBSTACLE_FACE,
-    TIMEOUT_COLOR,
-    consistency_figure,
     drawn_samples,
     outcome_text,
     parking_frames_figure,
-    plot_consistency,
     plot_parking_frames,
-    plot_success_map,
     read_car_trajectory,
-    read_start_grid,
-    success_map_figure,
-    view_limits,
     wheel_segments,
     write_parking_gif,
+)
+from mosys.plots.car_scene import FAILURE_COLOR, OBSTACLE_FACE, view_limits
+from mosys.plots.car_starts import (
+    TIMEOUT_COLOR,
+    consistency_figure,
+    plot_consistency,
+    plot_success_map,
+    read_start_grid,
+    success_map_figure,
 )
 from mosys.plots.style import GIF_HOLD_MS, PlotInputError, frame_indices
 
@@ -353,11 +354,11 @@ def test_view_limits_clip_long_obstacles_to_the_cars_region():
     wall = np.array([[-100.0, -1.0], [100.0, -1.0], [100.0, 0.0], [-100.0, 0.0]])
     far = np.array([[50.0, 50.0], [51.0, 50.0], [51.0, 51.0]])
     (x0, y0), (x1, y1) = view_limits(cars, [wall, far])
-    assert x0 == pytest.approx(-car.VIEW_MARGIN - car.EDGE_MARGIN)
-    assert x1 == pytest.approx(4.0 + car.VIEW_MARGIN + car.EDGE_MARGIN)
+    assert x0 == pytest.approx(-car_scene.VIEW_MARGIN - car_scene.EDGE_MARGIN)
+    assert x1 == pytest.approx(4.0 + car_scene.VIEW_MARGIN + car_scene.EDGE_MARGIN)
     # the wall shows as far as VIEW_MARGIN below the cars; the far obstacle is left out
-    assert y0 == pytest.approx(1.0 - car.VIEW_MARGIN - car.EDGE_MARGIN)
-    assert y1 == pytest.approx(3.0 + car.EDGE_MARGIN)
+    assert y0 == pytest.approx(1.0 - car_scene.VIEW_MARGIN - car_scene.EDGE_MARGIN)
+    assert y1 == pytest.approx(3.0 + car_scene.EDGE_MARGIN)
 
 
 # --------------------------------------------------------------------------- the plots
@@ -526,9 +527,9 @@ def test_excluded_starts_have_their_own_markers_and_are_not_counted(tmp_path):
     )
     shapes = {c.get_gid(): c.get_paths()[0].vertices.round(3).tobytes() for c in by_gid.values()}
     assert len(set(shapes.values())) == 5, "each kind of start has a marker of its own shape"
-    assert same_color(not_free.get_facecolor()[0], car.NOT_FREE_COLOR)
+    assert same_color(not_free.get_facecolor()[0], car_starts.NOT_FREE_COLOR)
     assert len(no_way.get_facecolor()) == 0  # hollow
-    assert same_color(no_way.get_edgecolor()[0], car.NO_WAY_COLOR)
+    assert same_color(no_way.get_edgecolor()[0], car_starts.NO_WAY_COLOR)
     (legend,) = figure.legends
     handles = dict(zip(legend_labels(figure), legend.legend_handles, strict=True))
     assert handles["cannot park (start on an obstacle or off the domain)"].get_marker() == "+"
@@ -561,7 +562,7 @@ def test_starts_that_are_not_free_are_drawn_by_what_they_overlap(tmp_path):
     colors = [by_gid[label].get_facecolor()[0] for label in labels]
     for first, second in ((0, 1), (0, 2), (1, 2)):
         assert not same_color(colors[first], colors[second])
-    assert same_color(colors[0], car.NOT_FREE_COLOR)
+    assert same_color(colors[0], car_starts.NOT_FREE_COLOR)
     panels = figure.axes[:3]  # headings 0°, 90°, 180°: the detail of each one's start at (6, 1)
     for ax, label in zip(panels, [labels[2], labels[1], labels[0]], strict=True):
         np.testing.assert_array_equal(markers(ax)[label], [[6, 1]])
@@ -624,7 +625,7 @@ def test_success_map_table_of_panels(tmp_path):
         assert (rows.index(round(box.y0, 6)), columns.index(round(box.x0, 6))) == (heading, steer)
         assert ax.get_title() == (
             f"start heading φ = {90 * heading}°, "
-            f"steer δ = {car.describe_value('steer', 30.0 * (steer - 1))}"
+            f"steer δ = {car_scene.describe_value('steer', 30.0 * (steer - 1))}"
         )
     assert [ax.get_ylabel() for ax in panels] == ["y (m)", "", ""] * 4
     assert [ax.get_xlabel() for ax in panels] == [""] * 9 + ["x (m)"] * 3
@@ -640,11 +641,11 @@ def test_success_map_table_of_panels(tmp_path):
 
 def test_marker_diameter_follows_the_grid_spacing():
     xy = np.array([[0.0, 0.0], [0.5, 0.0], [0.0, 2.0]])
-    assert car._marker_diameter(xy, 10.0) == pytest.approx(0.75 * 0.5 * 10.0)  # pt
-    low, high = car.MARKER_DIAMETER_RANGE
-    assert car._marker_diameter(xy, 1.0) == low
-    assert car._marker_diameter(xy, 100.0) == high
-    assert car._marker_diameter(xy[:1], 10.0) == high  # a single start
+    assert car_starts._marker_diameter(xy, 10.0) == pytest.approx(0.75 * 0.5 * 10.0)  # pt
+    low, high = car_starts.MARKER_DIAMETER_RANGE
+    assert car_starts._marker_diameter(xy, 1.0) == low
+    assert car_starts._marker_diameter(xy, 100.0) == high
+    assert car_starts._marker_diameter(xy[:1], 10.0) == high  # a single start
 
 
 def test_success_map_png(tmp_path):

@@ -67,7 +67,7 @@ rule car_gif:
 rule car_start_map:
     input:
         grid="results/car/start_grid.h5",
-        code=code_inputs("mosys.cli.plots", "mosys.plots.car"),  # mosys plot car
+        code=code_inputs("mosys.cli.plots", "mosys.plots.car_starts"),  # mosys plot car
     output:
         report("results/plots/car/start_map.png", caption="../report/car_map.rst", category="1990 paper: the self-parking car"),
     log:
@@ -82,7 +82,7 @@ rule car_start_map:
 rule car_consistency:
     input:
         grid="results/car/start_grid.h5",
-        code=code_inputs("mosys.cli.plots", "mosys.plots.car"),  # mosys plot car
+        code=code_inputs("mosys.cli.plots", "mosys.plots.car_starts"),  # mosys plot car
     output:
         report("results/plots/car/consistency.png", caption="../report/car_consistency.rst", category="1990 paper: the self-parking car"),
     log:

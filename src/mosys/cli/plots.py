@@ -129,12 +129,8 @@ def _car_check(args: argparse.Namespace) -> str | None:
 
 
 def _car(args: argparse.Namespace) -> None:
-    from mosys.plots.car import (
-        plot_consistency,
-        plot_parking_frames,
-        plot_success_map,
-        write_parking_gif,
-    )
+    from mosys.plots.car import plot_parking_frames, write_parking_gif
+    from mosys.plots.car_starts import plot_consistency, plot_success_map
 
     if args.frames:
         plot_parking_frames(args.trajectories, args.frames)
