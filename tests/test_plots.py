@@ -35,7 +35,6 @@ from mosys.plots.pendulum import (
     portrait_figure,
     portrait_starts,
     script_path_figure,
-    split_at_wraps,
     torque_figure,
     write_script_gif,
 )
@@ -197,34 +196,40 @@ def wrapped_paths(draw):
     return low + np.mod(unwrapped, period), period
 
 
+def wrap_axes(period: float) -> tuple[StateAxis, StateAxis]:
+    """An angle axis of ``period`` and a rate axis that does not wrap."""
+    return (
+        StateAxis("angle", "deg", -period / 2, period / 2, period),
+        StateAxis("omega", "deg/s", -1.0, 1.0, None),
+    )
+
+
 @given(wrapped_paths())
 @settings(max_examples=300, deadline=None)
-def test_split_at_wraps_has_no_jumps_and_loses_no_points(case):
+def test_cylinder_pieces_have_no_jumps_and_lose_no_points(case):
+    """Each piece, its borrowed neighbours aside, is a run of the path: the runs cover it once,
+    in order, split only where the angle jumps by more than half a period; and no piece, its
+    neighbours shifted by whole periods included, steps by more than half a period."""
     angle, period = case
-    slices = split_at_wraps(angle, period)
-    pieces = [angle[s] for s in slices]
-    joined = np.concatenate(pieces) if pieces else np.empty(0)
-    np.testing.assert_array_equal(joined, angle)
-    for piece in pieces:
-        assert len(piece) > 0
-        assert np.all(np.abs(np.diff(piece)) <= period / 2)
-    for before, after in zip(slices[:-1], slices[1:], strict=True):
-        assert before.stop == after.start  # splits only where it must: at a jump
-        assert abs(angle[after.start] - angle[before.stop - 1]) > period / 2
+    points = np.column_stack([angle, np.arange(len(angle), dtype=np.float64)])
+    pieces = cylinder_pieces(points, wrap_axes(period))
+    runs = []
+    for k, piece in enumerate(pieces):
+        assert np.all(np.abs(np.diff(piece[:, 0])) <= period / 2 * (1 + 1e-12))
+        runs.append(piece[(k > 0) : len(piece) - (k < len(pieces) - 1)])
+    joined = np.concatenate(runs) if runs else np.empty((0, 2))
+    np.testing.assert_array_equal(joined, points)
+    starts = np.cumsum([0] + [len(run) for run in runs])[1:-1]
+    for start in starts:  # splits only where it must: at a jump
+        assert abs(angle[start] - angle[start - 1]) > period / 2
 
 
-def test_split_at_wraps_counts_the_wraps_of_a_spinning_pendulum():
+def test_cylinder_pieces_count_the_wraps_of_a_spinning_pendulum():
     unwrapped = np.linspace(-170.0, 170.0 + 2 * 360.0, 500)  # two whole turns, counter-clockwise
     wrapped = -180.0 + np.mod(unwrapped + 180.0, 360.0)
-    assert len(split_at_wraps(wrapped, 360.0)) == 3
-    assert split_at_wraps(np.empty(0), 360.0) == []
-
-
-def test_split_at_wraps_rejects_bad_arguments():
-    with pytest.raises(ValueError, match="period must be positive"):
-        split_at_wraps(np.zeros(3), 0.0)
-    with pytest.raises(ValueError, match="1-D"):
-        split_at_wraps(np.zeros((3, 2)), 360.0)
+    path = np.column_stack([wrapped, np.zeros_like(wrapped)])
+    assert len(cylinder_pieces(path, PENDULUM_AXES)) == 3
+    assert cylinder_pieces(np.empty((0, 2)), PENDULUM_AXES) == []
 
 
 def test_cylinder_pieces_run_on_to_the_edges():

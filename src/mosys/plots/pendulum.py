@@ -86,19 +86,6 @@ class StateAxis:
 # --------------------------------------------------------------------------- cylindrical paths
 
 
-def split_at_wraps(angle: np.ndarray, period: float) -> list[slice]:
-    """Cut a wrapped angle (N,) into runs of consecutive samples wherever it jumps between
-    neighbours by more than half the ``period`` (same unit): the path went round the cylinder.
-    Within a run no step exceeds period / 2; the runs, in order, cover every sample once. Plot
-    each run as its own line so that no line streaks across a cylindrical plot."""
-    angle = np.asarray(angle, dtype=np.float64)
-    if angle.ndim != 1:
-        raise ValueError(f"angle must be 1-D, got shape {angle.shape}")
-    if not period > 0:
-        raise ValueError(f"period must be positive, got {period!r}")
-    return _slices(_wrap_breaks(angle, period), len(angle))
-
-
 def _wrap_breaks(angle: np.ndarray, period: float) -> np.ndarray:
     """Indices i where |angle[i] - angle[i-1]| > period / 2."""
     return np.flatnonzero(np.abs(np.diff(angle)) > period / 2) + 1
