@@ -352,7 +352,7 @@ def test_pendulum_g_rests_upright_or_hanging(pendulum_g, link1):
 def test_portrait_tints_each_basin(pendulum_g, link1):
     from matplotlib.collections import QuadMesh
 
-    from mosys.plots.pendulum import portrait_figure
+    from mosys.plots.controller import portrait_figure
 
     figure = portrait_figure(pendulum_g, link1)
     (ax,) = figure.axes
@@ -381,7 +381,7 @@ def test_portrait_tints_each_basin(pendulum_g, link1):
 
 def test_torque_table_marks_every_destination(pendulum_g):
     """It marked only the first (90 deg), and its title named that one alone."""
-    from mosys.plots.pendulum import torque_figure
+    from mosys.plots.controller import torque_figure
 
     figure = torque_figure(pendulum_g)
     ax = figure.axes[0]
@@ -399,7 +399,7 @@ def test_torque_table_marks_every_destination(pendulum_g):
 def test_a_single_destination_portrait_has_no_basins(link1, tmp_path):
     from matplotlib.collections import QuadMesh
 
-    from mosys.plots.pendulum import portrait_figure
+    from mosys.plots.controller import portrait_figure
 
     spec = parse_controller_spec(SPECS / "controllers" / "pendulum" / "A.ssc")
     generate_controller(spec, link1, tmp_path / "A.h5", quiet=True)

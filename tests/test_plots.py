@@ -25,19 +25,10 @@ from mosys.io.controller_table import (
 )
 from mosys.io.trajectory import FigureMotion, Trajectory, read_trajectory, write_trajectory
 from mosys.parsing.controller import parse_controller_spec
+from mosys.plots.controller import plot_torque, portrait_figure, portrait_starts, torque_figure
 from mosys.plots.controls import controls_figure
-from mosys.plots.pendulum import (
-    StateAxis,
-    cylinder_pieces,
-    format_state_axes,
-    plot_script,
-    plot_torque,
-    portrait_figure,
-    portrait_starts,
-    script_path_figure,
-    torque_figure,
-    write_script_gif,
-)
+from mosys.plots.script import plot_script, script_path_figure, write_script_gif
+from mosys.plots.state_space import StateAxis, cylinder_pieces, format_state_axes
 from mosys.plots.style import PlotInputError, controller_colors
 from mosys.ssc.generate import generate_controller
 
@@ -641,7 +632,7 @@ def test_script_figure_refuses_tables_of_which_none_drives_the_script(
 def test_phase_planes_pair_each_coordinate_with_its_rate():
     """A 2-D state is one plane; coordinates followed by their rates give a plane each; any
     other state is refused, naming its variables and units (the car hint for a car's)."""
-    from mosys.plots.pendulum import phase_planes
+    from mosys.plots.script import phase_planes
     from mosys.plots.style import PlotInputError
 
     def axes(*units, names=None):

@@ -635,7 +635,17 @@ SEARCHES = {"bsr_search", "composite_search"}
             {"composite_search", "composite_plots", "composite_table"},
             SIMULATION | {"bsr_search", "bsr_plots", "composite_robustness_table"},
         ),
-        (  # the 3-D plots, one module a job: the figure at rest only with the motion plots
+        (  # the plots, one module a job: a script's path and GIF, not a controller's maps
+            "plots/script.py",
+            {"script_plots"},
+            SIMULATION | SEARCHES | {"controller_plots", "free_swing", "car_frames"},
+        ),
+        (  # the start grid's map and consistency, not the manoeuvres' frames and GIF
+            "plots/car_starts.py",
+            {"car_start_map", "car_consistency"},
+            SIMULATION | SEARCHES | {"car_frames", "car_gif", "script_plots"},
+        ),
+        (  # the 3-D plots: the figure at rest only with the motion plots
             "plots/figure_at_rest.py",
             {"bsr3d_motion_plots"},
             SIMULATION | SEARCHES | {"bsr3d_learning_kinds", "bsr3d_seeds", "bsr_plots"},

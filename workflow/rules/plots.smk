@@ -8,7 +8,7 @@ rule controller_plots:
     input:
         table="results/controllers/{group}/{name}.h5",
         dynamics=plotted_controller_dynamics,
-        code=code_inputs("mosys.cli.plots", "mosys.plots.pendulum", "mosys.dynamics.load"),  # mosys plot controller
+        code=code_inputs("mosys.cli.plots", "mosys.plots.controller", "mosys.dynamics.load"),  # mosys plot controller
     output:
         portrait=report("results/plots/{group}/{name}_portrait.png", caption="../report/portrait.rst", category="1990 paper: the pendulum", subcategory="Figure 14 portraits"),
         torque=report("results/plots/{group}/{name}_torque.png", caption="../report/torque.rst", category="1990 paper: the pendulum", subcategory="torque tables"),
@@ -28,7 +28,7 @@ rule script_plots:
     input:
         trajectory="results/trajectories/{script}.h5",
         tables=lambda wildcards: [p for p in script_inputs(wildcards) if p.endswith(".h5")],
-        code=code_inputs("mosys.cli.plots", "mosys.plots.pendulum"),  # mosys plot script
+        code=code_inputs("mosys.cli.plots", "mosys.plots.script"),  # mosys plot script
     output:
         path=report("results/plots/{group}/{script}_path.png", caption="../report/script_path.rst", category="1990 paper: the pendulum", subcategory="scripts"),
         gif=report("results/plots/{group}/{script}.gif", caption="../report/script_gif.rst", category="1990 paper: the pendulum", subcategory="scripts"),

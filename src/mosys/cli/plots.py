@@ -25,7 +25,7 @@ def _controller_check(args: argparse.Namespace) -> str | None:
 
 
 def _controller(args: argparse.Namespace) -> None:
-    from mosys.plots.pendulum import plot_portrait, plot_torque
+    from mosys.plots.controller import plot_portrait, plot_torque
 
     if args.portrait:
         from mosys.dynamics.load import load_dynamics
@@ -51,7 +51,7 @@ def _script_check(args: argparse.Namespace) -> str | None:
 
 
 def _script(args: argparse.Namespace) -> None:
-    from mosys.plots.pendulum import plot_script, write_script_gif
+    from mosys.plots.script import plot_script, write_script_gif
 
     if args.path:
         plot_script(args.trajectory, args.tables, args.path)

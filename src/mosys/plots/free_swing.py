@@ -13,7 +13,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from mosys.dynamics.free_swing import free_swing
-from mosys.plots.pendulum import StateAxis, format_state_axes, plot_state_path
+from mosys.plots.state_space import StateAxis, format_state_axes, plot_state_path
 from mosys.plots.style import add_legend, new_figure, plot_style, save_figure
 
 LIBRATION_COLOR = "tab:blue"
