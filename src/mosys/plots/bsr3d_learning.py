@@ -86,11 +86,13 @@ def cut_start(results: Sequence[BsrResult], last: int) -> CutStart | None:
     0.8 and up), squeezing the curves into the top of the plot. None where nothing need be
     cut (the axis then shows every value)."""
     start = EARLY_SHARE * last
+
+    def held_from_start(result: BsrResult) -> np.ndarray:  # the value held at start, and after
+        first = int(np.searchsorted(result.evaluations, start, side="right")) - 1
+        return result.best_fitness[max(first, 0) :]
+
     everything = np.concatenate([r.best_fitness for r in results])
-    later = np.concatenate(
-        [r.best_fitness[max(np.searchsorted(r.evaluations, start, side="right") - 1, 0) :]
-         for r in results]
-    )  # fmt: skip
+    later = np.concatenate([held_from_start(r) for r in results])
     lowest, kept, highest = float(everything.min()), float(later.min()), float(everything.max())
     if not kept - lowest > EARLY_MOST * (highest - lowest):
         return None
