@@ -113,7 +113,7 @@ def rest_layout(span: np.ndarray, title_lines: int) -> RestLayout:
     small = tuple(
         (
             left,
-            height - top - (k + 1) * (REST_SMALL + REST_SMALL_GAP) + 0.45,
+            height - top - (k + 1) * (REST_SMALL + REST_SMALL_GAP) + REST_SMALL_LABELS,
             REST_SMALL,
             REST_SMALL,
         )
