@@ -7,6 +7,7 @@ figures are checked through their matplotlib artists (``learning_figure``,
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -21,7 +22,7 @@ from PIL import Image
 
 import mosys.plots.bsr as bsr
 from mosys.cli import main
-from mosys.io.bsr_result import BsrController, BsrResult, write_bsr_result
+from mosys.io.bsr_result import BsrController, BsrResult, read_bsr_result, write_bsr_result
 from mosys.io.trajectory import FigureMotion
 from mosys.plots.bsr import (
     best_result_path,
@@ -291,6 +292,34 @@ def test_learning_figure(searches: dict[str, list[Path]]) -> None:
     assert label_y[2] - label_y[1] > 0  # the tied seeds' labels moved apart
     with pytest.raises(PlotInputError, match="more than one search"):
         learning_figure([*searches["star_sense"], *searches["star_time"]])
+
+
+def test_learning_figure_cuts_off_a_first_population_far_below(
+    searches: dict[str, list[Path]], tmp_path: Path
+) -> None:
+    """Figure 8 (each seed, 2-D or 3-D) cuts off a start far below the rest, as Figure 7 does:
+    Rex's -7.7 over 60 of 60,000 evaluations left the curves in the top half of the plot."""
+    low_start = []
+    for path in searches["star_sense"]:
+        result = read_bsr_result(path)
+        # records at 10 and 20 evaluations far below, at 40 the first record's value: the
+        # value held at 1 % of the axis (50 of 5,000 evaluations) is the usual one
+        evaluations = np.concatenate([[10, 20, 40], result.evaluations])
+        best = np.concatenate([[-30.0, -30.0, result.best_fitness[0]], result.best_fitness])
+        low_start.append(tmp_path / path.name)
+        write_bsr_result(
+            low_start[-1],
+            dataclasses.replace(result, evaluations=evaluations, best_fitness=best),
+        )
+    curves, finals = learning_figure(low_start).axes
+    kept = min(float(read_bsr_result(p).best_fitness[0]) for p in searches["star_sense"])
+    assert curves.get_ylim()[0] == pytest.approx(kept - bsr.EARLY_PAD * (2.5 - kept))
+    assert [text.get_text() for text in curves.texts] == [
+        "↓ below the axis: the best of the first 20 evaluations, down to −30"
+    ]
+    assert finals.get_ylim()[0] >= curves.get_ylim()[0]  # the finals' panel within the cut
+    whole = learning_figure(searches["star_sense"]).axes[0]
+    assert not whole.texts  # nothing far below: nothing cut
 
 
 def test_finals_range_zooms_only_where_the_finals_lie_close() -> None:

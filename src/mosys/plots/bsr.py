@@ -86,6 +86,9 @@ TERMS = {
 LEARNING_WIDTH, LEARNING_HEIGHT = 9.5, 5.4  # inches
 TITLE_WIDTH = 110  # characters of a title line at the learning figures' width
 FINALS_WIDTH = 1.9  # inches: the panel of each seed's final best fitness
+EARLY_SHARE = 0.01  # of a linear evaluation axis: the start, too narrow to be read
+EARLY_MOST = 0.5  # of the y range: the most a curve's start may take before it is cut off
+EARLY_PAD = 0.08  # of the range kept: room below the lowest value kept
 FINALS_PAD = 0.15  # of the finals' span, above and below them where the panel zooms
 FINALS_LEAST = 0.04  # of the curves' y range: the closest the finals panel zooms
 FINALS_ZOOM = 0.5  # the panel zooms where its range is at most this share of the curves'
@@ -277,6 +280,67 @@ def curves_on_grid(results: Sequence[BsrResult]) -> tuple[np.ndarray, np.ndarray
     return grid, values
 
 
+@dataclass(frozen=True)
+class CutStart:
+    """Where a learning-curve plot's y axis leaves out the curves' first values: ``low`` (data
+    units) the axis's bottom, ``evaluations`` the count after which every curve is above it,
+    ``lowest`` the lowest value left out."""
+
+    low: float
+    evaluations: int
+    lowest: float
+
+
+def cut_start(results: Sequence[BsrResult], last: int) -> CutStart | None:
+    """The y axis's bottom for the best-so-far curves of ``results`` drawn on a linear axis of
+    ``last`` evaluations, where their first EARLY_SHARE of it would take more than EARLY_MOST
+    of the y range: the lowest value held from there on, padded. A first population's
+    best can lie far below everything after it (Rex's -7.7 for 60 of 60,000 evaluations, then
+    0.8 and up), squeezing the curves into the top of the plot. None where nothing need be
+    cut (the axis then shows every value)."""
+    start = EARLY_SHARE * last
+
+    def held_from_start(result: BsrResult) -> np.ndarray:  # the value held at start, and after
+        first = int(np.searchsorted(result.evaluations, start, side="right")) - 1
+        return result.best_fitness[max(first, 0) :]
+
+    everything = np.concatenate([r.best_fitness for r in results])
+    later = np.concatenate([held_from_start(r) for r in results])
+    lowest, kept, highest = float(everything.min()), float(later.min()), float(everything.max())
+    if not kept - lowest > EARLY_MOST * (highest - lowest):
+        return None
+    low = kept - EARLY_PAD * (highest - kept)
+    below = [r.evaluations[r.best_fitness < low] for r in results]
+    evaluations = max((int(e[-1]) for e in below if e.size), default=0)
+    return CutStart(low, evaluations, lowest)
+
+
+def note_cut_start(ax: Axes, cut: CutStart) -> None:
+    """``cut``: the y axis's bottom set to it and, in the plot's lower right (where the curves,
+    risen by then, leave room), what was left out."""
+    ax.set_ylim(bottom=cut.low)
+    ax.text(
+        0.985,
+        0.03,
+        f"↓ below the axis: the best of the first {cut.evaluations:,} evaluations, "
+        f"down to {minus_signs(f'{cut.lowest:.3g}')}",
+        transform=ax.transAxes,
+        ha="right",
+        va="bottom",
+        fontsize=8.5,
+        color="0.25",
+        bbox={"boxstyle": "round,pad=0.25", "facecolor": "white", "alpha": 0.85, "lw": 0},
+    )
+
+
+def cut_off_start(ax: Axes, results: Sequence[BsrResult], last: int) -> None:
+    """On ``ax``, learning curves of ``results`` on a linear axis of ``last`` evaluations: a
+    start far below the rest cut off and noted (``cut_start``, ``note_cut_start``)."""
+    cut = cut_start(results, last)
+    if cut is not None:
+        note_cut_start(ax, cut)
+
+
 def plot_learning(results: Sequence[str | Path], path: str | Path) -> None:
     """Write ``learning_figure`` as a PNG to ``path``."""
     with plot_style():
@@ -324,6 +388,7 @@ def learning_figure(results: Sequence[str | Path]) -> Figure:
                 curves, result, right_end, color=colors[str(seed)], label=f"seed {seed}"
             )
         label_learning_curves(curves, right_end)
+        cut_off_start(curves, [result for result, _ in loaded], right_end)
         _layout_learning(figure, title)
         final_values = np.array([r.best_fitness[-1] for r, _ in loaded])
         labels = seed_labels(seeds, final_values)

@@ -10,11 +10,9 @@ from search results ``results/bsr/NAME/seedK.h5``:
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import StrMethodFormatter
@@ -29,6 +27,7 @@ from mosys.plots.bsr import (
     LEARNING_WIDTH,
     FinalsColumn,
     curves_on_grid,
+    cut_off_start,
     draw_finals,
     draw_seed_curve,
     fitness_formula,
@@ -62,62 +61,6 @@ from mosys.plots.style import (
 SEED_ALPHA, SEED_WIDTH = 0.35, 0.9  # each seed's faint line
 MEDIAN_WIDTH = CURVE_WIDTH + 1.1  # pt
 KIND_COLORS = controller_colors(["time", "sense"])  # one colour per controller kind
-EARLY_SHARE = 0.01  # of a linear evaluation axis: the start, too narrow to be read
-EARLY_MOST = 0.5  # of the y range: the most a curve's start may take before it is cut off
-EARLY_PAD = 0.08  # of the range kept: room below the lowest value kept
-
-
-@dataclass(frozen=True)
-class CutStart:
-    """Where a learning-curve plot's y axis leaves out the curves' first values: ``low`` (data
-    units) the axis's bottom, ``evaluations`` the count after which every curve is above it,
-    ``lowest`` the lowest value left out."""
-
-    low: float
-    evaluations: int
-    lowest: float
-
-
-def cut_start(results: Sequence[BsrResult], last: int) -> CutStart | None:
-    """The y axis's bottom for the best-so-far curves of ``results`` drawn on a linear axis of
-    ``last`` evaluations, where their first EARLY_SHARE of it would take more than EARLY_MOST
-    of the y range: the lowest value held from there on, padded. A first population's
-    best can lie far below everything after it (Rex's -7.7 for 60 of 60,000 evaluations, then
-    0.8 and up), squeezing the curves into the top of the plot. None where nothing need be
-    cut (the axis then shows every value)."""
-    start = EARLY_SHARE * last
-
-    def held_from_start(result: BsrResult) -> np.ndarray:  # the value held at start, and after
-        first = int(np.searchsorted(result.evaluations, start, side="right")) - 1
-        return result.best_fitness[max(first, 0) :]
-
-    everything = np.concatenate([r.best_fitness for r in results])
-    later = np.concatenate([held_from_start(r) for r in results])
-    lowest, kept, highest = float(everything.min()), float(later.min()), float(everything.max())
-    if not kept - lowest > EARLY_MOST * (highest - lowest):
-        return None
-    low = kept - EARLY_PAD * (highest - kept)
-    below = [r.evaluations[r.best_fitness < low] for r in results]
-    evaluations = max((int(e[-1]) for e in below if e.size), default=0)
-    return CutStart(low, evaluations, lowest)
-
-
-def _note_cut_start(ax: Axes, cut: CutStart) -> None:
-    """``cut``: the y axis's bottom set to it and, in the plot's lower right (where the curves,
-    risen by then, leave room), what was left out."""
-    ax.set_ylim(bottom=cut.low)
-    ax.text(
-        0.985,
-        0.03,
-        f"↓ below the axis: the best of the first {cut.evaluations:,} evaluations, "
-        f"down to {minus_signs(f'{cut.lowest:.3g}')}",
-        transform=ax.transAxes,
-        ha="right",
-        va="bottom",
-        fontsize=8.5,
-        color="0.25",
-        bbox={"boxstyle": "round,pad=0.25", "facecolor": "white", "alpha": 0.85, "lw": 0},
-    )
 
 
 def _load_kind(paths: Sequence[str | Path], kind: str) -> tuple[str, list[BsrResult]]:
@@ -240,9 +183,7 @@ def learning_kinds_figure(
         else:
             ax.set_xlim(0, last * 1.12 if last > 0 else 1)
             ax.xaxis.get_major_locator().set_params(integer=True)  # whole counts
-            cut = cut_start([r for _, _, results in kinds for r in results], last)
-            if cut is not None:
-                _note_cut_start(ax, cut)
+            cut_off_start(ax, [r for _, _, results in kinds for r in results], last)
         _label_ends(ax, ends, last * (1.1 if log_x else 1.015))
         ax.xaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))
         ax.set_xlabel(f"controller evaluations (count{', log scale' if log_x else ''})")
@@ -344,6 +285,7 @@ def seeds_figure(results: Sequence[str | Path]) -> Figure:
             labels = seed_labels(seeds, values)
             columns.append(FinalsColumn(heading, values, labels, [color] * len(values)))
         label_learning_curves(curves, right_end)
+        cut_off_start(curves, [r for _, _, rs in kinds for r in rs], right_end)
         _lay_out_kinds(figure, entries, title, above=0.3, right=0.0)
         draw_finals(curves, finals, columns)
     return figure
