@@ -6,9 +6,7 @@
   ``/destination_index`` names it) is tinted behind the paths.
 - ``plot_torque``: a controller's torque table as a heat map, with cost-to-go contours.
 
-State-space plots put the table's first state variable (the angle θ, deg) across and the second
-(the rate ω, deg/s) up. A wrap axis is cylindrical, as in the paper: its left and right edges are
-the same angle, and a path that crosses them leaves at one edge and comes back at the other.
+Their axes and paths are ``mosys.plots.state_space``'s (a wrap axis drawn as a cylinder).
 """
 
 from __future__ import annotations

@@ -5,9 +5,7 @@
 - ``write_script_gif``: the pendulum swinging through the script, drawn from the trajectory's
   ``figure_motion``.
 
-State-space plots put the table's first state variable (the angle θ, deg) across and the second
-(the rate ω, deg/s) up. A wrap axis is cylindrical, as in the paper: its left and right edges are
-the same angle, and a path that crosses them leaves at one edge and comes back at the other.
+Their axes and paths are ``mosys.plots.state_space``'s (a wrap axis drawn as a cylinder).
 """
 
 from __future__ import annotations
