@@ -21,26 +21,26 @@ from matplotlib.collections import LineCollection, PolyCollection
 from PIL import Image
 
 import mosys.plots.bsr as bsr
+import mosys.plots.bsr_learning as bsr_learning
 from mosys.cli import main
 from mosys.io.bsr_result import BsrController, BsrResult, read_bsr_result, write_bsr_result
 from mosys.io.trajectory import FigureMotion
 from mosys.plots.bsr import (
-    best_result_path,
-    curves_on_grid,
     filmstrip_figure,
-    fitness_formula,
-    group_by_search,
-    learning_comparison_figure,
-    learning_figure,
     letter_levels,
     plot_filmstrip,
-    plot_learning,
-    plot_learning_comparison,
     pose_offsets,
-    read_result,
     rule_letter,
     write_motion_gif,
 )
+from mosys.plots.bsr_learning import (
+    curves_on_grid,
+    learning_comparison_figure,
+    learning_figure,
+    plot_learning,
+    plot_learning_comparison,
+)
+from mosys.plots.bsr_results import best_result_path, fitness_formula, group_by_search, read_result
 from mosys.plots.style import (
     PlotInputError,
     choose_interval,
@@ -313,7 +313,7 @@ def test_learning_figure_cuts_off_a_first_population_far_below(
         )
     curves, finals = learning_figure(low_start).axes
     kept = min(float(read_bsr_result(p).best_fitness[0]) for p in searches["star_sense"])
-    assert curves.get_ylim()[0] == pytest.approx(kept - bsr.EARLY_PAD * (2.5 - kept))
+    assert curves.get_ylim()[0] == pytest.approx(kept - bsr_learning.EARLY_PAD * (2.5 - kept))
     assert [text.get_text() for text in curves.texts] == [
         "↓ below the axis: the best of the first 20 evaluations, down to −30"
     ]
@@ -324,16 +324,18 @@ def test_learning_figure_cuts_off_a_first_population_far_below(
 
 def test_finals_range_zooms_only_where_the_finals_lie_close() -> None:
     # Bob's five finals on a scale from -52: a range of their own, padded
-    low, high = bsr.finals_range(np.array([3.22, 3.25, 3.33, 3.36, 3.89]), -52.0, 6.0)
-    assert high - low == pytest.approx(max(0.67 * (1 + 2 * bsr.FINALS_PAD), 0.04 * 58.0))
+    low, high = bsr_learning.finals_range(np.array([3.22, 3.25, 3.33, 3.36, 3.89]), -52.0, 6.0)
+    assert high - low == pytest.approx(max(0.67 * (1 + 2 * bsr_learning.FINALS_PAD), 0.04 * 58.0))
     assert (low + high) / 2 == pytest.approx((3.22 + 3.89) / 2)
     # spread over most of the curves' range: the curves' own scale
-    assert bsr.finals_range(np.array([15.0, 46.0]), 12.0, 48.0) is None
+    assert bsr_learning.finals_range(np.array([15.0, 46.0]), 12.0, 48.0) is None
     # all equal: the least span, about them
-    low, high = bsr.finals_range(np.array([2.0, 2.0]), 0.0, 10.0)
-    assert (low, high) == pytest.approx((2.0 - 5 * bsr.FINALS_LEAST, 2.0 + 5 * bsr.FINALS_LEAST))
-    assert bsr.finals_range(np.array([np.nan]), 0.0, 1.0) is None
-    assert bsr.finals_range(np.array([1.0]), 1.0, 1.0) is None
+    low, high = bsr_learning.finals_range(np.array([2.0, 2.0]), 0.0, 10.0)
+    assert (low, high) == pytest.approx(
+        (2.0 - 5 * bsr_learning.FINALS_LEAST, 2.0 + 5 * bsr_learning.FINALS_LEAST)
+    )
+    assert bsr_learning.finals_range(np.array([np.nan]), 0.0, 1.0) is None
+    assert bsr_learning.finals_range(np.array([1.0]), 1.0, 1.0) is None
 
 
 @given(
@@ -345,12 +347,12 @@ def test_finals_range_holds_every_final(values: list[float], low: float, size: f
     """Whatever the finals, the zoomed range holds them all, is no narrower than FINALS_LEAST
     and no wider than FINALS_ZOOM of the curves' range."""
     finals = np.clip(np.array(values), low, low + size)
-    zoom = bsr.finals_range(finals, low, low + size)
+    zoom = bsr_learning.finals_range(finals, low, low + size)
     if zoom is not None:
         rounding = 8 * math.ulp(abs(low) + size)  # the range's ends are rounded numbers
         assert zoom[0] <= finals.min() and finals.max() <= zoom[1]
-        assert bsr.FINALS_LEAST * size - rounding <= zoom[1] - zoom[0]
-        assert zoom[1] - zoom[0] <= bsr.FINALS_ZOOM * size + rounding
+        assert bsr_learning.FINALS_LEAST * size - rounding <= zoom[1] - zoom[0]
+        assert zoom[1] - zoom[0] <= bsr_learning.FINALS_ZOOM * size + rounding
 
 
 def test_learning_plot_writes_a_png(searches: dict[str, list[Path]], tmp_path: Path) -> None:

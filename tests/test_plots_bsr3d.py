@@ -22,15 +22,14 @@ from hypothesis import strategies as st
 from matplotlib.collections import LineCollection, PolyCollection
 from PIL import Image
 
-import mosys.plots.bsr as bsr
 import mosys.plots.bsr3d as bsr3d
 import mosys.plots.bsr3d_learning as bsr3d_learning
+import mosys.plots.bsr_learning as bsr_learning
 import mosys.plots.figure_at_rest as figure_at_rest
 import mosys.plots.scene3d as scene3d
 from mosys.cli import main
 from mosys.io.bsr_result import BsrController, BsrResult, read_bsr_result, write_bsr_result
 from mosys.io.trajectory import FigureMotion
-from mosys.plots.bsr import TITLE_WIDTH, curves_on_grid
 from mosys.plots.bsr3d import (
     chain_paths,
     filmstrip_figure,
@@ -45,6 +44,8 @@ from mosys.plots.bsr3d_learning import (
     plot_seeds,
     seeds_figure,
 )
+from mosys.plots.bsr_learning import curves_on_grid
+from mosys.plots.bsr_results import TITLE_WIDTH
 from mosys.plots.figure_at_rest import figure_at_rest_figure, plot_figure_at_rest
 from mosys.plots.scene3d import (
     FRONT,
@@ -541,11 +542,11 @@ def test_learning_kinds_cuts_off_a_first_population_far_below(
         low_start.append(tmp_path / path.name)
         write_bsr_result(low_start[-1], dataclasses.replace(result, best_fitness=best))
     results = [read_bsr_result(path) for path in low_start + kinds["sense"]]
-    cut = bsr.cut_start(results, 150_000)
+    cut = bsr_learning.cut_start(results, 150_000)
     # the curves rise: the lowest kept is the lowest held at 1 % of the axis, 1,500 evaluations
     kept = min(float(r.best_fitness[r.evaluations <= 1_500][-1]) for r in results)
-    assert cut == bsr.CutStart(
-        low=pytest.approx(kept - bsr.EARLY_PAD * (3.4 - kept)),
+    assert cut == bsr_learning.CutStart(
+        low=pytest.approx(kept - bsr_learning.EARLY_PAD * (3.4 - kept)),
         evaluations=113,
         lowest=-40.0,
     )
@@ -557,7 +558,7 @@ def test_learning_kinds_cuts_off_a_first_population_far_below(
         "2",
     ]
     # a start that stays within half the range is drawn whole, as is any start on a log axis
-    assert bsr.cut_start([read_bsr_result(p) for p in kinds["sense"]], 150_000) is None
+    assert bsr_learning.cut_start([read_bsr_result(p) for p in kinds["sense"]], 150_000) is None
     (logged,) = learning_kinds_figure(low_start, [], log_x=True).axes
     assert logged.get_ylim()[0] < -40 and len(logged.texts) == 1
 

@@ -27,7 +27,7 @@ rule bsr_search:
 rule bsr_plots:
     input:
         results=bsr_seed_results,
-        code=code_inputs("mosys.cli.plots", "mosys.plots.bsr"),  # mosys plot bsr
+        code=code_inputs("mosys.cli.plots", "mosys.plots.bsr", "mosys.plots.bsr_learning"),  # mosys plot bsr
     output:
         learning=report("results/plots/bsr/{name}/learning.png", caption="../report/bsr_learning.rst", category="1995 paper: BSR controllers (2-D)", subcategory="{name}"),
         filmstrip=report("results/plots/bsr/{name}/filmstrip.png", caption="../report/bsr_filmstrip.rst", category="1995 paper: BSR controllers (2-D)", subcategory="{name}"),
@@ -45,7 +45,7 @@ rule bsr_plots:
 rule bsr_learning_curves:
     input:
         results=lambda wildcards: bsr_all_results(),
-        code=code_inputs("mosys.cli.plots", "mosys.plots.bsr"),  # mosys plot bsr-learning
+        code=code_inputs("mosys.cli.plots", "mosys.plots.bsr_learning"),  # mosys plot bsr-learning
     output:
         report("results/plots/bsr/learning_curves.png", caption="../report/bsr_curves.rst", category="1995 paper: BSR controllers (2-D)", subcategory="all searches"),
     log:

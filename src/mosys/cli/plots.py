@@ -197,12 +197,12 @@ def _bsr_check(args: argparse.Namespace) -> str | None:
 
 
 def _bsr(args: argparse.Namespace) -> None:
-    from mosys.plots import bsr
+    from mosys.plots import bsr, bsr_learning, bsr_results
 
     if args.learning:
-        bsr.plot_learning(args.results, args.learning)
+        bsr_learning.plot_learning(args.results, args.learning)
     if args.filmstrip or args.gif:
-        best = bsr.best_result_path(args.results)  # highest best_fitness, ties to lowest seed
+        best = bsr_results.best_result_path(args.results)  # highest fitness, ties to lowest seed
         if args.filmstrip:
             bsr.plot_filmstrip(best, args.filmstrip)
         if args.gif:
@@ -217,9 +217,10 @@ def _bsr_learning_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _bsr_learning(args: argparse.Namespace) -> None:
-    from mosys.plots import bsr
+    from mosys.plots import bsr_learning, bsr_results
 
-    bsr.plot_learning_comparison(bsr.group_by_search(args.results), args.output)
+    results = bsr_results.group_by_search(args.results)
+    bsr_learning.plot_learning_comparison(results, args.output)
 
 
 def _bsr3d_arguments(parser: argparse.ArgumentParser) -> None:

@@ -36,8 +36,7 @@ from matplotlib.lines import Line2D
 
 from mosys.io.bsr_result import BsrResult
 from mosys.io.trajectory import FigureMotion
-from mosys.plots.bsr import (
-    FOLLOW_POSES,
+from mosys.plots.bsr_results import (
     KIND_TEXT,
     TERMS,
     best_result_path,
@@ -68,6 +67,7 @@ from mosys.plots.scene3d import (
     shadow_segments,
 )
 from mosys.plots.style import (
+    FOLLOW_POSES,
     GIF_DPI,
     GIF_FPS,
     GIF_MAX_FRAMES,

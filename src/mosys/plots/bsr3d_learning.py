@@ -18,11 +18,10 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import StrMethodFormatter
 
 from mosys.io.bsr_result import BsrResult
-from mosys.plots.bsr import (
+from mosys.plots.bsr_learning import (
     CURVE_WIDTH,
     FINALS_WIDTH,
     KIND_LINESTYLE,
-    KIND_TEXT,
     LEARNING_HEIGHT,
     LEARNING_WIDTH,
     FinalsColumn,
@@ -30,15 +29,18 @@ from mosys.plots.bsr import (
     cut_off_start,
     draw_finals,
     draw_seed_curve,
-    fitness_formula,
     label_learning_curves,
     learning_axes,
     learning_figure,
+    seed_labels,
+    shared_decimals,
+)
+from mosys.plots.bsr_results import (
+    KIND_TEXT,
+    fitness_formula,
     read_result,
     root_attrs,
     search_name,
-    seed_labels,
-    shared_decimals,
     wrapped,
 )
 from mosys.plots.style import (

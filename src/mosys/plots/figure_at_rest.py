@@ -14,7 +14,9 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from mosys.io.trajectory import FigureMotion
-from mosys.plots.bsr import read_result
+from mosys.plots.bsr_results import (
+    read_result,
+)
 from mosys.plots.scene3d import (
     FLOOR_DARK,
     FLOOR_EDGE,

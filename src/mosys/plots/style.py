@@ -487,6 +487,7 @@ GIF_DPI = 100  # dots per inch of animation frames (at 80 their text was 7 px hi
 GIF_HOLD_MS = 1500  # ms the last frame of an animation stays up before the loop restarts
 GIF_FPS = 25  # frames per second of motion time: a frame every 40 ms
 GIF_MAX_FRAMES = 150  # a longer motion gets a wider step (``frame_samples``)
+FOLLOW_POSES = 3.0  # a figure ranging wider than this many pose widths is followed by the view
 
 
 def check_animation_options(fps: object, max_frames: object) -> None:
