@@ -1,8 +1,9 @@
-"""The one base module of the plot families (``pendulum``, ``car``, ``luxo``, ``bsr``,
-``composite``), which import it and nothing of each other: the shared look (figure sizes, fonts,
-markers, colours), the error a bad input raises, the sampling of a motion at regular times, the
-scene views, the stick figure the BSR and composite plots and the concatenation editor draw, the
-atomic PNG write and the blitted, atomically written animated GIF.
+"""The one base module of the plot families (the state-space plots, the car's, Luxo's, the BSR
+searches', the composite's), which import it and nothing of each other's but a family's own
+base (``state_space``, ``car_scene``, ``bsr_results``, ``scene3d``): the shared look (figure
+sizes, fonts, markers, colours), the error a bad input raises, the sampling of a motion at
+regular times, the scene views, the stick figure the BSR and composite plots and the
+concatenation editor draw, the atomic PNG write and the blitted, atomically written animated GIF.
 
 Figures are built with matplotlib's object API on an Agg canvas (no pyplot, no global figure
 state), so plotting works headless and in parallel Snakemake jobs.
