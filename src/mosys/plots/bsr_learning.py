@@ -129,9 +129,13 @@ def cut_start(results: Sequence[BsrResult], last: int) -> CutStart | None:
     return CutStart(low, evaluations, lowest)
 
 
-def note_cut_start(ax: Axes, cut: CutStart) -> None:
-    """``cut``: the y axis's bottom set to it and, in the plot's lower right (where the curves,
-    risen by then, leave room), what was left out."""
+def cut_off_start(ax: Axes, results: Sequence[BsrResult], last: int) -> None:
+    """On ``ax``, learning curves of ``results`` on a linear axis of ``last`` evaluations: where
+    ``cut_start`` cuts, the y axis's bottom set there and, in the plot's lower right (where the
+    curves, risen by then, leave room), what was left out."""
+    cut = cut_start(results, last)
+    if cut is None:
+        return
     ax.set_ylim(bottom=cut.low)
     ax.text(
         0.985,
@@ -145,14 +149,6 @@ def note_cut_start(ax: Axes, cut: CutStart) -> None:
         color="0.25",
         bbox={"boxstyle": "round,pad=0.25", "facecolor": "white", "alpha": 0.85, "lw": 0},
     )
-
-
-def cut_off_start(ax: Axes, results: Sequence[BsrResult], last: int) -> None:
-    """On ``ax``, learning curves of ``results`` on a linear axis of ``last`` evaluations: a
-    start far below the rest cut off and noted (``cut_start``, ``note_cut_start``)."""
-    cut = cut_start(results, last)
-    if cut is not None:
-        note_cut_start(ax, cut)
 
 
 def plot_learning(results: Sequence[str | Path], path: str | Path) -> None:
