@@ -61,6 +61,7 @@ from mosys.plots.style import (
     PlotInputError,
     controller_colors,
     frame_samples,
+    lighten,
     samples_to_the_end,
 )
 
@@ -416,7 +417,7 @@ def test_filmstrip_draws_the_chain_as_one_motion(chain: dict[str, list[Path]]) -
     assert len(poses) == 13
     colors = bsr3d.search_colors(joined)
     drawn = {tuple(np.round(c.get_color()[0], 6)) for c in poses}
-    assert tuple(np.round(bsr3d.lighten(colors[0], bsr3d.LIGHTEST), 6)) in drawn  # t = 0
+    assert tuple(np.round(lighten(colors[0], bsr3d.LIGHTEST), 6)) in drawn  # t = 0
     assert tuple(np.round(colors[2], 6)) in drawn  # t = 6 s, the last search's end
     # the centre of mass's path on the floor: one line per search, each starting where the
     # one before ends

@@ -30,7 +30,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.cm import ScalarMappable
 from matplotlib.collections import LineCollection
-from matplotlib.colors import ListedColormap, Normalize, to_rgba
+from matplotlib.colors import ListedColormap, Normalize
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
@@ -85,6 +85,7 @@ from mosys.plots.style import (
     draw_pose,
     fit_aspect,
     frame_samples,
+    lighten,
     mark_start,
     minus_signs,
     pan,
@@ -262,13 +263,6 @@ def search_colors(chain: ChainMotion) -> list[tuple[float, float, float, float]]
     """One colour per search of the chain (``controller_colors`` of their names)."""
     colors = controller_colors(list(dict.fromkeys(chain.names)))
     return [colors[name] for name in chain.names]
-
-
-def lighten(color: str | tuple[float, ...], amount: float) -> tuple[float, float, float, float]:
-    """``color`` mixed ``amount`` (0..1) with white."""
-    rgba = np.array(to_rgba(color))
-    rgba[:3] += (1.0 - rgba[:3]) * float(np.clip(amount, 0.0, 1.0))
-    return tuple(float(c) for c in rgba)
 
 
 def pose_colors(chain: ChainMotion) -> list[tuple[float, float, float, float]]:

@@ -24,7 +24,6 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib.collections import LineCollection
-from matplotlib.colors import to_rgba
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.typing import ColorType
@@ -55,6 +54,7 @@ from mosys.plots.style import (
     frame_indices,
     frame_samples,
     keep_left_labels_in,
+    lighten,
     minus_signs,
     new_figure,
     plot_style,
@@ -215,10 +215,7 @@ def phase_colors(phases: Sequence[Mapping]) -> list[tuple[float, float, float, f
 def shade(color: ColorType, fraction: float) -> tuple[float, float, float, float]:
     """``color`` for a pose ``fraction`` (0..1) of the way through its phase: mixed LIGHTEST
     with white at 0, pure at 1."""
-    rgba = np.array(to_rgba(color))
-    white = LIGHTEST * (1.0 - float(np.clip(fraction, 0.0, 1.0)))
-    rgba[:3] = rgba[:3] * (1.0 - white) + white
-    return tuple(float(c) for c in rgba)
+    return lighten(color, LIGHTEST * (1.0 - float(np.clip(fraction, 0.0, 1.0))))
 
 
 # --------------------------------------------------------------------------- the filmstrips

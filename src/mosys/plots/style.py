@@ -23,7 +23,7 @@ from matplotlib.artist import Artist
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection
-from matplotlib.colors import LinearSegmentedColormap, to_rgb
+from matplotlib.colors import LinearSegmentedColormap, to_rgb, to_rgba
 from matplotlib.figure import Figure
 from matplotlib.legend_handler import HandlerTuple
 from matplotlib.lines import Line2D
@@ -155,6 +155,13 @@ def axis_label(name: str, unit: str) -> str:
     """Axis label of a state variable: its symbol and unit, e.g. ``angle θ (deg)``."""
     symbol = SYMBOLS.get(name)
     return f"{name} {symbol} ({unit})" if symbol else f"{name} ({unit})"
+
+
+def lighten(color: ColorType, amount: float) -> tuple[float, float, float, float]:
+    """``color`` mixed ``amount`` (0..1) with white."""
+    rgba = np.array(to_rgba(color))
+    rgba[:3] += (1.0 - rgba[:3]) * float(np.clip(amount, 0.0, 1.0))
+    return tuple(float(c) for c in rgba)
 
 
 def controller_colors(names: Sequence[str]) -> dict[str, tuple[float, float, float, float]]:
