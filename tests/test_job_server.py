@@ -36,6 +36,10 @@ class Server:
         """(pid, "started: mosys ..." or "ended: exit N") for each job line of the log."""
         return re.findall(r"job (\d+) (started: .*|ended: .*)$", self.log.read_text(), re.M)
 
+    def declined(self) -> list[str]:
+        """The commands the server declined, each 'mosys ...: reason', from its log."""
+        return re.findall(r"declined: (.*)$", self.log.read_text(), re.M)
+
     def wait_for_end(self, pid: str, timeout: float = 20.0) -> str:
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
@@ -265,6 +269,10 @@ def test_a_request_the_server_cannot_serve_runs_in_the_client(server, tmp_path):
         assert done.returncode == 0, done.stderr
         assert (tmp_path / out).read_text() == "a.txt\n"
     assert server.jobs() == []
+    assert server.declined() == [  # the log says why each ran by itself
+        f"mosys index a.txt -o 1.txt: NUMBA_CACHE_DIR={str(tmp_path)!r}, not None",
+        "mosys index a.txt -o 2.txt: NUMBA_OPT='0', not None",
+    ]
 
 
 @pytest.mark.parametrize(
@@ -288,7 +296,8 @@ def test_a_malformed_request_is_refused_and_the_server_serves_on(server, tmp_pat
     (tmp_path / "a.txt").write_text("a")
     done = mosys(server, "index", "a.txt", "-o", "listed.txt", cwd=tmp_path)
     assert done.returncode == 0 and server.process.poll() is None
-    assert [line for _, line in server.jobs()][0] == "started: mosys index a.txt -o listed.txt"
+    started = [line for _, line in server.jobs()][:1]  # (a source edited meanwhile: declined)
+    assert started == ["started: mosys index a.txt -o listed.txt"], server.log.read_text()
 
 
 HUNG_UP_CLIENT = """

@@ -415,6 +415,7 @@ def _start_job(connection, selector) -> tuple[int, int] | None:
             return None
         reason = decline_reason(request)
         if reason is not None:
+            _log(f"declined: mosys {shlex.join(request['argv'])}: {reason}")  # it runs itself
             _send_line(connection, f"declined {reason}")
             return None
         try:
