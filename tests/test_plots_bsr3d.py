@@ -548,11 +548,12 @@ def test_learning_kinds_cuts_off_a_first_population_far_below(
     kept = min(float(r.best_fitness[r.evaluations <= 1_500][-1]) for r in results)
     assert cut == bsr_learning.CutStart(
         low=pytest.approx(kept - bsr_learning.EARLY_PAD * (3.4 - kept)),
+        high=pytest.approx(3.4 + bsr_learning.EARLY_TOP * (3.4 - kept)),  # not 5 % of 43.4
         evaluations=113,
         lowest=-40.0,
     )
     (ax,) = learning_kinds_figure(low_start, kinds["sense"]).axes
-    assert ax.get_ylim()[0] == pytest.approx(cut.low)
+    assert ax.get_ylim() == pytest.approx((cut.low, cut.high))
     assert [text.get_text() for text in ax.texts] == [
         "↓ below the axis: the best of the first 113 evaluations, down to −40",
         "2.75",  # the final medians
@@ -688,6 +689,119 @@ def test_close_finals_get_a_scale_of_their_own(tmp_path: Path) -> None:
     assert finals.get_ylim() == curves.get_ylim()
     assert finals.get_title() == "final best fitness"
     assert not curves.patches
+
+
+def write_curves(directory: Path, name: str, kind: str, finals: dict[int, float]) -> list[Path]:
+    """A search whose seeds climb fast from about -60 and then creep up to ``finals[K]`` over
+    the rest of 150,000 evaluations (Bob's walk): made up, as ``write_learning``."""
+    paths = write_learning(directory, name, kind, finals)
+    for path, (seed, final) in zip(paths, finals.items(), strict=True):
+        result = read_bsr_result(path)
+        e = result.evaluations.astype(float)
+        best = final - 60.0 * np.exp(-e / 1_500.0) - 0.3 * seed * (1 - e / 150_000)
+        write_bsr_result(path, dataclasses.replace(result, best_fitness=best))
+    return paths
+
+
+def assert_band_enlarges_the_late_progress(figure, late_low: float, late_high: float) -> None:
+    """The curves drawn again under themselves in the range of their late progress, the finals
+    beside them on that scale, the range shaded on the whole curves, the figure taller."""
+    curves, finals, band = figure.axes
+    low, high = band.get_ylim()
+    assert finals.get_ylim() == (low, high) and low < late_low and late_high < high
+    padded = 1 + 2 * bsr_learning.FINALS_PAD  # the late values' span, padded as the finals'
+    assert high - low <= padded * bsr_learning.LATE_SPREAD * np.ptp(curves.get_ylim())
+    for drawn, again in zip(curves.lines, band.lines, strict=True):
+        np.testing.assert_array_equal(drawn.get_xdata(), again.get_xdata())
+        np.testing.assert_array_equal(drawn.get_ydata(), again.get_ydata())
+        assert (drawn.get_color(), drawn.get_linestyle()) == (
+            again.get_color(),
+            again.get_linestyle(),
+        )
+        assert drawn.get_drawstyle() == again.get_drawstyle() == "steps-post"
+    (shade,) = curves.patches
+    assert (shade.get_y(), shade.get_y() + shade.get_height()) == pytest.approx((low, high))
+    assert band.get_xlabel() == "controller evaluations (count)" and not curves.get_xlabel()
+    assert not any(label.get_visible() for label in curves.get_xticklabels())
+    assert band.get_position().y1 < curves.get_position().y0  # under the curves
+    assert finals.get_position().y0 == pytest.approx(band.get_position().y0)  # beside the band
+    assert finals.get_title() == "final best fitness"
+    height = bsr_learning.LEARNING_HEIGHT + bsr_learning.BAND_HEIGHT
+    assert figure.get_size_inches() == pytest.approx((bsr_learning.LEARNING_WIDTH, height))
+
+
+def test_late_progress_too_narrow_to_read_is_enlarged_under_the_curves(tmp_path: Path) -> None:
+    """Bob's seeds climbed from -70 in the first 5,000 evaluations and then from 2.5 to 3.75
+    over 55,000 more, which on that scale was one line: the curves are drawn again in the range
+    of their late progress, and the finals beside them on that scale."""
+    sense = write_curves(tmp_path, "bob_sense", "sense", {1: 3.2, 2: 3.9, 3: 3.5})
+    late = np.concatenate(
+        [bsr_learning.held_from(read_bsr_result(p), 0.25 * 150_000) for p in sense]
+    )
+    assert np.ptp(late) > 0.5  # the late progress: 2.9 to 3.9, each seed creeping up
+    one = seeds_figure(sense)
+    assert_band_enlarges_the_late_progress(one, late.min(), late.max())
+    assert [text.get_text() for text in one.axes[1].texts] == [
+        "seed 1: 3.20",
+        "seed 2: 3.90",
+        "seed 3: 3.50",
+    ]
+    time = write_curves(tmp_path, "bob_time", "time", {1: 2.4, 2: 2.9, 3: 2.1})
+    late = np.concatenate(
+        [bsr_learning.held_from(read_bsr_result(p), 0.25 * 150_000) for p in [*sense, *time]]
+    )
+    both = seeds_figure([*sense, *time])
+    assert_band_enlarges_the_late_progress(both, late.min(), late.max())
+    assert [tick.get_text() for tick in both.axes[1].get_xticklabels()] == [
+        "sense-based\nmedian 3.50",
+        "time-based\nmedian 2.40",
+    ]
+    out = tmp_path / "seeds.png"
+    plot_seeds([*sense, *time], out)
+    assert_png(out, least_width=800)
+
+
+def test_late_progress_that_can_be_read_is_not_enlarged(kinds: dict[str, list[Path]]) -> None:
+    """Seeds that climb over most of the search (Rex's walk) are read on the curves' own scale:
+    no band, and the figure keeps its size."""
+    figure = seeds_figure([*kinds["time"], *kinds["sense"]])
+    assert len(figure.axes) == 2
+    assert figure.get_size_inches() == pytest.approx(
+        (bsr_learning.LEARNING_WIDTH, bsr_learning.LEARNING_HEIGHT)
+    )
+    assert (
+        bsr_learning.late_band([read_bsr_result(p) for p in kinds["time"]], 150_000, -1.0, 4.0)
+        is None
+    )
+
+
+def test_a_median_label_has_a_leader_only_where_its_curve_falls_short(
+    kinds: dict[str, list[Path]], tmp_path: Path
+) -> None:
+    """Figure 7's final medians: a curve that runs to its label has no line before the number
+    (a short line there read as a minus sign, '—5.61'); one that ends well before the longest
+    has a dotted leader from its end."""
+    (ax,) = learning_kinds_figure(kinds["time"], kinds["sense"]).axes
+    labels = {text.get_text(): text for text in ax.texts}
+    assert labels["2.75"].arrow_patch is None and labels["2"].arrow_patch is None
+    shorter = []
+    for path in kinds["sense"]:
+        result = read_bsr_result(path)
+        kept = result.evaluations <= 75_000
+        shorter.append(tmp_path / path.name)
+        write_bsr_result(
+            shorter[-1],
+            dataclasses.replace(
+                result,
+                evaluations=result.evaluations[kept],
+                best_fitness=result.best_fitness[kept],
+            ),
+        )
+    (ax,) = learning_kinds_figure(kinds["time"], shorter).axes
+    labels = {text.get_text(): text for text in ax.texts}
+    assert labels["2.75"].arrow_patch is None
+    (short,) = [text for name, text in labels.items() if name != "2.75"]
+    assert short.arrow_patch is not None and short.arrow_patch.get_linestyle() == ":"
 
 
 # --------------------------------------------------------------------------- a figure at rest

@@ -21,6 +21,7 @@ from mosys.io.bsr_result import BsrResult
 from mosys.plots.bsr_learning import (
     CURVE_WIDTH,
     FINALS_WIDTH,
+    FITNESS_LABEL,
     KIND_LINESTYLE,
     LEARNING_HEIGHT,
     LEARNING_WIDTH,
@@ -29,6 +30,7 @@ from mosys.plots.bsr_learning import (
     cut_off_start,
     draw_finals,
     draw_seed_curve,
+    enlarge_band,
     label_learning_curves,
     learning_axes,
     learning_figure,
@@ -99,13 +101,17 @@ def plot_learning_kinds(
 
 def _label_ends(ax, ends: list[tuple[object, float, float]], x: float) -> None:
     """Each median curve's final value, in its colour, at ``x`` beyond the longest curve's end
-    and spread so that no two overlap, with a thin line from a shorter curve's end (at its own
-    end a shorter curve's label sat on the longer curve)."""
+    and spread so that no two overlap, with a thin dotted line from the curve's end where it
+    is shorter (by more than 3 % of the longest) or its label was moved (at its own end a
+    shorter curve's label sat on the longer curve). A curve that runs to its label at its own
+    height has none: a short line before the number read as a minus sign ('—5.61')."""
     low, high = ax.get_ylim()
     height = ax.get_position().height * ax.figure.get_size_inches()[1]
     gap = (high - low) * (11.5 / 72) / height  # a label's height, data units
     heights = spread_labels(np.array([end[2] for end in ends]), gap, low + gap / 2, high - gap / 2)
+    longest = max(end[1] for end in ends)
     for (color, evaluations, value), label_y in zip(ends, heights, strict=True):
+        leader = evaluations < 0.97 * longest or abs(label_y - value) > gap / 4
         ax.annotate(
             minus_signs(f"{value:.3g}"),
             (evaluations, value),
@@ -114,7 +120,16 @@ def _label_ends(ax, ends: list[tuple[object, float, float]], x: float) -> None:
             fontsize=9,
             color=color,
             fontweight="bold",
-            arrowprops={"arrowstyle": "-", "color": color, "lw": 0.8, "shrinkA": 0, "shrinkB": 2},
+            arrowprops={
+                "arrowstyle": "-",
+                "color": color,
+                "lw": 0.8,
+                "linestyle": ":",
+                "shrinkA": 0,
+                "shrinkB": 4,
+            }
+            if leader
+            else None,
         )
     ax.set_ylim(low, high)
 
@@ -189,7 +204,7 @@ def learning_kinds_figure(
         _label_ends(ax, ends, last * (1.1 if log_x else 1.015))
         ax.xaxis.set_major_formatter(StrMethodFormatter("{x:,.0f}"))
         ax.set_xlabel(f"controller evaluations (count{', log scale' if log_x else ''})")
-        ax.set_ylabel("best fitness so far (Σ weight × term)")
+        ax.set_ylabel(FITNESS_LABEL)
         _lay_out_kinds(figure, entries, title, above=0.1, right=0.3)
     return figure
 
@@ -243,7 +258,9 @@ def seeds_figure(results: Sequence[str | Path]) -> Figure:
     that its runs vary). One search: ``mosys.plots.bsr.learning_figure``. Two: each seed's
     learning curve in its kind's colour (sense-based solid, time-based dashed), and beside them
     each seed's final best fitness, a column per kind, on a scale of their own where they lie
-    close together (``draw_finals``). PlotInputError when no file is given, or the files are of
+    close together (``draw_finals``); where the seeds' late progress is too narrow to be read,
+    the curves drawn again in its range, enlarged, with the finals beside them
+    (``enlarge_band``). PlotInputError when no file is given, or the files are of
     more than one search of a kind or more than two searches."""
     if not results:
         raise PlotInputError("plot_seeds: no BSR result files given")
@@ -288,6 +305,7 @@ def seeds_figure(results: Sequence[str | Path]) -> Figure:
             columns.append(FinalsColumn(heading, values, labels, [color] * len(values)))
         label_learning_curves(curves, right_end)
         cut_off_start(curves, [r for _, _, rs in kinds for r in rs], right_end)
+        band = enlarge_band(curves, finals, [r for _, _, rs in kinds for r in rs], right_end)
         _lay_out_kinds(figure, entries, title, above=0.3, right=0.0)
-        draw_finals(curves, finals, columns)
+        draw_finals(curves, finals, columns, band)
     return figure

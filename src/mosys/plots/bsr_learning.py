@@ -58,12 +58,20 @@ FINALS_WIDTH = 1.9  # inches: the panel of each seed's final best fitness
 EARLY_SHARE = 0.01  # of a linear evaluation axis: the start, too narrow to be read
 EARLY_MOST = 0.5  # of the y range: the most a curve's start may take before it is cut off
 EARLY_PAD = 0.08  # of the range kept: room below the lowest value kept
+EARLY_TOP = 0.05  # of the range kept: room above the highest value (matplotlib's own margin)
 FINALS_PAD = 0.15  # of the finals' span, above and below them where the panel zooms
 FINALS_LEAST = 0.04  # of the curves' y range: the closest the finals panel zooms
 FINALS_ZOOM = 0.5  # the panel zooms where its range is at most this share of the curves'
+LATE_SHARE = 0.25  # of the evaluation axis: the curves from here on are a search's late progress
+LATE_SPREAD = 0.1  # of the y range: late progress narrower than this is enlarged in a band
 FINALS_TICKS = 0.4  # inches right of the finals panel for its own scale's tick labels
-ZOOM_COLOR = "#ebebeb"  # the zoomed range, shaded behind the curves and the finals panel
+BAND_HEIGHT = 2.8  # inches: the figure grows by this for the enlarged band under the curves
+BAND_SHARE = 0.68  # the enlarged band's height, as a share of the whole curves' panel
+BAND_GAP = 0.14  # between the curves' panel and the band's, a share of their mean height
+ZOOM_COLOR = "#ebebeb"  # the zoomed range, shaded behind the curves, the band and the finals
 CURVE_WIDTH = 1.5  # pt
+FITNESS_SO_FAR, FITNESS_UNIT = "best fitness so far", "(Σ weight × term)"  # a curve's y axis
+FITNESS_LABEL = f"{FITNESS_SO_FAR} {FITNESS_UNIT}"
 COMPARISON_WIDTH, COMPARISON_HEIGHT = 12.5, 5.6  # inches
 BAND_ALPHA = 0.16  # the min..max band of a search's seeds
 SUPTITLE_TOP, AXES_TITLE = 0.1, 0.38  # inches: above the figure's title, for an axes title
@@ -94,49 +102,52 @@ def curves_on_grid(results: Sequence[BsrResult]) -> tuple[np.ndarray, np.ndarray
     return grid, values
 
 
+def held_from(result: BsrResult, evaluations: float) -> np.ndarray:
+    """The best fitness values ``result`` holds from ``evaluations`` on: the one held there
+    (its first record where it starts later) and every later one."""
+    first = int(np.searchsorted(result.evaluations, evaluations, side="right")) - 1
+    return result.best_fitness[max(first, 0) :]
+
+
 @dataclass(frozen=True)
 class CutStart:
-    """Where a learning-curve plot's y axis leaves out the curves' first values: ``low`` (data
-    units) the axis's bottom, ``evaluations`` the count after which every curve is above it,
-    ``lowest`` the lowest value left out."""
+    """Where a learning-curve plot's y axis leaves out the curves' first values: ``low`` and
+    ``high`` (data units) the axis's ends, ``evaluations`` the count after which every curve is
+    above ``low``, ``lowest`` the lowest value left out."""
 
     low: float
+    high: float
     evaluations: int
     lowest: float
 
 
 def cut_start(results: Sequence[BsrResult], last: int) -> CutStart | None:
-    """The y axis's bottom for the best-so-far curves of ``results`` drawn on a linear axis of
+    """The y axis's ends for the best-so-far curves of ``results`` drawn on a linear axis of
     ``last`` evaluations, where their first EARLY_SHARE of it would take more than EARLY_MOST
-    of the y range: the lowest value held from there on, padded. A first population's
+    of the y range: from the lowest value held from there on to the highest, padded by a share
+    of that range (the top's margin had been a share of the whole, blank). A first population's
     best can lie far below everything after it (Rex's -7.7 for 60 of 60,000 evaluations, then
     0.8 and up), squeezing the curves into the top of the plot. None where nothing need be
     cut (the axis then shows every value)."""
-    start = EARLY_SHARE * last
-
-    def held_from_start(result: BsrResult) -> np.ndarray:  # the value held at start, and after
-        first = int(np.searchsorted(result.evaluations, start, side="right")) - 1
-        return result.best_fitness[max(first, 0) :]
-
     everything = np.concatenate([r.best_fitness for r in results])
-    later = np.concatenate([held_from_start(r) for r in results])
+    later = np.concatenate([held_from(r, EARLY_SHARE * last) for r in results])
     lowest, kept, highest = float(everything.min()), float(later.min()), float(everything.max())
     if not kept - lowest > EARLY_MOST * (highest - lowest):
         return None
-    low = kept - EARLY_PAD * (highest - kept)
+    low, high = kept - EARLY_PAD * (highest - kept), highest + EARLY_TOP * (highest - kept)
     below = [r.evaluations[r.best_fitness < low] for r in results]
     evaluations = max((int(e[-1]) for e in below if e.size), default=0)
-    return CutStart(low, evaluations, lowest)
+    return CutStart(low, high, evaluations, lowest)
 
 
 def cut_off_start(ax: Axes, results: Sequence[BsrResult], last: int) -> None:
     """On ``ax``, learning curves of ``results`` on a linear axis of ``last`` evaluations: where
-    ``cut_start`` cuts, the y axis's bottom set there and, in the plot's lower right (where the
+    ``cut_start`` cuts, the y axis's ends set there and, in the plot's lower right (where the
     curves, risen by then, leave room), what was left out."""
     cut = cut_start(results, last)
     if cut is None:
         return
-    ax.set_ylim(bottom=cut.low)
+    ax.set_ylim(cut.low, cut.high)
     ax.text(
         0.985,
         0.03,
@@ -161,7 +172,9 @@ def learning_figure(results: Sequence[str | Path]) -> Figure:
     """Figure 8 ("Variability in search-algorithm performance") for one search: the best
     fitness so far against the number of controller evaluations, one line per seed, and in a
     narrow panel beside it each seed's final best fitness marked with its seed number, on a
-    scale of its own where the finals lie close together (``draw_finals``). The title names
+    scale of its own where the finals lie close together (``draw_finals``). Where the seeds'
+    late progress is too narrow to be read, the curves are drawn again in its range, enlarged,
+    under the whole curves, with the finals beside them (``enlarge_band``). The title names
     the search, the controller kind and the fitness function. The figure may be 2-D or 3-D.
     PlotInputError if the files are not all of one search."""
     if not results:
@@ -199,11 +212,12 @@ def learning_figure(results: Sequence[str | Path]) -> Figure:
             )
         label_learning_curves(curves, right_end)
         cut_off_start(curves, [result for result, _ in loaded], right_end)
+        band = enlarge_band(curves, finals, [result for result, _ in loaded], right_end)
         _layout_learning(figure, title)
         final_values = np.array([r.best_fitness[-1] for r, _ in loaded])
         labels = seed_labels(seeds, final_values)
         column = FinalsColumn("", final_values, labels, [colors[str(seed)] for seed in seeds])
-        draw_finals(curves, finals, [column])
+        draw_finals(curves, finals, [column], band)
     return figure
 
 
@@ -225,7 +239,7 @@ def label_learning_curves(curves: Axes, right_end: int) -> None:
     curves.set_xlim(0, right_end * 1.01 if right_end > 0 else 1)
     _thousands(curves.xaxis)
     curves.set_xlabel("controller evaluations (count)")
-    curves.set_ylabel("best fitness so far (Σ weight × term)")
+    curves.set_ylabel(FITNESS_LABEL)
     curves.set_title("learning curve of each seed", fontsize=10)
 
 
@@ -279,17 +293,86 @@ def finals_range(values: np.ndarray, low: float, high: float) -> tuple[float, fl
     return middle - span / 2, middle + span / 2
 
 
-def draw_finals(curves: Axes, finals: Axes, columns: Sequence[FinalsColumn]) -> None:
+def late_band(
+    results: Sequence[BsrResult], right_end: int, low: float, high: float
+) -> tuple[float, float] | None:
+    """The y range (data units) of the seeds' late progress, where it is too narrow to be read
+    on the curves' scale (``low``, ``high``): the values ``results`` hold from LATE_SHARE of
+    the ``right_end`` evaluations on, where they span at most LATE_SPREAD of that scale,
+    padded as ``finals_range`` pads the finals (they are among them). None where they span more
+    (the curves can be read as they are)."""
+    late = np.concatenate([held_from(r, LATE_SHARE * right_end) for r in results])
+    late = late[np.isfinite(late)]
+    if late.size == 0 or not np.ptp(late) <= LATE_SPREAD * (high - low):
+        return None
+    return finals_range(late, low, high)
+
+
+def enlarge_band(
+    curves: Axes, finals: Axes, results: Sequence[BsrResult], right_end: int
+) -> Axes | None:
+    """Where the seeds' late progress is too narrow to be read on the curves' scale
+    (``late_band``: Bob's seeds climb from 2.5 to 3.75 over 50,000 evaluations, on a scale
+    from -70 one line), the curves drawn again in its range, in a panel of their own under the
+    whole curves. The figure grows BAND_HEIGHT taller, the finals panel moves beside the band
+    and shares its scale, the band is shaded on the whole curves and the evaluations are
+    labelled under the band. Returns the band's axes, or None where nothing changes. Call once
+    the curves (``results``, drawn to ``right_end`` evaluations) are drawn and before the
+    figure's margins are set (they are in inches)."""
+    low, high = curves.get_ylim()
+    zoom = late_band(results, right_end, low, high)
+    if zoom is None:
+        return None
+    figure = curves.figure
+    width, height = figure.get_size_inches()
+    figure.set_size_inches(width, height + BAND_HEIGHT)
+    grid = figure.add_gridspec(
+        2,
+        2,
+        width_ratios=curves.get_subplotspec().get_gridspec().get_width_ratios(),
+        height_ratios=[1 - BAND_SHARE, BAND_SHARE],
+        hspace=BAND_GAP,
+    )
+    curves.set_subplotspec(grid[0, 0])
+    finals.set_subplotspec(grid[1, 1])
+    band = figure.add_subplot(grid[1, 0], sharex=curves)
+    for line in curves.lines:  # the seeds' curves, unlabelled
+        band.plot(
+            line.get_xdata(),
+            line.get_ydata(),
+            drawstyle=line.get_drawstyle(),
+            color=line.get_color(),
+            linestyle=line.get_linestyle(),
+            linewidth=line.get_linewidth(),
+            alpha=line.get_alpha(),
+        )
+    band.set_ylim(*zoom)
+    band.set_facecolor(ZOOM_COLOR)
+    band.set_xlabel(curves.get_xlabel())
+    band.set_ylabel(f"{FITNESS_SO_FAR},\nthe shaded band enlarged")
+    curves.set_ylabel(f"{FITNESS_SO_FAR}\n{FITNESS_UNIT}")  # no taller than its panel
+    curves.set_xlabel("")
+    curves.tick_params(axis="x", labelbottom=False)
+    curves.axhspan(*zoom, color=ZOOM_COLOR, zorder=0, linewidth=0)
+    curves.set_ylim(low, high)
+    finals.sharey(band)
+    finals.set_facecolor(ZOOM_COLOR)
+    return band
+
+
+def draw_finals(
+    curves: Axes, finals: Axes, columns: Sequence[FinalsColumn], band: Axes | None = None
+) -> None:
     """Each column's seeds as dots at their final best fitness, labelled, side by side in
     ``finals`` (after the curves are drawn and the figure laid out), each column's heading
-    below it and, where there are several, its median as a black bar. Where the finals lie
-    close together (``finals_range``) the panel has a scale of its own, its ticks on the right
-    (the figure's right margin widened for them), and the range it shows is shaded on
-    ``curves``."""
+    below it and, where there are several, its median as a black bar. Beside ``enlarge_band``'s
+    ``band`` the panel shares its scale. Otherwise, where the finals lie close together
+    (``finals_range``) the panel has a scale of its own, its ticks on the right (the figure's
+    right margin widened for them), and the range it shows is shaded on ``curves``."""
     low, high = curves.get_ylim()
     values = np.concatenate([column.values for column in columns])
-    zoom = finals_range(values, low, high)
-    shown_low, shown_high = zoom if zoom is not None else (low, high)
+    zoom = None if band is not None else finals_range(values, low, high)
+    shown_low, shown_high = band.get_ylim() if band is not None else zoom or (low, high)
     finals.set_xlim(0, 1)
     width = 1.0 / len(columns)
     if any(column.heading for column in columns):  # each column named below it
@@ -419,7 +502,7 @@ def learning_comparison_figure(results_by_search: Mapping[str, Sequence[str | Pa
             ax.set_xlim(0, right_end * 1.01 if right_end > 0 else 1)
             _thousands(ax.xaxis)
             ax.set_xlabel("controller evaluations (count)")
-        raw.set_ylabel("best fitness so far (Σ weight × term)")
+        raw.set_ylabel(FITNESS_LABEL)
         raw.set_title("median over seeds (line), min to max (shaded)", fontsize=10)
         scaled.set_ylabel("median best fitness / final median (fraction)")
         scaled.set_title("the median as a fraction of its final value", fontsize=10)
