@@ -52,7 +52,8 @@ def tables(smoke: bool, work: Path, shared: bool) -> tuple:
     """(problem, transitions, values): the exit tables, each node's own or (``shared``) shared by
     the motion classes as ``mosys dp`` builds them, and the converged cost-to-go."""
     from mosys.dynamics.load import figure_dynamics
-    from mosys.kernels.dp import discard_poorly_known_exits, exit_transitions_template
+    from mosys.kernels.dp import discard_poorly_known_exits
+    from mosys.kernels.dp_exits import exit_transitions_template
     from mosys.kernels.specialise import specialise
     from mosys.parsing.controller import parse_controller_spec
     from mosys.ssc import generate

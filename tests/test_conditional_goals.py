@@ -21,7 +21,7 @@ import pytest
 from mosys.dynamics.compile import compile_figure
 from mosys.dynamics.load import load_dynamics
 from mosys.io.controller_table import read_controller_table
-from mosys.kernels.dp import destination_indices
+from mosys.kernels.dp_destinations import destination_indices
 from mosys.parsing.controller import parse_controller_spec, parse_controller_text
 from mosys.parsing.tokens import SpecError
 from mosys.ssc.controller import Controller

@@ -14,7 +14,8 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from mosys.io.controller_table import read_controller_table
-from mosys.kernels.dp import first_crossing, hermite, sweep_order
+from mosys.kernels.dp import sweep_order
+from mosys.kernels.dp_exits import first_crossing, hermite
 from mosys.parsing.controller import parse_controller_spec, parse_controller_text
 from mosys.ssc.generate import generate_controller
 
@@ -102,7 +103,7 @@ def test_a_segment_too_stiff_to_follow_stops_trying(tmp_path):
     comes near that."""
     from mosys.dynamics.compile import compile_figure
     from mosys.dynamics.load import load_dynamics
-    from mosys.kernels.dp import (
+    from mosys.kernels.dp_exits import (
         MAX_SEGMENT_SECONDS,
         STIFF_STEP_FRACTION,
         exit_transitions_template,
@@ -175,7 +176,7 @@ def test_kernels_load_outside_the_dp_timings(figure_12_tables):
 GENERATE_IN_A_NEW_PROCESS = """
 import sys
 from mosys.dynamics.load import load_dynamics
-from mosys.kernels.dp import exit_transitions_template
+from mosys.kernels.dp_exits import exit_transitions_template
 from mosys.kernels.specialise import specialise
 from mosys.parsing.controller import parse_controller_spec
 from mosys.ssc.generate import generate_controller

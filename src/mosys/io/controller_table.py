@@ -48,7 +48,7 @@ class ControllerTable:
     value} per ``dest`` line in file order (``dest`` is the first), spec units; and
     ``destination_index`` (n_1, ..., n_d) int64, dataset ``/destination_index``: the index into
     ``destinations`` of the destination the node's optimal path ends at, -1 where the value is
-    inf (``kernels.dp.destination_indices`` says how it is found).
+    inf (``kernels.dp_destinations.destination_indices`` says how it is found).
 
     arrival_value: (n_1, ..., n_d) s, dataset ``/arrival_value``, for a ``policy lookahead``
     table whose policy line has ``arrival_value`` (None otherwise, and a file without it reads

@@ -1,5 +1,5 @@
 """Whether a vehicle braking from its state comes to rest in its arrival box: where both the
-lookahead runtime (``kernels.lookahead``) and the DP's exit transitions (``kernels.dp``) end a
+lookahead runtime (``kernels.lookahead``) and the DP's exit transitions (``kernels.dp_exits``) end a
 segment at the destination."""
 
 from __future__ import annotations

@@ -82,7 +82,7 @@ DEFAULT_TOLERANCE = (
     1e-6  # s: largest change of the cost-to-go in one sweep that counts as converged
 )
 DEFAULT_MAX_ITERATIONS = 1000
-DEFAULT_DT = 0.05  # s: the longest step of the DP's integrator (kernels.dp)
+DEFAULT_DT = 0.05  # s: the longest step of the DP's integrator (kernels.dp_exits)
 MIN_DT = 1e-5  # s: below this a segment that stays in its cell (2 s) would take 200,000 steps
 MAX_NODES = 100_000_000  # state grid nodes (product of the ssd samples): 0.8 GB per table
 MAX_CONTROLS = 1_000_000  # control samples (product of the torq samples) tried at each node

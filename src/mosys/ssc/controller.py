@@ -26,7 +26,7 @@ from mosys.ssc.grid import FigureGrid, control_scale, figure_grid, figure_state_
 from mosys.ssc.regions import ARRIVAL_STEPS, REST_RATE, Bounds, Regions, state_periods
 
 CLOSED_LOOP_DT = 0.001  # s: the simulator step of the closed-loop runs that judge and draw a
-# table (quality, portraits); the DP's own steps are longer (kernels.dp)
+# table (quality, portraits); the DP's own steps are longer (kernels.dp_exits)
 
 if TYPE_CHECKING:  # the lookahead policy (a vehicle's) is imported when a table uses it
     from mosys.ssc.lookahead import Lookahead

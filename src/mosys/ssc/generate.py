@@ -1,7 +1,8 @@
 """Controller generation (paper §3.4–3.5): a ``.ssc`` spec and a figure's dynamics → a table.
 
 Validation against the figure, array set-up and the HDF5 write live here; the numeric work is in
-``mosys.kernels.dp``.
+``mosys.kernels.dp_exits`` (the exit transitions), ``mosys.kernels.dp`` (value iteration) and
+``mosys.kernels.dp_destinations`` (which destination a node's path ends at).
 """
 
 from __future__ import annotations
@@ -27,23 +28,27 @@ from mosys.kernels.compile_lock import CompilationBusyError, deferring
 from mosys.kernels.dp import (
     DEAD_END_BOUND,
     DEAD_END_SECONDS,
-    DESTINATION_MAX_SWEEPS,
-    DESTINATION_TOLERANCE,
-    SEGMENT_BOX_COLUMNS,
     UNKNOWN,
     best_controls,
-    destination_indices,
     discard_poorly_known_exits,
-    exit_transitions_template,
-    free_nodes,
     gauss_seidel_sweeps,
-    node_coordinates,
     policy_tables,
     prefetch_pays,
     reach_sweep,
+    sweep_order,
+)
+from mosys.kernels.dp_destinations import (
+    DESTINATION_MAX_SWEEPS,
+    DESTINATION_TOLERANCE,
+    destination_indices,
+)
+from mosys.kernels.dp_exits import (
+    SEGMENT_BOX_COLUMNS,
+    exit_transitions_template,
+    free_nodes,
+    node_coordinates,
     replay_classes,
     segment_boxes,
-    sweep_order,
 )
 from mosys.kernels.specialise import specialise
 from mosys.limits import check_job
@@ -229,7 +234,7 @@ class Solution:
     trusts leads to the destination (none when the spec has no ``known_weight``).
     destination_index (N,) int64, for a spec with several ``dest`` lines (None otherwise): the
     line each node's optimal path ends at, -1 where the value is inf
-    (``dp.destination_indices``)."""
+    (``dp_destinations.destination_indices``)."""
 
     value: np.ndarray
     best_control: np.ndarray
@@ -288,15 +293,15 @@ class Transitions:
         )
 
     def outputs(self) -> tuple[np.ndarray | None, ...]:
-        """What ``dp.exit_transitions_template`` writes: exit_index, exit_weight, segment_cost,
-        to_destination."""
+        """What ``dp_exits.exit_transitions_template`` writes: exit_index, exit_weight,
+        segment_cost, to_destination."""
         return self.arrays()[:4]
 
 
 def exit_transition_arguments(
     problem: Problem, dynamics: ModuleType, dt: float, aim: float | None = None
 ) -> tuple[tuple, tuple, tuple]:
-    """The exit-transition kernel's arguments (``dp.exit_transitions_template``) before
+    """The exit-transition kernel's arguments (``dp_exits.exit_transitions_template``) before
     ``nodes``, its obstacles and its arrival box (``arrival_arguments``, scaled by ``aim``), SI."""
     grid = problem.grid
     # the kernels take SI controls; K stays per spec unit: K |u_spec| = (K / scale) |u_SI|
@@ -320,7 +325,7 @@ def exit_transition_arguments(
 
 
 def arrival_arguments(problem: Problem, dynamics: ModuleType, aim: float | None = None) -> tuple:
-    """The exit kernel's arrival arguments (``dp.exit_transitions_template``): a lookahead
+    """The exit kernel's arrival arguments (``dp_exits.exit_transitions_template``): a lookahead
     table's arrival box scaled by ``aim`` (None: the spec's ``aim``; README, "The self-parking
     car") and braking, else a disabled placeholder."""
     spec, grid = problem.spec, problem.grid
@@ -361,9 +366,9 @@ class MotionClasses:
     """The nodes that move alike: for a model whose equations read none of the controller axes
     its ``IGNORABLE_STATES`` names (axes that do not wrap and have at least 3 nodes), every
     node of a class (the nodes differing only on those axes) moves the same way under a
-    control, shifted (``dp.replay_classes``). class_of (N,) int64; representative (C,) int64: a
-    node of each class, in the middle of the ignorable axes, so that its exits stay on the
-    grid; relative_slot (S,) bool: the model-state slots of the ignorable axes."""
+    control, shifted (``dp_exits.replay_classes``). class_of (N,) int64; representative (C,)
+    int64: a node of each class, in the middle of the ignorable axes, so that its exits stay on
+    the grid; relative_slot (S,) bool: the model-state slots of the ignorable axes."""
 
     class_of: np.ndarray
     representative: np.ndarray
@@ -521,7 +526,7 @@ def compute_transitions(
 ) -> Transitions:
     """The exit transitions of the nodes where ``valid`` (N,) bool is True, in chunks of nodes,
     showing progress unless ``quiet``; with ``classes``, each class's segments are integrated
-    once (``record_classes``) and replayed at its nodes (``dp.replay_classes``), which share
+    once (``record_classes``) and replayed at its nodes (``dp_exits.replay_classes``), which share
     its exit shapes. arguments: ``exit_transition_arguments``."""
     before, obstacles, arrival = arguments
     controls = problem.control_samples.shape[0]
@@ -588,7 +593,7 @@ def record_classes(
 ) -> tuple[Transitions, tuple]:
     """Integrate each class's segments once from its representative, without obstacles or
     arrival box (``recording``: the steps counted, then written) and return the class's exits
-    (one row per class: its shapes and costs) and ``dp.replay_classes``'s record arguments
+    (one row per class: its shapes and costs) and ``dp_exits.replay_classes``'s record arguments
     (record_start, record_count, record, relative_slot, the segment boxes)."""
     before, obstacles, arrival = arguments
     grid = problem.grid
@@ -633,7 +638,8 @@ def record_classes(
 
 def check_transitions_finite(problem: Problem, transitions: Transitions) -> None:
     """SimulationError at the spec's ``dyn`` line if some segment's state became non-finite
-    (its cost nan, ``dp.exit_transitions_template``), naming the first such node and control."""
+    (its cost nan, ``dp_exits.exit_transitions_template``), naming the first such node and
+    control."""
     diverged = np.argwhere(np.isnan(transitions.segment_cost))
     if not diverged.size:
         return
