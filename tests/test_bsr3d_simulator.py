@@ -14,8 +14,10 @@ from hypothesis import strategies as st
 
 from mosys.bsr.figure import load_bsr_figure
 from mosys.bsr.start import standing_state as standing_state_2d
+from mosys.kernels import bsr3d_contact as contact
 from mosys.kernels import bsr3d_simulate as sim
 from mosys.kernels import bsr_simulate as planar
+from mosys.kernels import rotation3d
 from mosys.parsing.tokens import Token
 
 NAN = float("nan")
@@ -105,7 +107,7 @@ class Stepper:
 
     def rotation(self) -> np.ndarray:
         out = np.empty((3, 3))
-        sim.rotation_of(self.state[sim.QW : sim.QW + 4], out)
+        rotation3d.rotation_of(self.state[sim.QW : sim.QW + 4], out)
         return out
 
     def step(self, target: np.ndarray, tau: float, dt: float) -> None:
@@ -394,14 +396,14 @@ def contact_case(u, r, inverse_mass=1 / 42.1, spin_inertia=(3.0, 4.0, 2.5), worl
     inertia tensor (3, 3)), the points' velocities after them, and whether the impulses follow
     the friction rule (False: the floor's frictionless last resort)."""
     count = len(u)
-    m = sim.MAX_CONTACTS
+    m = contact.MAX_CONTACTS
     uu, rr = np.zeros((m, 3)), np.zeros((m, 3))
     uu[:count], rr[:count] = u, r
     if world_inverse is None:
         world_inverse = np.diag(1.0 / np.asarray(spin_inertia))
     impulse = np.zeros((m, 3))
     responses = np.zeros((m, m, 3, 3))
-    frictional = sim.contact_impulses(
+    frictional = contact.contact_impulses(
         uu,
         rr,
         count,
@@ -511,13 +513,13 @@ def skew(v: np.ndarray) -> np.ndarray:
 
 def responses_of(r, count, inverse_mass, world_inverse):
     """The kernel's responses (M, M, 3, 3) among the first ``count`` points of r (M, 3)."""
-    m = sim.MAX_CONTACTS
+    m = contact.MAX_CONTACTS
     responses, spins = np.zeros((m, m, 3, 3)), np.zeros((m, 3, 3))
     for j in range(count):
-        sim.spin_per_impulse(r, j, world_inverse, spins)
+        contact.spin_per_impulse(r, j, world_inverse, spins)
     for i in range(count):
         for j in range(count):
-            sim.response(r, i, j, inverse_mass, spins, responses)
+            contact.response(r, i, j, inverse_mass, spins, responses)
     return responses
 
 
@@ -528,7 +530,7 @@ def test_a_contacts_response_is_the_rigid_bodys(seed):
     velocity change at r_i per unit impulse at r_j, E/M - [r_i]x I⁻¹ [r_j]x, written out
     independently here."""
     rng = np.random.default_rng(seed)
-    m = sim.MAX_CONTACTS
+    m = contact.MAX_CONTACTS
     r = rng.normal(0.0, 0.5, (m, 3))
     a = rng.normal(size=(3, 3))
     world_inverse = np.linalg.inv(a @ a.T + np.eye(3))
@@ -593,7 +595,7 @@ def test_the_shared_friction_solve_finds_the_fixed_point_of_the_dense_plain_iter
     impulse pushing, the kernel ends at the same impulses; and for two contacts with no z in r
     or u (iterated plainly, as the 2-D rule is) it agrees on whether they push."""
     rng = np.random.default_rng(7)
-    m = sim.MAX_CONTACTS
+    m = contact.MAX_CONTACTS
     compared = dict.fromkeys(range(2, m + 1), 0)
     planar_cases = 0
     in_plane = np.random.default_rng(11)
@@ -623,20 +625,20 @@ def test_the_shared_friction_solve_finds_the_fixed_point_of_the_dense_plain_iter
         uu, rr = np.zeros((m, 3)), np.zeros((m, 3))
         uu[:count], rr[:count] = u, r
         responses = responses_of(rr, count, inverse_mass, world_inverse)
-        compliance = sim.COMPLIANCE * (responses[0, 0, 0, 0] + responses[0, 0, 1, 1])
+        compliance = contact.COMPLIANCE * (responses[0, 0, 0, 0] + responses[0, 0, 1, 1])
         compliance = 0.0 if count < 3 else compliance
         impulse = np.zeros((m, 3))
         active = np.r_[np.ones(count), np.zeros(m - count)]
         system, pairs = np.zeros((m + 4, m + 4)), np.zeros((m, m, 9))
-        scale_a = sim._normal_block(uu, rr, active, count, responses, system, compliance, pairs)
+        scale_a = contact._normal_block(uu, rr, active, count, responses, system, compliance, pairs)
         assert scale_a > 0.0
         mixing, weight, share = np.zeros((3, m, m)), np.zeros(m), np.zeros(m)
-        code = sim._shared_friction(
+        code = contact._shared_friction(
             uu, rr, active, count, impulse, system, mixing, weight, share, True, pairs, scale_a
         )
         # two in the plane iterate plainly in the kernel too, and as often; others settle more
         # slowly plainly
-        iterations = sim.FIXED_POINT_ITERATIONS if planar else 500
+        iterations = contact.FIXED_POINT_ITERATIONS if planar else 500
         reference = plain_shares(u, r, responses[:count, :count], compliance, True, iterations)
         if planar:
             assert (code == -1) == (reference is not None)

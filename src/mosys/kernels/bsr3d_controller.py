@@ -50,8 +50,6 @@ from mosys.kernels.bsr3d_simulate import (
     CZ,
     JOINTS,
     VX,
-    apply,
-    conjugate,
     joint_trig,
     lane_work,
     new_step_works,
@@ -71,6 +69,7 @@ from mosys.kernels.bsr_controller import (
 )
 from mosys.kernels.bsr_simulate import CONTACT_TOLERANCE
 from mosys.kernels.lanes import LANES
+from mosys.kernels.rotation3d import apply, conjugate
 from mosys.kernels.soundness import state_is_sound
 
 # the columns of terms_out (``parsing.bsr.FITNESS_TERMS_3D`` names them in this order)
