@@ -56,7 +56,9 @@ def tables(smoke: bool, work: Path, shared: bool) -> tuple:
     from mosys.kernels.dp_exits import exit_transitions_template
     from mosys.kernels.specialise import specialise
     from mosys.parsing.controller import parse_controller_spec
-    from mosys.ssc import generate
+    from mosys.ssc import solution
+    from mosys.ssc.exits import MotionClasses, compute_transitions, exit_transition_arguments
+    from mosys.ssc.problem import build_problem
 
     path = work / "park_sweeps.ssc"
     path.write_text(spec_text(smoke))
@@ -64,19 +66,19 @@ def tables(smoke: bool, work: Path, shared: bool) -> tuple:
     dynamics = figure_dynamics(
         spec.figure, ROOT / "results/dynamics", spec.error, spec.figure_token
     )
-    problem = generate.build_problem(spec, dynamics)
+    problem = build_problem(spec, dynamics)
     exits = specialise(exit_transitions_template, dynamics, parallel=True)
-    arguments = generate.exit_transition_arguments(problem, dynamics, spec.dt)
-    classes = generate.MotionClasses.of(problem, dynamics) if shared else None
-    generate.load_kernels(exits, arguments, problem, classes)
-    transitions = generate.compute_transitions(
+    arguments = exit_transition_arguments(problem, dynamics, spec.dt)
+    classes = MotionClasses.of(problem, dynamics) if shared else None
+    solution.load_kernels(exits, arguments, problem, classes)
+    transitions = compute_transitions(
         exits, arguments, problem, problem.node_valid, classes, quiet=False
     )
-    reachable = generate.reachable_nodes(
+    reachable = solution.reachable_nodes(
         transitions, problem.is_destination, problem.grid.axis_count
     )
     discard_poorly_known_exits(*transitions.arrays(), reachable, spec.known_weight)
-    value, *_ = generate.value_iteration(
+    value, *_ = solution.value_iteration(
         problem, transitions, reachable, spec.tolerance, spec.max_iterations, quiet=False
     )
     return problem, transitions, value
@@ -92,10 +94,11 @@ def time_sweeps(problem, transitions, value: np.ndarray) -> pd.DataFrame:
         gather_policy,
         gauss_seidel_sweep,
         policy_sweep,
+        policy_tables,
         prefetch_pays,
         sweep_order,
     )
-    from mosys.ssc.generate import policy_tables, sweep_blocks
+    from mosys.ssc.solution import sweep_blocks
 
     grid, arrays = problem.grid, transitions.arrays()
     order = np.empty(grid.node_count, dtype=np.int64)

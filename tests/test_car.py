@@ -23,8 +23,9 @@ from mosys.parsing.controller import parse_controller_text, render_controller_sp
 from mosys.parsing.figure import parse_figure_text
 from mosys.parsing.tokens import SpecError
 from mosys.parsing.vehicle import Vehicle
-from mosys.ssc.generate import build_problem, generate_controller
+from mosys.ssc.generate import generate_controller
 from mosys.ssc.parking import parking_outcome
+from mosys.ssc.problem import build_problem
 
 CAR_LINE = (
     "vehicle wheelbase=2.5 length=4.0 width=1.7 front_overhang=0.8 wheel_radius=0.3 "
@@ -520,11 +521,13 @@ def test_a_run_that_touches_an_obstacle_is_a_failure_even_if_it_ends_parked():
 def transitions_of(problem, car, classes):
     """The exit transitions of ``problem``, its classes replayed or (None) every node
     integrated, and each exit's corners (absolute flat node indices) and weights (R, U, K)."""
-    from mosys.ssc import generate
+    from mosys.kernels.dp_exits import exit_transitions_template
+    from mosys.kernels.specialise import specialise
+    from mosys.ssc.exits import compute_transitions, exit_transition_arguments
 
-    kernel = generate.specialise(generate.exit_transitions_template, car, parallel=True)
-    arguments = generate.exit_transition_arguments(problem, car, problem.spec.dt)
-    transitions = generate.compute_transitions(
+    kernel = specialise(exit_transitions_template, car, parallel=True)
+    arguments = exit_transition_arguments(problem, car, problem.spec.dt)
+    transitions = compute_transitions(
         kernel, arguments, problem, problem.node_valid, classes, quiet=True
     )
     nodes = np.flatnonzero(transitions.row_of >= 0)
@@ -540,7 +543,7 @@ def test_replaying_each_class_gives_the_transitions_of_integrating_every_node(ca
     """The car's equations read neither x nor y, so each (heading, steer, speed) class is
     integrated once and replayed at its nodes, with the obstacles, the domain and the arrival
     box tested at each node: the same exits as integrating from every node, to rounding."""
-    from mosys.ssc.generate import MotionClasses
+    from mosys.ssc.exits import MotionClasses
 
     problem = build_problem(parse_controller_text(SMALL + policy, "small.ssc"), car)
     classes = MotionClasses.of(problem, car)

@@ -32,8 +32,9 @@ from mosys.limits import LimitError
 from mosys.parsing.controller import parse_controller_text
 from mosys.parsing.tokens import SpecError
 from mosys.ssc.controller import Controller
-from mosys.ssc.generate import build_problem, generate_controller
+from mosys.ssc.generate import generate_controller
 from mosys.ssc.parking import NOT_FREE, evaluate_starts
+from mosys.ssc.problem import build_problem
 
 ARRIVAL = "policy lookahead x=0.1 y=0.1 heading=4\n"
 DT = 0.01
@@ -484,7 +485,7 @@ def test_an_aim_shrinks_the_dps_arrival_box_so_values_only_grow(small, car, tmp_
     (``arrival_value``), the table keeps the cost-to-go to the whole box too
     (``/arrival_value``): the values of the table aiming at it, which keeps them as its own
     ``/value``, at the same nodes and within the tolerance (its sweeps start from the aimed
-    values: ``ssc.generate.arrival_solution``); not asked for, it keeps none."""
+    values: ``ssc.solution.arrival_solution``); not asked for, it keeps none."""
     spec = parse_controller_text(SMALL + ARRIVAL.replace("\n", " aim=0.5 arrival_value\n"), "a")
     generate_controller(spec, car, tmp_path / "a.h5", quiet=True)
     aimed = Controller.load(tmp_path / "a.h5", car)

@@ -7,7 +7,9 @@ import pytest
 
 from mosys.io.controller_table import read_controller_table
 from mosys.parsing.controller import parse_controller_text
-from mosys.ssc.generate import build_problem, generate_controller, solve
+from mosys.ssc.generate import generate_controller
+from mosys.ssc.problem import build_problem
+from mosys.ssc.solution import solve
 
 DOUBLE_INTEGRATOR_SPEC = """
 dyn double_integrator
@@ -164,7 +166,7 @@ def test_dp_is_general_in_state_dimensions_and_controls(tmp_path):
 
 
 def solve_double_integrator(double_integrator, quiet=True, warm=None):
-    """The double integrator's DP to the origin (``ssc.generate.solve``): (spec, solution)."""
+    """The double integrator's DP to the origin (``ssc.solution.solve``): (spec, solution)."""
     spec = parse_controller_text(DOUBLE_INTEGRATOR_SPEC, "double_integrator.ssc")
     problem = build_problem(spec, double_integrator)
     return spec, solve(

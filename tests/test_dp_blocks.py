@@ -1,4 +1,4 @@
-"""Value iteration in blocks (``kernels.dp``, ``ssc.generate.sweep_blocks``): a sweep in two
+"""Value iteration in blocks (``kernels.dp``, ``ssc.solution.sweep_blocks``): a sweep in two
 blocks (``blocked_gauss_seidel_sweep``) is, bit for bit, each block's part of the order swept
 with its own values as it leaves them and the other block's as they stood at the sweep's start,
 in every sweep order and on one thread or two; sweeps in blocks reach the fixed point that one
@@ -24,7 +24,9 @@ from mosys.kernels.dp import (
     sweep_order,
 )
 from mosys.parsing.controller import parse_controller_text
-from mosys.ssc import generate
+from mosys.ssc import solution
+from mosys.ssc.exits import Transitions
+from mosys.ssc.problem import build_problem
 
 
 @pytest.mark.parametrize("threads", [1, 2])
@@ -118,7 +120,7 @@ def test_sweeps_in_two_blocks_reach_the_fixed_point_of_one_from_above(seed):
         assert np.max(value[finite] - exact[finite]) < 1e-4
 
 
-def local_transitions(counts: np.ndarray, reach: int) -> generate.Transitions:
+def local_transitions(counts: np.ndarray, reach: int) -> Transitions:
     """Exit tables whose corners lie within ``reach`` node indices of their node (zero weight
     beyond), the first axis's first layer removed."""
     nodes = int(counts.prod())
@@ -126,23 +128,23 @@ def local_transitions(counts: np.ndarray, reach: int) -> generate.Transitions:
     row_of[: nodes // counts[0]] = -1
     index = np.array([[[-reach, 1, 5 * reach]]], dtype=np.int32)
     weight = np.array([[[0.5, 0.5, 0.0]]], dtype=np.float32)
-    return generate.Transitions(
+    return Transitions(
         index, weight, np.ones((nodes, 1)), np.zeros((nodes, 1), np.bool_), row_of, row_of * 0
     )
 
 
 def test_the_blocks_split_the_nodes_evenly_and_copy_what_is_read_across(monkeypatch):
     counts = np.array((10, 4, 5), dtype=np.int64)  # layers of 20 nodes
-    assert generate.sweep_blocks(counts, local_transitions(counts, 21))[0].tolist() == [0, 200]
-    monkeypatch.setattr(generate, "BLOCKED_SWEEP_NODES", 100)
-    blocks, edges = generate.sweep_blocks(counts, local_transitions(counts, 21))
+    assert solution.sweep_blocks(counts, local_transitions(counts, 21))[0].tolist() == [0, 200]
+    monkeypatch.setattr(solution, "BLOCKED_SWEEP_NODES", 100)
+    blocks, edges = solution.sweep_blocks(counts, local_transitions(counts, 21))
     # 180 nodes kept in layers 1..9: the first block holds layers 0..5 (100 kept, 80 after)
     assert blocks.tolist() == [0, 120, 200]
     assert edges.tolist() == [[80, 160]]  # 21 nodes reach across two layers each side
-    blocks, edges = generate.sweep_blocks(counts, local_transitions(counts, 20))
+    blocks, edges = solution.sweep_blocks(counts, local_transitions(counts, 20))
     assert edges.tolist() == [[100, 140]]
     # a corner that wraps round the first axis: one block, the plain sweep
-    blocks, edges = generate.sweep_blocks(counts, local_transitions(counts, 180))
+    blocks, edges = solution.sweep_blocks(counts, local_transitions(counts, 180))
     assert blocks.tolist() == [0, 200] and edges is None
 
 
@@ -150,15 +152,15 @@ def test_the_car_controller_in_blocks_is_the_same_on_one_thread_and_two(car, mon
     """The car test's SMALL grid swept in two blocks (as a grid of BLOCKED_SWEEP_NODES is):
     bit-identical values and controls on one thread and on two, each node's value within the
     tolerance of the one-block solution."""
-    problem = generate.build_problem(parse_controller_text(SMALL, "small.ssc"), car)
-    one = generate.solve(problem, car, 1e-6, 3000, problem.spec.dt, quiet=True)
-    monkeypatch.setattr(generate, "BLOCKED_SWEEP_NODES", 0)
+    problem = build_problem(parse_controller_text(SMALL, "small.ssc"), car)
+    one = solution.solve(problem, car, 1e-6, 3000, problem.spec.dt, quiet=True)
+    monkeypatch.setattr(solution, "BLOCKED_SWEEP_NODES", 0)
     before = numba.get_num_threads()
     solutions = []
     try:
         for threads in (1, 2):
             numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
-            solutions.append(generate.solve(problem, car, 1e-6, 3000, problem.spec.dt, quiet=True))
+            solutions.append(solution.solve(problem, car, 1e-6, 3000, problem.spec.dt, quiet=True))
     finally:
         numba.set_num_threads(before)
     first, second = solutions

@@ -109,7 +109,8 @@ def test_a_segment_too_stiff_to_follow_stops_trying(tmp_path):
         exit_transitions_template,
     )
     from mosys.kernels.specialise import specialise
-    from mosys.ssc.generate import Transitions, build_problem, exit_transition_arguments
+    from mosys.ssc.exits import Transitions, exit_transition_arguments
+    from mosys.ssc.problem import build_problem
 
     compile_figure(SPECS / "figures" / "luxo_grounded.fig", tmp_path / "luxo_grounded.py")
     dynamics = load_dynamics(tmp_path / "luxo_grounded.py")

@@ -29,7 +29,7 @@ def solve(
     count=100_000,
     blocks=None,
 ):
-    """Value iteration from ``bound`` as ``ssc.generate.value_iteration`` runs it: (values,
+    """Value iteration from ``bound`` as ``ssc.solution.value_iteration`` runs it: (values,
     Bellman sweeps, policy sweeps). blocks: ``dp.blocked_gauss_seidel_sweep``'s, each sweep's
     snapshot a full copy (default: one block, the plain sweeps)."""
     arrays, is_destination = tables

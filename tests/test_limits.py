@@ -16,7 +16,9 @@ from mosys.cli import main
 from mosys.errors import SimulationError
 from mosys.limits import DEFAULT_STEPS, check_job, memory_limit_bytes, physical_memory_bytes
 from mosys.parsing.controller import parse_controller_spec
-from mosys.ssc.generate import build_problem, dp_memory_bytes, solve
+from mosys.ssc.generate import dp_memory_bytes
+from mosys.ssc.problem import build_problem
+from mosys.ssc.solution import solve
 
 SPECS = Path(__file__).resolve().parents[1] / "specs"
 STEPS_HINT = 'raise MOSYS_MAX_STEPS to allow it (README, "Limits")'

@@ -41,7 +41,7 @@ class ControllerTable:
     attrs: every other root attribute (figure, dest, K, timings, ...), as read. dead_end:
     (n_1, ..., n_d) bool, dataset ``/dead_end``, for a spec with ``known_weight`` (None
     otherwise): the free nodes whose value is inf because no trusted exit leads on from them
-    (``ssc.generate``), not because they cannot be reached.
+    (``ssc.solution``), not because they cannot be reached.
 
     Several destinations (a spec with two or more ``dest`` lines; None for one, and a file
     without them reads as None): ``destinations``, root attr ``destinations``, one {name:

@@ -845,7 +845,7 @@ def best_controls(
     destination) and below ``settled_above`` (0 where there are none): at most 0 for values
     reached from an upper bound (each update only lowers a value that its own update does not
     exceed), above 0 where a value lies below what its best control gives, which no value
-    iteration from above leaves (``ssc.generate.solve`` checks a warm start by it)."""
+    iteration from above leaves (``ssc.solution.solve`` checks a warm start by it)."""
     excess = 0.0
     for node in range(value.shape[0]):
         row = row_of[node]
