@@ -66,6 +66,8 @@ def test_numbers_given_with_config_are_numbers(work):
             "config bsr3d.variability: a search of at least one kind (sense or time), found none",
         ),
         ("bsr3d:\n  variability: bob_walk\n", "'bob_walk' is not of type 'object'"),
+        ("bsr3d:\n  cameras: {rex: {elevation: 100}}\n", "100 is greater than the maximum of 90"),
+        ("bsr3d:\n  cameras: {rex: {zoom: 2}}\n", "'zoom' was unexpected"),
     ],
 )
 def test_a_config_naming_no_spec_or_an_impossible_grid_is_refused_before_anything_runs(
@@ -205,3 +207,26 @@ def test_the_configs_limits_reach_the_jobs(work):
     assert "specs/controllers/pendulum/A.ssc:9:6: expected a job that fits in 0.00 GiB" in log
     assert "raise MOSYS_MAX_MEMORY_GIB to allow it" in log
     assert not (work / "results/controllers/pendulum/A.h5").exists()
+
+
+def test_a_motions_camera_reaches_its_plot_only(work, tmp_path):
+    """config bsr3d.cameras sets a 3-D motion's filmstrip and GIF camera (README, "3-D
+    figures"): its options reach that motion's `mosys plot bsr3d` only, in a fixed order, from a
+    config file or from --config's strings; a motion without one lets the plot choose."""
+    camera = tmp_path / "camera.yaml"
+    camera.write_text(
+        "bsr3d:\n  cameras: {rex: {interval: 0.5, azimuth: 50, elevation: null}}\n",
+        encoding="utf-8",
+    )
+    targets = ("results/plots/bsr3d/rex/filmstrip.png", "results/plots/bsr3d/cujo/filmstrip.png")
+    code, output = dry_run(work, *targets, "--configfile", "config/config.yaml", str(camera))
+    assert code == 0, output
+    commands = set(re.findall(r"(mosys plot bsr3d .*) > results/logs", output))
+    rex = [line for line in commands if "bsr/rex_walk/" in line]
+    cujo = [line for line in commands if "bsr/cujo_bound/" in line]
+    assert len(rex) == len(cujo) == 1, commands
+    assert rex[0].endswith("--rest results/plots/bsr3d/rex/rest.png --azimuth 50 --interval 0.5")
+    assert cujo[0].endswith("--rest results/plots/bsr3d/cujo/rest.png")
+    code, output = dry_run(work, targets[0], "--config", "bsr3d={cameras: {rex: {azimuth: -30}}}")
+    assert code == 0, output
+    assert "--rest results/plots/bsr3d/rex/rest.png --azimuth -30.0" in output

@@ -15,10 +15,12 @@ rule bsr3d_motion_plots:
         "results/logs/plots/bsr3d/{motion}.log",
     benchmark:
         "results/benchmarks/plots/bsr3d/{motion}.tsv"
+    params:
+        view=bsr3d_view,  # config bsr3d.cameras
     threads: 1
     shell:
         "mosys plot bsr3d {input.results} --filmstrip {output.filmstrip} --gif {output.gif}"
-        " --rest {output.rest} > {log} 2>&1"
+        " --rest {output.rest}{params.view} > {log} 2>&1"
 
 
 rule bsr3d_learning_kinds:

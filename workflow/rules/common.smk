@@ -29,8 +29,9 @@ def typed_overrides(value, schema):
     was refused ('100' is not of type 'integer'). A string that is none is left, for the
     validation to refuse."""
     if isinstance(value, dict):
-        properties = schema.get("properties", {})
-        return {key: typed_overrides(item, properties.get(key, {})) for key, item in value.items()}
+        properties, others = schema.get("properties", {}), schema.get("additionalProperties")
+        others = others if isinstance(others, dict) else {}  # the schema of keys not listed
+        return {key: typed_overrides(item, properties.get(key, others)) for key, item in value.items()}
     if isinstance(value, list):
         prefix, rest = schema.get("prefixItems", []), schema.get("items", {})
         return [typed_overrides(item, prefix[k] if k < len(prefix) else rest)
@@ -670,6 +671,13 @@ def bsr3d_motion_searches(motion):
             )
         chain.insert(0, continued)
     return chain
+
+
+def bsr3d_view(wildcards):
+    """A 3-D motion's filmstrip and GIF camera as `mosys plot bsr3d` takes it (config
+    bsr3d.cameras; '' where none is set: the plot chooses), its options in a fixed order."""
+    camera = config["bsr3d"]["cameras"].get(wildcards.motion) or {}
+    return "".join(f" --{name} {camera[name]}" for name in sorted(camera) if camera[name] is not None)
 
 
 def bsr3d_motion_results(wildcards):
