@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import assert_png
-from hypothesis import given
+from hypothesis import event, given
 from hypothesis import strategies as st
 from matplotlib.collections import LineCollection, PolyCollection
 from PIL import Image
@@ -353,6 +353,50 @@ def test_finals_range_holds_every_final(values: list[float], low: float, size: f
         assert zoom[0] <= finals.min() and finals.max() <= zoom[1]
         assert bsr_learning.FINALS_LEAST * size - rounding <= zoom[1] - zoom[0]
         assert zoom[1] - zoom[0] <= bsr_learning.FINALS_ZOOM * size + rounding
+
+
+@given(
+    st.lists(
+        st.lists(st.floats(-100.0, 100.0), min_size=1, max_size=20),
+        min_size=1,
+        max_size=5,
+    ),
+    st.floats(0.0, 1.0),
+)
+def test_the_late_band_holds_the_late_values_and_is_narrow(
+    searches: dict[str, list[Path]], steps: list[list[float]], start: float
+) -> None:
+    """Whatever the seeds' curves (each a non-decreasing best so far, recorded at evaluations
+    1, 2, 4, ...), the band of their late progress, where there is one, holds every value
+    they hold from a quarter of the evaluations on, and is no wider than the late spread
+    allows, padded; where the late values span more than LATE_SPREAD of the scale there is
+    none."""
+    template = read_bsr_result(searches["star_sense"][0])
+    results = []
+    for rises in steps:
+        best = start + np.cumsum(np.abs(rises))  # non-decreasing, as a best so far is
+        evaluations = 2 ** np.arange(len(best), dtype=np.int64)
+        results.append(dataclasses.replace(template, evaluations=evaluations, best_fitness=best))
+    right_end = max(int(r.evaluations[-1]) for r in results)
+    everything = np.concatenate([r.best_fitness for r in results])
+    low, high = float(everything.min()) - 1.0, float(everything.max()) + 1.0
+    late = np.concatenate(
+        [bsr_learning.held_from(r, bsr_learning.LATE_SHARE * right_end) for r in results]
+    )
+    band = bsr_learning.late_band(results, right_end, low, high)
+    if np.ptp(late) > bsr_learning.LATE_SPREAD * (high - low):
+        event("late progress readable: no band")
+        assert band is None
+        return
+    event("late progress too narrow: a band")
+    assert band is not None
+    rounding = 8 * math.ulp(abs(low) + abs(high))
+    assert band[0] <= late.min() + rounding and late.max() - rounding <= band[1]
+    widest = max(
+        np.ptp(late) * (1 + 2 * bsr_learning.FINALS_PAD),
+        bsr_learning.FINALS_LEAST * (high - low),
+    )
+    assert band[1] - band[0] <= widest + rounding
 
 
 def test_learning_plot_writes_a_png(searches: dict[str, list[Path]], tmp_path: Path) -> None:
