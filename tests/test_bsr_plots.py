@@ -357,24 +357,26 @@ def test_finals_range_holds_every_final(values: list[float], low: float, size: f
 
 @given(
     st.lists(
-        st.lists(st.floats(-100.0, 100.0), min_size=1, max_size=20),
+        st.lists(st.floats(0.0, 100.0), min_size=1, max_size=20),
         min_size=1,
         max_size=5,
     ),
     st.floats(0.0, 1.0),
+    st.floats(0.0, 3.0),
 )
 def test_the_late_band_holds_the_late_values_and_is_narrow(
-    searches: dict[str, list[Path]], steps: list[list[float]], start: float
+    searches: dict[str, list[Path]], steps: list[list[float]], start: float, shrink: float
 ) -> None:
     """Whatever the seeds' curves (each a non-decreasing best so far, recorded at evaluations
-    1, 2, 4, ...), the band of their late progress, where there is one, holds every value
-    they hold from a quarter of the evaluations on, and is no wider than the late spread
-    allows, padded; where the late values span more than LATE_SPREAD of the scale there is
-    none."""
+    1, 2, 4, ..., its rises shrinking or not), the band of their late progress, where there is
+    one, holds every value they hold from a quarter of the evaluations on, and is no wider than
+    the late spread allows, padded; where the late values span more than LATE_SPREAD of the
+    scale, or nothing (one flat line), there is none."""
     template = read_bsr_result(searches["star_sense"][0])
     results = []
     for rises in steps:
-        best = start + np.cumsum(np.abs(rises))  # non-decreasing, as a best so far is
+        # non-decreasing, as a best so far is; rises shrinking as a search's do, or not
+        best = start + np.cumsum(np.array(rises) / (1.0 + shrink * np.arange(len(rises))) ** 2)
         evaluations = 2 ** np.arange(len(best), dtype=np.int64)
         results.append(dataclasses.replace(template, evaluations=evaluations, best_fitness=best))
     right_end = max(int(r.evaluations[-1]) for r in results)
@@ -386,6 +388,10 @@ def test_the_late_band_holds_the_late_values_and_is_narrow(
     band = bsr_learning.late_band(results, right_end, low, high)
     if np.ptp(late) > bsr_learning.LATE_SPREAD * (high - low):
         event("late progress readable: no band")
+        assert band is None
+        return
+    if np.ptp(late) == 0:
+        event("no late progress: no band")
         assert band is None
         return
     event("late progress too narrow: a band")

@@ -300,10 +300,10 @@ def late_band(
     on the curves' scale (``low``, ``high``): the values ``results`` hold from LATE_SHARE of
     the ``right_end`` evaluations on, where they span at most LATE_SPREAD of that scale,
     padded as ``finals_range`` pads the finals (they are among them). None where they span more
-    (the curves can be read as they are)."""
+    (the curves can be read as they are) or nothing (one flat line: nothing to enlarge)."""
     late = np.concatenate([held_from(r, LATE_SHARE * right_end) for r in results])
     late = late[np.isfinite(late)]
-    if late.size == 0 or not np.ptp(late) <= LATE_SPREAD * (high - low):
+    if late.size == 0 or not 0 < np.ptp(late) <= LATE_SPREAD * (high - low):
         return None
     return finals_range(late, low, high)
 
