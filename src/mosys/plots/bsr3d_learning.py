@@ -279,7 +279,8 @@ def seeds_figure(results: Sequence[str | Path]) -> Figure:
     with plot_style():
         figure = new_figure(LEARNING_WIDTH, LEARNING_HEIGHT)
         curves, finals = learning_axes(figure, 2 * FINALS_WIDTH - 0.7)
-        right_end = max(int(r.evaluations[-1]) for _, _, rs in kinds for r in rs)
+        every = [r for _, _, kind_results in kinds for r in kind_results]  # both kinds' seeds
+        right_end = max(int(r.evaluations[-1]) for r in every)
         for kind, name, kind_results in kinds:
             color, style = KIND_COLORS[kind], KIND_LINESTYLE[kind]
             seeds = [int(result.attrs["seed"]) for result in kind_results]
@@ -304,8 +305,8 @@ def seeds_figure(results: Sequence[str | Path]) -> Figure:
             labels = seed_labels(seeds, values)
             columns.append(FinalsColumn(heading, values, labels, [color] * len(values)))
         label_learning_curves(curves, right_end)
-        cut_off_start(curves, [r for _, _, rs in kinds for r in rs], right_end)
-        band = enlarge_band(curves, finals, [r for _, _, rs in kinds for r in rs], right_end)
+        cut_off_start(curves, every, right_end)
+        band = enlarge_band(curves, finals, every, right_end)
         _lay_out_kinds(figure, entries, title, above=0.3, right=0.0)
         draw_finals(curves, finals, columns, band)
     return figure

@@ -205,14 +205,15 @@ def learning_figure(results: Sequence[str | Path]) -> Figure:
     with plot_style():
         figure = new_figure(LEARNING_WIDTH, LEARNING_HEIGHT)
         curves, finals = learning_axes(figure, FINALS_WIDTH)
-        right_end = max(int(r.evaluations[-1]) for r, _ in loaded)
-        for (result, _), seed in zip(loaded, seeds, strict=True):
+        every = [result for result, _ in loaded]
+        right_end = max(int(r.evaluations[-1]) for r in every)
+        for result, seed in zip(every, seeds, strict=True):
             draw_seed_curve(
                 curves, result, right_end, color=colors[str(seed)], label=f"seed {seed}"
             )
         label_learning_curves(curves, right_end)
-        cut_off_start(curves, [result for result, _ in loaded], right_end)
-        band = enlarge_band(curves, finals, [result for result, _ in loaded], right_end)
+        cut_off_start(curves, every, right_end)
+        band = enlarge_band(curves, finals, every, right_end)
         _layout_learning(figure, title)
         final_values = np.array([r.best_fitness[-1] for r, _ in loaded])
         labels = seed_labels(seeds, final_values)
