@@ -68,6 +68,11 @@ def test_numbers_given_with_config_are_numbers(work):
         ("bsr3d:\n  variability: bob_walk\n", "'bob_walk' is not of type 'object'"),
         ("bsr3d:\n  cameras: {rex: {elevation: 100}}\n", "100 is greater than the maximum of 90"),
         ("bsr3d:\n  cameras: {rex: {zoom: 2}}\n", "'zoom' was unexpected"),
+        (  # NaN passes every bound of the schema
+            "bsr3d:\n  cameras: {rex: {azimuth: .nan}}\n",
+            "config bsr3d.cameras.rex.azimuth: expected a number, found nan",
+        ),
+        ("car:\n  start_grid:\n    heading: [0.0, .nan]\n", "config car.start_grid.heading[1]: "),
     ],
 )
 def test_a_config_naming_no_spec_or_an_impossible_grid_is_refused_before_anything_runs(

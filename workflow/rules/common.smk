@@ -5,6 +5,7 @@ import contextlib
 import functools
 import importlib.util
 import json
+import math
 import os
 import re
 import shutil
@@ -55,6 +56,20 @@ def typed_overrides(value, schema):
 CONFIG_SCHEMA = Path(workflow.current_basedir) / "../schemas/config.schema.yaml"
 config.update(typed_overrides(dict(config), yaml.safe_load(CONFIG_SCHEMA.read_text())))
 validate(config, str(CONFIG_SCHEMA))  # --config's strings typed first
+
+
+def nan_keys(value, key=""):
+    """The config keys whose value is NaN (a YAML .nan): the schema's bounds let it through,
+    since every comparison with NaN is false, and it failed only in the job that read it."""
+    if isinstance(value, dict):
+        return [k for name, item in value.items() for k in nan_keys(item, f"{key}.{name}".lstrip("."))]
+    if isinstance(value, list):
+        return [k for index, item in enumerate(value) for k in nan_keys(item, f"{key}[{index}]")]
+    return [key] if isinstance(value, float) and math.isnan(value) else []
+
+
+for _key in nan_keys(config):
+    raise WorkflowError(f"config {_key}: expected a number, found nan")
 
 
 def variability_searches():
