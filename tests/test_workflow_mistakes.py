@@ -70,9 +70,15 @@ def test_numbers_given_with_config_are_numbers(work):
         ("bsr3d:\n  cameras: {rex: {zoom: 2}}\n", "'zoom' was unexpected"),
         (  # NaN passes every bound of the schema
             "bsr3d:\n  cameras: {rex: {azimuth: .nan}}\n",
-            "config bsr3d.cameras.rex.azimuth: expected a number, found nan",
+            "config bsr3d.cameras.rex.azimuth: expected a finite number, found nan",
         ),
         ("car:\n  start_grid:\n    heading: [0.0, .nan]\n", "config car.start_grid.heading[1]: "),
+        (  # an infinity passes a lower bound alone
+            "car:\n  dt: .inf\n",
+            "config car.dt: expected a finite number, found inf",
+        ),
+        ("limits:\n  steps: .inf\n", "config limits.steps: expected a finite number, found inf"),
+        ("car:\n  start_grid:\n    steer: [-.inf]\n", "config car.start_grid.steer[0]: "),
     ],
 )
 def test_a_config_naming_no_spec_or_an_impossible_grid_is_refused_before_anything_runs(

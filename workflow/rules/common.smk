@@ -58,18 +58,22 @@ config.update(typed_overrides(dict(config), yaml.safe_load(CONFIG_SCHEMA.read_te
 validate(config, str(CONFIG_SCHEMA))  # --config's strings typed first
 
 
-def nan_keys(value, key=""):
-    """The config keys whose value is NaN (a YAML .nan): the schema's bounds let it through,
-    since every comparison with NaN is false, and it failed only in the job that read it."""
+def non_finite_keys(value, key=""):
+    """(key, value) of every config number that is NaN or infinite (a YAML .nan or .inf): the
+    schema's bounds let NaN through, since every comparison with it is false, and an infinity
+    through a lower bound alone (a step of .inf); each failed only in the job that read it. No
+    key takes an infinity for "no limit" (``limits`` takes null)."""
     if isinstance(value, dict):
-        return [k for name, item in value.items() for k in nan_keys(item, f"{key}.{name}".lstrip("."))]
+        return [
+            k for name, item in value.items() for k in non_finite_keys(item, f"{key}.{name}".lstrip("."))
+        ]
     if isinstance(value, list):
-        return [k for index, item in enumerate(value) for k in nan_keys(item, f"{key}[{index}]")]
-    return [key] if isinstance(value, float) and math.isnan(value) else []
+        return [k for index, item in enumerate(value) for k in non_finite_keys(item, f"{key}[{index}]")]
+    return [(key, value)] if isinstance(value, float) and not math.isfinite(value) else []
 
 
-for _key in nan_keys(config):
-    raise WorkflowError(f"config {_key}: expected a number, found nan")
+for _key, _value in non_finite_keys(config):
+    raise WorkflowError(f"config {_key}: expected a finite number, found {_value}")
 
 
 def variability_searches():
