@@ -166,6 +166,11 @@ def test_filmstrips_draw_both_panels_in_phase_colours(
         assert got == [pytest.approx(color) for color in expected]
         assert ax.get_aspect() == 1.0
         assert sum(c == to_rgba("black") for c in got) == len(phases) - 1
+        # every pose drawn lies STRIP_MARGIN inches inside the view's sides, round ends whole
+        x0, x1 = ax.get_xlim()
+        margin = style.STRIP_MARGIN * (x1 - x0) / (ax.get_position().width * figure.get_figwidth())
+        x = stored.motion.endpoints[poses.samples][..., 0]
+        assert x.min() >= x0 + 0.99 * margin and x.max() <= x1 - 0.99 * margin
     assert panels[0].get_xlim() == panels[1].get_xlim()  # one view for both
     out = tmp_path / "strips.png"
     plot_filmstrips(result_path, out, interval=0.25)

@@ -391,7 +391,9 @@ def filmstrips_figure(result_path: str | Path, interval: float | None = None) ->
     panel_height = (y1 - y0) / scale
     if panel_height > PANEL_HEIGHT_MAX:  # a tall scene: narrower panels at a larger scale
         data_width *= PANEL_HEIGHT_MAX / panel_height
-        scale *= panel_height / PANEL_HEIGHT_MAX
+        # the blank round the poses stays STRIP_MARGIN inches (scaling it with the panel left a
+        # fortieth of an inch, and the outermost rods' round ends cut in half)
+        scale = max((x_high - x_low) / (data_width - 2 * STRIP_MARGIN), 1e-6)
         (x0, x1), (y0, y1), places, label_base = layout(data_width, scale)
         panel_height = (y1 - y0) / scale
 
