@@ -16,6 +16,7 @@ from mosys.dynamics.load import load_dynamics
 from mosys.io.trajectory import read_trajectory
 from mosys.parsing.controller import parse_controller_spec
 from mosys.ssc.generate import generate_controller
+from mosys.ssc.regions import Regions
 
 SPECS = Path(__file__).resolve().parents[1] / "specs"
 DT = 0.001
@@ -84,3 +85,38 @@ def test_sim_until_dest_stops_at_rest_in_the_destination(tmp_path, dynamics_dir)
     assert trajectory.t[-1] < 4.0  # stopped early
     assert abs(end["angle"]) <= 0.02 * 10.0  # ARRIVAL_STEPS grid steps of 10 deg
     assert abs(end["omega"]) <= np.degrees(0.01)  # at rest: REST_RATE
+
+
+@pytest.mark.parametrize("once", [" once", ""])
+def test_a_breakpoint_written_many_times_acts_as_written_once(
+    tmp_path, dynamics_dir, a_and_b, once
+):
+    """2,000 copies of a ``when`` line: every ``once`` copy fires at the same instant and is
+    spent, a standing copy drives as one does; the motion is the one of a single line, bit for
+    bit. (The verb fuzz's 10,000 copies took 32 s: the boxes were made again at every hand-over;
+    now 1.8 s.)"""
+    head = "state link -135,350\nswapcon link conA.ctab\n"
+    line = f"when link angle>-60 angle<-20 swapcon conB.ctab{once}\n"
+    tail = "sim 2\nwhen link angle>100 angle<140 swapcon conA.ctab once\nsim 1\n"
+    (tmp_path / "single").mkdir()
+    (tmp_path / "many").mkdir()
+    single = run(tmp_path / "single", dynamics_dir, a_and_b, head + line + tail)
+    many = run(tmp_path / "many", dynamics_dir, a_and_b, head + line * 2000 + tail)
+    np.testing.assert_array_equal(many.state, single.state)
+    assert np.array(many.controllers)[many.controller].tolist() == (
+        np.array(single.controllers)[single.controller].tolist()
+    )
+    assert set(np.array(single.controllers)[single.controller]) == {"A", "B"}
+
+
+def test_regions_without_one_box_and_joined() -> None:
+    lower = np.array([[0.0, -1.0], [1.0, -2.0], [2.0, -3.0]])
+    boxes = Regions(lower, lower + 1.0, np.array([2 * np.pi, 0.0]))
+    fewer = boxes.without(1)
+    np.testing.assert_array_equal(fewer.lower, lower[[0, 2]])
+    np.testing.assert_array_equal(fewer.upper, lower[[0, 2]] + 1.0)
+    both = fewer.joined(boxes)
+    assert len(both) == 5
+    np.testing.assert_array_equal(both.lower, np.concatenate((lower[[0, 2]], lower)))
+    np.testing.assert_array_equal(both.membership(np.array([1.5, -1.5])), [0, 0, 0, 1, 0])
+    np.testing.assert_array_equal(boxes.lower, lower)  # unchanged

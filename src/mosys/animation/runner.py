@@ -423,29 +423,33 @@ def _simulate(
             f"than half a step (dt = {dt:g} s): no step simulated",
             file=sys.stderr,
         )
+    # the breakpoints' boxes, SI, made once and kept in step with exchange.breakpoints (made
+    # again at every stretch and every hand-over, 10,000 once breakpoints took 32 s)
+    breakpoint_boxes = regions(sources.dynamics, [box for box, _ in exchange.breakpoints])
+    once = np.array([when.once for _, when in exchange.breakpoints], dtype=np.bool_)
     while remaining > 0:
-        boxes = [box for box, _ in exchange.breakpoints]
-        breakpoints = len(boxes)
+        breakpoints = len(breakpoint_boxes)
+        boxes_si = breakpoint_boxes
         if command.until_dest:  # back at any of the active controller's destinations
-            boxes += exchange.active.arrival_boxes()
-        boxes_si = regions(sources.dynamics, boxes)
+            arrival = regions(sources.dynamics, exchange.active.arrival_boxes())
+            boxes_si = breakpoint_boxes.joined(arrival)
         inside = boxes_si.membership(figure_state)
         if inside[breakpoints:].any():
             break
-        fired = next(
-            (k for k, (_, when) in enumerate(exchange.breakpoints) if when.once and inside[k]),
-            None,
-        )
-        if fired is not None:  # the state hands over: a swapcon made by the state
-            when = exchange.breakpoints.pop(fired)[1]
+        holding = inside[:breakpoints]
+        fired = np.flatnonzero(once & holding)
+        if fired.size:  # the state hands over: a swapcon made by the state
+            k = int(fired[0])
+            when = exchange.breakpoints.pop(k)[1]
+            breakpoint_boxes = breakpoint_boxes.without(k)
+            once = np.delete(once, k)
             exchange.active = sources.controllers[when.controller]
             exchange.line = when.token.line
             continue
         driver, line = exchange.active, exchange.line
-        for k, (_, when) in enumerate(exchange.breakpoints):
-            if inside[k]:
-                driver, line = sources.controllers[when.controller], when.token.line
-                break
+        if holding.any():
+            when = exchange.breakpoints[int(holding.argmax())][1]
+            driver, line = sources.controllers[when.controller], when.token.line
         if recorder.drive(driver.name):
             _check_domain(script, driver, line, figure_state, recorder)
         slots = driver.control_slot

@@ -39,6 +39,20 @@ class Regions:
         region_membership(np.ascontiguousarray(state), self.lower, self.upper, self.period, out)
         return out
 
+    def without(self, k: int) -> Regions:
+        """These boxes but the k-th."""
+        return Regions(
+            np.delete(self.lower, k, axis=0), np.delete(self.upper, k, axis=0), self.period
+        )
+
+    def joined(self, other: Regions) -> Regions:
+        """These boxes, then ``other``'s (over the same state)."""
+        return Regions(
+            np.concatenate((self.lower, other.lower)),
+            np.concatenate((self.upper, other.upper)),
+            self.period,
+        )
+
 
 def state_periods(dynamics: ModuleType) -> np.ndarray:
     """(S,) 2π for each angle coordinate of the model, 0 for every other state variable."""
