@@ -5,6 +5,7 @@ phase portraits and the CLI from controllers generated here by the DP from the r
 from __future__ import annotations
 
 import dataclasses
+import json
 from pathlib import Path
 
 import numpy as np
@@ -351,6 +352,53 @@ def test_a_breakpoint_box_open_in_omega_is_shaded_across_the_plot_only(
     assert (x0, x1) == (75.0, 105.0)
     assert (y0, y1) == pytest.approx(ax.get_ylim())
     assert "breakpoint: 75 < angle < 105 → D (once)" in legend_labels(figure)
+
+
+def test_copies_of_a_breakpoint_are_shaded_once_and_counted(trajectory, drawn_tables, tmp_path):
+    """500 ``when`` lines with one box and controller (the verb fuzz wrote 10,000): their
+    shading stacked opaque over the path; now one box, and the legend counts the lines. A
+    different controller on the same box is a box of its own."""
+    source = read_trajectory(trajectory)
+    copy = {"box": {"angle": [75.0, 105.0]}, "controller": "D", "once": True}
+    written = [dict(copy, line=3 + k) for k in range(500)]
+    written.append(dict(copy, controller="A", line=503))
+    path = tmp_path / "copies.h5"
+    attrs = dict(source.attrs, breakpoints=json.dumps(written))
+    write_trajectory(path, dataclasses.replace(source, attrs=attrs))
+    figure = script_path_figure(path, [drawn_tables["A"], drawn_tables["D"]])
+    (ax,) = figure.axes
+    boxes = [patch for patch in ax.patches if patch.get_alpha() == pytest.approx(0.18)]
+    assert len(boxes) == 2
+    labels = legend_labels(figure)
+    assert "breakpoint: 75 < angle < 105 → D (once, 500 lines)" in labels
+    assert "breakpoint: 75 < angle < 105 → A (once)" in labels
+
+
+def test_many_distinct_breakpoints_are_shaded_and_counted_in_the_legend(
+    trajectory, drawn_tables, tmp_path
+):
+    """300 ``when`` boxes made a legend taller than the figure, and matplotlib raised."""
+    source = read_trajectory(trajectory)
+    written = [
+        {"box": {"angle": [k - 150.0, k - 149.5]}, "controller": "AD"[k % 2], "once": False}
+        for k in range(300)
+    ]
+    path = tmp_path / "distinct.h5"
+    attrs = dict(source.attrs, breakpoints=json.dumps(written))
+    write_trajectory(path, dataclasses.replace(source, attrs=attrs))
+    figure = script_path_figure(path, [drawn_tables["A"], drawn_tables["D"]])
+    (ax,) = figure.axes
+    assert len([patch for patch in ax.patches if patch.get_alpha() == pytest.approx(0.18)]) == 300
+    labels = [label for label in legend_labels(figure) if "breakpoint" in label]
+    assert labels == [
+        "breakpoint: -150 < angle < -149.5 → A",
+        "breakpoint: -149 < angle < -148.5 → D",
+        "breakpoint: -148 < angle < -147.5 → A",
+        "297 more breakpoints, each in its controller's colour",
+    ]
+    out = tmp_path / "distinct.png"
+    plot_script(path, [drawn_tables["A"], drawn_tables["D"]], out)
+    assert assert_png(out) == (912, 768)
 
 
 def test_script_writes_a_png(trajectory, drawn_tables, tmp_path):

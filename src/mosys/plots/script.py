@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -378,20 +379,40 @@ def _source_kinds(trajectory: Trajectory) -> dict[str, str]:
     }
 
 
+def bound_text(name: str, low: float, high: float) -> str:
+    """A breakpoint's bounds on one state variable as the script reads: ``75 < angle < 105``,
+    and one side where the other is open (``omega > 1000``, not ``1000 < omega < inf``)."""
+    if low == -math.inf:
+        return f"{name} < {high:g}"
+    if high == math.inf:
+        return f"{name} > {low:g}"
+    return f"{low:g} < {name} < {high:g}"
+
+
+BREAKPOINT_ENTRIES = 4  # legend entries for breakpoints at most (the last counts the rest)
+
+
 def _shade_breakpoints(
     ax: Axes, trajectory: Trajectory, axes: Sequence[StateAxis], colors: dict
 ) -> list[tuple[object, str]]:
     """Shade each state-space breakpoint's box (the trajectory's root attr ``breakpoints``) in
     its controller's colour, clipped to the plot's limits (set before this is called): bounds
-    on variables other than the plot's two, and open bounds, span the plot. Returns the legend
-    entries."""
+    on variables other than the plot's two, and open bounds, span the plot. Breakpoints that
+    differ only in their line are one box and one legend entry, which counts them (copies
+    stacked their shading opaque over the path); past BREAKPOINT_ENTRIES distinct ones the
+    legend names the first few and counts the rest (300 made a legend taller than the figure,
+    and matplotlib raised). Returns the legend entries."""
     entries = []
     # Clipped here, not by Agg: a dashed edge is dashed along its whole length before clipping,
     # and an edge a million plot-widths long took 16 s to draw.
     view = (ax.get_xlim(), ax.get_ylim())
-    for breakpoint_ in json.loads(str(trajectory.attrs.get("breakpoints", "[]"))):
-        box = breakpoint_["box"]
-        color = colors.get(breakpoint_["controller"], "0.5")
+    written = json.loads(str(trajectory.attrs.get("breakpoints", "[]")))
+    copies = Counter(
+        json.dumps([b["box"], b["controller"], b["once"]], sort_keys=True) for b in written
+    )
+    for key, count in copies.items():
+        box, controller, once = json.loads(key)
+        color = colors.get(controller, "0.5")
         limits = []
         for axis, (view_low, view_high) in zip(axes, view, strict=True):
             low, high = box.get(axis.name, (-math.inf, math.inf))
@@ -409,10 +430,17 @@ def _shade_breakpoints(
             zorder=1,
         )
         ax.add_patch(patch)
-        bounds = ", ".join(f"{low:g} < {name} < {high:g}" for name, (low, high) in box.items())
-        how = " (once)" if breakpoint_["once"] else ""
+        bounds = ", ".join(bound_text(name, low, high) for name, (low, high) in box.items())
+        how = ["once"] if once else []
+        how += [f"{count:,} lines"] if count > 1 else []
+        how_text = f" ({', '.join(how)})" if how else ""
         handle = Rectangle((0, 0), 1, 1, facecolor=color, alpha=0.3, edgecolor=color)
-        entries.append((handle, f"breakpoint: {bounds} → {breakpoint_['controller']}{how}"))
+        entries.append((handle, f"breakpoint: {bounds} → {controller}{how_text}"))
+    if len(entries) > BREAKPOINT_ENTRIES:
+        rest = len(entries) - BREAKPOINT_ENTRIES + 1
+        handle = Rectangle((0, 0), 1, 1, facecolor="0.5", alpha=0.3, edgecolor="0.5")
+        label = f"{rest:,} more breakpoints, each in its controller's colour"
+        entries = [*entries[: BREAKPOINT_ENTRIES - 1], (handle, label)]
     return entries
 
 

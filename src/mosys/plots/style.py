@@ -244,20 +244,27 @@ def add_legend(
     fontsize: float | str | None = None,
 ) -> None:
     """The figure's legend from (handle, label) pairs, below the axes so that it hides no data
-    (the margins are set here, see ``arrange``); a tuple handle draws its parts overlaid."""
+    (the margins are set here, see ``arrange``); a tuple handle draws its parts overlaid. In
+    ``ncols`` columns, or fewer where that is wider than the figure (long labels ran off both
+    its sides)."""
     handles = [handle for handle, _ in entries]
     labels = [label for _, label in entries]
-    figure.legend(
-        handles,
-        labels,
-        loc="lower center",
-        bbox_to_anchor=(0.5, 0.005),
-        ncols=ncols,
-        fontsize=fontsize,
-        framealpha=0.9,
-        handler_map=LEGEND_HANDLERS,
-    )
-    arrange(figure, legend_rows=-(-len(entries) // ncols))
+    for columns in range(max(ncols, 1), 0, -1):
+        legend = figure.legend(
+            handles,
+            labels,
+            loc="lower center",
+            bbox_to_anchor=(0.5, 0.005),
+            ncols=columns,
+            fontsize=fontsize,
+            framealpha=0.9,
+            handler_map=LEGEND_HANDLERS,
+        )
+        width = legend.get_window_extent(figure.canvas.get_renderer()).width
+        if columns == 1 or width <= figure.bbox.width:
+            break
+        legend.remove()
+    arrange(figure, legend_rows=-(-len(entries) // columns))
 
 
 # --------------------------------------------------------------------------- sampling a motion
