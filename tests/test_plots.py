@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 from matplotlib.collections import QuadMesh
 from matplotlib.colors import same_color
 from matplotlib.contour import ContourSet
+from matplotlib.lines import Line2D
 from PIL import Image
 
 from mosys.cli import main
@@ -30,7 +31,14 @@ from mosys.plots.controller import plot_torque, portrait_figure, portrait_starts
 from mosys.plots.controls import controls_figure
 from mosys.plots.script import plot_script, script_path_figure, write_script_gif
 from mosys.plots.state_space import StateAxis, cylinder_pieces, format_state_axes
-from mosys.plots.style import PlotInputError, controller_colors
+from mosys.plots.style import (
+    MARGIN_BOTTOM,
+    MARGIN_TOP,
+    PlotInputError,
+    add_legend,
+    controller_colors,
+    new_figure,
+)
 from mosys.ssc.generate import generate_controller
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -814,3 +822,35 @@ def test_a_wide_rate_axis_is_not_ticked_every_100_degrees_per_second():
         format_state_axes(ax, axes)
         ticks = [t for t in ax.get_yticks() if -reach * 1.02 <= t <= reach * 1.02]
         assert 5 <= len(ticks) <= most, ticks
+
+
+@pytest.mark.parametrize(
+    ("labels", "columns"),
+    [
+        (["short"] * 6, 3),  # fits: as asked
+        (["a breakpoint's bounds on several state variables, " * 2] * 6, 1),  # too wide
+    ],
+)
+def test_a_legend_takes_fewer_columns_where_its_columns_are_wider_than_the_figure(labels, columns):
+    figure = new_figure(9.12, 7.68)
+    figure.add_subplot()
+    add_legend(figure, [(Line2D([], []), label) for label in labels], ncols=3)
+    (legend,) = figure.legends
+    figure.canvas.draw()  # the texts' places
+    renderer = figure.canvas.get_renderer()
+    starts = {round(text.get_window_extent(renderer).x0) for text in legend.get_texts()}
+    assert len(starts) == columns
+    assert legend.get_window_extent(renderer).width <= figure.bbox.width
+
+
+@pytest.mark.parametrize("entries", [6, 60, 300])
+def test_a_long_legend_makes_the_figure_taller_not_the_axes_vanish(entries):
+    """300 entries in 3 columns left the axes no room, and matplotlib raised; the axes keep
+    at least half the height they have without a legend, the figure growing for it."""
+    figure = new_figure(9.12, 7.68)
+    ax = figure.add_subplot()
+    add_legend(figure, [(Line2D([], []), f"controller C{k}") for k in range(entries)], ncols=3)
+    height = ax.get_position().height * figure.get_figheight()
+    without = 7.68 - MARGIN_TOP - MARGIN_BOTTOM
+    assert height >= 0.5 * without - 1e-9
+    assert (figure.get_figheight() == 7.68) == (entries == 6)

@@ -80,16 +80,23 @@ MARGIN_LEFT, MARGIN_RIGHT, MARGIN_BOTTOM, MARGIN_TOP = 0.8, 0.25, 0.55, 0.2
 TITLE_LINE = 0.22  # inches per title line
 LEGEND_SIZE = 8.5  # pt: a legend of many entries (the 3-D plots')
 LEGEND_ROW = 0.21  # inches per legend row, and once more for the legend's frame
+LEGEND_KEEPS = 0.5  # of the subplots' height without a legend, kept under a long one
 
 
 def arrange(figure: Figure, legend_rows: int = 0) -> None:
     """Fixed margins around the subplots for the longest axes title and a legend of
-    ``legend_rows`` rows below them."""
+    ``legend_rows`` rows below them. A legend that would leave the subplots less than
+    LEGEND_KEEPS of the height they have without it makes the figure taller instead (a
+    hundred entries left no room, and matplotlib raised)."""
     width, height = figure.get_size_inches()
     titles = [ax.get_title() for ax in figure.axes if ax.get_title()]
     title_lines = max((title.count("\n") + 1 for title in titles), default=0)
     top = MARGIN_TOP + TITLE_LINE * title_lines
     bottom = MARGIN_BOTTOM + (LEGEND_ROW * (legend_rows + 1) if legend_rows else 0.0)
+    least = LEGEND_KEEPS * (height - top - MARGIN_BOTTOM)  # inches for the subplots
+    if height - top - bottom < least:
+        height = top + bottom + least
+        figure.set_size_inches(width, height)
     figure.subplots_adjust(
         left=MARGIN_LEFT / width,
         right=1 - MARGIN_RIGHT / width,
