@@ -5,7 +5,8 @@ lines deleted, duplicated, swapped or borrowed from other specs, unknown keyword
 binary bytes, invalid UTF-8, 100 kB lines, deeply nested composite expressions), or a numeric
 command-line option made hostile, together with the ``mosys`` command lines that run it: one
 ``Step`` (argv, the outputs it writes, the HDF5 contract they follow) or two (``compile`` a mutated
-figure, then ``run`` a script on it).
+figure, then ``run`` a script on it; ``run`` a mutated script or motor program, then draw what
+it wrote with ``plot script`` or ``plot car``).
 
 ``Pool`` runs cases in long-lived worker processes (spawned, so nothing of pytest's process leaks
 in): each worker calls ``mosys.cli.main(argv)`` in-process, with its stdout and stderr (the file
@@ -495,25 +496,35 @@ def ssc_cases(draw) -> Case:
     return _spec_case(draw, "ssc", source, f"{name}.ssc", (step,))
 
 
+def _plot_script_step(car: bool) -> Step:
+    """Draw the trajectory a ``run`` step wrote: the car's Figure 19 frames, else the script's
+    state-space path (with no tables: a mutated script may name any of them or none). A file
+    the run wrote is a file the plots must draw (10,000 copies of a breakpoint stacked opaque,
+    300 distinct ones raised in matplotlib)."""
+    if car:
+        argv = ("plot", "car", "{case}/trajectory.h5", "--frames", "{case}/plot.png")
+    else:
+        argv = ("plot", "script", "{case}/trajectory.h5", "--path", "{case}/plot.png")
+    return Step(argv, ("plot.png",), "plot")
+
+
 @st.composite
 def anim_cases(draw) -> Case:
     """A mutated animation script: the pendulum's four (A-G tables, swing.mot) or the car's six
-    (the small car table as conpark.ctab) through ``mosys run``."""
+    (the small car table as conpark.ctab) through ``mosys run``, then drawn."""
     script = draw(st.sampled_from(PENDULUM_SCRIPTS + CAR_SCRIPTS))
     name = f"{script}.anim"
-    step = (
-        _car_run(f"{{case}}/{name}")
-        if script.startswith("park")
-        else _pendulum_run(f"{{case}}/{name}")
-    )
-    return _spec_case(draw, "anim", f"specs/scripts/{name}", name, (step,))
+    car = script.startswith("park")
+    step = _car_run(f"{{case}}/{name}") if car else _pendulum_run(f"{{case}}/{name}")
+    return _spec_case(draw, "anim", f"specs/scripts/{name}", name, (step, _plot_script_step(car)))
 
 
 @st.composite
 def mot_cases(draw) -> Case:
-    """A mutated motor program (specs/motor/link1/swing.mot) under pendulum_swing.anim."""
+    """A mutated motor program (specs/motor/link1/swing.mot) under pendulum_swing.anim, drawn."""
     step = _pendulum_run("{specs}/scripts/pendulum_swing.anim", motor="{case}/motor")
-    return _spec_case(draw, "mot", "specs/motor/link1/swing.mot", "motor/link1/swing.mot", (step,))
+    steps = (step, _plot_script_step(car=False))
+    return _spec_case(draw, "mot", "specs/motor/link1/swing.mot", "motor/link1/swing.mot", steps)
 
 
 @st.composite
@@ -1154,6 +1165,7 @@ CONTRACTS: dict[str, tuple[tuple[str, str], ...]] = {
     "composite": tuple((f"figure_motion/{name}", "finite") for name in FIGURE_MOTION)
     + tuple((f"before/figure_motion/{name}", "finite") for name in FIGURE_MOTION),
     "start_grid": (("start", "finite"),),
+    "plot": (),  # a PNG (its signature checked)
 }
 
 # What a verb may print on stderr before its one-line error: progress lines, its own warnings
@@ -1192,6 +1204,8 @@ def _check_contract(path: Path, contract: str) -> list[str]:
     import numpy as np
 
     problems = []
+    if path.suffix == ".png" and path.read_bytes()[:8] != b"\x89PNG\r\n\x1a\n":
+        problems.append(f"missing: {path.name} is not a PNG")
     if path.suffix != ".h5":
         return problems
     try:

@@ -10,6 +10,7 @@ import math
 from pathlib import Path
 
 import h5py
+import matplotlib
 import numpy as np
 import pytest
 from conftest import assert_png
@@ -17,11 +18,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from matplotlib.collections import PathCollection, PolyCollection
 from matplotlib.colors import same_color
+from matplotlib.figure import Figure
 from matplotlib.patches import Polygon
 from PIL import Image
 
+import mosys.plots.car as car_plots
 import mosys.plots.car_scene as car_scene
 import mosys.plots.car_starts as car_starts
+import mosys.plots.style as style
 from mosys.io.start_grid import (
     NO_WAY,
     NOT_FREE,
@@ -423,6 +427,53 @@ def test_parking_frames_figure(parks, crashes, lost):
     red = [p for p in panels[1].patches if same_color(p.get_edgecolor(), FAILURE_COLOR)]
     assert len(red) == 1, "the colliding outline is drawn in red"
     assert not [p for p in panels[0].patches if same_color(p.get_edgecolor(), FAILURE_COLOR)]
+
+
+def test_a_long_run_draws_at_most_outlines_max_outlines(tmp_path, parks):
+    """A 200 s loop at 0.3 s would draw 667 outlines (the verb fuzz's 2,000 s run drew 6,667,
+    a black disk, in 15 s): a round interval that draws 100 to 150 instead, in the legend; a
+    short run beside it takes the same interval."""
+    loop = write_car_trajectory(
+        tmp_path / "loop.h5", drive((-2.0, 6.0, 0.0, 20.0), [(20, 0.8, 200.0)]), seconds=200.0
+    )
+    figure = parking_frames_figure([parks, loop], interval=0.3)
+    assert "car every 1.5 s, light → dark" in legend_labels(figure)
+    for ax, path in zip((ax for ax in figure.axes if ax.get_title()), (parks, loop), strict=True):
+        run = read_car_trajectory(path)
+        (between,) = [c for c in ax.collections if isinstance(c, PolyCollection)]
+        assert len(between.get_paths()) == len(drawn_samples(run.t, 1.5)) - 2
+    assert len(drawn_samples(read_car_trajectory(loop).t, 1.5)) <= car_plots.OUTLINES_MAX
+
+
+def test_a_path_agg_cannot_draw_in_one_piece_is_drawn_in_pieces(tmp_path, parks, monkeypatch):
+    """Agg's "Exceeded cell block limit" (OverflowError: a car run of 2,000 s at 1e9 m/s) was
+    a traceback; the figure is drawn again with Agg's path chunking, only then."""
+    calls = []
+    real = Figure.savefig
+
+    def savefig(self, *args, **kwargs):
+        calls.append(matplotlib.rcParams["agg.path.chunksize"])
+        if len(calls) == 1:
+            raise OverflowError("Exceeded cell block limit in Agg.")
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(Figure, "savefig", savefig)
+    out = tmp_path / "frames.png"
+    plot_parking_frames([parks], out)
+    assert calls == [0, style.AGG_CHUNK]
+    assert_png(out)
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["frames.png", "park_1.h5"]
+
+
+def test_a_long_runs_gif_keeps_to_the_frame_limit_in_real_time(tmp_path, lost, monkeypatch):
+    """A 2,000 s run's GIF took 2.4 GiB and more than two minutes (a frame per 0.05 s): past
+    REAL_TIME_MAX_FRAMES the step widens to whole hundredths, each frame shown that long."""
+    monkeypatch.setattr(car_plots, "REAL_TIME_MAX_FRAMES", 20)
+    out = tmp_path / "lost.gif"
+    write_parking_gif(lost, out)  # 6 s: 121 frames at 20 fps
+    with Image.open(out) as gif:
+        assert gif.n_frames == 20  # every 0.32 s (6 s / 19, rounded up), and the last
+        assert gif.info["duration"] == 320
 
 
 def test_parking_frames_png(tmp_path, parks, crashes, lost):

@@ -6,12 +6,13 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 from pathlib import Path
 
 import numpy as np
 import pytest
 from conftest import assert_png
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from matplotlib.collections import QuadMesh
 from matplotlib.colors import same_color
@@ -19,6 +20,7 @@ from matplotlib.contour import ContourSet
 from matplotlib.lines import Line2D
 from PIL import Image
 
+import mosys.plots.script as script_plots
 from mosys.cli import main
 from mosys.io.controller_table import (
     ControllerTable,
@@ -29,7 +31,12 @@ from mosys.io.trajectory import FigureMotion, Trajectory, read_trajectory, write
 from mosys.parsing.controller import parse_controller_spec
 from mosys.plots.controller import plot_torque, portrait_figure, portrait_starts, torque_figure
 from mosys.plots.controls import controls_figure
-from mosys.plots.script import plot_script, script_path_figure, write_script_gif
+from mosys.plots.script import (
+    covered_pieces,
+    plot_script,
+    script_path_figure,
+    write_script_gif,
+)
 from mosys.plots.state_space import StateAxis, cylinder_pieces, format_state_axes
 from mosys.plots.style import (
     MARGIN_BOTTOM,
@@ -37,6 +44,7 @@ from mosys.plots.style import (
     PlotInputError,
     add_legend,
     controller_colors,
+    frame_step,
     new_figure,
 )
 from mosys.ssc.generate import generate_controller
@@ -413,6 +421,24 @@ def test_script_writes_a_png(trajectory, drawn_tables, tmp_path):
     out = tmp_path / "script.png"
     plot_script(trajectory, [drawn_tables["A"], drawn_tables["D"]], out)
     assert assert_png(out) == (912, 768)
+
+
+def test_a_long_scripts_gif_keeps_to_the_frame_limit_in_real_time(
+    trajectory, tmp_path, monkeypatch
+):
+    monkeypatch.setattr(script_plots, "REAL_TIME_MAX_FRAMES", 6)
+    out = tmp_path / "script.gif"
+    write_script_gif(trajectory, out)  # 1 s: 26 frames at 25 fps
+    with Image.open(out) as gif:
+        assert gif.n_frames == 6  # every 0.2 s
+        assert gif.info["duration"] == 200
+
+
+def test_frame_step():
+    assert frame_step(1.0, 25, 600) == 0.04  # a frame per 1/fps
+    assert frame_step(0.0, 20, 600) == 0.05
+    assert frame_step(2000.0, 20, 600) == 3.34  # 2000 / 599, up to whole hundredths
+    assert frame_step(29.96, 20, 600) == 0.06  # 600 frames would be 0.050017 s apart
 
 
 def test_gif_is_animated(trajectory, tmp_path):
@@ -854,3 +880,50 @@ def test_a_long_legend_makes_the_figure_taller_not_the_axes_vanish(entries):
     without = 7.68 - MARGIN_TOP - MARGIN_BOTTOM
     assert height >= 0.5 * without - 1e-9
     assert (figure.get_figheight() == 7.68) == (entries == 6)
+
+
+ANGLE = StateAxis("angle", "deg", -180.0, 180.0, 360.0)
+OMEGA = StateAxis("omega", "deg/s", -520.0, 520.0, None)
+
+
+def test_a_breakpoint_box_is_drawn_where_the_runtime_reads_it():
+    view = (-180.0, 180.0)
+    assert covered_pieces(75.0, 105.0, ANGLE, view) == [(75.0, 105.0)]
+    assert covered_pieces(170.0, 190.0, ANGLE, view) == [(170.0, 180.0), (-180.0, -170.0)]
+    assert covered_pieces(435.0, 465.0, ANGLE, view) == [(75.0, 105.0)]  # a turn on
+    # the verb fuzz's 7.5e13..1.05e26 deg: every angle, not a box from 7.5e13 (a hang)
+    assert covered_pieces(7.5e13, 1.05e26, ANGLE, view) == [view]
+    assert covered_pieces(75.0, math.inf, ANGLE, view) == [(75.0, 180.0)]  # one side: as it is
+    assert covered_pieces(600.0, 700.0, OMEGA, (-520.0, 520.0)) == []  # off the plot
+    assert covered_pieces(-1e300, 1e300, OMEGA, (-520.0, 520.0)) == [(-520.0, 520.0)]
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    low=st.floats(-1e4, 1e4),
+    width=st.floats(0.0, 800.0),
+    angle=st.floats(-180.0, 180.0, exclude_max=True),
+)
+def test_an_angle_is_shaded_exactly_where_it_lies_in_the_box(low, width, angle):
+    """On a wrap axis, an angle of the view lies in a drawn piece exactly where the runtime's
+    test (``inside_region``: modulo the period from the lower bound) puts it in the box."""
+    high = low + width
+    pieces = covered_pieces(low, high, ANGLE, (-180.0, 180.0))
+    shifted = low + (angle - low) % 360.0
+    edges = [low, high] + [end for piece in pieces for end in piece]
+    assume(all(abs(shifted - edge) > 1e-6 and abs(angle - edge) > 1e-6 for edge in edges))
+    assume(abs(shifted - (low + 360.0)) > 1e-6)
+    inside = low <= shifted <= high
+    assert inside == any(a <= angle <= b for a, b in pieces)
+
+
+def test_a_breakpoint_off_the_plot_says_so_in_the_legend(trajectory, drawn_tables, tmp_path):
+    source = read_trajectory(trajectory)
+    written = [{"box": {"omega": [600.0, 700.0]}, "controller": "D", "once": False, "line": 3}]
+    path = tmp_path / "off.h5"
+    attrs = dict(source.attrs, breakpoints=json.dumps(written))
+    write_trajectory(path, dataclasses.replace(source, attrs=attrs))
+    figure = script_path_figure(path, [drawn_tables["A"], drawn_tables["D"]])
+    (ax,) = figure.axes
+    assert not [patch for patch in ax.patches if patch.get_alpha() == pytest.approx(0.18)]
+    assert "breakpoint: 600 < omega < 700 → D (outside the plot)" in legend_labels(figure)

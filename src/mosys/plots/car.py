@@ -60,10 +60,13 @@ from mosys.plots.style import (
     DESTINATION_COLOR,
     GIF_DPI,
     GIF_HOLD_MS,
+    REAL_TIME_MAX_FRAMES,
     PlotInputError,
     add_legend,
     animation_frames,
+    choose_interval,
     frame_indices,
+    frame_step,
     minus_signs,
     plot_style,
     samples_to_the_end,
@@ -72,6 +75,7 @@ from mosys.plots.style import (
 )
 
 FRAME_INTERVAL = 0.3  # s between the outlines drawn in a parking panel
+OUTLINES_MAX = 150  # outlines a panel draws at most (a 2,000 s run drew 6,667, in 15 s)
 PARKING_GIF_FPS = 20  # frames per second of motion time in a parking GIF
 DEFAULT_WHEEL_RADIUS = 0.3  # m, when a trajectory records no wheel_radius
 TRACK_FRACTION = 0.82  # track / body width, when a trajectory records no track
@@ -370,12 +374,17 @@ def parking_frames_figure(
     """Figure 19: one panel per car trajectory (2 rows × 3 columns for six; any count works),
     each to scale in metres over the same x/y limits: the obstacles (grey), the destination
     (the car's outline at the goal, dotted), the car's outline every ``interval`` seconds
-    (light to dark with time, the start and final outlines thick) and the reference point's path.
+    (light to dark with time, the start and final outlines thick; for a run so long that it
+    would draw more than OUTLINES_MAX, every round interval that draws 100 to 150) and the
+    reference point's path.
     A run that hits an obstacle is drawn up to its first colliding sample, that outline red. Each
     panel's title: the file stem, its start state, and the outcome (a failure in red)."""
     if not trajectory_paths:
         raise PlotInputError("plot_parking_frames: no trajectories given")
     runs = [read_car_trajectory(path) for path in trajectory_paths]
+    longest = max(float(run.t[-1] - run.t[0]) for run in runs)
+    if longest / interval + 1 > OUTLINES_MAX:  # a long run: fewer outlines, a round interval
+        interval = choose_interval(longest, (OUTLINES_MAX * 2 // 3, OUTLINES_MAX))
     samples = [drawn_samples(run.t, interval, run.collision_index) for run in runs]
     car_points = []
     for run, drawn in zip(runs, samples, strict=True):
@@ -446,14 +455,17 @@ def write_parking_gif(
     the car's outline with its four wheels (short thick segments, the front pair turned by the
     steer angle), the path so far, the time and the speed. ``fps`` frames per second of motion time
     (the sample at or after each frame time, and the last, see ``samples_to_the_end``), each
-    frame round(1000 / fps) ms; a run that collides stops at its first colliding sample, drawn
-    red; the last frame is held GIF_HOLD_MS ms; loops. Frames are blitted
-    (``animation_frames``) and written with one shared palette (``write_gif``)."""
+    frame round(1000 / fps) ms (a run longer than REAL_TIME_MAX_FRAMES frames: a wider step,
+    ``frame_step``, each frame as long, so that it still plays in real time); a run that
+    collides stops at its first colliding sample, drawn red; the last frame is held GIF_HOLD_MS
+    ms; loops. Frames are blitted (``animation_frames``) and written with one shared palette
+    (``write_gif``)."""
     if not fps > 0:
         raise ValueError(f"fps must be positive, got {fps!r}")
     run = read_car_trajectory(trajectory_path)
     last = len(run.t) - 1 if run.collision_index < 0 else run.collision_index
-    samples = samples_to_the_end(run.t[: last + 1], 1.0 / fps)
+    step = frame_step(float(run.t[last] - run.t[0]), fps, REAL_TIME_MAX_FRAMES)
+    samples = samples_to_the_end(run.t[: last + 1], step)
     every = np.arange(last + 1)
     limits = view_limits(
         np.concatenate(
@@ -522,4 +534,4 @@ def write_parking_gif(
 
         moving = [path, body, *wheels, caption]  # in drawing (z) order
         frames = animation_frames(figure, moving, range(len(samples)), update)
-    write_gif(frames, out_path, [round(1000 / fps)] * (len(frames) - 1) + [GIF_HOLD_MS])
+    write_gif(frames, out_path, [round(1000 * step)] * (len(frames) - 1) + [GIF_HOLD_MS])

@@ -10,6 +10,7 @@ Their axes and paths are ``mosys.plots.state_space``'s (a wrap axis drawn as a c
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 from collections import Counter
@@ -40,6 +41,7 @@ from mosys.plots.style import (
     GIF_DPI,
     GIF_FPS,
     MARGIN_TOP,
+    REAL_TIME_MAX_FRAMES,
     TITLE_LINE,
     PlotInputError,
     add_legend,
@@ -47,6 +49,7 @@ from mosys.plots.style import (
     controller_colors,
     counted,
     destination_handle,
+    frame_step,
     mark_destination,
     mark_start,
     new_figure,
@@ -392,19 +395,43 @@ def bound_text(name: str, low: float, high: float) -> str:
 BREAKPOINT_ENTRIES = 4  # legend entries for breakpoints at most (the last counts the rest)
 
 
+def covered_pieces(
+    low: float, high: float, axis: StateAxis, view: tuple[float, float]
+) -> list[tuple[float, float]]:
+    """The pieces of a plot axis's ``view`` (spec units) that a breakpoint's bounds [low, high]
+    on its variable cover, as the runtime reads them (``kernels.regions.inside_region``): on a
+    wrap axis with both bounds finite, modulo its period (a box across the seam is two pieces,
+    one a period or wider the whole axis); else as they are. Clipped to the view, where a
+    dashed edge is not dashed along its whole length first (an edge a million plot-widths long
+    took Agg 16 s); none where the box lies outside it."""
+    if axis.period and math.isfinite(low) and math.isfinite(high):
+        if high - low >= axis.period:
+            pieces = [view]
+        else:
+            start = axis.low + (low - axis.low) % axis.period
+            end = start + (high - low)
+            seam = axis.low + axis.period
+            pieces = [(start, min(end, seam))]
+            if end > seam:  # across the seam: the rest from the axis's other end
+                pieces.append((axis.low, end - axis.period))
+    else:
+        pieces = [(low, high)]
+    clipped = [(max(a, view[0]), min(b, view[1])) for a, b in pieces]
+    return [(a, b) for a, b in clipped if a <= b]
+
+
 def _shade_breakpoints(
     ax: Axes, trajectory: Trajectory, axes: Sequence[StateAxis], colors: dict
 ) -> list[tuple[object, str]]:
     """Shade each state-space breakpoint's box (the trajectory's root attr ``breakpoints``) in
-    its controller's colour, clipped to the plot's limits (set before this is called): bounds
-    on variables other than the plot's two, and open bounds, span the plot. Breakpoints that
-    differ only in their line are one box and one legend entry, which counts them (copies
-    stacked their shading opaque over the path); past BREAKPOINT_ENTRIES distinct ones the
-    legend names the first few and counts the rest (300 made a legend taller than the figure,
-    and matplotlib raised). Returns the legend entries."""
+    its controller's colour, in the pieces of the plot (its limits set before this is called)
+    that it covers (``covered_pieces``): bounds on variables other than the plot's two, and
+    open bounds, span the plot. Breakpoints that differ only in their line are one box and one
+    legend entry, which counts them (copies stacked their shading opaque over the path); past
+    BREAKPOINT_ENTRIES distinct ones the legend names the first few and counts the rest (300
+    made a legend taller than the figure, and matplotlib raised). Returns the legend
+    entries."""
     entries = []
-    # Clipped here, not by Agg: a dashed edge is dashed along its whole length before clipping,
-    # and an edge a million plot-widths long took 16 s to draw.
     view = (ax.get_xlim(), ax.get_ylim())
     written = json.loads(str(trajectory.attrs.get("breakpoints", "[]")))
     copies = Counter(
@@ -413,26 +440,27 @@ def _shade_breakpoints(
     for key, count in copies.items():
         box, controller, once = json.loads(key)
         color = colors.get(controller, "0.5")
-        limits = []
-        for axis, (view_low, view_high) in zip(axes, view, strict=True):
-            low, high = box.get(axis.name, (-math.inf, math.inf))
-            limits.append((max(low, view_low), min(high, view_high)))
-        (x0, x1), (y0, y1) = limits
-        patch = Rectangle(
-            (x0, y0),
-            x1 - x0,
-            y1 - y0,
-            facecolor=color,
-            alpha=0.18,
-            edgecolor=color,
-            linestyle="--",
-            linewidth=1.0,
-            zorder=1,
+        x_pieces, y_pieces = (
+            covered_pieces(*box.get(axis.name, (-math.inf, math.inf)), axis, limits)
+            for axis, limits in zip(axes, view, strict=True)
         )
-        ax.add_patch(patch)
+        for (x0, x1), (y0, y1) in itertools.product(x_pieces, y_pieces):
+            patch = Rectangle(
+                (x0, y0),
+                x1 - x0,
+                y1 - y0,
+                facecolor=color,
+                alpha=0.18,
+                edgecolor=color,
+                linestyle="--",
+                linewidth=1.0,
+                zorder=1,
+            )
+            ax.add_patch(patch)
         bounds = ", ".join(bound_text(name, low, high) for name, (low, high) in box.items())
         how = ["once"] if once else []
         how += [f"{count:,} lines"] if count > 1 else []
+        how += [] if x_pieces and y_pieces else ["outside the plot"]
         how_text = f" ({', '.join(how)})" if how else ""
         handle = Rectangle((0, 0), 1, 1, facecolor=color, alpha=0.3, edgecolor=color)
         entries.append((handle, f"breakpoint: {bounds} → {controller}{how_text}"))
@@ -451,14 +479,16 @@ def write_script_gif(trajectory_path: str | Path, out_path: str | Path, fps: int
     limits from the data; a caption with the time and active controller. ``fps`` frames per
     second of motion time (the sample at or after each frame time, one frame more when the
     end is nearer the next frame time than the last; every frame round(1000 / fps) ms, the last
-    not held); loops forever. Frames are blitted (``animation_frames``) and written with one
-    palette for all (``write_gif``).
+    not held; a script longer than REAL_TIME_MAX_FRAMES frames: a wider step, ``frame_step``,
+    each frame as long, so that it still plays in real time); loops forever. Frames are
+    blitted (``animation_frames``) and written with one palette for all (``write_gif``).
     """
     trajectory = read_trajectory(trajectory_path)
     motion = trajectory.motion
     if motion is None or len(motion.t) == 0:
         raise PlotInputError(f"{trajectory_path}: no figure_motion group to animate")
-    frame_times = np.arange(motion.t[0], motion.t[-1] + 0.5 / fps, 1.0 / fps)
+    step = frame_step(float(motion.t[-1] - motion.t[0]), fps, REAL_TIME_MAX_FRAMES)
+    frame_times = np.arange(motion.t[0], motion.t[-1] + 0.5 * step, step)
     samples = np.minimum(np.searchsorted(motion.t, frame_times - 1e-9), len(motion.t) - 1)
     sample_index = np.clip(np.searchsorted(trajectory.t, motion.t + 1e-9) - 1, 0, None)
     active = [trajectory.controllers[trajectory.controller[sample_index[s]]] for s in samples]
@@ -526,4 +556,4 @@ def write_script_gif(trajectory_path: str | Path, out_path: str | Path, fps: int
 
         moving = [*rods, joints, pivot, centre_of_mass, caption]  # in drawing (z) order
         frames = animation_frames(figure, moving, range(len(samples)), update)
-    write_gif(frames, out_path, round(1000 / fps))
+    write_gif(frames, out_path, round(1000 * step))

@@ -119,6 +119,9 @@ def keep_left_labels_in(figure: Figure, ax: Axes, pad: float = 0.08) -> None:
 
 
 FIGURE_FORMATS = ("png", "pdf", "svg")  # what a plot's file name may end in
+# vertices Agg draws a long line in at a time where it cannot in one (a car run of 2,000 s at
+# 1e9 m/s: OverflowError, "Exceeded cell block limit"); only then, so other plots keep their pixels
+AGG_CHUNK = 10_000
 
 
 def save_figure(figure: Figure, path: str | Path) -> None:
@@ -129,7 +132,16 @@ def save_figure(figure: Figure, path: str | Path) -> None:
     if extension not in FIGURE_FORMATS:
         allowed = ", ".join(f".{name}" for name in FIGURE_FORMATS)
         raise PlotInputError(f"{path}: a plot's file name ends in {allowed}")
-    write_atomically(path, lambda partial: figure.savefig(partial, format=extension, dpi=DPI))
+
+    def save(partial: Path) -> None:
+        try:
+            figure.savefig(partial, format=extension, dpi=DPI)
+        except OverflowError:  # Agg's cell limit: a path too intricate to fill in one piece
+            FigureCanvasAgg(figure)  # a new renderer: the failed one draws nothing more
+            with matplotlib.rc_context({"agg.path.chunksize": AGG_CHUNK}):
+                figure.savefig(partial, format=extension, dpi=DPI)
+
+    write_atomically(path, save)
 
 
 TEXT_LUMINANCE = 0.18  # text on white at most this luminant: contrast about 4.5 : 1
@@ -509,6 +521,10 @@ GIF_DPI = 100  # dots per inch of animation frames (at 80 their text was 7 px hi
 GIF_HOLD_MS = 1500  # ms the last frame of an animation stays up before the loop restarts
 GIF_FPS = 25  # frames per second of motion time: a frame every 40 ms
 GIF_MAX_FRAMES = 150  # a longer motion gets a wider step (``frame_samples``)
+# frames of a script's or a parking run's GIF at most: one per 1/fps s of a run up to 24 s (a
+# script's 25 fps) or 30 s (the car's 20 fps); a longer one gets a wider step (a 2,000 s car run
+# took 2.4 GiB and over two minutes)
+REAL_TIME_MAX_FRAMES = 600
 FOLLOW_POSES = 3.0  # a figure ranging wider than this many pose widths is followed by the view
 
 
@@ -520,14 +536,18 @@ def check_animation_options(fps: object, max_frames: object) -> None:
         raise ValueError(f"max_frames must be a whole number of at least 2, got {max_frames!r}")
 
 
-def frame_samples(t: np.ndarray, fps: int, max_frames: int) -> tuple[np.ndarray, float]:
-    """The samples of ``t`` (s, non-decreasing) an animation shows, one per 1/fps s of motion
-    time (the step widened to keep to ``max_frames``, and rounded up to whole hundredths, the
-    unit of a GIF's frame durations, so that the animation plays in real time), the last sample
-    always included; and the step, s."""
-    span = float(t[-1] - t[0])
+def frame_step(span: float, fps: int, max_frames: int) -> float:
+    """Seconds of motion a frame of an animation of ``span`` s shows: 1/fps, widened to keep
+    to ``max_frames`` frames, and rounded up to whole hundredths, the unit of a GIF's frame
+    durations, so that the animation plays in real time."""
     step = max(1.0 / fps, span / (max_frames - 1)) if span > 0 else 1.0 / fps
-    step = math.ceil(step * 100.0 - 1e-9) / 100.0
+    return math.ceil(step * 100.0 - 1e-9) / 100.0
+
+
+def frame_samples(t: np.ndarray, fps: int, max_frames: int) -> tuple[np.ndarray, float]:
+    """The samples of ``t`` (s, non-decreasing) an animation shows, one per ``frame_step`` of
+    motion time, the last sample always included; and the step, s."""
+    step = frame_step(float(t[-1] - t[0]), fps, max_frames)
     return samples_to_the_end(t, step, max_frames), step
 
 
