@@ -5,8 +5,8 @@ lines deleted, duplicated, swapped or borrowed from other specs, unknown keyword
 binary bytes, invalid UTF-8, 100 kB lines, deeply nested composite expressions), or a numeric
 command-line option made hostile, together with the ``mosys`` command lines that run it: one
 ``Step`` (argv, the outputs it writes, the HDF5 contract they follow) or two (``compile`` a mutated
-figure, then ``run`` a script on it; ``run`` a mutated script or motor program, then draw what
-it wrote with ``plot script`` or ``plot car``).
+figure, then ``run`` a script on it; or any verb, then draw what it wrote: ``plot script``,
+``plot car``, ``plot controller``, ``plot bsr``, ``plot bsr3d``, ``plot composite``).
 
 ``Pool`` runs cases in long-lived worker processes (spawned, so nothing of pytest's process leaks
 in): each worker calls ``mosys.cli.main(argv)`` in-process, with its stdout and stderr (the file
@@ -489,11 +489,22 @@ def fig_cases(draw) -> Case:
 
 @st.composite
 def ssc_cases(draw) -> Case:
-    """A mutated controller spec (pendulum A-G, the small car) through ``mosys dp``."""
+    """A mutated controller spec (pendulum A-G, the small car) through ``mosys dp``; a
+    pendulum table then drawn (``plot controller``: its portrait and torque map)."""
     name = draw(st.sampled_from([*PENDULUM_TABLES, "car"]))
     source = CAR_SMALL_NAME if name == "car" else f"specs/controllers/pendulum/{name}.ssc"
     step = _dp_step(f"{{case}}/{name}.ssc", draw(st.booleans()))
-    return _spec_case(draw, "ssc", source, f"{name}.ssc", (step,))
+    if name == "car":
+        return _spec_case(draw, "ssc", source, f"{name}.ssc", (step,))
+    plot = Step(
+        (
+            "plot", "controller", "{case}/table.h5", "--dynamics", "{shared}/dynamics/link1.py",
+            "--portrait", "{case}/portrait.png", "--torque", "{case}/torque.png",
+        ),
+        ("portrait.png", "torque.png"),
+        "plot",
+    )  # fmt: skip
+    return _spec_case(draw, "ssc", source, f"{name}.ssc", (step, plot))
 
 
 def _plot_script_step(car: bool) -> Step:
@@ -529,18 +540,28 @@ def mot_cases(draw) -> Case:
 
 @st.composite
 def bsr_cases(draw) -> Case:
-    """A mutated BSR search spec (2-D and unchained 3-D) searched for one generation."""
+    """A mutated BSR search spec (2-D and unchained 3-D) searched for one generation, its best
+    motion then drawn (``plot bsr`` or ``plot bsr3d --filmstrip``)."""
     search = draw(st.sampled_from(BSR_SEARCHES))
     step = _bsr_step(f"{{case}}/{search}.bsr")
-    return _spec_case(draw, "bsr", f"specs/bsr/{search}.bsr", f"{search}.bsr", (step,))
+    kind = "bsr3d" if search.split("_")[0] in ("cujo", "rex", "bob") else "bsr"
+    argv = ("plot", kind, "{case}/seed.h5", "--filmstrip", "{case}/filmstrip.png")
+    plot = Step(argv, ("filmstrip.png",), "plot")
+    return _spec_case(draw, "bsr", f"specs/bsr/{search}.bsr", f"{search}.bsr", (step, plot))
 
 
 @st.composite
 def comp_cases(draw) -> Case:
-    """A mutated composite script (Table 4's) on tiny BSR results, a tiny search."""
+    """A mutated composite script (Table 4's) on tiny BSR results, a tiny search, then drawn
+    (``plot composite``: Figures 13 and 14, the search)."""
     step = _composite_step("{case}/starman_show.comp")
+    argv = (
+        "plot", "composite", "{case}/composite.h5", "--filmstrips", "{case}/strips.png",
+        "--search", "{case}/search.png",
+    )  # fmt: skip
+    plot = Step(argv, ("strips.png", "search.png"), "plot")
     source = "specs/composite/starman_show.comp"
-    return _spec_case(draw, "comp", source, "starman_show.comp", (step,))
+    return _spec_case(draw, "comp", source, "starman_show.comp", (step, plot))
 
 
 FLOATS = (
