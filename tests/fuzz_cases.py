@@ -6,7 +6,8 @@ binary bytes, invalid UTF-8, 100 kB lines, deeply nested composite expressions),
 command-line option made hostile, together with the ``mosys`` command lines that run it: one
 ``Step`` (argv, the outputs it writes, the HDF5 contract they follow) or two (``compile`` a mutated
 figure, then ``run`` a script on it; or any verb, then draw what it wrote: ``plot script``,
-``plot car``, ``plot controller``, ``plot bsr``, ``plot bsr3d``, ``plot composite``).
+``plot car`` (frames; a start grid's map), ``plot controller``, ``plot bsr``, ``plot bsr3d``,
+``plot composite``).
 
 ``Pool`` runs cases in long-lived worker processes (spawned, so nothing of pytest's process leaks
 in): each worker calls ``mosys.cli.main(argv)`` in-process, with its stdout and stderr (the file
@@ -593,7 +594,8 @@ def run_option_case(script: str, dt: str) -> Case:
 
 
 def starts_case(options: tuple[str, ...]) -> Case:
-    """``mosys starts`` on the small car table with ``options`` (then the defaults below)."""
+    """``mosys starts`` on the small car table with ``options`` (then the defaults below), then
+    its success map and consistency plot."""
     given = {word for word in options if word.startswith("--")}
     defaults = {"--x": ("-1", "1", "2"), "--y": ("1.2", "1.8", "1"), "--seconds": ("2",)}
     full = list(options)
@@ -608,7 +610,12 @@ def starts_case(options: tuple[str, ...]) -> Case:
         ("starts.h5",),
         "start_grid",
     )  # fmt: skip
-    return Case("cli", "", (f"starts {' '.join(options)}",), (), (step,))
+    argv = (
+        "plot", "car", "--map", "{case}/starts.h5", "{case}/map.png", "--consistency",
+        "{case}/starts.h5", "{case}/consistency.png",
+    )  # fmt: skip
+    plot = Step(argv, ("map.png", "consistency.png"), "plot")
+    return Case("cli", "", (f"starts {' '.join(options)}",), (), (step, plot))
 
 
 def bsr_option_case(search: str, seed: str, generations: str, threads: str) -> Case:
