@@ -41,6 +41,19 @@ def result_path(composite_workspace) -> Path:
     return composite_workspace.result
 
 
+def test_a_tall_panel_narrowed_keeps_its_margin_round_the_poses() -> None:
+    margin = style.STRIP_MARGIN
+    # 10 m of poses on 12.88 of 13 inches, 7.2 inches tall: half as wide, and the margin kept
+    width, scale = composite.narrowed(13.0, 10.0 / 12.88, 7.2, 10.0)
+    assert width == pytest.approx(6.5)
+    assert (width - 10.0 / scale) / 2 == pytest.approx(margin)
+    # no x extent (a motion straight up), and a panel too narrow for two margins: the ratio
+    for x_span, height in ((0.0, 7.2), (1.0, 1e6)):
+        width, scale = composite.narrowed(13.0, 0.1, height, x_span)
+        assert width == pytest.approx(13.0 * composite.PANEL_HEIGHT_MAX / height)
+        assert scale == pytest.approx(0.1 * height / composite.PANEL_HEIGHT_MAX)
+
+
 def test_strip_poses_of_a_known_motion() -> None:
     t = np.round(np.arange(301) * 0.01, 10)  # 0 to 3 s
     phase = np.searchsorted([1.0, 2.05], t, side="right")  # switch samples: the phase they start

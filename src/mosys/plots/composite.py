@@ -308,6 +308,21 @@ def plot_filmstrips(
         save_figure(filmstrips_figure(result_path, interval), path)
 
 
+def narrowed(
+    data_width: float, scale: float, panel_height: float, x_span: float
+) -> tuple[float, float]:
+    """The data width (inches) and scale (m per inch) of a panel ``panel_height`` inches tall
+    at ``scale``, made PANEL_HEIGHT_MAX tall: narrower by that ratio, the scale larger by it,
+    and larger still where that keeps STRIP_MARGIN inches of blank round poses ``x_span`` m
+    wide (scaling the margin with the panel left a fortieth of an inch, and the outermost
+    rods' round ends were cut in half); a panel too narrow for two margins keeps the ratio."""
+    data_width *= PANEL_HEIGHT_MAX / panel_height
+    scale *= panel_height / PANEL_HEIGHT_MAX
+    if data_width > 4 * STRIP_MARGIN:
+        scale = max(scale, x_span / (data_width - 2 * STRIP_MARGIN))
+    return data_width, scale
+
+
 def filmstrips_figure(result_path: str | Path, interval: float | None = None) -> Figure:
     """Figures 13 and 14 in one figure: above, the motion from the guessed transition points
     (``before/figure_motion``); below, the refined one (``figure_motion``). Each panel draws
@@ -390,10 +405,7 @@ def filmstrips_figure(result_path: str | Path, interval: float | None = None) ->
     (x0, x1), (y0, y1), places, label_base = layout(data_width, scale)
     panel_height = (y1 - y0) / scale
     if panel_height > PANEL_HEIGHT_MAX:  # a tall scene: narrower panels at a larger scale
-        data_width *= PANEL_HEIGHT_MAX / panel_height
-        # the blank round the poses stays STRIP_MARGIN inches (scaling it with the panel left a
-        # fortieth of an inch, and the outermost rods' round ends cut in half)
-        scale = max((x_high - x_low) / (data_width - 2 * STRIP_MARGIN), 1e-6)
+        data_width, scale = narrowed(data_width, scale, panel_height, x_high - x_low)
         (x0, x1), (y0, y1), places, label_base = layout(data_width, scale)
         panel_height = (y1 - y0) / scale
 
