@@ -93,7 +93,7 @@ def arrange(figure: Figure, legend_rows: int = 0) -> None:
     title_lines = max((title.count("\n") + 1 for title in titles), default=0)
     top = MARGIN_TOP + TITLE_LINE * title_lines
     bottom = MARGIN_BOTTOM + (LEGEND_ROW * (legend_rows + 1) if legend_rows else 0.0)
-    least = LEGEND_KEEPS * (height - top - MARGIN_BOTTOM)  # inches for the subplots
+    least = max(LEGEND_KEEPS * (height - top - MARGIN_BOTTOM), 0.0)  # inches for the subplots
     if height - top - bottom < least:
         height = top + bottom + least
         figure.set_size_inches(width, height)
