@@ -68,6 +68,11 @@ def test_numbers_given_with_config_are_numbers(work):
         ("bsr3d:\n  variability: bob_walk\n", "'bob_walk' is not of type 'object'"),
         ("bsr3d:\n  cameras: {rex: {elevation: 100}}\n", "100 is greater than the maximum of 90"),
         ("bsr3d:\n  cameras: {rex: {zoom: 2}}\n", "'zoom' was unexpected"),
+        (  # a camera for no motion was ignored: the plots went ahead with their own
+            "bsr3d:\n  cameras: {rexx: {azimuth: 10}}\n",
+            "config bsr3d.cameras: 'rexx' names no motion of bsr3d.motions"
+            " (cujo, rex, bob, bob_time) and no search spec (specs/bsr/rexx.bsr does not exist)",
+        ),
         (  # NaN passes every bound of the schema
             "bsr3d:\n  cameras: {rex: {azimuth: .nan}}\n",
             "config bsr3d.cameras.rex.azimuth: expected a finite number, found nan",

@@ -128,6 +128,14 @@ def configured_specs():
 for _key, _spec in configured_specs():
     if not Path(_spec).is_file():
         raise WorkflowError(f"config {_key}: {Path(_spec).stem!r} names no spec ({_spec} does not exist)")
+# A camera for a name that is neither a motion nor a search spec would be ignored without a word.
+for _motion in config["bsr3d"]["cameras"]:
+    if _motion not in config["bsr3d"]["motions"] and not Path(f"specs/bsr/{_motion}.bsr").is_file():
+        raise WorkflowError(
+            f"config bsr3d.cameras: {_motion!r} names no motion of bsr3d.motions"
+            f" ({', '.join(config['bsr3d']['motions'])}) and no search spec"
+            f" (specs/bsr/{_motion}.bsr does not exist)"
+        )
 if not variability_searches():
     raise WorkflowError("config bsr3d.variability: a search of at least one kind (sense or time), found none")
 
