@@ -43,6 +43,27 @@ def test_numbers_given_with_config_are_numbers(work):
     assert code != 0 and "'many' is not of type 'integer', 'null'" in output
 
 
+def test_a_whole_float_where_an_integer_is_wanted_is_that_integer(work, tmp_path):
+    """The schema takes 2.0 (and 1e300) as an integer; 1e300 seeds raised in a slice."""
+    counts = {}
+    for seeds in ("2.0", "2", "1.0e+300", "null"):
+        extra = tmp_path / "seeds.yaml"
+        extra.write_text(f"bsr3d:\n  seeds: {seeds}\n", encoding="utf-8")
+        args = ("--configfile", "config/config.yaml", str(extra), "--quiet", "rules")
+        code, output = dry_run(work, "results/bsr3d_all", *args)
+        assert code == 0, output
+        counts[seeds] = re.search(r"^bsr_search\s+(\d+)$", output, re.M).group(1)
+    assert counts["2.0"] == counts["2"] and counts["1.0e+300"] == counts["null"], counts
+
+
+def test_the_car_gif_script_draws_on_the_car_controllers_when_left_out_of_car_scripts(work):
+    """car.gif_script is the car's: left out of car.scripts, it had drawn on controllers of
+    its own name (specs/controllers/park_1/), and the dry run stopped."""
+    code, output = dry_run(work, "results/car_all", "--config", "car={scripts: [park_3]}")
+    assert code == 0, output
+    assert "mosys run specs/scripts/park_1.anim" in output, output
+
+
 @pytest.mark.parametrize(
     ("config", "message"),
     [

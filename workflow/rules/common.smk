@@ -28,7 +28,8 @@ def typed_overrides(value, schema):
     """``value`` with the strings the schema wants as numbers, booleans or null made so:
     Snakemake's ``--config`` passes nested values as strings, and bsr='{generations: 100}'
     was refused ('100' is not of type 'integer'). A string that is none is left, for the
-    validation to refuse."""
+    validation to refuse. A whole float where the schema wants an integer (``seeds: 2.0``,
+    ``1e300``), which the schema passes, is made an int: ``seeds: 1e300`` raised in a slice."""
     if isinstance(value, dict):
         properties, others = schema.get("properties", {}), schema.get("additionalProperties")
         others = others if isinstance(others, dict) else {}  # the schema of keys not listed
@@ -37,10 +38,12 @@ def typed_overrides(value, schema):
         prefix, rest = schema.get("prefixItems", []), schema.get("items", {})
         return [typed_overrides(item, prefix[k] if k < len(prefix) else rest)
                 for k, item in enumerate(value)]
-    if not isinstance(value, str):
-        return value
     kinds = schema.get("type", [])
     kinds = [kinds] if isinstance(kinds, str) else kinds
+    if isinstance(value, float) and "integer" in kinds and value.is_integer():
+        return int(value)  # the schema takes 3.0 as an integer, and Python's slices did not
+    if not isinstance(value, str):
+        return value
     text = value.strip()
     if "null" in kinds and text in ("null", "~"):
         return None
@@ -442,8 +445,11 @@ def script_figure(script):
 
 
 def drives_car(script):
-    """Whether a script is the car's: in car.scripts, or its object line names the car's figure."""
-    return script in config["car"]["scripts"] or script_figure(script) == config["car"]["figure"]
+    """Whether a script is the car's: in car.scripts, car.gif_script, or its object line names
+    the car's figure (a GIF script left out of car.scripts drew on controllers of its own name)."""
+    car = config["car"]
+    return (script in car["scripts"] or script == car["gif_script"]
+            or script_figure(script) == car["figure"])
 
 
 def script_group_and_reason(script):
@@ -455,7 +461,8 @@ def script_group_and_reason(script):
                 "config pendulum.group: the script is the pendulum's, or in pendulum.scripts")
     if drives_car(script):
         return (config["car"]["group"],
-                "config car.group: the script is in car.scripts, or drives the car's figure")
+                "config car.group: the script is in car.scripts or car.gif_script, or drives"
+                " the car's figure")
     if script_figure(script) == config["luxo"]["figure"]:
         return config["luxo"]["group"], "config luxo.group: the script animates Luxo's figure"
     return script, "the script's own name, as for any script not configured otherwise"
