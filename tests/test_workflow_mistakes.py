@@ -89,6 +89,29 @@ def test_the_car_gif_script_draws_on_the_car_controllers_when_left_out_of_car_sc
         ("bsr3d:\n  variability: bob_walk\n", "'bob_walk' is not of type 'object'"),
         ("bsr3d:\n  cameras: {rex: {elevation: 100}}\n", "100 is greater than the maximum of 90"),
         ("bsr3d:\n  cameras: {rex: {zoom: 2}}\n", "'zoom' was unexpected"),
+        (  # a chain out of order was refused by the plot, after every search had run
+            "bsr3d:\n  motions: {rex: [rex_walk, rex_walk_again, rex_turn]}\n",
+            "config bsr3d.motions.rex: rex_walk_again continues rex_turn (its spec's chain"
+            " line), so it cannot follow rex_walk: list a chain's searches in order",
+        ),
+        (
+            "bsr3d:\n  targets: {chain: [rex_turn, rex_walk_again, rex_walk]}\n",
+            "config bsr3d.targets.chain: rex_walk continues no search (its spec has no chain"
+            " line), so it cannot follow rex_walk_again",
+        ),
+        (  # a 3-D search among the 2-D ones was refused by the 2-D table, after it had run
+            "bsr:\n  searches: [starman_jump, rex_walk]\n",
+            "config bsr.searches: rex_walk is a search of the 3-D figure rex"
+            " (specs/bsr/rex_walk.bsr); bsr.searches takes searches of 2-D figures",
+        ),
+        (
+            "bsr3d:\n  motions: {cujo: [beryl_tumble]}\n",
+            "config bsr3d.motions.cujo: beryl_tumble is a search of the 2-D figure beryl",
+        ),
+        (
+            "composite:\n  robustness: {rex_walk_sense: starman_jump}\n",
+            "config composite.robustness: rex_walk_sense is a search of the 3-D figure rex",
+        ),
         (  # a camera for no motion was ignored: the plots went ahead with their own
             "bsr3d:\n  cameras: {rexx: {azimuth: 10}}\n",
             "config bsr3d.cameras: 'rexx' names no motion of bsr3d.motions"

@@ -620,6 +620,69 @@ def bsr_chain(name):
     return spec.chain
 
 
+def check_chains_in_order():
+    """A chain of searches in the config (bsr3d.motions, bsr3d.targets.chain) lists each search
+    after the one it continues (its spec's chain line): the plot and the targets table refuse
+    it otherwise, but only once every search of it has run (half an hour at the paper's
+    budgets)."""
+    chains = [(f"bsr3d.motions.{motion}", chain) for motion, chain in config["bsr3d"]["motions"].items()]
+    chains.append(("bsr3d.targets.chain", config["bsr3d"]["targets"]["chain"]))
+    for key, chain in chains:
+        for before, search in zip(chain, chain[1:]):
+            continued = bsr_chain(search)
+            if continued != before:
+                continues = (f"continues {continued} (its spec's chain line)" if continued
+                             else "continues no search (its spec has no chain line)")
+                raise WorkflowError(
+                    f"config {key}: {search} {continues}, so it cannot follow {before}: list a"
+                    " chain's searches in order, each after the one it continues"
+                )
+
+
+check_chains_in_order()
+
+
+@functools.cache
+def search_dimensions(name):
+    """2 or 3, the dimensions of a search's figure; None where its figure spec is missing, does
+    not parse or is a vehicle (the search's own job says why)."""
+    from mosys.parsing.figure import parse_figure_spec
+    from mosys.parsing.tokens import SpecError
+
+    figure = parsed_spec(f"specs/bsr/{name}.bsr").figure
+    try:
+        return getattr(parse_figure_spec(f"specs/figures/{figure}.fig"), "dimensions", None)
+    except (SpecError, OSError):
+        return None
+
+
+def check_dimensions():
+    """The config's lists of 2-D searches hold 2-D ones and those of 3-D searches 3-D ones: the
+    2-D table, plots and composite refuse a 3-D result and the 3-D ones a 2-D result, but only
+    once the search has run."""
+    bsr3d, roles = config["bsr3d"], config["bsr3d"]["targets"]
+    lists = [
+        (2, "bsr.searches", config["bsr"]["searches"]),
+        (2, "composite.robustness",
+         [*config["composite"]["robustness"], *config["composite"]["robustness"].values()]),
+        (3, "bsr3d.searches", bsr3d["searches"]),
+        (3, "bsr3d.targets", [roles["bound"], *roles["chain"], roles["walk"], roles["time_walk"]]),
+    ]
+    lists += [(3, f"bsr3d.motions.{motion}", chain) for motion, chain in bsr3d["motions"].items()]
+    for wanted, key, names in lists:
+        for name in names:
+            found = search_dimensions(name)
+            if found is not None and found != wanted:
+                figure = parsed_spec(f"specs/bsr/{name}.bsr").figure
+                raise WorkflowError(
+                    f"config {key}: {name} is a search of the {found}-D figure {figure}"
+                    f" (specs/bsr/{name}.bsr); {key} takes searches of {wanted}-D figures"
+                )
+
+
+check_dimensions()
+
+
 def bsr_chain_results(wildcards):
     """The result files of the search this one continues: its job waits for them, and editing
     that search's spec reruns this one too."""
