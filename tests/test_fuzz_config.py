@@ -1,8 +1,8 @@
 """The workflow's config under fuzzing: mutated copies of ``config/config.yaml`` planned by
 Snakemake (dry runs of a copy of the workflow, nothing built).
 
-Each case changes one or two of the config's values, or a key of one of its maps of names, and
-plans one of the aggregate targets. A value is replaced by one of its own kind most of the time
+Each case changes one or two of the config's values, or adds a key to one of its maps of names,
+and plans one of the aggregate targets. A value is replaced by one of its own kind most of the time
 (another spec of the same folder for a name, a scaled or negated number, a list shortened,
 lengthened or with a name twice) and otherwise by a hostile one (a string for a number, 1e300,
 an empty list, null). Every case ends in one class:
@@ -102,17 +102,17 @@ def of_its_kind(rng: random.Random, old):
 def mutated(rng: random.Random, base: dict) -> tuple[dict, list]:
     """A copy of the config with one or two changes, and the changes."""
     config, changes = copy.deepcopy(base), []
-    if rng.random() < 0.25:  # a key of a map of names renamed, or another added
-        section = rng.choice(NAME_MAPS)
-        names = at(config, section)
+    if rng.random() < 0.25:  # a key added to a map of names, with the value of another
+        section = rng.choice(NAME_MAPS)  # (no key is taken away: Snakemake merges the case's
+        names = at(config, section)  # file into the shipped config, whose keys stay)
         key = rng.choice(sorted(names) or ["x"])
         new = rng.choice([*ALL_NAMES, "", "a b"])
-        value = names.pop(key, None) if rng.random() < 0.5 else copy.deepcopy(names.get(key))
+        value = copy.deepcopy(names.get(key))
         if section == ("bsr3d", "cameras"):
             value = rng.choice([{}, {"azimuth": 10}, None, {"interval": 1e-9}])
         names[new] = value
         changes.append((".".join(section), new, value))
-    paths = [path for path in leaves(base)]
+    paths = list(leaves(base))
     for _ in range(rng.choice([0, 1, 1, 2]) if changes else rng.choice([1, 1, 2])):
         path = rng.choice(paths)
         try:
@@ -126,6 +126,8 @@ def mutated(rng: random.Random, base: dict) -> tuple[dict, list]:
 
 
 def draw_cases(seed: int, count: int) -> list[tuple[str, dict, list]]:
+    """``count`` cases drawn from ``seed``, the same for the same seed: (target, config,
+    changes)."""
     rng = random.Random(seed)
     base = yaml.safe_load((ROOT / "config" / "config.yaml").read_text(encoding="utf-8"))
     return [(rng.choice(TARGETS), *mutated(rng, base)) for _ in range(count)]
@@ -147,6 +149,7 @@ def judge(done: subprocess.CompletedProcess, work: Path) -> tuple[str, str]:
 
 
 def plan(work: Path, target: str, config: dict) -> tuple[str, str]:
+    """Dry-run ``target`` in the copy ``work`` with ``config`` given after the shipped one."""
     extra = work / "fuzz.yaml"
     extra.write_text(yaml.safe_dump(config), encoding="utf-8")
     done = run_snakemake(work, "--dry-run", "--configfile", "fuzz.yaml", "--", target)
