@@ -84,10 +84,28 @@ def variability_searches():
     return [name for name in config["bsr3d"]["variability"].values() if name]
 
 
+def configured_searches():
+    """(config key, search names) for every list of searches the config names."""
+    bsr3d, composite = config["bsr3d"], config["composite"]
+    searches = [
+        ("bsr.searches", config["bsr"]["searches"]),
+        ("bsr.full_budget", config["bsr"]["full_budget"]),
+        ("bsr3d.searches", bsr3d["searches"]),
+        ("bsr3d.full_budget", bsr3d["full_budget"]),
+        ("bsr3d.kinds", list(bsr3d["kinds"].values())),
+        ("bsr3d.variability", variability_searches()),
+        ("composite.robustness", [*composite["robustness"], *composite["robustness"].values()]),
+    ]
+    searches += [(f"bsr3d.motions.{motion}", chain) for motion, chain in bsr3d["motions"].items()]
+    for part, value in bsr3d["targets"].items():
+        searches.append((f"bsr3d.targets.{part}", value if isinstance(value, list) else [value]))
+    return searches
+
+
 def configured_specs():
     """(config key, spec file) for every spec the config names."""
     pendulum, car, luxo = config["pendulum"], config["car"], config["luxo"]
-    bsr3d, composite = config["bsr3d"], config["composite"]
+    composite = config["composite"]
     named = [
         ("pendulum.figure", f"specs/figures/{pendulum['figure']}.fig"),
         ("car.figure", f"specs/figures/{car['figure']}.fig"),
@@ -108,19 +126,7 @@ def configured_specs():
         ("car.scripts", car["scripts"]),
     ):
         named += [(key, f"specs/scripts/{name}.anim") for name in names]
-    searches = [
-        ("bsr.searches", config["bsr"]["searches"]),
-        ("bsr.full_budget", config["bsr"]["full_budget"]),
-        ("bsr3d.searches", bsr3d["searches"]),
-        ("bsr3d.full_budget", bsr3d["full_budget"]),
-        ("bsr3d.kinds", list(bsr3d["kinds"].values())),
-        ("bsr3d.variability", variability_searches()),
-        ("composite.robustness", [*composite["robustness"], *composite["robustness"].values()]),
-    ]
-    searches += [(f"bsr3d.motions.{motion}", chain) for motion, chain in bsr3d["motions"].items()]
-    for part, value in bsr3d["targets"].items():
-        searches.append((f"bsr3d.targets.{part}", value if isinstance(value, list) else [value]))
-    for key, names in searches:
+    for key, names in configured_searches():
         named += [(key, f"specs/bsr/{name}.bsr") for name in names]
     named += [("composite.scripts", f"specs/composite/{name}.comp") for name in composite["scripts"]]
     return named
@@ -656,20 +662,20 @@ def search_dimensions(name):
         return None
 
 
+# The dimensions of the searches a config key (or a key of the map under it) lists; the budgets'
+# lists and Figures 7 and 8 (bsr3d.kinds, bsr3d.variability: learning curves, 2-D too) take either.
+SEARCH_DIMENSIONS = {"bsr.searches": 2, "composite.robustness": 2, "bsr3d.searches": 3,
+                     "bsr3d.motions": 3, "bsr3d.targets": 3}
+
+
 def check_dimensions():
     """The config's lists of 2-D searches hold 2-D ones and those of 3-D searches 3-D ones: the
     2-D table, plots and composite refuse a 3-D result and the 3-D ones a 2-D result, but only
     once the search has run."""
-    bsr3d, roles = config["bsr3d"], config["bsr3d"]["targets"]
-    lists = [
-        (2, "bsr.searches", config["bsr"]["searches"]),
-        (2, "composite.robustness",
-         [*config["composite"]["robustness"], *config["composite"]["robustness"].values()]),
-        (3, "bsr3d.searches", bsr3d["searches"]),
-        (3, "bsr3d.targets", [roles["bound"], *roles["chain"], roles["walk"], roles["time_walk"]]),
-    ]
-    lists += [(3, f"bsr3d.motions.{motion}", chain) for motion, chain in bsr3d["motions"].items()]
-    for wanted, key, names in lists:
+    for key, names in configured_searches():
+        wanted = SEARCH_DIMENSIONS.get(".".join(key.split(".")[:2]))  # bsr3d.motions.rex: 3
+        if wanted is None:
+            continue
         for name in names:
             found = search_dimensions(name)
             if found is not None and found != wanted:
