@@ -16,6 +16,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from contract_check import contract_problems
 
 from mosys.io.controller_table import read_controller_table
 from mosys.io.start_grid import NO_WAY, NOT_FREE, read_start_grid
@@ -557,6 +558,19 @@ def test_no_lone_contact_slides_in_any_motion_the_pipeline_built(composite_built
     assert sum(len(contacts) for contacts in found.values()) > 50  # the rule is exercised
     slid = {name: sliding(contacts) for name, contacts in found.items() if sliding(contacts)}
     assert slid == {}
+
+
+@pytest.mark.slow
+def test_every_file_the_pipeline_built_keeps_its_contract(composite_built):
+    # DESIGN.md's contracts read as another tool reads them (tests/contract_check.py: h5py
+    # alone): the pendulum's tables and trajectories, the car's and Luxo's where this module's
+    # tests built them, every 2-D search and the composite result
+    counts, problems = contract_problems(composite_built)
+    assert counts["controller table"] >= len(PENDULUM_CONTROLLERS)
+    assert counts["trajectory"] >= 4  # the pendulum's script and its three others
+    assert counts["bsr result"] == 5 * 5 + 3 * 3
+    assert counts["composite result"] == 1
+    assert problems == []
 
 
 @pytest.mark.slow

@@ -12,6 +12,7 @@ import h5py
 import numpy as np
 import pandas as pd
 import pytest
+from contract_check import contract_problems
 from test_workflow import copy_workflow, edited_spec, planned_jobs, snakemake
 
 from mosys.bsr.lone_contact import lone_contacts, sliding
@@ -61,24 +62,21 @@ def test_bsr3d_all_builds_every_search_plot_and_the_table(built):
 
 @pytest.mark.slow
 def test_every_3d_result_keeps_the_contract(built):
+    # DESIGN.md's BSR result and 3-D figure_motion as another tool reads them
+    # (tests/contract_check.py: shapes, attributes, the terms measured again on the motion)
+    counts, problems = contract_problems(built)
+    assert counts["bsr result"] == 2 * len(SEARCHES)
+    assert problems == []
     for name in SEARCHES:
         for path in results(built, name):
             with h5py.File(path, "r") as h5:
                 motion = h5["best/figure_motion"]
-                n = motion["t"].shape[0]
                 rods = len(motion.attrs["rod_names"])
-                assert motion["endpoints"].shape == (n, rods, 2, 3)
-                assert motion["com"].shape == (n, 3)
                 assert int(motion.attrs["dimensions"]) == 3
                 assert motion.attrs["heading_rod"] in list(motion.attrs["rod_names"])
-                assert json.loads(motion.attrs["terrain"]) == [[-1000, 0], [1000, 0]]
                 feet = json.loads(motion.attrs["feet"])
                 assert feet and all(0 <= rod < rods and end in (0, 1) for rod, end in feet)
-                terms = json.loads(h5.attrs["fitness_terms"])
-                assert {"distance", "sideways", "heading_change", "max_height"} <= set(terms)
-                assert h5["best/active_rule"].shape == (n,)
                 assert h5.attrs["chain"] == CHAIN.get(name, "")
-                assert np.all(np.diff(h5["learning_curve/best_fitness"][()]) >= 0)
                 # unchained searches start facing +x
                 if not h5.attrs["chain"]:
                     assert motion["com"][0, 2] == pytest.approx(0.0, abs=1e-12)
