@@ -3,17 +3,23 @@
 Other tools read results/ by the contracts alone, so this module reads the files as such a
 tool would: with h5py and numpy, none of mosys's own readers, and checks what DESIGN.md
 promises of each kind (controller tables, trajectories, the ``figure_motion`` group, BSR and
-composite results): the datasets, their shapes and types, the root attributes, and the
-numbers that the contract defines in terms of others (a destination node's cost-to-go 0, a
-figure's centre of mass from its rods, a search's terms measured on its best motion, a chained
-search starting where the search it continues ends). ``contract_problems`` returns one line per
-broken promise, naming the file.
+composite results, generated dynamics modules): the datasets, their shapes and types, the
+root attributes, and the numbers that the contract defines in terms of others (a destination
+node's cost-to-go 0, a figure's centre of mass from its rods, a search's terms measured on its
+best motion, a chained search starting where the search it continues ends, a mass matrix times
+qdd giving forcing). ``contract_problems`` returns one line per broken promise, naming the file.
 """
 
 from __future__ import annotations
 
+import ast
 import hashlib
+import importlib.util
 import json
+import os
+import subprocess
+import sys
+import tempfile
 from collections import Counter
 from pathlib import Path
 
@@ -27,6 +33,8 @@ ROD_LENGTH = 1e-6  # m: a rod's drawn length against its attribute (rods are rig
 CENTRE_OF_MASS = 1e-6  # m: com against the mass-weighted rod centres
 TERM = 1e-6  # tolerance of a fitness term recomputed from best/figure_motion
 HEADING = 1e-9  # rad: an unchained 3-D search starts facing +x
+DYNAMICS = 1e-9  # relative: mass_matrix(q) @ qdd(q, qd, tau) against forcing(q, qd, tau)
+DYNAMICS_IMPORTS = {"math", "numpy", "numba"}  # a generated module is importable on its own
 
 CONTROLLER_ATTRS = [
     "format_version",
@@ -140,7 +148,7 @@ def controller_table_problems(path: Path, spec: Path | None) -> list[str]:
             if index.shape != shape or index.dtype != np.int64:
                 out.append(f"/destination_index is {index.dtype} {index.shape}")
             elif np.any((index == -1) != np.isinf(value)):
-                out.append("/destination_index is -1 exactly where /value is not inf")
+                out.append("/destination_index is not -1 exactly where /value is inf")
         for dest in destinations:
             nodes = destination_nodes(axes, order, dest)
             if not nodes.any():
@@ -373,6 +381,78 @@ def composite_result_problems(path: Path, spec: Path | None) -> list[str]:
     return out
 
 
+def dynamics_module_problems(path: Path) -> list[str]:
+    """results/dynamics/F.py against DESIGN.md's generated dynamics module, checked in a new
+    interpreter (``module_problems_here``) with a numba cache of its own, so that nothing is
+    written beside the file: a figure's module imports only math, numpy and numba, so it is
+    importable on its own; it names its coordinates and rates (Q_NAMES, QD_NAMES); and at random
+    states mass_matrix(q) is symmetric and positive definite, and mass_matrix(q) @ qdd(q, qd,
+    tau) == forcing(q, qd, tau). A built-in vehicle's (MODEL_KIND "vehicle") is not an
+    articulated figure and has no mass matrix: only its imports are checked."""
+    code = (
+        "import json, sys; sys.path.insert(0, sys.argv[1]); "
+        "from contract_check import module_problems_here; "
+        "print(json.dumps(module_problems_here(sys.argv[2])))"
+    )
+    with tempfile.TemporaryDirectory() as cache:
+        done = subprocess.run(
+            [sys.executable, "-c", code, str(Path(__file__).parent), str(path)],
+            capture_output=True,
+            text=True,
+            env=dict(os.environ, NUMBA_CACHE_DIR=cache),
+        )
+    if done.returncode != 0:
+        return [f"does not import and run on its own: {done.stderr.strip().splitlines()[-1:]}"]
+    return json.loads(done.stdout)
+
+
+def module_problems_here(path: str, seed: int = 0) -> list[str]:
+    """``dynamics_module_problems`` in this interpreter."""
+    path = Path(path)
+    tree = ast.parse(path.read_text())
+    imported = {
+        alias.name.split(".")[0]
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Import)
+        for alias in node.names
+    }
+    imported |= {
+        node.module.split(".")[0]
+        for node in ast.walk(tree)
+        if isinstance(node, ast.ImportFrom) and node.module
+    }
+    out = [
+        f"imports {name}, not only math, numpy and numba"
+        for name in sorted(imported - DYNAMICS_IMPORTS)
+    ]
+    name = f"contract_dynamics_{path.stem}"  # numba imports it by name to load its cache
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    if getattr(module, "MODEL_KIND", "figure") != "figure":
+        return out
+    q_names, qd_names = getattr(module, "Q_NAMES", None), getattr(module, "QD_NAMES", None)
+    if not (
+        isinstance(q_names, tuple) and isinstance(qd_names, tuple) and len(q_names) == len(qd_names)
+    ):
+        return [*out, "Q_NAMES and QD_NAMES are not tuples of one name per coordinate"]
+    n = len(q_names)
+    rng = np.random.default_rng(seed)
+    for _ in range(5):
+        q, qd, tau = rng.uniform(-1, 1, n), rng.uniform(-2, 2, n), rng.uniform(-5, 5, n)
+        mass = module.mass_matrix(q)
+        if mass.shape != (n, n) or not np.allclose(mass, mass.T, rtol=0, atol=1e-12):
+            return [*out, f"mass_matrix(q) is not a symmetric {n} x {n} matrix"]
+        if np.linalg.eigvalsh(mass).min() <= 0:
+            out.append("mass_matrix(q) is not positive definite")
+        forcing = module.forcing(q, qd, tau)
+        residual = np.abs(mass @ module.qdd(q, qd, tau) - forcing).max()
+        if residual > DYNAMICS * max(1.0, np.abs(forcing).max()):
+            out.append(f"mass_matrix(q) @ qdd(q, qd, tau) differs from forcing by {residual:.2e}")
+    return out
+
+
 def spec_or_none(path: Path) -> Path | None:
     return path if path.is_file() else None
 
@@ -399,4 +479,6 @@ def contract_problems(work: Path) -> tuple[Counter, list[str]]:
     for path in sorted(results.glob("composite/*.h5")):
         spec = spec_or_none(work / "specs/composite" / f"{path.stem}.comp")
         check("composite result", path, composite_result_problems(path, spec))
+    for path in sorted(results.glob("dynamics/*.py")):
+        check("dynamics module", path, dynamics_module_problems(path))
     return counts, problems

@@ -563,13 +563,14 @@ def test_no_lone_contact_slides_in_any_motion_the_pipeline_built(composite_built
 @pytest.mark.slow
 def test_every_file_the_pipeline_built_keeps_its_contract(composite_built):
     # DESIGN.md's contracts read as another tool reads them (tests/contract_check.py: h5py
-    # alone): the pendulum's tables and trajectories, the car's and Luxo's where this module's
-    # tests built them, every 2-D search and the composite result
+    # alone): the pendulum's tables, trajectories and dynamics, the car's and Luxo's where this
+    # module's tests built them, every 2-D search and the composite result
     counts, problems = contract_problems(composite_built)
     assert counts["controller table"] >= len(PENDULUM_CONTROLLERS)
     assert counts["trajectory"] >= 4  # the pendulum's script and its three others
     assert counts["bsr result"] == 5 * 5 + 3 * 3
     assert counts["composite result"] == 1
+    assert counts["dynamics module"] >= 1  # the pendulum's link1
     assert problems == []
 
 
