@@ -365,19 +365,21 @@ def test_editing_an_obstacle_rebuilds_the_car_and_nothing_else(workflow):
     spec = workflow / "specs/controllers/car/park.ssc"
     text = spec.read_text()
     assert "obstacle front_car 2.3,0.15" in text
-    spec.write_text(text.replace("obstacle front_car 2.3,0.15", "obstacle front_car 2.4,0.15"))
-    assert planned_jobs(workflow, "results/car_all", *CI) == {
-        "dp_controller": 1,
-        "run_script": len(CAR_SCRIPTS),
-        "car_start_grid": 1,
-        "car_frames": 1,
-        "car_gif": 1,
-        "car_start_map": 1,
-        "car_consistency": 1,
-        "car_controller_table": 1,
-        "car_all": 1,
-    }
-    assert planned_jobs(workflow) == pendulum_plan  # the pendulum does not depend on the car
+    # the edit is taken back after (text and time stamp): the built car keeps its spec's sha256
+    with edited_spec(spec, text.replace("front_car 2.3,0.15", "front_car 2.4,0.15")):
+        assert planned_jobs(workflow, "results/car_all", *CI) == {
+            "dp_controller": 1,
+            "run_script": len(CAR_SCRIPTS),
+            "car_start_grid": 1,
+            "car_frames": 1,
+            "car_gif": 1,
+            "car_start_map": 1,
+            "car_consistency": 1,
+            "car_controller_table": 1,
+            "car_all": 1,
+        }
+        assert planned_jobs(workflow) == pendulum_plan  # the pendulum does not depend on the car
+    assert planned_jobs(workflow, "results/car_all", *CI) == {}
 
 
 @pytest.mark.slow
