@@ -11,6 +11,7 @@ import h5py
 import numpy as np
 import pandas as pd
 import pytest
+from contract_check import composite_result_problems
 
 from mosys.bsr.search import nominal_run
 from mosys.cli import main
@@ -36,26 +37,12 @@ def session_of(workspace, script_path=None):
 
 
 def test_the_result_file_keeps_the_contract(composite_workspace):
+    # DESIGN.md's result, read as another tool reads it (tests/contract_check.py)
+    assert composite_result_problems(composite_workspace.result, composite_workspace.script) == []
     with h5py.File(composite_workspace.result, "r") as h5:
         for group in ("figure_motion", "before/figure_motion"):
-            n = h5[f"{group}/t"].shape[0]
-            assert h5[f"{group}/endpoints"].shape == (n, 5, 2, 2)
-            assert h5[f"{group}/com"].shape == (n, 2)
+            assert h5[f"{group}/endpoints"].shape[1:] == (5, 2, 2)
             assert np.all(np.diff(h5[f"{group}/t"][()]) > 0)
-            for key in ("rod_names", "rod_mass", "rod_length", "rod_com", "rod_inertia"):
-                assert key in h5[group].attrs
-        for key in (
-            "format_version",
-            "script",
-            "phases",
-            "phases_before",
-            "score_before",
-            "score_after",
-            "simulations",
-            "spec_sha256",
-            "wall_seconds",
-        ):
-            assert key in h5.attrs, key
         assert h5.attrs["simulations"] == 4 * 3 * 2 + 1  # Q x G x H mutants and the guess
         phases = json.loads(h5.attrs["phases"])
         guess = json.loads(h5.attrs["phases_before"])
