@@ -88,8 +88,11 @@ COMPOSITE_ATTRS = [
 CAR_ORDER = ["x", "y", "heading", "steer", "speed"]
 
 
-def sha256(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
+def spec_hash_problems(attrs: h5py.AttributeManager, spec: Path | None) -> list[str]:
+    """A file's ``spec_sha256`` against the sha256 of its spec (None: not checked)."""
+    if spec is None or attrs["spec_sha256"] == hashlib.sha256(spec.read_bytes()).hexdigest():
+        return []
+    return [f"spec_sha256 is not the sha256 of {spec.name}"]
 
 
 def missing(attrs: h5py.AttributeManager, names: list[str]) -> list[str]:
@@ -168,8 +171,7 @@ def controller_table_problems(path: Path, spec: Path | None) -> list[str]:
                 out.append(f"the car's state_order is {order}, not {CAR_ORDER}")
             if names(attrs["control_names"]) != ["steer_rate", "wheel_accel"]:
                 out.append("the car's controls are not steer_rate, wheel_accel")
-        if spec is not None and attrs["spec_sha256"] != sha256(spec):
-            out.append(f"spec_sha256 is not the sha256 of {spec.name}")
+        out += spec_hash_problems(attrs, spec)
     return out
 
 
@@ -327,8 +329,7 @@ def bsr_result_problems(path: Path, spec: Path | None) -> list[str]:
                 out.append(
                     f"fitness_terms {name} {terms[name]!r}, measured on the motion {float(value)!r}"
                 )
-        if spec is not None and attrs["spec_sha256"] != sha256(spec):
-            out.append(f"spec_sha256 is not the sha256 of {spec.name}")
+        out += spec_hash_problems(attrs, spec)
     return out
 
 
@@ -376,8 +377,7 @@ def composite_result_problems(path: Path, spec: Path | None) -> list[str]:
                 for earlier, later in zip(phases, phases[1:], strict=False)
             ):
                 out.append(f"{name}: phases end before they start, or overlap")
-        if spec is not None and result.attrs["spec_sha256"] != sha256(spec):
-            out.append(f"spec_sha256 is not the sha256 of {spec.name}")
+        out += spec_hash_problems(result.attrs, spec)
     return out
 
 
