@@ -84,6 +84,9 @@ LEGEND_COLUMNS = 2
 SEARCH_WIDTH, SEARCH_HEIGHT = 8.0, 4.8  # inches
 GUESS_COLOR = "0.45"
 CURVE_COLOR = "#1f77b4"
+# the largest script total drawn: matplotlib's tick locator overflows on an axis near 1e308
+# (the script's arithmetic may give any double, as `total = 1e308 + cartwheel` does)
+DRAWABLE_SCORE = 1e300
 
 # animation
 GIF_WIDTH = 8.0  # inches, the scene's data area: the whole travel is shown, no panning
@@ -554,6 +557,14 @@ def plot_search(result_path: str | Path, path: str | Path) -> None:
         save_figure(search_figure(result_path), path)
 
 
+def drawable_scores(scores: np.ndarray) -> np.ndarray:
+    """``scores`` (any shape) as float64 with nan where a value cannot be drawn: ±inf, nan or
+    beyond ±DRAWABLE_SCORE."""
+    values = np.asarray(scores, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        return np.where(np.abs(values) <= DRAWABLE_SCORE, values, np.nan)
+
+
 def score_limits(scores: np.ndarray, before: float) -> tuple[float, float] | None:
     """The y-axis limits of the search's scores (G + 1,) and the guess's total ``before``:
     their finite values with a margin below and above (the script's arithmetic may give ±inf
@@ -594,24 +605,29 @@ def search_figure(result_path: str | Path) -> Figure:
     )
     if before > 0 and np.isfinite(before) and np.isfinite(after):
         note += f" (× {distinct_text(after / before, 1.0)})"
-    if not np.isfinite(np.append(scores, before)).all():
-        note += "\nscores of ±inf or nan (the script's arithmetic) are not drawn"
+    drawn_scores, (drawn_before,) = drawable_scores(scores), drawable_scores([before])
+    if np.isnan(np.append(drawn_scores, drawn_before)).any():
+        note += (
+            f"\nscores of ±inf, nan or beyond ±{DRAWABLE_SCORE:.0e} (the script's arithmetic)"
+            " are not drawn"
+        )
     with plot_style():
         figure = new_figure(SEARCH_WIDTH, SEARCH_HEIGHT)
         ax = figure.subplots()
-        ax.axhline(before, color=GUESS_COLOR, linestyle=":", linewidth=1.3, zorder=1)
-        ax.step(generations, scores, where="post", color=CURVE_COLOR, linewidth=1.8, zorder=3)
-        ax.plot(generations, scores, "o", color=CURVE_COLOR, markersize=4, zorder=4)
-        ax.annotate(
-            f"the guess: {shown_before}",
-            xy=(generations[-1], before),
-            xytext=(0, -4),
-            textcoords="offset points",
-            ha="right",
-            va="top",
-            color=GUESS_COLOR,
-            fontsize=9,
-        )
+        ax.step(generations, drawn_scores, where="post", color=CURVE_COLOR, lw=1.8, zorder=3)
+        ax.plot(generations, drawn_scores, "o", color=CURVE_COLOR, markersize=4, zorder=4)
+        if not np.isnan(drawn_before):
+            ax.axhline(drawn_before, color=GUESS_COLOR, linestyle=":", linewidth=1.3, zorder=1)
+            ax.annotate(
+                f"the guess: {shown_before}",
+                xy=(generations[-1], drawn_before),
+                xytext=(0, -4),
+                textcoords="offset points",
+                ha="right",
+                va="top",
+                color=GUESS_COLOR,
+                fontsize=9,
+            )
         ax.text(
             0.98,
             0.5,
@@ -623,7 +639,7 @@ def search_figure(result_path: str | Path) -> Figure:
             bbox={"boxstyle": "round,pad=0.35", "facecolor": "white", "alpha": 0.9},
         )
         ax.set_xlim(-0.3, max(generations[-1], 1) + 0.3)
-        limits = score_limits(scores, before)
+        limits = score_limits(drawn_scores, drawn_before)
         if limits is not None:
             ax.set_ylim(*limits)
         ax.xaxis.get_major_locator().set_params(integer=True)
