@@ -5,13 +5,17 @@ motion's GIF) from the real small composite result of the ``composite_workspace`
 
 from __future__ import annotations
 
+import io
 import shutil
 from pathlib import Path
 
 import h5py
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 from conftest import assert_png
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from matplotlib.colors import to_rgba
 from PIL import Image
 
@@ -27,6 +31,7 @@ from mosys.plots.composite import (
     score_limits,
     search_curve,
     search_figure,
+    search_plot,
     shade,
     strip_poses,
     switch_label_places,
@@ -237,6 +242,31 @@ def test_only_scores_an_axis_can_hold_are_drawn() -> None:
     drawn = drawable_scores(np.array([1.0, -1e300, 1e300, 1.1e300, -1e308, np.inf, np.nan]))
     np.testing.assert_array_equal(drawn[:3], [1.0, -1e300, 1e300])
     assert np.isnan(drawn[3:]).all()
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(st.floats(), min_size=1, max_size=12),
+    st.floats(),
+    st.sampled_from([1.0, 1e-300, 1e150, 1e300]),
+)
+def test_the_search_plot_draws_any_totals(values: list[float], after: float, scale: float) -> None:
+    """Any doubles a script's arithmetic gives (its numbers are not bounded), scaled so that
+    both tiny and huge spans come up: the figure renders, the totals an axis can hold are its
+    points, and the note says so when any is left out."""
+    with np.errstate(over="ignore"):
+        scores = np.array(values) * scale
+    figure = search_plot(np.arange(len(scores)), scores, after, "Q = 2, G = 1, H = 1", "any")
+    figure.savefig(io.BytesIO(), format="png")
+    (ax,) = figure.axes
+    (curve,) = [line for line in ax.lines if line.get_drawstyle() == "steps-post"]
+    drawn = curve.get_ydata()
+    kept = np.abs(scores) <= 1e300
+    np.testing.assert_array_equal(np.isnan(drawn), ~kept)
+    np.testing.assert_array_equal(drawn[kept], scores[kept])
+    left_out = "are not drawn" in ax.texts[-1].get_text()
+    assert left_out == (not kept.all())
+    plt.close(figure)
 
 
 @pytest.mark.parametrize(

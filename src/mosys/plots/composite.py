@@ -585,28 +585,44 @@ def score_limits(scores: np.ndarray, before: float) -> tuple[float, float] | Non
 
 
 def search_figure(result_path: str | Path) -> Figure:
-    """Figure 5's transition-point search: the best script total (the script's ``total``,
-    unitless) after each generation 0 to G (0: the guessed transition points), a dotted line at
-    the guess's total; annotated with the search's size (Q, G, H), the simulations it ran and
-    its wall time (s), and the gain."""
+    """Figure 5's transition-point search (``search_plot``) of the composite result at
+    ``result_path``, annotated with the search's size (Q, G, H), the simulations it ran and its
+    wall time (s)."""
     result = read_composite(result_path)
     generations, scores = search_curve(result)
     attrs = result.attrs
-    before, after = float(attrs["score_before"]), float(attrs["score_after"])
     size = (
         f"Q = {attrs['search_q']}, G = {attrs['search_g']}, H = {attrs['search_h']}: "
         if {"search_q", "search_g", "search_h"} <= attrs.keys()
         else ""
     )
-    shown_before, shown_after = score_texts(before, after)
-    note = (
+    facts = (
         f"{size}{int(attrs['simulations']):,} simulations in {float(attrs['wall_seconds']):.3g} s"
-        f"\nscript total {shown_before} → {shown_after}"
     )
+    return search_plot(
+        generations,
+        scores,
+        float(attrs["score_after"]),
+        facts,
+        script_name(result, result_path),
+    )
+
+
+def search_plot(
+    generations: np.ndarray, scores: np.ndarray, after: float, facts: str, name: str
+) -> Figure:
+    """Figure 5's transition-point search of the script ``name``: the best script total (the
+    script's ``total``, unitless) ``scores`` (G + 1,) after each of the ``generations`` 0 to G
+    (0: the guessed transition points), a dotted line at the guess's total ``scores[0]``; a
+    note of ``facts`` (one line), the totals before and ``after`` and the gain. Any doubles
+    are drawn: those no axis can hold (``drawable_scores``) are left out, and the note says so."""
+    before = float(scores[0])
+    shown_before, shown_after = score_texts(before, after)
+    note = f"{facts}\nscript total {shown_before} → {shown_after}"
     if before > 0 and np.isfinite(before) and np.isfinite(after):
         note += f" (× {distinct_text(after / before, 1.0)})"
     drawn_scores, (drawn_before,) = drawable_scores(scores), drawable_scores([before])
-    if np.isnan(np.append(drawn_scores, drawn_before)).any():
+    if np.isnan(drawn_scores).any():
         note += (
             f"\nscores of ±inf, nan or beyond ±{DRAWABLE_SCORE:.0e} (the script's arithmetic)"
             " are not drawn"
@@ -614,10 +630,11 @@ def search_figure(result_path: str | Path) -> Figure:
     with plot_style():
         figure = new_figure(SEARCH_WIDTH, SEARCH_HEIGHT)
         ax = figure.subplots()
+        if not np.isnan(drawn_before):
+            ax.axhline(drawn_before, color=GUESS_COLOR, linestyle=":", linewidth=1.3, zorder=1)
         ax.step(generations, drawn_scores, where="post", color=CURVE_COLOR, lw=1.8, zorder=3)
         ax.plot(generations, drawn_scores, "o", color=CURVE_COLOR, markersize=4, zorder=4)
         if not np.isnan(drawn_before):
-            ax.axhline(drawn_before, color=GUESS_COLOR, linestyle=":", linewidth=1.3, zorder=1)
             ax.annotate(
                 f"the guess: {shown_before}",
                 xy=(generations[-1], drawn_before),
@@ -646,7 +663,7 @@ def search_figure(result_path: str | Path) -> Figure:
         ax.set_xlabel("generation (0: the guessed transition points)")
         ax.set_ylabel("best script total so far")
         ax.set_title(
-            f"Composite motion {script_name(result, result_path)}: transition-point search "
+            f"Composite motion {name}: transition-point search "
             "(Figure 5)\nthe best script total after each generation",
             fontsize=11,
         )
