@@ -458,27 +458,56 @@ def spec_or_none(path: Path) -> Path | None:
 
 
 def contract_problems(work: Path) -> tuple[Counter, list[str]]:
-    """Every contract file under work/results, checked: (how many of each kind, problems)."""
+    """Every contract file under work/results, checked: (how many of each kind, problems). A
+    file that cannot be read as its contract says (a dataset or group missing, a wrong type)
+    is one problem naming what failed, and the other files are still checked."""
     results = work / "results"
     counts: Counter = Counter()
     problems = []
 
-    def check(kind: str, path: Path, found: list[str]) -> None:
+    def check(kind: str, path: Path, problems_of, *arguments) -> None:
         counts[kind] += 1
+        try:
+            found = problems_of(path, *arguments)
+        except (KeyError, ValueError, TypeError, IndexError, OSError) as error:
+            found = [f"cannot be read as the contract says ({type(error).__name__}: {error})"]
         problems.extend(f"{path.relative_to(work)}: {p}" for p in found)
 
     for path in sorted(results.glob("controllers/*/*.h5")):
         spec = spec_or_none(work / "specs/controllers" / path.parent.name / f"{path.stem}.ssc")
-        check("controller table", path, controller_table_problems(path, spec))
+        check("controller table", path, controller_table_problems, spec)
     for path in sorted(results.glob("trajectories/*.h5")):
-        check("trajectory", path, trajectory_problems(path))
+        check("trajectory", path, trajectory_problems)
     for path in sorted(results.glob("bsr/*/seed*.h5")):
         spec = spec_or_none(work / "specs/bsr" / f"{path.parent.name}.bsr")
-        check("bsr result", path, bsr_result_problems(path, spec))
-    problems += chain_problems(results)
+        check("bsr result", path, bsr_result_problems, spec)
+    try:
+        problems += chain_problems(results)
+    except (KeyError, ValueError, TypeError, IndexError, OSError) as error:
+        problems.append(f"chained searches cannot be read ({type(error).__name__}: {error})")
     for path in sorted(results.glob("composite/*.h5")):
         spec = spec_or_none(work / "specs/composite" / f"{path.stem}.comp")
-        check("composite result", path, composite_result_problems(path, spec))
+        check("composite result", path, composite_result_problems, spec)
     for path in sorted(results.glob("dynamics/*.py")):
-        check("dynamics module", path, dynamics_module_problems(path))
+        check("dynamics module", path, dynamics_module_problems)
     return counts, problems
+
+
+def main(argv: list[str]) -> int:
+    """``python tests/contract_check.py [WORKDIR]``: check every contract file under
+    WORKDIR/results (default: the current directory), print what was checked and each problem;
+    exit 1 where there is one, 0 where there is none."""
+    work = Path(argv[0] if argv else ".")
+    if not (work / "results").is_dir():
+        print(f"contract_check: no results/ folder in {work}", file=sys.stderr)
+        return 2
+    counts, problems = contract_problems(work)
+    checked = ", ".join(f"{count} {kind}" for kind, count in sorted(counts.items()))
+    print(f"contract_check: {checked or 'no contract files'}; {len(problems)} problems")
+    for problem in problems:
+        print(problem)
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,55 @@
+"""The contract checker's command (``python tests/contract_check.py WORKDIR``, which CI runs on
+the paper tables' build): its exit codes, and malformed files reported, not raised."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import h5py
+import pytest
+from contract_check import main
+
+
+def test_no_results_folder_is_refused(tmp_path: Path, capsys) -> None:
+    assert main([str(tmp_path)]) == 2
+    assert f"no results/ folder in {tmp_path}" in capsys.readouterr().err
+
+
+def test_an_empty_results_folder_has_no_problems(tmp_path: Path, capsys) -> None:
+    (tmp_path / "results").mkdir()
+    assert main([str(tmp_path)]) == 0
+    assert capsys.readouterr().out == "contract_check: no contract files; 0 problems\n"
+
+
+def test_malformed_files_are_problems_named_by_file(tmp_path: Path, capsys) -> None:
+    trajectories = tmp_path / "results/trajectories"
+    trajectories.mkdir(parents=True)
+    with h5py.File(trajectories / "no_state.h5", "w") as trajectory:
+        trajectory["t"] = [0.0, 0.01]
+        for name in ("state_order", "control_names", "controllers"):
+            trajectory.attrs[name] = "x"
+    with h5py.File(trajectories / "no_attrs.h5", "w") as trajectory:
+        trajectory["t"] = [0.0]
+    (trajectories / "not_hdf5.h5").write_bytes(b"not an HDF5 file")
+    bsr = tmp_path / "results/bsr/walk"
+    bsr.mkdir(parents=True)
+    (bsr / "seed1.h5").write_bytes(b"")
+    assert main([str(tmp_path)]) == 1
+    out = capsys.readouterr().out.splitlines()
+    assert out[0] == "contract_check: 1 bsr result, 3 trajectory; 7 problems"
+    assert out[1:4] == [
+        f"results/trajectories/no_attrs.h5: lacks root attr {name}"
+        for name in ("state_order", "control_names", "controllers")
+    ]
+    unreadable = "cannot be read as the contract says"
+    assert out[4].startswith(f"results/trajectories/no_state.h5: {unreadable} (KeyError: ")
+    assert out[5].startswith(f"results/trajectories/not_hdf5.h5: {unreadable} (OSError: ")
+    assert out[6].startswith(f"results/bsr/walk/seed1.h5: {unreadable} (OSError: ")
+    assert out[7].startswith("chained searches cannot be read (OSError: ")
+
+
+@pytest.mark.parametrize("argv", [[], ["."]])
+def test_the_working_directory_is_the_default(tmp_path: Path, monkeypatch, argv) -> None:
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "results").mkdir()
+    assert main(argv) == 0
