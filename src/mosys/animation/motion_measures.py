@@ -15,6 +15,7 @@ from itertools import pairwise
 import numpy as np
 
 from mosys.io.trajectory import Trajectory
+from mosys.kernels.libm import arctan2_each
 
 # settled: the base flat (within BASE_FLAT_DEG of a whole number of turns), the joints within
 # JOINT_DEG of the standing pose, and at rest (speeds below these)
@@ -134,7 +135,7 @@ def settled(trajectory: Trajectory, standing: dict[str, float]) -> np.ndarray:
     motion = trajectory.motion
     assert motion is not None
     base = motion.endpoints[:, 0, 1] - motion.endpoints[:, 0, 0]
-    ok = np.abs(np.degrees(np.arctan2(base[:, 1], base[:, 0]))) <= BASE_FLAT_DEG
+    ok = np.abs(np.degrees(arctan2_each(base[:, 1], base[:, 0]))) <= BASE_FLAT_DEG
     order = trajectory.state_order
     coordinates = len(order) // 2
     for k, name in enumerate(order):

@@ -57,6 +57,7 @@ from mosys.kernels.bsr_controller import (
     run_population,
 )
 from mosys.kernels.compile_lock import cold_compilation_seconds
+from mosys.kernels.libm import exp_each
 from mosys.kernels.soundness import steps_before_blow_up, unsoundness
 from mosys.parsing.bsr import FITNESS_TERMS, BsrSpec
 from mosys.parsing.tokens import SpecError, Token, location
@@ -346,12 +347,10 @@ class _Population:
         span = figure.joint_max - figure.joint_min
         self.target[...] = figure.joint_min + span * draws[:, :, :j]
         log_low, log_high = math.log(low), math.log(high)
-        self.tau[...] = np.array(
-            [math.exp(log_low + (log_high - log_low) * u) for u in draws[:, :, j].ravel()]
-        ).reshape(c, r)
+        self.tau[...] = exp_each(log_low + (log_high - log_low) * draws[:, :, j])
         if v:
             side_low, side_high = math.log(SIDE_MIN), math.log(SIDE_MAX)
-            self.side[...] = np.exp(
+            self.side[...] = exp_each(
                 side_low + (side_high - side_low) * draws[:, :, j + 1 : j + 1 + v]
             )
             self.center[...] = CENTER_MIN + (CENTER_MAX - CENTER_MIN) * draws[:, :, j + 1 + v :]
@@ -370,7 +369,7 @@ class _Population:
         self.tau[k, i] = math.exp(rng.uniform(math.log(low), math.log(high)))
         v = self.center.shape[2]
         if v:
-            self.side[k, i] = np.exp(rng.uniform(math.log(SIDE_MIN), math.log(SIDE_MAX), v))
+            self.side[k, i] = exp_each(rng.uniform(math.log(SIDE_MIN), math.log(SIDE_MAX), v))
             if senses is None:
                 self.center[k, i] = rng.uniform(CENTER_MIN, CENTER_MAX, v)
             elif self.setup.relevance == "contain":
@@ -404,7 +403,9 @@ class _Population:
                 self.center[k, i] + rng.normal(0.0, CREEP_CENTER, v), CENTER_MIN, CENTER_MAX
             )
             self.side[k, i] = np.clip(
-                self.side[k, i] * np.exp(rng.normal(0.0, CREEP_LOG_SIDE, v)), SIDE_MIN, SIDE_MAX
+                self.side[k, i] * exp_each(rng.normal(0.0, CREEP_LOG_SIDE, v)),
+                SIDE_MIN,
+                SIDE_MAX,
             )
         else:
             self.segment[k, i] = np.clip(

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mosys.kernels.libm import exp_each
 from mosys.parsing.composite_script import (
     ENDPOINT,
     FALLOFF_FRACTION,
@@ -97,7 +98,7 @@ def falloff(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     the target b (at least 0.2): exp(-((a - b) / w)^2), w = 0.2 max(|b|, 1). One w apart gives
     exp(-1) = 0.37, two give 0.018; 159 ticks ?= 159 is 1, w = 31.8 ticks."""
     width = FALLOFF_FRACTION * np.maximum(np.abs(b), 1.0)
-    return np.exp(-np.square((a - b) / width))
+    return exp_each(-np.square((a - b) / width))
 
 
 def _evaluate(expr: Expr, values: Mapping[str, np.ndarray]) -> np.ndarray:

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mosys.io.composite_result import CompositeMotion
+from mosys.kernels.libm import arctan2_each
 
 GROUND = 0.001  # m: an endpoint this close to the ground touches it (the BSR contact tolerance)
 
@@ -34,7 +35,7 @@ def phase_measures(stored: CompositeMotion) -> list[PhaseMeasures]:
     ends = stored.motion.endpoints
     com = stored.motion.com
     rod = ends[:, 0, 1] - ends[:, 0, 0]
-    angle = np.unwrap(np.arctan2(rod[:, 1], rod[:, 0]))
+    angle = np.unwrap(arctan2_each(rod[:, 1], rod[:, 0]))
     lowest = ends[..., 1].min(axis=(1, 2))
     measures = []
     for k in range(int(stored.phase.max()) + 1):
