@@ -1,10 +1,10 @@
-"""The same spec and seed give the same numbers on another x86-64 processor: nothing a search
-stores is computed by NumPy's processor-dependent SIMD code (on AVX-512, NumPy's exp differs
-from libm's in the last bit for about 5 % of arguments; a search drew its rules' sides with it,
-so the same seed stored other sides on a machine without AVX-512). Here such a machine is
-emulated by switching NumPy's dispatched code off (``NPY_DISABLE_CPU_FEATURES``: the processor
-then runs NumPy's baseline code, as one without those features would; the numba kernels are
-compiled for the processor either way)."""
+"""What the same spec and seed store does not depend on the SIMD instructions the processor
+has: nothing a search stores is computed by NumPy's processor-dependent SIMD code (on AVX-512,
+NumPy's exp differs from libm's in the last bit for about 5 % of arguments; a search drew its
+rules' sides with it, so the same seed stored other sides on a machine without AVX-512). Here
+such a machine is emulated by switching NumPy's dispatched code off
+(``NPY_DISABLE_CPU_FEATURES``: the processor then runs NumPy's baseline code, as one without
+those features would; the numba kernels are compiled for the processor either way)."""
 
 from __future__ import annotations
 
