@@ -86,6 +86,8 @@ COMPOSITE_ATTRS = [
     "wall_seconds",
 ]
 CAR_ORDER = ["x", "y", "heading", "steer", "speed"]
+# what reading a file that breaks its contract raises (a dataset missing, a wrong type, not HDF5)
+UNREADABLE = (KeyError, ValueError, TypeError, IndexError, OSError)
 
 
 def spec_hash_problems(attrs: h5py.AttributeManager, spec: Path | None) -> list[str]:
@@ -469,7 +471,7 @@ def contract_problems(work: Path) -> tuple[Counter, list[str]]:
         counts[kind] += 1
         try:
             found = problems_of(path, *arguments)
-        except (KeyError, ValueError, TypeError, IndexError, OSError) as error:
+        except UNREADABLE as error:
             found = [f"cannot be read as the contract says ({type(error).__name__}: {error})"]
         problems.extend(f"{path.relative_to(work)}: {p}" for p in found)
 
@@ -483,7 +485,7 @@ def contract_problems(work: Path) -> tuple[Counter, list[str]]:
         check("bsr result", path, bsr_result_problems, spec)
     try:
         problems += chain_problems(results)
-    except (KeyError, ValueError, TypeError, IndexError, OSError) as error:
+    except UNREADABLE as error:
         problems.append(f"chained searches cannot be read ({type(error).__name__}: {error})")
     for path in sorted(results.glob("composite/*.h5")):
         spec = spec_or_none(work / "specs/composite" / f"{path.stem}.comp")

@@ -632,9 +632,6 @@ def search_plot(
         ax = figure.subplots()
         if not np.isnan(drawn_before):
             ax.axhline(drawn_before, color=GUESS_COLOR, linestyle=":", linewidth=1.3, zorder=1)
-        ax.step(generations, drawn_scores, where="post", color=CURVE_COLOR, lw=1.8, zorder=3)
-        ax.plot(generations, drawn_scores, "o", color=CURVE_COLOR, markersize=4, zorder=4)
-        if not np.isnan(drawn_before):
             ax.annotate(
                 f"the guess: {shown_before}",
                 xy=(generations[-1], drawn_before),
@@ -645,6 +642,8 @@ def search_plot(
                 color=GUESS_COLOR,
                 fontsize=9,
             )
+        ax.step(generations, drawn_scores, where="post", color=CURVE_COLOR, lw=1.8, zorder=3)
+        ax.plot(generations, drawn_scores, "o", color=CURVE_COLOR, markersize=4, zorder=4)
         ax.text(
             0.98,
             0.5,
