@@ -9,6 +9,9 @@ import contextlib
 import errno
 import os
 import signal
+import subprocess
+import sys
+import textwrap
 import threading
 import time
 from pathlib import Path
@@ -245,34 +248,76 @@ def test_a_read_only_folder_is_named_not_the_hidden_partial(tmp_path, monkeypatc
 
 def test_a_stop_during_a_kernels_compilation_waits_for_its_end(monkeypatch, capsys):
     """Raised inside numba's compilation, the exception went through a ctypes callback, which
-    printed 'Exception ignored ...' with a traceback and lost it: a first stop is kept for the
-    compilation's end (``compile_lock`` raises it there), a second stops at once."""
-    from mosys.errors import forget_stops, raise_if_stopped, stop_received
+    printed 'Exception ignored ...' with a traceback and lost it: a first stop is kept while
+    numba holds its compiler lock and raised as it lets go, a second stops at once."""
+    from numba.core.compiler_lock import global_compiler_lock
+
+    from mosys.errors import forget_stops, stop_received
     from mosys.kernels import compile_lock
 
     forget_stops()
-    monkeypatch.setattr(compile_lock, "_depth", 1)  # as while a kernel compiles
+    # as while a kernel missing from the cache compiles, numba holding its compiler lock
+    monkeypatch.setattr(compile_lock, "_depth", 1)
+    held_to_the_end = slept = False
     try:
-        with pytest.raises(KeyboardInterrupt), stop_signals_raise():
+        with pytest.raises(KeyboardInterrupt), stop_signals_raise(), global_compiler_lock:
             os.kill(os.getpid(), signal.SIGINT)
             time.sleep(0.2)  # the handler has run by now, and raised nothing
             assert stop_received() == signal.SIGINT
             assert capsys.readouterr().err == "mosys: stopping when numba's compilation ends\n"
-            with pytest.raises(KeyboardInterrupt):
-                raise_if_stopped()  # what the compilation's end does
-            os.kill(os.getpid(), signal.SIGINT)  # a second Ctrl-C: at once
+            held_to_the_end = True
+        assert held_to_the_end  # raised as the lock was let go, not inside
+        with pytest.raises(KeyboardInterrupt), stop_signals_raise(), global_compiler_lock:
+            os.kill(os.getpid(), signal.SIGINT)  # a second Ctrl-C: at once, lock or not
             time.sleep(5)
+            slept = True
+        assert not slept
     finally:
         forget_stops()  # else this process's next outputs would be held back as stopped
+
+
+def test_a_stop_inside_numbas_callbacks_stops_the_command_as_numba_lets_go(tmp_path):
+    """A SIGTERM that came while numba loaded a kernel from its cache (a served job stopped in
+    its first second) was raised inside LLVM's object-cache callback, where ctypes swallowed it:
+    the command ran on (here, for good, into a module that sleeps). The stop is now kept while
+    numba holds its compiler lock and raised as it lets go. Here it arrives inside that very
+    callback, at the first kernel the command loads or compiles."""
+    script = tmp_path / "stopped_in_callback.py"
+    script.write_text(
+        textwrap.dedent(
+            """
+            import os, signal, sys
+            from llvmlite.binding import executionengine
+
+            sent = []
+
+            def notify(engine, data):  # LLVM's callback, one stop arriving inside it
+                if not sent:
+                    sent.append(os.kill(os.getpid(), signal.SIGTERM))
+                return engine._raw_object_cache_notify(data)
+
+            executionengine._notify_c_hook = executionengine._ObjectCacheNotifyFunc(notify)
+            from mosys.cli import main
+
+            sys.exit(main(sys.argv[1:]))
+            """
+        )
+    )
+    sleeper = tmp_path / "sleeper.py"
+    sleeper.write_text("import time\n\ntime.sleep(600)\n")
+    argv = [sys.executable, str(script), "plot", "free-swing", "--dynamics", str(sleeper)]
+    done = subprocess.run(
+        [*argv, "-o", str(tmp_path / "x.png")], capture_output=True, text=True, timeout=300
+    )
+    assert done.returncode == 128 + signal.SIGTERM, done.stderr
+    assert "Exception ignored" not in done.stderr
+    assert not (tmp_path / "x.png").exists()
 
 
 def test_a_partial_left_by_a_killed_writer_goes_with_the_next_write(tmp_path):
     """A writer killed outright (SIGKILL) cannot remove its partial file: one stayed beside a
     plot after a rebuild. The next write of that output removes the partials of writers that
     no longer run; a running writer's, and another output's, stay."""
-    import subprocess
-    import sys
-
     dead = int(subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
                               capture_output=True, text=True, check=True).stdout)  # fmt: skip
     path = tmp_path / "C_portrait.png"

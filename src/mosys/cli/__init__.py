@@ -224,8 +224,10 @@ def stop_signals_raise() -> Iterator[None]:
         compile_lock = sys.modules.get("mosys.kernels.compile_lock")
         if first and compile_lock is not None and compile_lock.compiling():
             # raised inside numba's ctypes callbacks, it would be swallowed with a traceback:
-            # raised when the compilation ends instead; a second signal stops at once
-            print("mosys: stopping when numba's compilation ends", file=sys.stderr, flush=True)
+            # raised when numba lets go of its compiler lock instead (a kernel loaded from the
+            # cache: at once; a cold compilation: when it ends); a second signal stops at once
+            if compile_lock.compiling_cold():
+                print("mosys: stopping when numba's compilation ends", file=sys.stderr, flush=True)
             return
         if number == signal.SIGINT:
             raise KeyboardInterrupt

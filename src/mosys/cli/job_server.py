@@ -276,7 +276,7 @@ def _fork_warm_up(selector) -> tuple[int, int]:
     """Fork a process that imports ``PRELOADED``, compiling into numba's cache the kernels
     their imports compile, beside the jobs (a job that needs one meanwhile waits for it under
     the compile lock, then loads it); its pid and a pidfd readable when it ends."""
-    pid = os.fork()
+    pid = _fork()
     if pid == 0:  # never returns
         code = 1
         try:
@@ -291,6 +291,23 @@ def _fork_warm_up(selector) -> tuple[int, int]:
             os._exit(code)
     _log(f"warm-up {pid} started: compiling what the preloads need")
     return pid, os.pidfd_open(pid)
+
+
+def _fork() -> int:
+    """``os.fork()``, the child with the default action for each of ``FORWARDED_SIGNALS`` (a
+    stop stops it) before it can receive one: they are blocked across the fork, so that one sent
+    to the child at once (a client forwards its signals as soon as it has the job's pid) waits
+    for the default action rather than reaching the server's handlers, which only note a stop
+    in a list the child never reads."""
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, FORWARDED_SIGNALS)
+    try:
+        pid = os.fork()
+        if pid == 0:
+            for number in FORWARDED_SIGNALS:
+                signal.signal(number, signal.SIG_DFL)
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
+    return pid
 
 
 def _leave_server(selector) -> None:
@@ -419,7 +436,7 @@ def _start_job(connection, selector) -> tuple[int, int] | None:
             _send_line(connection, f"declined {reason}")
             return None
         try:
-            pid = os.fork()
+            pid = _fork()
         except OSError:
             return None
         if pid == 0:  # the job: it keeps none of the server's sockets, and never returns
@@ -459,10 +476,8 @@ def _run_job(request: dict, fds: list[int]) -> int:
 
 def _become_client(request: dict, fds: list[int]) -> None:
     """Take the client's standard streams (``fds``, /dev/null for those it has not), working
-    directory, environment (numba's settings re-read from it) and arguments, and the default
-    signal handlers."""
-    for number in FORWARDED_SIGNALS:
-        signal.signal(number, signal.SIG_DFL)
+    directory, environment (numba's settings re-read from it) and arguments, and Python's own
+    Ctrl-C (KeyboardInterrupt; ``_fork`` gave the other stop signals their default action)."""
     signal.signal(signal.SIGINT, signal.default_int_handler)
     null = os.open(os.devnull, os.O_RDWR)
     for fd in (0, 1, 2):

@@ -24,6 +24,12 @@ compile different kernels side by side rather than one after the other.
 Within ``cache_only()`` a top-level compilation that misses the cache raises
 ``ColdCompilationError`` instead (the job server imports kernel modules ahead of its jobs, and
 must not spend seconds compiling one while its jobs wait to be reported).
+
+While numba holds its compiler lock it calls back into Python through ctypes (LLVM's object
+cache, for a kernel loaded from the cache as for one compiled), and ctypes swallows an
+exception raised there. The command line therefore keeps a stop signal that arrives then
+(``compiling``) for the moment numba lets go of the lock, where it is raised
+(``serialize_cold_compilation``).
 """
 
 from __future__ import annotations
@@ -31,6 +37,7 @@ from __future__ import annotations
 import contextlib
 import os
 import sys
+import threading
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -45,9 +52,17 @@ _depth = 0  # top-level compilations under the lock in progress; numba's compile
 
 
 def compiling() -> bool:
-    """Whether numba is compiling a kernel that missed its cache: a stop signal's exception
-    raised now would be raised inside numba's ctypes callbacks, which swallow it (the command
-    line defers it to the compilation's end, ``errors.raise_if_stopped``)."""
+    """Whether numba holds its compiler lock in this thread (compiling a kernel, loading one
+    from its cache, or setting itself up): a stop signal's exception raised now could be raised
+    inside numba's ctypes callbacks, which swallow it. The command line keeps the stop instead,
+    and it is raised where numba lets go of the lock (``serialize_cold_compilation``)."""
+    lock = sys.modules.get("numba.core.compiler_lock")
+    return _installed and lock is not None and lock.global_compiler_lock.is_locked()
+
+
+def compiling_cold() -> bool:
+    """Whether numba is compiling a kernel that missed its cache (seconds, or a minute before
+    a first 3-D search)."""
     return _depth > 0
 
 
@@ -180,8 +195,22 @@ def serialize_cold_compilation() -> None:
         def on_end(self, _event: event.Event) -> None:
             pass
 
+    class StopAtRelease(event.Listener):
+        """Raises a stop kept while numba held its compiler lock (``compiling``) as the main
+        thread's outermost hold of it ends: outside numba's callbacks, before the command
+        goes on."""
+
+        def on_start(self, _event: event.Event) -> None:
+            pass
+
+        def on_end(self, _event: event.Event) -> None:
+            main = threading.current_thread() is threading.main_thread()
+            if main and not global_compiler_lock.is_locked():
+                raise_if_stopped()
+
     probe = MissProbe()
     event.register("numba:compile", probe)
+    event.register("numba:compiler_lock", StopAtRelease())
     compile_signature = Dispatcher.compile
 
     def compile_once(self: Dispatcher, sig):
@@ -211,7 +240,6 @@ def serialize_cold_compilation() -> None:
                         _depth -= 1
             finally:
                 _cold_seconds += time.perf_counter() - began
-                raise_if_stopped()  # a stop the command line deferred while this compiled
 
     compile_once.__doc__ = compile_signature.__doc__
     Dispatcher.compile = compile_once
