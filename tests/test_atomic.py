@@ -281,7 +281,8 @@ def test_a_stop_inside_numbas_callbacks_stops_the_command_as_numba_lets_go(tmp_p
     its first second) was raised inside LLVM's object-cache callback, where ctypes swallowed it:
     the command ran on (here, for good, into a module that sleeps). The stop is now kept while
     numba holds its compiler lock and raised as it lets go. Here it arrives inside that very
-    callback, at the first kernel the command loads or compiles."""
+    callback, at the first kernel the command loads or compiles (llvmlite's module-level ctypes
+    hook, ``executionengine._notify_c_hook``, replaced before numba makes its engine)."""
     script = tmp_path / "stopped_in_callback.py"
     script.write_text(
         textwrap.dedent(
