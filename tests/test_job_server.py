@@ -203,7 +203,10 @@ def test_signals_reach_the_job_and_a_job_whose_client_dies_is_stopped(server, tm
             assert time.monotonic() < deadline, server.log.read_text()
             time.sleep(0.02)
         (job,) = new
-        time.sleep(0.3)  # the job is asleep importing the module
+        # the job is loading its kernels or asleep importing the module: stopped either way (in
+        # the first, until 2026-12-07, a stop was lost in numba's callbacks: README, "A full
+        # disk, a signal")
+        time.sleep(0.3)
         client.send_signal(kill_client)
         client.wait(timeout=20)
         assert server.wait_for_end(job) == "ended: exit 143"  # SIGTERM, forwarded or sent
