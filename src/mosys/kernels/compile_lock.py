@@ -56,8 +56,11 @@ def compiling() -> bool:
     from its cache, or setting itself up): a stop signal's exception raised now could be raised
     inside numba's ctypes callbacks, which swallow it. The command line keeps the stop instead,
     and it is raised where numba lets go of the lock (``serialize_cold_compilation``)."""
-    lock = sys.modules.get("numba.core.compiler_lock")
-    return _installed and lock is not None and lock.global_compiler_lock.is_locked()
+    if not _installed:  # numba not set up by this module: nothing would raise the kept stop
+        return False
+    from numba.core.compiler_lock import global_compiler_lock  # imported by the installation
+
+    return global_compiler_lock.is_locked()
 
 
 def compiling_cold() -> bool:
