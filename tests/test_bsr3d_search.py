@@ -31,7 +31,7 @@ fall below=0.5
 CUJO = load_bsr_figure3d("specs/figures", "test.bsr", Token("cujo", 1, 1))
 
 
-def setup(text: str = SPEC, chain: ChainStart | None = None):
+def bound_search(text: str = SPEC, chain: ChainStart | None = None):
     return bind_search3d(parse_bsr_text(text, "test.bsr"), CUJO, chain=chain)
 
 
@@ -55,7 +55,7 @@ def setup(text: str = SPEC, chain: ChainStart | None = None):
 )
 def test_a_3d_spec_names_what_its_figure_has(text, message):
     with pytest.raises(SpecError) as error:
-        setup(text)
+        bound_search(text)
     assert str(error.value).startswith(message)
 
 
@@ -69,9 +69,9 @@ def test_a_3d_spec_names_what_its_figure_has(text, message):
 def test_a_start_angle_outside_its_joints_range_is_refused(start, message):
     """It was clipped to the range without a word (a 60 deg start of a 25 deg leg stood at 25)."""
     with pytest.raises(SpecError) as error:
-        setup(SPEC.replace("spine=0", f"spine=0 {start}"))
+        bound_search(SPEC.replace("spine=0", f"spine=0 {start}"))
     assert str(error.value).startswith(message), str(error.value)
-    setup(SPEC.replace("spine=0", "spine=0 head=15 head_turn=0"))  # the ends are in it
+    bound_search(SPEC.replace("spine=0", "spine=0 head=15 head_turn=0"))  # the ends are in it
 
 
 @pytest.mark.parametrize(
@@ -107,7 +107,7 @@ def test_a_search_needing_what_its_figure_lacks_is_refused(tmp_path, dropped, fi
 
 def test_a_new_sense_rule_contains_a_point_of_the_parents_sense_trajectory():
     spec = SPEC.replace("controller time rules=3 period=0.4", "controller sense rules=3")
-    bound = setup(spec)
+    bound = bound_search(spec)
     rng = np.random.default_rng(4)
     population = _Population(bound, rng)
     senses = rng.uniform(0.0, 1.0, (30, len(CUJO.sense_names)))
@@ -126,16 +126,17 @@ def test_a_sense_based_search_enriches_a_first_set_and_keeps_its_best():
     """§4.2: three rounds of the relevance mutation enrich "the first set of 100 motion
     controllers"; the best C of them go on (here a first set of 8 for C = 4, to be quick)."""
     spec = SPEC.replace("controller time rules=3 period=0.4", "controller sense rules=3")
-    sense = setup(spec)
+    sense = bound_search(spec)
     assert (sense.enrich_rounds, sense.first_set, sense.first_size) == (3, 100, 100)
-    assert (setup(SPEC).enrich_rounds, setup(SPEC).first_size) == (0, 4)  # time-based: C
+    time = bound_search(SPEC)
+    assert (time.enrich_rounds, time.first_size) == (0, 4)  # time-based: C
     outcome = run_search(dataclasses.replace(sense, first_set=8), 1)
     # 8 controllers, three rounds of 8 more, then C = 4 per generation
     assert list(outcome.evaluations) == [32, 36, 40, 44]
 
 
 def test_the_first_set_keeps_its_best_controllers_in_order():
-    population = _Population(setup(), np.random.default_rng(5), size=6)
+    population = _Population(bound_search(), np.random.default_rng(5), size=6)
     population.fitness[:] = [0.5, 3.0, -1.0, 2.0, 3.0, 0.0]
     kept = population.take(np.argsort(-population.fitness, kind="stable")[:3])
     assert kept.fitness.tolist() == [3.0, 3.0, 2.0]  # ties keep their order: 1, then 4
@@ -147,7 +148,7 @@ def test_a_search_gives_the_same_result_on_one_thread_and_two():
     results = []
     for threads in (1, 2):
         numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
-        outcome = run_search(setup(), 3)
+        outcome = run_search(bound_search(), 3)
         results.append((outcome.best_fitness, outcome.terms, outcome.rod_ends))
     numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
     for one, two in zip(*results, strict=True):
@@ -155,10 +156,10 @@ def test_a_search_gives_the_same_result_on_one_thread_and_two():
 
 
 def test_a_chained_search_starts_from_the_state_it_is_given():
-    first = run_search(setup(), 1)
+    first = run_search(bound_search(), 1)
     text = SPEC.replace("start spine=0\n", "") + "chain cujo_bound\n"
     chain = ChainStart("cujo_bound", 1, first.final_state, first.final_force)
-    continued = run_search(setup(text, chain), 1)
+    continued = run_search(bound_search(text, chain), 1)
     np.testing.assert_allclose(continued.rod_ends[0], first.rod_ends[-1], rtol=0, atol=1e-12)
     np.testing.assert_allclose(continued.com[0], first.com[-1], rtol=0, atol=1e-12)
 
@@ -200,11 +201,11 @@ def test_continuing_a_result_without_a_final_state_is_a_clear_error(tmp_path):
 
 
 def test_a_chain_whose_final_state_is_another_figures_is_refused_at_the_chain_line():
-    first = run_search(setup(), 1)
+    first = run_search(bound_search(), 1)
     text = SPEC.replace("start spine=0\n", "") + "chain cujo_bound\n"
     chain = ChainStart("cujo_bound", 1, first.final_state[:-2], first.final_force)
     with pytest.raises(SpecError) as error:
-        setup(text, chain)
+        bound_search(text, chain)
     size = first.final_state.size
     assert str(error.value).endswith(
         f"expected a search of figure 'cujo' to continue ({size} state values and "
@@ -219,7 +220,7 @@ def test_final_spin_is_the_bodys_rate_at_the_end():
     from mosys.kernels import bsr3d_simulate as sim
     from mosys.parsing.bsr import FITNESS_TERMS_3D
 
-    outcome = run_search(setup(), 1)
+    outcome = run_search(bound_search(), 1)
     state = outcome.final_state
     work = sim.new_step_work(CUJO.arrays.parent.shape[0], CUJO.arrays.endpoints.shape[0])
     sim.start_step_work(CUJO.arrays, state, work)
@@ -238,7 +239,7 @@ def test_net_rotation_is_the_size_of_the_heading_change():
 
     turns = []
     for seed in (1, 2, 3):
-        terms = run_search(setup(), seed).terms
+        terms = run_search(bound_search(), seed).terms
         turned = terms[FITNESS_TERMS_3D.index("heading_change")]
         assert terms[FITNESS_TERMS_3D.index("net_rotation")] == abs(turned)
         turns.append(turned)

@@ -37,12 +37,12 @@ fitness distance=1 contact_distance=1
 """
 
 
-def setup(text: str = SPEC, generations: int | None = None):
+def bound_search(text: str = SPEC, generations: int | None = None):
     return bind_search(parse_bsr_text(text, "test.bsr"), STARMAN, generations)
 
 
 def test_initial_rules_follow_table_2():
-    population = _Population(setup(), np.random.default_rng(0))
+    population = _Population(bound_search(), np.random.default_rng(0))
     figure = STARMAN
     assert np.all(population.target >= figure.joint_min) and np.all(
         population.target <= figure.joint_max
@@ -61,8 +61,8 @@ def test_the_first_rules_drawn_at_once_are_those_drawn_rule_by_rule(kind, seed):
     """``draw_first_rules`` draws every number in one call; the rules are bit for bit those of
     ``draw_rule`` called rule after rule from the same generator (a seed's search is unchanged)."""
     text = SPEC.replace("controller sense rules=6", f"controller {kind} rules=6")
-    at_once = _Population(setup(text), np.random.default_rng(seed))
-    by_rule = _Population(setup(text), np.random.default_rng(0))
+    at_once = _Population(bound_search(text), np.random.default_rng(seed))
+    by_rule = _Population(bound_search(text), np.random.default_rng(0))
     rng = np.random.default_rng(seed)
     for k in range(by_rule.tau.shape[0]):
         for i in range(by_rule.tau.shape[1]):
@@ -72,7 +72,7 @@ def test_the_first_rules_drawn_at_once_are_those_drawn_rule_by_rule(kind, seed):
 
 
 def test_a_reinitialised_rule_fires_at_a_corner_on_the_sense_trajectory():
-    population = _Population(setup(), np.random.default_rng(1))
+    population = _Population(bound_search(), np.random.default_rng(1))
     senses = np.random.default_rng(2).uniform(0, 1, (201, len(STARMAN.sense_names)))
     population.draw_rule(3, 2, np.random.default_rng(3), senses)
     half = population.side[3, 2] / 2 * CORNER_INSIDE
@@ -86,7 +86,7 @@ def test_a_reinitialised_rule_fires_at_a_corner_on_the_sense_trajectory():
 
 
 def test_creep_stays_inside_the_ranges():
-    bound = setup()
+    bound = bound_search()
     population = _Population(bound, np.random.default_rng(4))
     rng = np.random.default_rng(5)
     for _ in range(200):
@@ -99,7 +99,7 @@ def test_creep_stays_inside_the_ranges():
 
 @pytest.mark.parametrize("generations", [20, pytest.param(150, marks=pytest.mark.slow)])
 def test_the_learning_curve_climbs_and_the_best_is_rerun_from_the_nominal_start(generations):
-    outcome = run_search(setup(generations=generations), 7)
+    outcome = run_search(bound_search(generations=generations), 7)
     assert outcome.evaluations[0] == 6 and outcome.evaluations[-1] == 6 * (generations + 1)
     assert np.all(np.diff(outcome.best_fitness) >= 0)
     assert outcome.best_fitness[-1] > outcome.best_fitness[0]
@@ -111,20 +111,22 @@ def test_a_seed_gives_the_same_result_with_one_thread_or_two():
     threads = numba.get_num_threads()
     try:
         numba.set_num_threads(1)
-        one = run_search(setup(), 8)
+        one = run_search(bound_search(), 8)
         numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
-        two = run_search(setup(), 8)
+        two = run_search(bound_search(), 8)
     finally:
         numba.set_num_threads(threads)
     np.testing.assert_array_equal(one.best_fitness, two.best_fitness)
     np.testing.assert_array_equal(one.controller.center, two.controller.center)
     np.testing.assert_array_equal(one.rod_ends, two.rod_ends)
-    other = run_search(setup(), 7)
+    other = run_search(bound_search(), 7)
     assert not np.array_equal(other.best_fitness, one.best_fitness)
 
 
 def test_perturbed_starts_differ_and_stand_on_the_floor():
-    spec = setup(SPEC.replace("fitness", "perturb angle=5 joints=10 speed=0.2 spin=20\nfitness"))
+    spec = bound_search(
+        SPEC.replace("fitness", "perturb angle=5 joints=10 speed=0.2 spin=20\nfitness")
+    )
     rng = np.random.default_rng(0)
     starts = [
         perturbed_state(STARMAN, spec.root_angle, spec.joints, 0.0, spec.spec.perturbation, rng)
@@ -155,14 +157,14 @@ def test_the_result_file_keeps_the_contract(tmp_path):
 def test_a_start_name_the_figure_lacks_is_an_error_at_its_word():
     text = SPEC.replace("leg_b=-20", "knee=-20")
     with pytest.raises(SpecError) as error:
-        setup(text)
+        bound_search(text)
     assert str(error.value) == (
         "test.bsr:6:44: expected a coordinate of figure 'starman' (torso, x, arm_a, arm_b, "
         "leg_a, leg_b), found 'knee=-20'"
     )
     text = SPEC + "fall torso.distal arm_c.distal\n"
     with pytest.raises(SpecError) as error:
-        setup(text)
+        bound_search(text)
     assert str(error.value) == (
         "test.bsr:8:19: expected an endpoint of figure 'starman' (torso.proximal, torso.distal, "
         "arm_a.distal, arm_b.distal, leg_a.distal, leg_b.distal), found 'arm_c.distal'"
@@ -171,7 +173,7 @@ def test_a_start_name_the_figure_lacks_is_an_error_at_its_word():
 
 def test_a_term_of_the_other_dimension_is_an_error_at_its_word():
     with pytest.raises(SpecError) as error:
-        setup(SPEC.replace("fitness distance=1", "fitness distance=1 sideways=-1"))
+        bound_search(SPEC.replace("fitness distance=1", "fitness distance=1 sideways=-1"))
     assert "expected a fitness term of figure 'starman' (distance, max_height, " in str(error.value)
     assert str(error.value).endswith("found 'sideways=-1'")
 

@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# The tests against the oldest versions pyproject.toml allows (tools/oldest.txt; README, "Tests,
+# benchmarks, CI"): this checkout's HEAD cloned into a temporary directory, a new virtualenv with
+# mosys and its test extras installed at those versions, then the lints and the README's test command there.
+# Arguments go to pytest (e.g. -m "not slow"). About 12 minutes on 2 cores (a cold numba cache).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+git clone -q . "$work/main"
+cd "$work/main"
+python3 -m venv .venv
+. .venv/bin/activate
+pip install -q -e ".[test]" -c tools/oldest.txt
+pip list 2>/dev/null | grep -i -E "^(numpy|numba|llvmlite|sympy|h5py|pandas|tabulate|matplotlib|pillow|snakemake|pytest|pytest-xdist|hypothesis|ruff|import-linter) "
+ruff check .
+ruff format --check .
+lint-imports
+pytest "$@"
