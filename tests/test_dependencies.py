@@ -8,7 +8,7 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
-from packaging.requirements import Requirement
+from packaging.requirements import Requirement  # packaging: one of pytest's own requirements
 from packaging.version import Version
 
 ROOT = Path(__file__).resolve().parent.parent
