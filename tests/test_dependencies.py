@@ -14,26 +14,25 @@ from packaging.version import Version
 ROOT = Path(__file__).resolve().parent.parent
 
 
+def version_of(text: str, operator: str) -> tuple[str, Version]:
+    """A requirement's name and the version of its one ``operator`` clause (``>=``, ``==``)."""
+    requirement = Requirement(text)
+    (version,) = [spec.version for spec in requirement.specifier if spec.operator == operator]
+    return requirement.name, Version(version)
+
+
 def floors() -> dict[str, Version]:
     """The ``>=`` version of every dependency and test extra in pyproject.toml, by name."""
     project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
-    found = {}
-    for text in project["dependencies"] + project["optional-dependencies"]["test"]:
-        requirement = Requirement(text)
-        (floor,) = [spec.version for spec in requirement.specifier if spec.operator == ">="]
-        found[requirement.name] = Version(floor)
-    return found
+    texts = project["dependencies"] + project["optional-dependencies"]["test"]
+    return dict(version_of(text, ">=") for text in texts)
 
 
 def pins() -> dict[str, Version]:
     """The ``==`` version of every line of tools/oldest.txt, by name."""
-    found = {}
-    for line in (ROOT / "tools/oldest.txt").read_text().splitlines():
-        if line.strip() and not line.startswith("#"):
-            requirement = Requirement(line)
-            (pin,) = [spec.version for spec in requirement.specifier if spec.operator == "=="]
-            found[requirement.name] = Version(pin)
-    return found
+    lines = (ROOT / "tools/oldest.txt").read_text().splitlines()
+    pinned = [line for line in lines if line.strip() and not line.startswith("#")]
+    return dict(version_of(line, "==") for line in pinned)
 
 
 def test_every_floor_is_pinned_in_the_oldest_versions_file():

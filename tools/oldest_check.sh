@@ -12,7 +12,9 @@ cd "$work/main"
 python3 -m venv .venv
 . .venv/bin/activate
 pip install -q -e ".[test]" -c tools/oldest.txt
-pip list 2>/dev/null | grep -i -E "^(numpy|numba|llvmlite|sympy|h5py|pandas|tabulate|matplotlib|pillow|snakemake|pytest|pytest-xdist|hypothesis|ruff|import-linter) "
+# the versions installed: every package of tools/oldest.txt, and numba's llvmlite
+names=$(grep -v '^#' tools/oldest.txt | cut -d= -f1 | paste -sd'|')
+pip list 2>/dev/null | grep -i -E "^(${names}|llvmlite) "
 ruff check .
 ruff format --check .
 lint-imports
