@@ -86,6 +86,8 @@ def verb_listing(families: tuple[Family, ...] = FAMILIES) -> str:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """``mosys``'s parser: a subcommand per verb of every family (``plot car``: the kind
+    ``car`` of the verb ``plot``), each with its arguments and its verb to call."""
     parser = argparse.ArgumentParser(
         prog="mosys",
         usage="%(prog)s [-h] [--version] VERB ...",

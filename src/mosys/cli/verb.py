@@ -13,6 +13,7 @@ from mosys.parsing.tokens import MAX_WHOLE
 
 
 def no_check(args: argparse.Namespace) -> str | None:
+    """A verb's check when its arguments need none beyond argparse's: no problem."""
     return None
 
 

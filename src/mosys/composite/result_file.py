@@ -43,6 +43,8 @@ def phase_table(session: CompositeSession, ticks: np.ndarray) -> list[dict]:
 
 
 def stored_motion(session: CompositeSession, scored: ScoredMotion) -> CompositeMotion:
+    """A scored motion as the result file keeps it: its rod ends (samples, rods, 2, 2) m and
+    centre of mass as a figure motion at the session's dt, with each sample's phase and rule."""
     motion = scored.motion
     return CompositeMotion(
         motion=session.figure.motion(motion.rod_ends, motion.com, session.dt),

@@ -317,6 +317,8 @@ class Summary:
 
 
 def summarise(dataset: h5py.Dataset) -> Summary:
+    """``mosys info``'s summary of one dataset, read block by block (a dataset of another kind
+    than numbers, booleans or strings is only named)."""
     summary = Summary(dataset)
     if summary.kind != "other":
         for block in _blocks(dataset, summary.kind):

@@ -146,4 +146,5 @@ def terms_text(
 
 
 def result_kind(result: BsrResult) -> str:
+    """The result's controller kind (``time`` or ``sense``), as its file says it."""
     return str(result.attrs.get("controller_kind", result.controller.kind))

@@ -192,11 +192,14 @@ def panel_figure(
 
 
 def suptitle(figure: Figure, text: str) -> None:
+    """The figure's title, its top 0.08 in below the figure's top edge whatever its height."""
     height = figure.get_size_inches()[1]
     figure.suptitle(text, y=1 - 0.08 / height, va="top", fontsize=SUPTITLE_SIZE)
 
 
-def panel_title(ax: Axes, first_line: str, outcome: str | None = None, failed=False) -> None:
+def panel_title(
+    ax: Axes, first_line: str, outcome: str | None = None, failed: bool = False
+) -> None:
     """A panel's title: ``first_line`` in black over an ``outcome`` line, red when ``failed``
     (the outcome text carries the gid ``outcome``)."""
     if outcome is None:
@@ -279,5 +282,7 @@ def draw_scene(ax: Axes, scene: CarScene, limits: np.ndarray) -> None:
 
 
 def scene_points(scene: CarScene) -> np.ndarray:
+    """The car's outline (corners, 2) m placed at the scene's destination (for the view's
+    limits)."""
     d = scene.destination
     return place_outline(scene.body_outline, d["x"], d["y"], d["heading"])

@@ -164,7 +164,7 @@ def shadow_segments(poses: np.ndarray, camera: Camera) -> np.ndarray:
     return project(flat, camera)[..., :2].reshape(-1, 2, 2)
 
 
-def draw_shadows(ax, poses: np.ndarray, camera: Camera) -> None:
+def draw_shadows(ax: Axes, poses: np.ndarray, camera: Camera) -> None:
     """Draw the poses' (..., rods, 2, 3) m shadows on the floor, under everything else."""
     shadows = LineCollection(
         shadow_segments(poses, camera),

@@ -104,6 +104,8 @@ def table_axes(table: ControllerTable, path: str | Path = "") -> tuple[StateAxis
 
 
 def car_hint(state_order: Sequence[str], figure: str = "") -> str:
+    """What to add to a refusal of a car's table or trajectory (named by ``figure`` or known by
+    its heading and steer axes): the verb that draws it; "" for any other."""
     if figure == "car" or {"heading", "steer"} <= set(state_order):
         return " (a car's runs are drawn by mosys plot car)"
     return ""
