@@ -1,0 +1,1 @@
+"""The HDF5 contracts (docs/formats/), atomic writes and progress lines."""

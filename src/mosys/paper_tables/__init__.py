@@ -1,0 +1,1 @@
+"""The papers' tables, each from the result files the pipeline builds."""

@@ -1,0 +1,1 @@
+"""Drawings: ``style`` is the one base every plot family shares."""

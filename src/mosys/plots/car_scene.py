@@ -129,6 +129,9 @@ def view_limits(car_points: np.ndarray, obstacles: Sequence[np.ndarray]) -> np.n
 
 @dataclass(frozen=True)
 class PanelLayout:
+    """A figure of car scene panels: the figure, its panels in reading order and the colour
+    bar's axes (None without one)."""
+
     figure: Figure
     panels: list[Axes]
     colorbar: Axes | None
