@@ -56,6 +56,28 @@ def test_a_whole_float_where_an_integer_is_wanted_is_that_integer(work, tmp_path
     assert counts["2.0"] == counts["2"] and counts["1.0e+300"] == counts["null"], counts
 
 
+def test_the_command_line_reads_numbers_as_a_yaml_file_does(work):
+    """--config passes nested values as strings: seeds: 2.0 was refused ('2.0' is not of type
+    'integer') where a YAML file's is 2, and dt: .inf got the schema's message, not the
+    finite-number check's."""
+    counts = {}
+    for seeds in ("2.0", "2", "1e300", "null"):
+        budget = f"bsr3d={{seeds: {seeds}}}"
+        code, output = dry_run(work, "results/bsr3d_all", "--config", budget, "--quiet", "rules")
+        assert code == 0, output
+        counts[seeds] = re.search(r"^bsr_search\s+(\d+)$", output, re.M).group(1)
+    assert counts["2.0"] == counts["2"] != counts["null"] == counts["1e300"], counts
+    for config, message in [
+        ("bsr3d={seeds: 2.5}", "2.5 is not of type 'integer', 'null'"),
+        ("car={dt: .inf}", "config car.dt: expected a finite number, found inf"),
+        ("car={dt: -.Inf}", "-inf is less than or equal to the minimum of 0"),
+        ("car={dt: .nan}", "config car.dt: expected a finite number, found nan"),
+        ("bsr={generations: many}", "'many' is not of type 'integer', 'null'"),
+    ]:
+        code, output = dry_run(work, "results/pendulum_all", "--config", config)
+        assert code != 0 and message in output, (config, output)
+
+
 def test_the_car_gif_script_draws_on_the_car_controllers_when_left_out_of_car_scripts(work):
     """car.gif_script is the car's: left out of car.scripts, it had drawn on controllers of
     its own name (specs/controllers/park_1/), and the dry run stopped."""

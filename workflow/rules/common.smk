@@ -28,8 +28,10 @@ def typed_overrides(value, schema):
     """``value`` with the strings the schema wants as numbers, booleans or null made so:
     Snakemake's ``--config`` passes nested values as strings, and bsr='{generations: 100}'
     was refused ('100' is not of type 'integer'). A string that is none is left, for the
-    validation to refuse. A whole float where the schema wants an integer (``seeds: 2.0``,
-    ``1e300``), which the schema passes, is made an int: ``seeds: 1e300`` raised in a slice."""
+    validation to refuse; a number where the schema wants an integer or a number is made one
+    (a fraction where it wants an integer stays a float, for the validation to refuse). A whole
+    float where the schema wants an integer (``seeds: 2.0``, ``1e300``), which the schema
+    passes, is made an int: ``seeds: 1e300`` raised in a slice."""
     if isinstance(value, dict):
         properties, others = schema.get("properties", {}), schema.get("additionalProperties")
         others = others if isinstance(others, dict) else {}  # the schema of keys not listed
@@ -50,10 +52,27 @@ def typed_overrides(value, schema):
     if "boolean" in kinds and text.lower() in ("true", "false"):
         return text.lower() == "true"
     if "integer" in kinds and re.fullmatch(r"[+-]?[0-9]+", text):
-        return int(text)
-    if "number" in kinds and re.fullmatch(NUMBER, text):
+        return int(text)  # exactly, however long
+    number = yaml_number(text)
+    if number is None:
+        return value
+    if "integer" in kinds and number.is_integer():
+        return int(number)  # as from a YAML file: seeds: 2.0 is 2
+    return number if "number" in kinds or "integer" in kinds else value
+
+
+def yaml_number(text):
+    """The float a YAML file reads ``text`` as (``2.0``, ``1e300``, ``.inf``, ``-.Inf``,
+    ``.nan``), or None: on the command line they came as strings, and ``seeds: 2.0`` was
+    refused as one while a YAML file's was taken, and ``.inf`` missed the finite-number check."""
+    if re.fullmatch(NUMBER, text):
         return float(text)
-    return value
+    sign, core = (-1.0, text[1:]) if text[:1] == "-" else (1.0, text.removeprefix("+"))
+    if core in (".inf", ".Inf", ".INF"):
+        return sign * math.inf
+    if text in (".nan", ".NaN", ".NAN"):
+        return math.nan
+    return None
 
 
 CONFIG_SCHEMA = Path(workflow.current_basedir) / "../schemas/config.schema.yaml"
