@@ -50,7 +50,8 @@ def spec_text(smoke: bool) -> str:
 
 def tables(smoke: bool, work: Path, shared: bool) -> tuple:
     """(problem, transitions, values): the exit tables, each node's own or (``shared``) shared by
-    the motion classes as ``mosys dp`` builds them, and the converged cost-to-go."""
+    the motion classes as ``mosys dp`` builds them, and the converged cost-to-go; the car's
+    compiled figure is ``work``/car.py."""
     from mosys.dynamics.load import figure_dynamics
     from mosys.kernels.dp import discard_poorly_known_exits
     from mosys.kernels.dp_exits import exit_transitions_template
@@ -63,9 +64,7 @@ def tables(smoke: bool, work: Path, shared: bool) -> tuple:
     path = work / "park_sweeps.ssc"
     path.write_text(spec_text(smoke))
     spec = parse_controller_spec(path)
-    dynamics = figure_dynamics(
-        spec.figure, ROOT / "results/dynamics", spec.error, spec.figure_token
-    )
+    dynamics = figure_dynamics(spec.figure, work, spec.error, spec.figure_token)
     problem = build_problem(spec, dynamics)
     exits = specialise(exit_transitions_template, dynamics, parallel=True)
     arguments = exit_transition_arguments(problem, dynamics, spec.dt)
@@ -175,12 +174,15 @@ def main() -> None:
     args = parser.parse_args()
     import tempfile
 
+    from mosys.dynamics.compile import compile_figure
+
     frames = []
-    for shared in (False, True):
-        with tempfile.TemporaryDirectory() as tmp:
+    with tempfile.TemporaryDirectory() as tmp:  # its own car.py: results/ may hold none
+        compile_figure(ROOT / "specs/figures/car.fig", Path(tmp) / "car.py")
+        for shared in (False, True):
             problem, transitions, value = tables(args.smoke, Path(tmp), shared)
-        frames.append(time_sweeps(problem, transitions, value))
-        del problem, transitions, value
+            frames.append(time_sweeps(problem, transitions, value))
+            del problem, transitions, value
     write_results(pd.concat(frames, ignore_index=True), "dp_sweeps", args.smoke)
 
 
