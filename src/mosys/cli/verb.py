@@ -155,7 +155,9 @@ def add_budget(parser: argparse.ArgumentParser, default: str | None = "paper") -
         "--budget",
         type=budget_name,
         default=default,
-        help="name of the config that built it (default: paper)",
+        help="name of the config that built it (default: "
+        + (default or "paper, or custom with --generations")
+        + ")",
     )
 
 
