@@ -157,11 +157,6 @@ def read_spec_text(path: str | Path) -> tuple[str, str]:
     return text, hashlib.sha256(data).hexdigest()
 
 
-def read_spec(path: str | Path) -> list[Line]:
-    """Read and tokenize a spec file (errors as ``read_spec_text``)."""
-    return tokenize(read_spec_text(path)[0], str(path))
-
-
 def format_number(value: float) -> str:
     """A number in spec text: the shortest repr that reads back to the same float (``2``,
     ``0.1``, ``1e-06``)."""
