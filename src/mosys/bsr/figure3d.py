@@ -13,12 +13,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from mosys.bsr.figure import (
     check_bsr_figure,
     distinct_endpoints,
+    load_rod_figure,
     rod_figure_motion,
 )
 from mosys.io.trajectory import FigureMotion
@@ -29,7 +31,7 @@ from mosys.parsing.figure import (
     JointLimit,
     default_swing_name,
 )
-from mosys.parsing.tokens import ENDPOINT_ENDS, SpecError
+from mosys.parsing.tokens import ENDPOINT_ENDS, SpecError, Token
 
 # the figure_motion contract's contact attribute of every 3-D BSR motion
 CONTACT_MODEL = "bsr3d-impulse: rigid-body impulses at rod endpoints, paper's friction"
@@ -187,6 +189,11 @@ def bsr_figure3d(figure: Figure) -> BsrFigure3D:
         heading_offset=figure.heading_offset,
         feet=_distinct_feet(figure, index, endpoints),
     )
+
+
+def load_bsr_figure3d(figures_dir: str | Path, spec_path: str, token: Token) -> BsrFigure3D:
+    """The 3-D BSR figure a spec names (``load_rod_figure``, then ``bsr_figure3d``)."""
+    return bsr_figure3d(load_rod_figure(figures_dir, spec_path, token))
 
 
 def _ranges(path: str, joint: Joint, limit: JointLimit | None) -> list[tuple[float, float]]:
