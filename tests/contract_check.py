@@ -86,6 +86,24 @@ COMPOSITE_ATTRS = [
     "wall_seconds",
 ]
 CAR_ORDER = ["x", "y", "heading", "steer", "speed"]
+# attributes that list names (DESIGN.md's state_order, control_names, controllers and rod_names,
+# and mosys's own lists): strings, also when the list is empty
+NAME_LISTS = {
+    "state_order",
+    "control_names",
+    "controllers",
+    "rod_names",
+    "rods",
+    "joint_names",
+    "sense_names",
+    "controller_kinds",
+    "switch_controllers",
+    "domain_violation_controllers",
+    "obstacle_names",
+    "controller_files",
+    "units",
+}
+NOT_NAMES = {"bsr result": {"controllers"}}  # a BSR result's root controllers is C, a count
 # what reading a file that breaks its contract raises (a dataset missing, a wrong type, not HDF5)
 UNREADABLE = (KeyError, ValueError, TypeError, IndexError, OSError)
 
@@ -104,6 +122,23 @@ def missing(attrs: h5py.AttributeManager, names: list[str]) -> list[str]:
 def names(value) -> list[str]:
     """A list-of-str attribute as Python strings (h5py may give bytes)."""
     return [v.decode() if isinstance(v, bytes) else str(v) for v in np.atleast_1d(value)]
+
+
+def name_list_problems(path: Path, names: set[str] = NAME_LISTS) -> list[str]:
+    """Every attribute of ``names`` in the file that is not stored as strings (h5py writes an
+    empty Python list as float64: a reader checking the type found numbers)."""
+    problems = []
+    with h5py.File(path, "r") as h5:
+
+        def visit(_name: str, item: h5py.HLObject) -> None:
+            for key in names & set(item.attrs):
+                stored = item.attrs.get_id(key).dtype
+                if h5py.check_string_dtype(stored) is None:
+                    problems.append(f"{item.name} attr {key}: names stored as {stored}, not text")
+
+        visit("/", h5)
+        h5.visititems(visit)
+    return problems
 
 
 def destination_nodes(axes: list[np.ndarray], order: list[str], dest: dict) -> np.ndarray:
@@ -471,6 +506,8 @@ def contract_problems(work: Path) -> tuple[Counter, list[str]]:
         counts[kind] += 1
         try:
             found = problems_of(path, *arguments)
+            if path.suffix == ".h5":
+                found += name_list_problems(path, NAME_LISTS - NOT_NAMES.get(kind, set()))
         except UNREADABLE as error:
             found = [f"cannot be read as the contract says ({type(error).__name__}: {error})"]
         problems.extend(f"{path.relative_to(work)}: {p}" for p in found)

@@ -6,8 +6,9 @@ from __future__ import annotations
 from pathlib import Path
 
 import h5py
+import numpy as np
 import pytest
-from contract_check import main
+from contract_check import main, name_list_problems
 
 
 def test_no_results_folder_is_refused(tmp_path: Path, capsys) -> None:
@@ -46,6 +47,21 @@ def test_malformed_files_are_problems_named_by_file(tmp_path: Path, capsys) -> N
     assert out[5].startswith(f"results/trajectories/not_hdf5.h5: {unreadable} (OSError: ")
     assert out[6].startswith(f"results/bsr/walk/seed1.h5: {unreadable} (OSError: ")
     assert out[7].startswith("chained searches cannot be read (OSError: ")
+
+
+def test_names_stored_as_numbers_are_a_problem(tmp_path: Path) -> None:
+    """An empty list of names written as a plain list is float64 to h5py: the trajectories'
+    domain_violation_controllers and time-based searches' sense_names were, until 2026-12-07."""
+    path = tmp_path / "names.h5"
+    with h5py.File(path, "w") as h5:
+        h5.attrs["controllers"] = []
+        h5.attrs["state_order"] = np.array([], dtype=h5py.string_dtype())
+        h5.create_group("best/controller").attrs["sense_names"] = []
+        h5.attrs["other"] = []
+    assert name_list_problems(path) == [
+        "/ attr controllers: names stored as float64, not text",
+        "/best/controller attr sense_names: names stored as float64, not text",
+    ]
 
 
 @pytest.mark.parametrize("argv", [[], ["."]])

@@ -17,6 +17,7 @@ from mosys.animation.runner import (
 )
 from mosys.dynamics.figure_motion import figure_contacts, figure_motion
 from mosys.dynamics.load import figure_dynamics
+from mosys.io.attributes import string_list
 from mosys.io.controller_table import read_controller_table
 from mosys.io.trajectory import Trajectory, write_trajectory
 from mosys.parsing.script import SwapController, parse_script
@@ -81,12 +82,14 @@ def run_animation_script(
             "spec_sha256": script.spec_sha256,
             "figure": figure,
             "dt": dt,
-            "controller_kinds": list(run.source_kinds),
+            "controller_kinds": string_list(run.source_kinds),
             "switch_times": [time for time, _ in run.switches],
-            "switch_controllers": [name for _, name in run.switches],
+            "switch_controllers": string_list(name for _, name in run.switches),
             "samples_outside_domain": int(run.outside.sum()),
             "domain_violation_times": [v.t for v in run.domain_violations],
-            "domain_violation_controllers": [v.controller for v in run.domain_violations],
+            "domain_violation_controllers": string_list(
+                v.controller for v in run.domain_violations
+            ),
             "breakpoints": json.dumps(
                 [
                     {

@@ -14,6 +14,7 @@ import numpy as np
 from mosys.bsr.result_file import motion_step_bytes
 from mosys.composite.session import CompositeSession, ScoredMotion, open_session
 from mosys.composite.transitions import TransitionSearch, search_transitions
+from mosys.io.attributes import string_list
 from mosys.io.composite_result import (
     CompositeMotion,
     CompositeResult,
@@ -134,7 +135,7 @@ def composite_to_file(
             "scores_before": encode_scores(before.scores),
             "scores_after": encode_scores(after.scores),
             "seeds": np.array(session.seeds, np.int64),
-            "controller_files": list(session.controller_files),
+            "controller_files": string_list(session.controller_files),
             "search_q": settings.q,
             "search_g": settings.g,
             "search_h": settings.h,

@@ -12,7 +12,7 @@ listed in ``units``.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 
 import h5py
 import numpy as np
@@ -36,6 +36,14 @@ def string_tuple(values: object) -> tuple[str, ...]:
     return tuple(string_attr(v) for v in np.atleast_1d(values))
 
 
+def string_list(values: Iterable[object]) -> np.ndarray:
+    """A list of strings as an attribute value: variable-length UTF-8 strings, also when the list
+    is empty (h5py stores a plain empty list as float64, and a reader checking the type saw
+    numbers: ``sense_names`` of every time-based search, ``domain_violation_controllers`` of
+    most trajectories)."""
+    return np.array([str(value) for value in values], dtype=h5py.string_dtype())
+
+
 def set_unit(dataset: h5py.Dataset, unit: str) -> None:
     """Give ``dataset`` its ``unit`` attr (one of the vocabulary above)."""
     dataset.attrs["unit"] = unit
@@ -54,7 +62,7 @@ def set_column_units(dataset: h5py.Dataset, units: Sequence[str] | None) -> None
         raise ValueError(
             f"{dataset.name}: {len(units)} units {units} for {dataset.shape[-1]} columns"
         )
-    dataset.attrs["units"] = np.array(units, dtype=h5py.string_dtype())
+    dataset.attrs["units"] = string_list(units)
     if not units:  # no columns: nothing to measure
         set_unit(dataset, DIMENSIONLESS)
     else:

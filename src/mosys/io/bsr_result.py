@@ -20,7 +20,14 @@ import h5py
 import numpy as np
 
 from mosys.io.atomic import write_hdf5_atomically
-from mosys.io.attributes import DIMENSIONLESS, INDEX, SI_STATE, create_with_unit, string_tuple
+from mosys.io.attributes import (
+    DIMENSIONLESS,
+    INDEX,
+    SI_STATE,
+    create_with_unit,
+    string_list,
+    string_tuple,
+)
 from mosys.io.contracts import open_contract
 from mosys.io.provenance import provenance_attributes
 from mosys.io.trajectory import FigureMotion, read_figure_motion, write_figure_motion
@@ -111,8 +118,8 @@ def write_bsr_result(path: str | Path, result: BsrResult) -> None:
         best = h5.create_group("best")
         controller = best.create_group("controller")
         _write_controller(controller, result.controller)
-        controller.attrs["joint_names"] = list(result.joint_names)
-        controller.attrs["sense_names"] = list(result.sense_names)
+        controller.attrs["joint_names"] = string_list(result.joint_names)
+        controller.attrs["sense_names"] = string_list(result.sense_names)
         write_figure_motion(best.create_group("figure_motion"), result.motion)
         create_with_unit(best, "active_rule", np.asarray(result.active_rule, np.int64), INDEX)
         if result.final_state is not None:

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mosys.errors import InputError
-from mosys.io.attributes import string_attr, string_tuple
+from mosys.io.attributes import string_attr, string_list, string_tuple
 from mosys.io.controller_table import ControllerTable
 
 DESTINATION_KEYS = ("x", "y", "heading")
@@ -91,7 +91,7 @@ def car_scene_attributes(scene: CarScene) -> dict:
     attributes = {
         "body_outline": json.dumps(scene.body_outline.tolist()),
         "obstacles": json.dumps([polygon.tolist() for polygon in scene.obstacles]),
-        "obstacle_names": list(scene.obstacle_names),
+        "obstacle_names": string_list(scene.obstacle_names),
         "destination": json.dumps(scene.destination),
         "wheelbase": scene.wheelbase,
     }

@@ -21,6 +21,7 @@ from mosys.io.attributes import (
     column_units,
     create_with_unit,
     set_column_units,
+    string_list,
     string_tuple,
 )
 from mosys.io.contracts import open_contract
@@ -122,8 +123,8 @@ def write_controller_table(path: str | Path, table: ControllerTable) -> None:
                 dataset.dims[k].attach_scale(axes[name])
                 dataset.dims[k].label = name
         h5.attrs["format_version"] = FORMAT_VERSION
-        h5.attrs["state_order"] = list(table.state_order)
-        h5.attrs["control_names"] = list(table.control_names)
+        h5.attrs["state_order"] = string_list(table.state_order)
+        h5.attrs["control_names"] = string_list(table.control_names)
         h5.attrs["control_min"] = np.asarray(table.control_min, dtype=np.float64)
         h5.attrs["control_max"] = np.asarray(table.control_max, dtype=np.float64)
         h5.attrs["K"] = np.asarray(table.effort_weight, dtype=np.float64)

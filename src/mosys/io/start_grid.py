@@ -29,6 +29,7 @@ from mosys.io.attributes import (
     column_units,
     create_with_unit,
     set_column_units,
+    string_list,
     string_tuple,
 )
 from mosys.io.contracts import open_hdf5
@@ -149,7 +150,7 @@ def write_start_grid(path: str | Path, grid: StartGrid) -> None:
         if grid.excluded_detail is not None:
             detail = np.asarray(grid.excluded_detail, dtype=object)
             create_with_unit(h5, "excluded_detail", detail, TEXT, dtype=STRING)
-        h5.attrs["state_order"] = list(grid.state_order)
+        h5.attrs["state_order"] = string_list(grid.state_order)
         for key, value in grid.attrs.items():
             h5.attrs[key] = value
         h5.attrs.update(provenance_attributes())  # this process wrote it, whatever was read

@@ -21,6 +21,7 @@ from mosys.io.attributes import (
     column_units,
     create_with_unit,
     set_column_units,
+    string_list,
     string_tuple,
 )
 from mosys.io.contracts import open_contract
@@ -60,7 +61,7 @@ def write_figure_motion(group: h5py.Group, motion: FigureMotion) -> None:
     create_with_unit(group, "t", np.asarray(motion.t, dtype=np.float64), "s")
     create_with_unit(group, "endpoints", np.asarray(motion.endpoints, dtype=np.float64), "m")
     create_with_unit(group, "com", np.asarray(motion.com, dtype=np.float64), "m")
-    group.attrs["rod_names"] = list(motion.rod_names)
+    group.attrs["rod_names"] = string_list(motion.rod_names)
     group.attrs["rod_mass"] = np.asarray(motion.rod_mass, dtype=np.float64)
     group.attrs["rod_length"] = np.asarray(motion.rod_length, dtype=np.float64)
     group.attrs["rod_com"] = np.asarray(motion.rod_com, dtype=np.float64)
@@ -146,9 +147,9 @@ def write_trajectory(path: str | Path, trajectory: Trajectory) -> None:
         controller = np.asarray(trajectory.controller, np.int64)
         create_with_unit(h5, "controller", controller, INDEX)
         h5.attrs["format_version"] = FORMAT_VERSION
-        h5.attrs["state_order"] = list(trajectory.state_order)
-        h5.attrs["control_names"] = list(trajectory.control_names)
-        h5.attrs["controllers"] = list(trajectory.controllers)
+        h5.attrs["state_order"] = string_list(trajectory.state_order)
+        h5.attrs["control_names"] = string_list(trajectory.control_names)
+        h5.attrs["controllers"] = string_list(trajectory.controllers)
         for key, value in trajectory.attrs.items():
             h5.attrs[key] = value
         if trajectory.motion is not None:
@@ -159,7 +160,7 @@ def write_trajectory(path: str | Path, trajectory: Trajectory) -> None:
             position = np.asarray(contacts.position, np.float64)
             create_with_unit(group, "position", position, "m")
             create_with_unit(group, "force", np.asarray(contacts.force, np.float64), "N")
-            group.attrs["rods"] = list(contacts.rods)
+            group.attrs["rods"] = string_list(contacts.rods)
             group.attrs["fraction"] = np.asarray(contacts.fraction, np.float64)
         h5.attrs.update(provenance_attributes())  # this process wrote it, whatever was read
 

@@ -18,6 +18,7 @@ from types import ModuleType
 import numpy as np
 
 from mosys import __version__
+from mosys.io.attributes import string_list
 from mosys.io.controller_table import ControllerTable, write_controller_table
 from mosys.kernels.dp_exits import node_coordinates
 from mosys.limits import check_job
@@ -98,7 +99,7 @@ def figure_attributes(problem: Problem, dynamics: ModuleType) -> dict:
     if obstacles.active:
         attrs["body_outline"] = json.dumps(obstacles.outline.tolist())
         attrs["obstacles"] = json.dumps(obstacles.polygons())
-        attrs["obstacle_names"] = list(obstacles.names)
+        attrs["obstacle_names"] = string_list(obstacles.names)
         attrs["domain"] = json.dumps(obstacles.domain.tolist())
     return attrs
 
