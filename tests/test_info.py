@@ -479,6 +479,23 @@ def test_info_measures_the_papers_rules_on_each_bsr_motion(made, capsys):
     assert "the paper's rules" not in info_of(made["trajectory"], capsys)  # a pendulum
 
 
+def test_a_composite_result_with_only_the_contracts_groups_is_one(made, tmp_path, capsys):
+    """DESIGN.md's composite result is its two figure_motion groups and root attrs; mosys
+    recognised one only by its own /search/best_score, and said another tool's was none."""
+    path = tmp_path / "contract_only.h5"
+    shutil.copy(made["composite result"], path)
+    with h5py.File(path, "a") as h5:
+        for name in ("search", "phase", "active_rule", "before/phase", "before/active_rule"):
+            del h5[name]
+    out = info_of(path, capsys)
+    assert out.startswith(f"{path}: composite result, format_version 1 ")
+    argv = ["composite-table", str(path), "--csv", str(tmp_path / "t.csv")]
+    assert main([*argv, "--md", str(tmp_path / "t.md")]) == 2  # mosys's reader needs its own
+    assert capsys.readouterr().err.startswith(
+        f"mosys: {path}: a composite result that lacks what mosys reads ("
+    )
+
+
 def test_info_of_a_file_of_an_older_mosys(tmp_path, capsys):
     """No units, no provenance, no scales: reported as such."""
     path = tmp_path / "old.h5"

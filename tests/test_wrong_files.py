@@ -67,8 +67,8 @@ CASES = [
     (
         "composite-table odd",
         lambda f, o: ["composite-table", f["odd"], "--csv", o / "t.csv", "--md", o / "t.md"],
-        "mosys: {odd}: not a composite result (it lacks figure_motion, before/figure_motion, "
-        "search/best_score; docs/formats/composite_result.md)",
+        "mosys: {odd}: not a composite result (it lacks figure_motion, before/figure_motion; "
+        "docs/formats/composite_result.md)",
     ),
     (
         "pendulum-table text",

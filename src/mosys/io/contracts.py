@@ -48,11 +48,8 @@ CONTRACTS = (
         ("best/controller", "best/figure_motion"),
         ("learning_curve/evaluations", "learning_curve/best_fitness", "best/active_rule"),
     ),
-    Contract(
-        "composite result",
-        "composite_result.md",
-        ("figure_motion", "before/figure_motion"),
-        ("search/best_score",),
+    Contract(  # DESIGN.md's two groups alone (mosys's /search/best_score is not the contract's)
+        "composite result", "composite_result.md", ("figure_motion", "before/figure_motion"), ()
     ),
     Contract(
         "start grid",
