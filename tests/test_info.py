@@ -491,8 +491,10 @@ def test_a_composite_result_with_only_the_contracts_groups_is_one(made, tmp_path
     assert out.startswith(f"{path}: composite result, format_version 1 ")
     argv = ["composite-table", str(path), "--csv", str(tmp_path / "t.csv")]
     assert main([*argv, "--md", str(tmp_path / "t.md")]) == 2  # mosys's reader needs its own
-    assert capsys.readouterr().err.startswith(
-        f"mosys: {path}: a composite result that lacks what mosys reads ("
+    assert capsys.readouterr().err == (
+        f"mosys: {path}: a composite result without phase, active_rule, before/phase, "
+        "before/active_rule, search/best_score, which mosys reads beside the contract "
+        "(docs/formats/composite_result.md)\n"
     )
 
 

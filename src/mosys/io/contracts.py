@@ -21,13 +21,16 @@ from mosys.files import input_problem
 
 @dataclass(frozen=True)
 class Contract:
-    """A kind of file mosys writes: its name, its page in docs/formats/, and the groups and
-    datasets (paths from the root) every such file has."""
+    """A kind of file mosys writes: its name, its page in docs/formats/, the groups and
+    datasets (paths from the root) every such file has, and the datasets of mosys's own that its
+    readers need beside them (``reads``: a file another tool wrote to the contract alone is of
+    the kind, but mosys cannot read it)."""
 
     name: str
     page: str
     groups: tuple[str, ...]
     datasets: tuple[str, ...]
+    reads: tuple[str, ...] = ()
 
     def met_by(self, h5: h5py.File) -> bool:
         return not self.missing(h5)
@@ -48,8 +51,12 @@ CONTRACTS = (
         ("best/controller", "best/figure_motion"),
         ("learning_curve/evaluations", "learning_curve/best_fitness", "best/active_rule"),
     ),
-    Contract(  # DESIGN.md's two groups alone (mosys's /search/best_score is not the contract's)
-        "composite result", "composite_result.md", ("figure_motion", "before/figure_motion"), ()
+    Contract(  # DESIGN.md's two groups alone: the rest is mosys's own
+        "composite result",
+        "composite_result.md",
+        ("figure_motion", "before/figure_motion"),
+        (),
+        ("phase", "active_rule", "before/phase", "before/active_rule", "search/best_score"),
     ),
     Contract(
         "start grid",
@@ -85,8 +92,9 @@ def open_hdf5(path: str | Path) -> h5py.File:
 def open_contract(path: str | Path, name: str) -> Iterator[h5py.File]:
     """``path`` open for reading as a file of the contract ``name`` (a key of ``CONTRACT``).
     InputError naming the file: missing, not HDF5 or unreadable; of another kind (which) or of
-    none (what it lacks); or lacking, inside the block, an attribute, group or dataset the
-    reader looks for (h5py's KeyError)."""
+    none (what it lacks); without the datasets of mosys's own its readers need (which); or
+    lacking, inside the block, an attribute, group or dataset the reader looks for (h5py's
+    KeyError)."""
     contract = CONTRACT[name]
     with open_hdf5(path) as h5:
         missing = contract.missing(h5)
@@ -94,6 +102,12 @@ def open_contract(path: str | Path, name: str) -> Iterator[h5py.File]:
             other = kind_of(h5)
             what = f"a {other.name}" if other is not None else f"it lacks {', '.join(missing)}"
             raise InputError(f"{path}: not a {name} ({what}; docs/formats/{contract.page})")
+        lacking = [p for p in contract.reads if not isinstance(h5.get(p), h5py.Dataset)]
+        if lacking:
+            raise InputError(
+                f"{path}: a {name} without {', '.join(lacking)}, which mosys reads beside the "
+                f"contract (docs/formats/{contract.page})"
+            )
         try:
             yield h5
         except KeyError as error:  # an attribute or object the contract's readers need
