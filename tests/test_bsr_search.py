@@ -178,6 +178,24 @@ def test_a_term_of_the_other_dimension_is_an_error_at_its_word():
     assert str(error.value).endswith("found 'sideways=-1'")
 
 
+def test_the_3d_options_are_refused_for_a_2d_figure():
+    """filter= and a fall line's below= were ignored without a word for a 2-D figure: a fall
+    line of below= alone measured nothing, and fall= weighed a term that was always 0."""
+    filtered = SPEC.replace("controller sense rules=6", "controller sense rules=6 filter=0.3")
+    with pytest.raises(SpecError) as error:
+        bound_search(filtered)
+    assert str(error.value) == (
+        "test.bsr:2:26: expected no filter= for a 2-D figure (the senses' low-pass filter is "
+        "3-D's), found 'filter=0.3'"
+    )
+    with pytest.raises(SpecError) as error:
+        bound_search(SPEC + "fall below=0.3\n")
+    assert str(error.value) == (
+        "test.bsr:8:6: expected no below= for a 2-D figure (it has fallen when an endpoint of "
+        "its 'fall' line touches the floor; a height is 3-D's), found 'below=0.3'"
+    )
+
+
 def test_a_search_by_hand_records_its_budget_and_threads(tmp_path, capsys):
     """By hand with --generations the file said budget 'paper' (the tables then compared it
     with the paper) and threads 0."""

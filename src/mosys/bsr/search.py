@@ -282,8 +282,17 @@ def bind_names(
 
 def bind_search(spec: BsrSpec, figure: BsrFigure, generations: int | None = None) -> SearchSetup:
     """Check the spec's names against the figure (start coordinates, fall endpoints, terms) and
-    lay out its numbers; a name the figure lacks raises SpecError at its word. ``generations``
-    overrides the spec's G (a reduced budget)."""
+    lay out its numbers; a name the figure lacks, or a 3-D option, raises SpecError at its word.
+    ``generations`` overrides the spec's G (a reduced budget)."""
+    three_d_only = {
+        "filter": "no filter= for a 2-D figure (the senses' low-pass filter is 3-D's)",
+        "fall.below": "no below= for a 2-D figure (it has fallen when an endpoint of its 'fall' "
+        "line touches the floor; a height is 3-D's)",
+    }
+    for key, expected in three_d_only.items():  # both were ignored without a word (a
+        # fall line of below= alone measured nothing)
+        if key in spec.tokens:
+            raise SpecError.at(spec.path, spec.tokens[key], expected)
     names = bind_names(spec, figure, FITNESS_TERMS)
     return SearchSetup.bound(spec, figure, names, generations, PlanarSimulation())
 
