@@ -194,6 +194,11 @@ ERRORS = [
         EXAMPLE + "fall lower.proximal\n",
         "x.bsr:11:1: expected one 'fall' line only (the first is line 10), found 'fall'",
     ),
+    (  # it said 'found end of line' at the start of a line that has one
+        EXAMPLE + "chain walk\n",
+        "x.bsr:7:1: expected no 'start' line in a search that continues 'walk' (it starts where "
+        "that search's best motion ends), found 'start'",
+    ),
     # figure
     (replace_line(2, "figure"), "x.bsr:2:7: expected a name for the figure, found end of line"),
     (

@@ -250,14 +250,12 @@ class _Parser:
         for keyword in REQUIRED:
             if keyword not in self.first_line:
                 raise missing_line(self.path, lines, keyword)
-        if self.chain and "start" in self.first_line:
-            raise SpecError(
-                self.path,
-                self.first_line["start"],
-                1,
+        if self.chain and "start" in self.first_line:  # at its keyword ('found end of line')
+            start = next(line.keyword for line in lines if line.keyword.text == "start")
+            raise self.error(
+                start,
                 f"no 'start' line in a search that continues '{self.chain}' (it starts where "
                 "that search's best motion ends)",
-                None,
             )
         if self.fall_weight is not None and "fall" not in self.first_line:
             raise self.error(
