@@ -179,8 +179,8 @@ def parse_number(token: Token, path: str, what: str, text: str | None = None) ->
 def parse_int(
     token: Token, path: str, what: str, minimum: int | None = None, maximum: int | None = None
 ) -> int:
-    """A whole number (no sign, point or exponent), at least ``minimum`` and at most ``maximum``
-    if given."""
+    """A whole number (an optional sign, no point or exponent), at least ``minimum`` and at most
+    ``maximum`` if given."""
     if re.fullmatch(r"[+-]?\d+", token.text) is None:
         raise SpecError(path, token.line, token.column, f"a whole number for {what}", token.text)
     try:
