@@ -1,0 +1,134 @@
+"""The ``mosys info`` examples in docs/formats/ against ``mosys info`` on the same kind of file made
+now: the same sections, root attribute names, groups, datasets and group attribute names (the
+values, such as hashes, timings and fitness, may differ). Three examples had drifted unnoticed
+(a table and a search without ``policy_sweeps`` and ``compile_seconds``, a trajectory's
+``/state`` without its units), found by reading the pages against real files on 2026-12-07.
+The car's examples are left out: their files take a minute to make."""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+
+from mosys.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+FORMATS = ROOT / "docs" / "formats"
+SPECS = ROOT / "specs"
+
+
+def example(page: str, marker: str) -> list[str]:
+    """The lines of the first code block after the line of ``page`` holding ``marker``."""
+    lines = (FORMATS / page).read_text(encoding="utf-8").splitlines()
+    at = next(k for k, line in enumerate(lines) if marker in line)
+    start = next(k for k in range(at, len(lines)) if lines[k].startswith("```")) + 1
+    end = next(k for k in range(start, len(lines)) if lines[k].startswith("```"))
+    return lines[start:end]
+
+
+KEPT = ("root attributes", "groups and datasets")  # the sections whose names are compared
+
+
+def structure(lines: list[str]) -> dict[str, list[str]]:
+    """The section titles (``sections``), and for the KEPT sections the names in them: a root
+    attribute's name; a group's path; a dataset's path, dtype and unit (the columns the table's
+    header places); ``PATH @NAME`` for a group's attribute."""
+    titles: list[str] = []
+    names: dict[str, list[str]] = {}
+    current: list[str] | None = None
+    group, columns = "", {}
+    for line in lines:
+        if line and not line.startswith(" ") and line.endswith(":"):
+            line = re.sub(r" \(\d+\):$", ":", line)  # "root attributes (34):": the names count
+            titles.append(line)
+            current = names.setdefault(line, []) if line.startswith(KEPT) else None
+        elif current is None or not line.strip():
+            continue
+        elif line.split()[0] == "path":  # the header: where the columns start
+            columns = {word: line.index(f" {word}") + 1 for word in ("dtype", "unit", "summary")}
+        elif line.startswith("    "):  # an attribute of the group above
+            current.append(f"{group} @{line.split()[0]}")
+        elif line.split()[1:2] == ["group"] or not line.startswith("  /"):
+            group = line.split()[0]  # a group, or a root attribute's name
+            if group != "git_commit":  # absent outside a git checkout (docs/formats/README.md)
+                current.append(group)
+        else:
+            dtype = line[columns["dtype"] : columns["unit"]].strip()
+            unit = line[columns["unit"] : columns["summary"]].strip()
+            current.append(f"{line.split()[0]} {dtype} [{unit}]")
+    return {"sections": titles, **names}
+
+
+def info(path: Path, capsys) -> list[str]:
+    assert main(["info", str(path)]) == 0
+    return capsys.readouterr().out.splitlines()
+
+
+def same_structure(page: str, marker: str, path: Path, capsys, partial: bool = False) -> None:
+    """The example's structure is that of ``mosys info path`` (``partial``: an example of some
+    sections only, compared on those)."""
+    shown = structure(example(page, marker))
+    made = structure(info(path, capsys))
+    if partial:
+        made["sections"] = [title for title in made["sections"] if title in shown["sections"]]
+    assert shown == {key: made.get(key) for key in shown}, f"docs/formats/{page}: {marker}"
+    assert shown.keys() == made.keys() or partial, f"docs/formats/{page}: {marker}"
+
+
+@pytest.fixture(scope="module")
+def pendulum_run(pendulum_tables, link1, tmp_path_factory) -> Path:
+    """specs/scripts/pendulum.anim run on the six controllers, as the pipeline runs it."""
+    from mosys.animation.trajectory_file import run_animation_script
+
+    root = tmp_path_factory.mktemp("examples")
+    dynamics = root / "dynamics"
+    dynamics.mkdir()
+    shutil.copy(link1.__file__, dynamics / "link1.py")
+    out = root / "pendulum.h5"
+    script = SPECS / "scripts" / "pendulum.anim"
+    run_animation_script(script, pendulum_tables, dynamics, out, 0.01, SPECS / "motor")
+    return out
+
+
+def test_the_controller_table_example(pendulum_tables, capsys):
+    marker = "mosys info results/controllers/pendulum/A.h5"
+    same_structure("controller_table.md", marker, pendulum_tables / "A.h5", capsys)
+
+
+def test_the_trajectory_and_figure_motion_examples(pendulum_run, capsys):
+    same_structure("trajectory.md", "Figure 15 script", pendulum_run, capsys)
+    marker = "The pendulum's trajectory"
+    same_structure("figure_motion.md", marker, pendulum_run, capsys, partial=True)
+
+
+def test_the_bsr_result_example(tmp_path, capsys):
+    from mosys.bsr.result_file import search_to_file
+
+    out = tmp_path / "starman_jump_robust" / "seed1.h5"
+    spec = SPECS / "bsr" / "starman_jump_robust.bsr"
+    search_to_file(spec, SPECS / "figures", 1, out, 4, budget="docs")
+    capsys.readouterr()
+    marker = "mosys info results/bsr/starman_jump_robust/seed1.h5"
+    same_structure("bsr_result.md", marker, out, capsys)
+
+
+def test_the_composite_result_example(tmp_path, capsys):
+    from mosys.bsr.result_file import search_to_file
+    from mosys.composite.result_file import composite_to_file
+    from mosys.composite.session import find_controller_files
+    from mosys.parsing.composite import parse_composite_script
+
+    script = SPECS / "composite" / "starman_show.comp"
+    for search in {phase.controller for phase in parse_composite_script(script).phases}:
+        out = tmp_path / "bsr" / search / "seed1.h5"
+        search_to_file(SPECS / "bsr" / f"{search}.bsr", SPECS / "figures", 1, out, 2)
+    files = find_controller_files(parse_composite_script(script), tmp_path / "bsr")
+    out = tmp_path / "starman_show.h5"
+    sizes = {"q": 2, "g": 1, "h": 1}
+    composite_to_file(script, files, out, SPECS / "figures", SPECS / "bsr", sizes)
+    capsys.readouterr()
+    marker = "mosys info results/composite/starman_show.h5"
+    same_structure("composite_result.md", marker, out, capsys)
