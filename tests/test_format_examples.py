@@ -47,7 +47,7 @@ def structure(lines: list[str]) -> dict[str, list[str]]:
             current = names.setdefault(line, []) if line.startswith(KEPT) else None
         elif current is None or not line.strip():
             continue
-        elif line.split()[0] == "path":  # the header: where the columns start
+        elif line.startswith("  path "):  # the datasets' header: where the columns start
             columns = {word: line.index(f" {word}") + 1 for word in ("dtype", "unit", "summary")}
         elif line.startswith("    "):  # an attribute of the group above
             current.append(f"{group} @{line.split()[0]}")
@@ -80,7 +80,8 @@ def same_structure(page: str, marker: str, path: Path, capsys, partial: bool = F
 
 @pytest.fixture(scope="module")
 def pendulum_run(pendulum_tables, link1, tmp_path_factory) -> Path:
-    """specs/scripts/pendulum.anim run on the six controllers, as the pipeline runs it."""
+    """specs/scripts/pendulum.anim run on the six controllers (at a step of 10 ms: the file's
+    structure does not depend on it)."""
     from mosys.animation.trajectory_file import run_animation_script
 
     root = tmp_path_factory.mktemp("examples")
