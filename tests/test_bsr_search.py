@@ -154,43 +154,39 @@ def test_the_result_file_keeps_the_contract(tmp_path):
     assert result.attrs["budget"] == "test" and result.controller.kind == "sense"
 
 
-def test_a_start_name_the_figure_lacks_is_an_error_at_its_word():
-    text = SPEC.replace("leg_b=-20", "knee=-20")
+def binding_error(text: str) -> str:
+    """The message of the SpecError that binding the spec ``text`` to Star-Man raises."""
     with pytest.raises(SpecError) as error:
         bound_search(text)
-    assert str(error.value) == (
+    return str(error.value)
+
+
+def test_a_start_name_the_figure_lacks_is_an_error_at_its_word():
+    assert binding_error(SPEC.replace("leg_b=-20", "knee=-20")) == (
         "test.bsr:6:44: expected a coordinate of figure 'starman' (torso, x, arm_a, arm_b, "
         "leg_a, leg_b), found 'knee=-20'"
     )
-    text = SPEC + "fall torso.distal arm_c.distal\n"
-    with pytest.raises(SpecError) as error:
-        bound_search(text)
-    assert str(error.value) == (
+    assert binding_error(SPEC + "fall torso.distal arm_c.distal\n") == (
         "test.bsr:8:19: expected an endpoint of figure 'starman' (torso.proximal, torso.distal, "
         "arm_a.distal, arm_b.distal, leg_a.distal, leg_b.distal), found 'arm_c.distal'"
     )
 
 
 def test_a_term_of_the_other_dimension_is_an_error_at_its_word():
-    with pytest.raises(SpecError) as error:
-        bound_search(SPEC.replace("fitness distance=1", "fitness distance=1 sideways=-1"))
-    assert "expected a fitness term of figure 'starman' (distance, max_height, " in str(error.value)
-    assert str(error.value).endswith("found 'sideways=-1'")
+    message = binding_error(SPEC.replace("fitness distance=1", "fitness distance=1 sideways=-1"))
+    assert "expected a fitness term of figure 'starman' (distance, max_height, " in message
+    assert message.endswith("found 'sideways=-1'")
 
 
 def test_the_3d_options_are_refused_for_a_2d_figure():
     """filter= and a fall line's below= were ignored without a word for a 2-D figure: a fall
     line of below= alone measured nothing, and fall= weighed a term that was always 0."""
     filtered = SPEC.replace("controller sense rules=6", "controller sense rules=6 filter=0.3")
-    with pytest.raises(SpecError) as error:
-        bound_search(filtered)
-    assert str(error.value) == (
+    assert binding_error(filtered) == (
         "test.bsr:2:26: expected no filter= for a 2-D figure (the senses' low-pass filter is "
         "3-D's), found 'filter=0.3'"
     )
-    with pytest.raises(SpecError) as error:
-        bound_search(SPEC + "fall below=0.3\n")
-    assert str(error.value) == (
+    assert binding_error(SPEC + "fall below=0.3\n") == (
         "test.bsr:8:6: expected no below= for a 2-D figure (it has fallen when an endpoint of "
         "its 'fall' line touches the floor; a height is 3-D's), found 'below=0.3'"
     )
