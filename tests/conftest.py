@@ -3,19 +3,26 @@ results trees) and the helpers the spec-parser tests share."""
 
 from __future__ import annotations
 
+import math
 import shutil
 import textwrap
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TypeVar
+from typing import TYPE_CHECKING, TypeVar
 
+import numpy as np
 import pytest
 
 from mosys.parsing.tokens import END_OF_FILE, SpecError, shortened_words, shown_text
 
+if TYPE_CHECKING:
+    from mosys.io.start_grid import StartGrid
+
 ROOT = Path(__file__).resolve().parents[1]
 SPECS = ROOT / "specs"
+BSR_SEARCHES = ("starman_cartwheel_robust", "starman_jump_robust", "starman_shuffle_robust")
+CAR_STATE = ("x", "y", "heading", "steer", "speed")
 
 
 # --- what the spec-parser tests share -------------------------------------------------------
@@ -284,3 +291,59 @@ def pytest_terminal_summary(terminalreporter) -> None:
     for nodeid, text in _summaries:
         terminalreporter.section(nodeid)
         terminalreporter.write_line(text)
+
+
+@pytest.fixture(scope="session")
+def made(pendulum_tables, link1, tmp_path_factory) -> dict[str, Path]:
+    """One file of each kind mosys writes, small, by kind (``mosys info``'s tests, the
+    docs/formats examples' test)."""
+    from mosys.animation.trajectory_file import run_animation_script
+    from mosys.bsr.result_file import search_to_file
+    from mosys.composite.result_file import composite_to_file
+    from mosys.composite.session import find_controller_files
+    from mosys.io.start_grid import write_start_grid
+    from mosys.parsing.composite import parse_composite_script
+
+    root = tmp_path_factory.mktemp("info")
+    dynamics = root / "dynamics"
+    dynamics.mkdir()
+    shutil.copy(link1.__file__, dynamics / "link1.py")
+    script = root / "swing.anim"
+    script.write_text("state link -135,350\nswapcon link conB.ctab\nsim 0.4\n")
+    motor = SPECS / "motor"
+    run_animation_script(script, pendulum_tables, dynamics, root / "swing.h5", 0.01, motor)
+    bsr = root / "bsr"
+    for name in BSR_SEARCHES:
+        search_to_file(
+            SPECS / "bsr" / f"{name}.bsr", SPECS / "figures", 1, bsr / name / "seed1.h5", 2
+        )
+    comp = root / "starman_show.comp"
+    shutil.copy(SPECS / "composite" / "starman_show.comp", comp)
+    files = find_controller_files(parse_composite_script(comp), bsr)
+    sizes = {"q": 2, "g": 1, "h": 1}
+    composite_to_file(comp, files, root / "show.h5", SPECS / "figures", SPECS / "bsr", sizes)
+    write_start_grid(root / "grid.h5", start_grid())
+    return {
+        "controller table": pendulum_tables / "A.h5",
+        "trajectory": root / "swing.h5",
+        "BSR search result": bsr / "starman_jump_robust" / "seed1.h5",
+        "composite result": root / "show.h5",
+        "start grid": root / "grid.h5",
+    }
+
+
+def start_grid() -> StartGrid:
+    """Three car starts: one parks in 7.5 s, one times out, one overlaps an obstacle."""
+    from mosys.io.start_grid import NOT_FREE, StartGrid
+
+    return StartGrid(
+        start=np.array([[1.5, 2.0, 0.0, 0.0, 0.0], [-1.0, 1.5, 5.0, 0.0, 0.0], [0, 0.6, 0, 0, 0]]),
+        state_order=CAR_STATE,
+        parked=np.array([True, False, False]),
+        collided=np.array([False, False, False]),
+        parking_seconds=np.array([7.5, math.nan, math.nan]),
+        excluded=np.array(["", "", NOT_FREE], dtype=object),
+        cost_to_go=np.array([7.0, 9.0, math.inf]),
+        path_length=np.array([2.0, 3.0, math.nan]),
+        attrs={"controller": "park", "simulated_seconds": 10.0, "dt": 0.01},
+    )

@@ -3,15 +3,13 @@ now: the same sections, root attribute names, groups, datasets and group attribu
 values, such as hashes, timings and fitness, may differ). Three examples had drifted unnoticed
 (a table and a search without ``policy_sweeps`` and ``compile_seconds``, a trajectory's
 ``/state`` without its units), found by reading the pages against real files on 2026-12-07.
-The car's examples are left out: their files take a minute to make."""
+The files are conftest's ``made`` (``mosys info``'s tests share them); the car's examples are
+left out: their files take a minute to make."""
 
 from __future__ import annotations
 
 import re
-import shutil
 from pathlib import Path
-
-import pytest
 
 from mosys.cli import main
 
@@ -78,58 +76,22 @@ def same_structure(page: str, marker: str, path: Path, capsys, partial: bool = F
     assert shown.keys() == made.keys() or partial, f"docs/formats/{page}: {marker}"
 
 
-@pytest.fixture(scope="module")
-def pendulum_run(pendulum_tables, link1, tmp_path_factory) -> Path:
-    """specs/scripts/pendulum.anim run on the six controllers (at a step of 10 ms: the file's
-    structure does not depend on it)."""
-    from mosys.animation.trajectory_file import run_animation_script
-
-    root = tmp_path_factory.mktemp("examples")
-    dynamics = root / "dynamics"
-    dynamics.mkdir()
-    shutil.copy(link1.__file__, dynamics / "link1.py")
-    out = root / "pendulum.h5"
-    script = SPECS / "scripts" / "pendulum.anim"
-    run_animation_script(script, pendulum_tables, dynamics, out, 0.01, SPECS / "motor")
-    return out
-
-
-def test_the_controller_table_example(pendulum_tables, capsys):
+def test_the_controller_table_example(made, capsys):
     marker = "mosys info results/controllers/pendulum/A.h5"
-    same_structure("controller_table.md", marker, pendulum_tables / "A.h5", capsys)
+    same_structure("controller_table.md", marker, made["controller table"], capsys)
 
 
-def test_the_trajectory_and_figure_motion_examples(pendulum_run, capsys):
-    same_structure("trajectory.md", "Figure 15 script", pendulum_run, capsys)
+def test_the_trajectory_and_figure_motion_examples(made, capsys):
+    same_structure("trajectory.md", "Figure 15 script", made["trajectory"], capsys)
     marker = "The pendulum's trajectory"
-    same_structure("figure_motion.md", marker, pendulum_run, capsys, partial=True)
+    same_structure("figure_motion.md", marker, made["trajectory"], capsys, partial=True)
 
 
-def test_the_bsr_result_example(tmp_path, capsys):
-    from mosys.bsr.result_file import search_to_file
-
-    out = tmp_path / "starman_jump_robust" / "seed1.h5"
-    spec = SPECS / "bsr" / "starman_jump_robust.bsr"
-    search_to_file(spec, SPECS / "figures", 1, out, 4, budget="docs")
-    capsys.readouterr()
+def test_the_bsr_result_example(made, capsys):
     marker = "mosys info results/bsr/starman_jump_robust/seed1.h5"
-    same_structure("bsr_result.md", marker, out, capsys)
+    same_structure("bsr_result.md", marker, made["BSR search result"], capsys)
 
 
-def test_the_composite_result_example(tmp_path, capsys):
-    from mosys.bsr.result_file import search_to_file
-    from mosys.composite.result_file import composite_to_file
-    from mosys.composite.session import find_controller_files
-    from mosys.parsing.composite import parse_composite_script
-
-    script = SPECS / "composite" / "starman_show.comp"
-    for search in {phase.controller for phase in parse_composite_script(script).phases}:
-        out = tmp_path / "bsr" / search / "seed1.h5"
-        search_to_file(SPECS / "bsr" / f"{search}.bsr", SPECS / "figures", 1, out, 2)
-    files = find_controller_files(parse_composite_script(script), tmp_path / "bsr")
-    out = tmp_path / "starman_show.h5"
-    sizes = {"q": 2, "g": 1, "h": 1}
-    composite_to_file(script, files, out, SPECS / "figures", SPECS / "bsr", sizes)
-    capsys.readouterr()
+def test_the_composite_result_example(made, capsys):
     marker = "mosys info results/composite/starman_show.h5"
-    same_structure("composite_result.md", marker, out, capsys)
+    same_structure("composite_result.md", marker, made["composite result"], capsys)

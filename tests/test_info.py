@@ -3,15 +3,14 @@ writes has a ``unit``, every root the provenance attrs; a controller table's ``/
 dimension scales of its per-node datasets; ``mosys info`` reports each kind (exit 0) and refuses,
 with a one-line message and exit 2, a file that is not HDF5 or not mosys's.
 
-The files are made by mosys's own code at small sizes: the pendulum's tables (conftest), a
-script run on two of them, three BSR searches of two generations and a composite search of one;
-the start grid is written by ``write_start_grid`` from outcomes given here (evaluating real
-starts needs a car table: about 20 s)."""
+The files are made by mosys's own code at small sizes (conftest's ``made``): the pendulum's
+tables, a script run on two of them, three BSR searches of two generations and a composite
+search of one; the start grid is written by ``write_start_grid`` from outcomes given there
+(evaluating real starts needs a car table: about 20 s)."""
 
 from __future__ import annotations
 
 import dataclasses
-import math
 import shutil
 import subprocess
 import sys
@@ -20,7 +19,6 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-from conftest import SPECS
 
 from mosys.cli import main
 from mosys.io import info
@@ -31,67 +29,13 @@ from mosys.io.controller_table import (
     write_controller_table,
 )
 from mosys.io.provenance import PROVENANCE_KEYS, checkout_commit, provenance_attributes
-from mosys.io.start_grid import NOT_FREE, StartGrid, read_start_grid, write_start_grid
+from mosys.io.start_grid import read_start_grid
 from mosys.io.trajectory import Contacts, read_trajectory, write_trajectory
 
 # the vocabulary of docs/formats/README.md
 UNITS = {"s", "m", "m/s", "deg", "deg/s", "deg/s^2", "N", "N*m", "1"}
 UNITS |= {INDEX, TEXT, SI_STATE, SPEC, MIXED}
 ALWAYS = [key for key in PROVENANCE_KEYS if key != "git_commit"]
-BSR_SEARCHES = ("starman_cartwheel_robust", "starman_jump_robust", "starman_shuffle_robust")
-CAR_STATE = ("x", "y", "heading", "steer", "speed")
-
-
-@pytest.fixture(scope="module")
-def made(pendulum_tables, link1, tmp_path_factory) -> dict[str, Path]:
-    """One file of each kind, by kind."""
-    from mosys.animation.trajectory_file import run_animation_script
-    from mosys.bsr.result_file import search_to_file
-    from mosys.composite.result_file import composite_to_file
-    from mosys.composite.session import find_controller_files
-    from mosys.parsing.composite import parse_composite_script
-
-    root = tmp_path_factory.mktemp("info")
-    dynamics = root / "dynamics"
-    dynamics.mkdir()
-    shutil.copy(link1.__file__, dynamics / "link1.py")
-    script = root / "swing.anim"
-    script.write_text("state link -135,350\nswapcon link conB.ctab\nsim 0.4\n")
-    motor = SPECS / "motor"
-    run_animation_script(script, pendulum_tables, dynamics, root / "swing.h5", 0.01, motor)
-    bsr = root / "bsr"
-    for name in BSR_SEARCHES:
-        search_to_file(
-            SPECS / "bsr" / f"{name}.bsr", SPECS / "figures", 1, bsr / name / "seed1.h5", 2
-        )
-    comp = root / "starman_show.comp"
-    shutil.copy(SPECS / "composite" / "starman_show.comp", comp)
-    files = find_controller_files(parse_composite_script(comp), bsr)
-    sizes = {"q": 2, "g": 1, "h": 1}
-    composite_to_file(comp, files, root / "show.h5", SPECS / "figures", SPECS / "bsr", sizes)
-    write_start_grid(root / "grid.h5", start_grid())
-    return {
-        "controller table": pendulum_tables / "A.h5",
-        "trajectory": root / "swing.h5",
-        "BSR search result": bsr / "starman_jump_robust" / "seed1.h5",
-        "composite result": root / "show.h5",
-        "start grid": root / "grid.h5",
-    }
-
-
-def start_grid() -> StartGrid:
-    """Three car starts: one parks in 7.5 s, one times out, one overlaps an obstacle."""
-    return StartGrid(
-        start=np.array([[1.5, 2.0, 0.0, 0.0, 0.0], [-1.0, 1.5, 5.0, 0.0, 0.0], [0, 0.6, 0, 0, 0]]),
-        state_order=CAR_STATE,
-        parked=np.array([True, False, False]),
-        collided=np.array([False, False, False]),
-        parking_seconds=np.array([7.5, math.nan, math.nan]),
-        excluded=np.array(["", "", NOT_FREE], dtype=object),
-        cost_to_go=np.array([7.0, 9.0, math.inf]),
-        path_length=np.array([2.0, 3.0, math.nan]),
-        attrs={"controller": "park", "simulated_seconds": 10.0, "dt": 0.01},
-    )
 
 
 def datasets(path: Path) -> dict[str, dict]:
