@@ -37,9 +37,16 @@ class Contract:
 
     def missing(self, h5: h5py.File) -> list[str]:
         """The groups and datasets of the contract that ``h5`` lacks (or has as the other)."""
-        return [p for p in self.groups if not isinstance(h5.get(p), h5py.Group)] + [
-            p for p in self.datasets if not isinstance(h5.get(p), h5py.Dataset)
-        ]
+        return _absent(h5, self.groups, h5py.Group) + _absent(h5, self.datasets, h5py.Dataset)
+
+    def unread(self, h5: h5py.File) -> list[str]:
+        """The datasets of ``reads`` that ``h5`` lacks."""
+        return _absent(h5, self.reads, h5py.Dataset)
+
+
+def _absent(h5: h5py.File, paths: tuple[str, ...], kind: type) -> list[str]:
+    """The ``paths`` that are not a ``kind`` (group or dataset) in ``h5``."""
+    return [path for path in paths if not isinstance(h5.get(path), kind)]
 
 
 CONTRACTS = (
@@ -102,7 +109,7 @@ def open_contract(path: str | Path, name: str) -> Iterator[h5py.File]:
             other = kind_of(h5)
             what = f"a {other.name}" if other is not None else f"it lacks {', '.join(missing)}"
             raise InputError(f"{path}: not a {name} ({what}; docs/formats/{contract.page})")
-        lacking = [p for p in contract.reads if not isinstance(h5.get(p), h5py.Dataset)]
+        lacking = contract.unread(h5)
         if lacking:
             raise InputError(
                 f"{path}: a {name} without {', '.join(lacking)}, which mosys reads beside the "
