@@ -14,8 +14,6 @@ from conftest import SPECS
 import mosys
 from mosys.cli import FAMILIES, main
 
-USAGE = "usage: mosys [-h] [--version] VERB ...\n"
-
 
 def mosys_command(*args: str, cwd: Path) -> subprocess.CompletedProcess:
     return subprocess.run(
@@ -157,37 +155,39 @@ def test_index_of_missing_files(tmp_path, capsys):
     assert output.read_text() == f"{present}\n"
 
 
-def usage_error(message: str) -> str:
-    return f"{USAGE}mosys: error: {message}\n"
+def usage_error(verb: str, message: str) -> tuple[str, str]:
+    """A usage error of ``verb`` ("plot car"; "" for mosys itself): the program argparse names
+    in the usage line and the error line, and the error line's message."""
+    return f"mosys {verb}".strip(), message
 
 
 @pytest.mark.parametrize(
-    ("argv", "stderr"),
+    ("argv", "error"),
     [
         (
             ["plot", "controller", "C.h5"],
-            usage_error("plot controller: give --portrait and/or --torque"),
+            usage_error("plot controller", "give --portrait and/or --torque"),
         ),
         (
             ["plot", "controller", "C.h5", "--portrait", "P.png"],
-            usage_error("plot controller: --portrait needs --dynamics"),
+            usage_error("plot controller", "--portrait needs --dynamics"),
         ),
-        (["plot", "script", "T.h5"], usage_error("plot script: give --path and/or --gif")),
+        (["plot", "script", "T.h5"], usage_error("plot script", "give --path and/or --gif")),
         (
             ["plot", "car"],
-            usage_error("plot car: give --frames, --gif, --map and/or --consistency"),
+            usage_error("plot car", "give --frames, --gif, --map and/or --consistency"),
         ),
         (
             ["plot", "car", "--gif", "A.gif"],
-            usage_error("plot car: --frames and --gif need trajectories"),
+            usage_error("plot car", "--frames and --gif need trajectories"),
         ),
         (
             ["plot", "bsr", "R.h5"],
-            usage_error("plot bsr: give --learning, --filmstrip and/or --gif"),
+            usage_error("plot bsr", "give --learning, --filmstrip and/or --gif"),
         ),
         (
             ["plot", "composite", "R.h5"],
-            usage_error("plot composite: give --filmstrips, --search and/or --gif"),
+            usage_error("plot composite", "give --filmstrips, --search and/or --gif"),
         ),
         *(
             (
@@ -206,45 +206,45 @@ def usage_error(message: str) -> str:
                     *y,
                     *more,
                 ],
-                usage_error(message),
+                usage_error("starts", message),
             )
             for y, more, message in (
                 (
                     ("0", "1", "2"),
                     ("--threads", "0"),
-                    "starts: --threads must be a whole number from 1 to 2147483647, got 0",
+                    "--threads must be a whole number from 1 to 2147483647, got 0",
                 ),
-                (("0", "1", "2"), ("--dt", "0"), "starts: --dt must be a number > 0, got 0.0"),
+                (("0", "1", "2"), ("--dt", "0"), "--dt must be a number > 0, got 0.0"),
                 (
                     ("0", "1", "2"),
                     ("--seconds", "nan"),
-                    "starts: --seconds must be a number > 0, got nan",
+                    "--seconds must be a number > 0, got nan",
                 ),
                 (
                     ("0", "1", "0.5"),
                     (),
-                    "starts: --y's COUNT must be a whole number >= 1, got 0.5",
+                    "--y's COUNT must be a whole number >= 1, got 0.5",
                 ),
-                (("nan", "1", "2"), (), "starts: --y must be finite numbers, got nan 1.0 2.0"),
+                (("nan", "1", "2"), (), "--y must be finite numbers, got nan 1.0 2.0"),
                 (
                     ("0", "1", "1e6"),
                     (),
-                    "starts: at most 1,000,000 starts, asked for 2,000,000",
+                    "at most 1,000,000 starts, asked for 2,000,000",
                 ),
-                (("2", "1", "2"), (), "starts: --y's MIN must not exceed its MAX, got 2 1"),
-                (("3.5", "3.6", "1"), (), "starts: --y 3.5 3.6 1: one start needs MIN = MAX"),
+                (("2", "1", "2"), (), "--y's MIN must not exceed its MAX, got 2 1"),
+                (("3.5", "3.6", "1"), (), "--y 3.5 3.6 1: one start needs MIN = MAX"),
             )
         ),
         # issue 27's verb fuzz: numeric options nothing checked (tracebacks and hangs)
         *(
-            (argv, usage_error(message))
+            (argv, usage_error("run", message))
             for argv, message in (
                 (["run", "S.anim", "--controllers", "c", "--dt", dt, "-o", "T.h5"], message)
                 for dt, message in (
-                    ("0", "run: --dt must be a number > 0, got 0.0"),
-                    ("-1", "run: --dt must be a number > 0, got -1.0"),
-                    ("inf", "run: --dt must be a number > 0, got inf"),
-                    ("nan", "run: --dt must be a number > 0, got nan"),
+                    ("0", "--dt must be a number > 0, got 0.0"),
+                    ("-1", "--dt must be a number > 0, got -1.0"),
+                    ("inf", "--dt must be a number > 0, got inf"),
+                    ("nan", "--dt must be a number > 0, got nan"),
                 )
             )
         ),
@@ -252,48 +252,57 @@ def usage_error(message: str) -> str:
             (
                 ["composite", "S.comp", f"--{key}", value, "-o", "C.h5"],
                 usage_error(
-                    f"composite: --{key} must be a whole number from 1 to {2**31 - 1}, got {value}"
+                    "composite",
+                    f"--{key} must be a whole number from 1 to {2**31 - 1}, got {value}",
                 ),
             )  # fmt: skip
             for key, value in (("q", "-1"), ("g", "0"), ("h", "2147483648"))
         ),
         (
             ["dp", "S.ssc", "--tol", "-0.001", "-o", "T.h5"],
-            usage_error("dp: --tol must be a number > 0, got -0.001"),
+            usage_error("dp", "--tol must be a number > 0, got -0.001"),
         ),
         (
             ["dp", "S.ssc", "--max-iterations", "9223372036854775808", "-o", "T.h5"],
             usage_error(
-                "dp: --max-iterations must be a whole number from 1 to 2147483647, got "
-                "9223372036854775808"
+                "dp",
+                "--max-iterations must be a whole number from 1 to 2147483647, got "
+                "9223372036854775808",
             ),
         ),
         (
             ["bsr-search", "S.bsr", "--seed", "1", "--threads", "99999999999999999999999"]
             + ["-o", "R.h5"],
             usage_error(
-                "bsr-search: --threads must be a whole number from 0 to 2147483647, got "
-                "99999999999999999999999"
+                "bsr-search",
+                "--threads must be a whole number from 0 to 2147483647, got "
+                "99999999999999999999999",
             ),
         ),
-        ([], usage_error("the following arguments are required: verb")),
+        ([], usage_error("", "the following arguments are required: verb")),
         (
             ["compile", "F.fig"],
-            "usage: mosys compile [-h] -o OUTPUT spec\n"
-            "mosys compile: error: the following arguments are required: -o/--output\n",
+            usage_error("compile", "the following arguments are required: -o/--output"),
         ),
         (  # the verb's usage: the top level's named no verb
             ["info", "a.h5", "b.h5"],
-            "usage: mosys info [-h] file\nmosys info: error: unrecognized arguments: b.h5\n",
+            usage_error("info", "unrecognized arguments: b.h5"),
         ),
     ],
 )
-def test_bad_arguments(tmp_path, monkeypatch, capsys, argv, stderr):
+def test_bad_arguments(tmp_path, monkeypatch, capsys, argv, error):
+    """mosys's own checks of a verb's arguments print what argparse's print: the verb's usage
+    first, then ``mosys VERB: error: ...``."""
     monkeypatch.chdir(tmp_path)
     with pytest.raises(SystemExit) as exit_:
         main(argv)
     assert exit_.value.code == 2
-    assert capsys.readouterr() == ("", stderr)
+    out, err = capsys.readouterr()
+    prog, message = error
+    assert out == ""
+    assert err.startswith(f"usage: {prog} [-h]")
+    assert err.endswith(f"\n{prog}: error: {message}\n")
+    assert err.count(": error: ") == 1
     assert list(tmp_path.iterdir()) == []
 
 

@@ -118,7 +118,7 @@ def test_an_output_given_as_an_input_on_the_command_line_is_refused_before_runni
     message = refused(["starts", table, "--dynamics", pendulum / "dynamics" / "link1.py",
                        "--x", 0, 1, 2, "--y", 0, 1, 2, "-o", table], capsys)  # fmt: skip
     assert message == (
-        f"mosys: error: starts: --output {table} is also an input of this command; write the "
+        f"mosys starts: error: --output {table} is also an input of this command; write the "
         "output elsewhere"
     )
     assert table.read_bytes() == before
@@ -133,7 +133,7 @@ def test_two_outputs_naming_one_file_are_refused(pendulum, tmp_path, capsys):
     )  # fmt: skip
     assert (
         message
-        == f"mosys: error: plot controller: --portrait and --torque name the same file, {out}"
+        == f"mosys plot controller: error: --portrait and --torque name the same file, {out}"
     )
     assert not out.exists()
 
@@ -212,11 +212,11 @@ def test_the_job_server_replaces_only_a_socket(tmp_path, capsys):
     victim = tmp_path / "victim.h5"
     victim.write_bytes(b"kept")
     message = refused(["job-server", victim, "--idle", "1"], capsys)
-    assert message == f"mosys: error: job-server: {victim} exists and is not a socket; not replaced"
+    assert message == f"mosys job-server: error: {victim} exists and is not a socket; not replaced"
     assert victim.read_bytes() == b"kept"
     message = refused(["job-server", tmp_path / "no" / "sock"], capsys)
     assert message == (
-        f"mosys: error: job-server: {tmp_path}/no/sock: expected a path in an existing folder "
+        f"mosys job-server: error: {tmp_path}/no/sock: expected a path in an existing folder "
         f"({tmp_path}/no)"
     )
 
@@ -225,21 +225,21 @@ def test_the_job_server_replaces_only_a_socket(tmp_path, capsys):
     ("argv", "message"),
     [
         (["robustness-table", "r.h5", "--pair", "a", "a", "--csv", "t.csv", "--md", "t.md"],
-         "mosys: error: robustness-table: --pair a a: a robust search and another, its twin"),
+         "mosys robustness-table: error: --pair a a: a robust search and another, its twin"),
         (["plot", "controls", "t.h5", "--control", "", "-o", "c.png"],
-         "mosys: error: plot controls: --control must name a control (default: the first)"),
-        (["plot", "luxo", "t.h5"], "mosys: error: plot luxo: give --strip, --forces and/or --gif"),
+         "mosys plot controls: error: --control must name a control (default: the first)"),
+        (["plot", "luxo", "t.h5"], "mosys plot luxo: error: give --strip, --forces and/or --gif"),
         (["plot", "bsr3d", "r.h5", "--filmstrip", "f.png", "--interval", "inf"],
-         "mosys: error: plot bsr3d: --interval must be a positive number of seconds, got inf"),
+         "mosys plot bsr3d: error: --interval must be a positive number of seconds, got inf"),
         (["plot", "car", "--map", "g.h5", "map.gif"],
          "mosys plot car: error: argument --map: expected a file name ending in .png or .pdf "
          "or .svg, got 'map.gif'"),
         (["plot", "car", "--map", "g.h5", "same.png", "--consistency", "g.h5", "same.png"],
-         "mosys: error: plot car: --map and --consistency name the same file, same.png"),
+         "mosys plot car: error: --map and --consistency name the same file, same.png"),
         (["composite", "s.comp", "--controllers", "a/seed1.h5", "--bsr-results", "r", "-o",
-          "c.h5"], "mosys: error: composite: give --controllers or --bsr-results, not both"),
+          "c.h5"], "mosys composite: error: give --controllers or --bsr-results, not both"),
         (["composite", "s.comp", "--controllers", "a/table.h5", "-o", "c.h5"],
-         "mosys: error: composite: --controllers a/table.h5: expected a seed file, "
+         "mosys composite: error: --controllers a/table.h5: expected a seed file, "
          "SEARCH/seedK.h5"),
     ],
 )  # fmt: skip

@@ -302,7 +302,7 @@ def test_bsr_search_refuses_a_huge_seed_argument(tmp_path: Path) -> None:
     assert "Traceback" not in done.stderr
     assert done.returncode == 2
     assert done.stderr.endswith(
-        f"mosys: error: bsr-search: --seed must be a whole number from 0 to {MAX_INT64}, got "
+        f"mosys bsr-search: error: --seed must be a whole number from 0 to {MAX_INT64}, got "
         f"{HUGE_SEED}\n"
     )
     assert not list(tmp_path.glob("*.h5"))

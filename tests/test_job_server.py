@@ -353,7 +353,7 @@ def test_a_second_server_on_a_live_servers_socket_is_refused(server):
     )
     assert done.returncode == 2
     assert done.stderr.strip().splitlines()[-1] == (
-        f"mosys: error: job-server: a job server is already listening on {server.socket}"
+        f"mosys job-server: error: a job server is already listening on {server.socket}"
     )
     assert server.process.poll() is None and server.socket.exists()
 

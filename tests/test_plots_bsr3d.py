@@ -941,7 +941,10 @@ def test_cli_rejects_bad_input(
         with pytest.raises(SystemExit) as exit_:
             main(arguments)
         assert exit_.value.code == 2
-    assert "plot bsr3d-kinds: give --time and/or --sense result files" in capsys.readouterr().err
+    assert (
+        "mosys plot bsr3d-kinds: error: give --time and/or --sense result files"
+        in capsys.readouterr().err
+    )
     files = [str(path) for path in chain_files(chain)]
     for option, value, message in (
         ("--azimuth", "200", "--azimuth must be between -180 and 180 deg, got 200.0"),
@@ -951,7 +954,7 @@ def test_cli_rejects_bad_input(
         with pytest.raises(SystemExit) as exit_:
             main(["plot", "bsr3d", *files, "--filmstrip", str(out), option, value])
         assert exit_.value.code == 2
-        assert f"plot bsr3d: {message}" in capsys.readouterr().err
+        assert f"mosys plot bsr3d: error: {message}" in capsys.readouterr().err
     assert not out.exists()
 
 

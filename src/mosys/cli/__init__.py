@@ -140,11 +140,11 @@ def main(argv: list[str] | None = None) -> int:
     args, unknown = parser.parse_known_args(argv)
     if unknown:  # the verb's usage, not the top level's (which names no verb)
         args.verb_parser.error(f"unrecognized arguments: {' '.join(unknown)}")
-    problem = (
-        args.command.check(args)
-        or same_file_problem(args, args.file_options)
-        or environment_problem()
-    )
+    # a usage error of the verb's arguments under the verb's usage, as argparse's own are
+    problem = args.command.check(args) or same_file_problem(args, args.file_options)
+    if problem:
+        args.verb_parser.error(problem)
+    problem = environment_problem()  # no argument's fault: under mosys's own usage
     if problem:
         parser.error(problem)
     from mosys.files import command_files

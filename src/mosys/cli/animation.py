@@ -19,7 +19,7 @@ def _run_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run_check(args: argparse.Namespace) -> str | None:
-    return positive_number_problem("run", "dt", args.dt)
+    return positive_number_problem("dt", args.dt)
 
 
 def _run(args: argparse.Namespace) -> None:

@@ -37,10 +37,10 @@ def _bsr_search_check(args: argparse.Namespace) -> str | None:
     from mosys.parsing.tokens import MAX_INT64
 
     return first_problem(
-        whole_number_problem("bsr-search", "seed", args.seed, 0, MAX_INT64),
-        whole_number_problem("bsr-search", "generations", args.generations, 1),
+        whole_number_problem("seed", args.seed, 0, MAX_INT64),
+        whole_number_problem("generations", args.generations, 1),
         # 0: numba's default
-        whole_number_problem("bsr-search", "threads", args.threads, 0),
+        whole_number_problem("threads", args.threads, 0),
     )
 
 

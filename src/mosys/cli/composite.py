@@ -37,14 +37,14 @@ def _composite_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _composite_check(args: argparse.Namespace) -> str | None:
     if args.controllers is not None and args.bsr_results is not None:
-        return "composite: give --controllers or --bsr-results, not both"
+        return "give --controllers or --bsr-results, not both"
     from mosys.composite.session import SEED_FILE
 
     odd = [path for path in args.controllers or () if not SEED_FILE.fullmatch(Path(path).name)]
     if odd:
-        return f"composite: --controllers {odd[0]}: expected a seed file, SEARCH/seedK.h5"
+        return f"--controllers {odd[0]}: expected a seed file, SEARCH/seedK.h5"
     return first_problem(
-        *(whole_number_problem("composite", key, getattr(args, key), 1) for key in ("q", "g", "h"))
+        *(whole_number_problem(key, getattr(args, key), 1) for key in ("q", "g", "h"))
     )
 
 

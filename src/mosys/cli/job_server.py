@@ -531,17 +531,17 @@ def _check(args: argparse.Namespace) -> str | None:
     would be destroyed), or where a server already answers."""
     folder = os.path.dirname(args.socket) or "."
     if not os.path.isdir(folder):
-        return f"job-server: {args.socket}: expected a path in an existing folder ({folder})"
+        return f"{args.socket}: expected a path in an existing folder ({folder})"
     longest = max(len(os.fsencode(args.socket)), len(os.fsencode(_unready_path(args.socket))))
     if longest > SOCKET_PATH_BYTES:
-        return f"job-server: {args.socket}: a socket's path is at most {SOCKET_PATH_BYTES} bytes"
+        return f"{args.socket}: a socket's path is at most {SOCKET_PATH_BYTES} bytes"
     with contextlib.suppress(OSError):
         if not stat.S_ISSOCK(os.lstat(args.socket).st_mode):
-            return f"job-server: {args.socket} exists and is not a socket; not replaced"
+            return f"{args.socket} exists and is not a socket; not replaced"
         with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as probe:
             probe.connect(args.socket)  # answered: not stale
-            return f"job-server: a job server is already listening on {args.socket}"
-    return positive_number_problem("job-server", "idle", args.idle)
+            return f"a job server is already listening on {args.socket}"
+    return positive_number_problem("idle", args.idle)
 
 
 def _job_server(args: argparse.Namespace) -> None:

@@ -126,9 +126,7 @@ def _robustness_table_arguments(parser: argparse.ArgumentParser) -> None:
 def _robustness_table_check(args: argparse.Namespace) -> str | None:
     same = next((pair for pair in args.pair if pair[0] == pair[1]), None)
     if same:
-        return (
-            f"robustness-table: --pair {same[0]} {same[1]}: a robust search and another, its twin"
-        )
+        return f"--pair {same[0]} {same[1]}: a robust search and another, its twin"
     return None
 
 

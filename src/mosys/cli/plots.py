@@ -18,9 +18,9 @@ def _controller_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _controller_check(args: argparse.Namespace) -> str | None:
     if not (args.portrait or args.torque):
-        return "plot controller: give --portrait and/or --torque"
+        return "give --portrait and/or --torque"
     if args.portrait and not args.dynamics:
-        return "plot controller: --portrait needs --dynamics"
+        return "--portrait needs --dynamics"
     return None
 
 
@@ -46,7 +46,7 @@ def _script_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _script_check(args: argparse.Namespace) -> str | None:
     if not (args.path or args.gif):
-        return "plot script: give --path and/or --gif"
+        return "give --path and/or --gif"
     return None
 
 
@@ -67,7 +67,7 @@ def _controls_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _controls_check(args: argparse.Namespace) -> str | None:
     if args.control is not None and not args.control.strip():
-        return "plot controls: --control must name a control (default: the first)"
+        return "--control must name a control (default: the first)"
     return None
 
 
@@ -122,9 +122,9 @@ def _car_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _car_check(args: argparse.Namespace) -> str | None:
     if not (args.frames or args.gif or args.map or args.consistency):
-        return "plot car: give --frames, --gif, --map and/or --consistency"
+        return "give --frames, --gif, --map and/or --consistency"
     if (args.frames or args.gif) and not args.trajectories:
-        return "plot car: --frames and --gif need trajectories"
+        return "--frames and --gif need trajectories"
     return None
 
 
@@ -160,7 +160,7 @@ def _luxo_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _luxo_check(args: argparse.Namespace) -> str | None:
     if not (args.strip or args.forces or args.gif):
-        return "plot luxo: give --strip, --forces and/or --gif"
+        return "give --strip, --forces and/or --gif"
     return None
 
 
@@ -192,7 +192,7 @@ def _bsr_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _bsr_check(args: argparse.Namespace) -> str | None:
     if not (args.learning or args.filmstrip or args.gif):
-        return "plot bsr: give --learning, --filmstrip and/or --gif"
+        return "give --learning, --filmstrip and/or --gif"
     return None
 
 
@@ -252,13 +252,13 @@ def _bsr3d_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _bsr3d_check(args: argparse.Namespace) -> str | None:
     if not (args.filmstrip or args.gif or args.rest):
-        return "plot bsr3d: give --filmstrip, --gif and/or --rest"
+        return "give --filmstrip, --gif and/or --rest"
     if args.interval is not None and not 0 < args.interval < float("inf"):
-        return f"plot bsr3d: --interval must be a positive number of seconds, got {args.interval}"
+        return f"--interval must be a positive number of seconds, got {args.interval}"
     if args.azimuth is not None and not -180 <= args.azimuth <= 180:
-        return f"plot bsr3d: --azimuth must be between -180 and 180 deg, got {args.azimuth}"
+        return f"--azimuth must be between -180 and 180 deg, got {args.azimuth}"
     if args.elevation is not None and not 0 <= args.elevation <= 90:
-        return f"plot bsr3d: --elevation must be between 0 and 90 deg, got {args.elevation}"
+        return f"--elevation must be between 0 and 90 deg, got {args.elevation}"
     return None
 
 
@@ -292,7 +292,7 @@ def _bsr3d_kinds_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _bsr3d_kinds_check(args: argparse.Namespace) -> str | None:
     if not (args.time or args.sense):
-        return "plot bsr3d-kinds: give --time and/or --sense result files"
+        return "give --time and/or --sense result files"
     return None
 
 
@@ -331,7 +331,7 @@ def _composite_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _composite_check(args: argparse.Namespace) -> str | None:
     if not (args.filmstrips or args.search or args.gif):
-        return "plot composite: give --filmstrips, --search and/or --gif"
+        return "give --filmstrips, --search and/or --gif"
     return None
 
 

@@ -35,8 +35,8 @@ def _dp_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _dp_check(args: argparse.Namespace) -> str | None:
     return first_problem(
-        positive_number_problem("dp", "tol", args.tol),
-        whole_number_problem("dp", "max-iterations", args.max_iterations, 1),
+        positive_number_problem("tol", args.tol),
+        whole_number_problem("max-iterations", args.max_iterations, 1),
     )
 
 
@@ -88,27 +88,27 @@ MAX_STARTS = 1_000_000  # a start runs for seconds; a million take days on two c
 
 def _starts_check(args: argparse.Namespace) -> str | None:
     problem = first_problem(
-        whole_number_problem("starts", "threads", args.threads, 1),
-        positive_number_problem("starts", "seconds", args.seconds),
-        positive_number_problem("starts", "dt", args.dt),
+        whole_number_problem("threads", args.threads, 1),
+        positive_number_problem("seconds", args.seconds),
+        positive_number_problem("dt", args.dt),
     )
     if problem:
         return problem
     for name in ("x", "y", "heading", "steer"):
         values = getattr(args, name)
         if not all(math.isfinite(value) for value in values):
-            return f"starts: --{name} must be finite numbers, got {' '.join(map(str, values))}"
+            return f"--{name} must be finite numbers, got {' '.join(map(str, values))}"
     for axis in ("x", "y"):
         low, high, count = getattr(args, axis)
         if count < 1 or count != int(count):
-            return f"starts: --{axis}'s COUNT must be a whole number >= 1, got {count:g}"
+            return f"--{axis}'s COUNT must be a whole number >= 1, got {count:g}"
         if low > high:
-            return f"starts: --{axis}'s MIN must not exceed its MAX, got {low:g} {high:g}"
+            return f"--{axis}'s MIN must not exceed its MAX, got {low:g} {high:g}"
         if count == 1 and low != high:  # it used MIN alone, without a word
-            return f"starts: --{axis} {low:g} {high:g} 1: one start needs MIN = MAX"
+            return f"--{axis} {low:g} {high:g} 1: one start needs MIN = MAX"
     starts = args.x[2] * args.y[2] * len(args.heading) * len(args.steer)
     if starts > MAX_STARTS:
-        return f"starts: at most {MAX_STARTS:,} starts, asked for {starts:,.0f}"
+        return f"at most {MAX_STARTS:,} starts, asked for {starts:,.0f}"
     return None
 
 

@@ -18,19 +18,19 @@ def no_check(args: argparse.Namespace) -> str | None:
 
 
 def whole_number_problem(
-    verb: str, option: str, value: int | None, low: int, high: int = MAX_WHOLE
+    option: str, value: int | None, low: int, high: int = MAX_WHOLE
 ) -> str | None:
     """The usage error of ``--option`` outside ``low..high`` (None: not given, fine)."""
     if value is None or low <= value <= high:
         return None
-    return f"{verb}: --{option} must be a whole number from {low} to {high}, got {value}"
+    return f"--{option} must be a whole number from {low} to {high}, got {value}"
 
 
-def positive_number_problem(verb: str, option: str, value: float | None) -> str | None:
+def positive_number_problem(option: str, value: float | None) -> str | None:
     """The usage error of ``--option`` that is not a finite number > 0 (None: not given)."""
     if value is None or 0 < value < float("inf"):
         return None
-    return f"{verb}: --{option} must be a number > 0, got {value}"
+    return f"--{option} must be a number > 0, got {value}"
 
 
 def first_problem(*problems: str | None) -> str | None:
@@ -124,7 +124,7 @@ def same_file_problem(args: argparse.Namespace, options: FileOptions) -> str | N
         if value:
             other = written.setdefault(os.path.realpath(value), option)
             if other != option:
-                return f"{args.command.name}: {other} and {option} name the same file, {value}"
+                return f"{other} and {option} name the same file, {value}"
     for value in options.inputs(args):
         for text in value if isinstance(value, list) else [value]:
             for path in text if isinstance(text, list) else [text]:
@@ -132,7 +132,7 @@ def same_file_problem(args: argparse.Namespace, options: FileOptions) -> str | N
                     option = written.get(os.path.realpath(path))
                     if option:
                         return (
-                            f"{args.command.name}: {option} {path} is also an input of this "
+                            f"{option} {path} is also an input of this "
                             "command; write the output elsewhere"
                         )
     return None
