@@ -10,7 +10,8 @@ and six had gone stale.
 
 Only the errors mosys raises before it computes anything are reproduced (no DP or search runs);
 runtime errors (``the state became non-finite``) and warnings have no ``expected`` and are not
-collected.
+collected. The usage errors the README shows (``mosys VERB: error: ...``) are held to what
+their command lines print the same way.
 """
 
 from __future__ import annotations
@@ -239,6 +240,41 @@ def test_the_example_is_what_mosys_prints(start, tmp_path, monkeypatch, capsys, 
     assert not list(tmp_path.glob("out.*")), "an output was written"
 
 
+# --- usage errors (``mosys VERB: error: ...``, shown without the usage argparse prints first) -
+
+USAGE_EXAMPLE = re.compile(r"^ *(mosys [a-z][a-z0-9 -]*: error: .*)$", re.MULTILINE)
+USAGE_EXAMPLES = [
+    match.group(1)
+    for document in DOCUMENTS
+    for match in USAGE_EXAMPLE.finditer(document.read_text(encoding="utf-8"))
+]
+A_TABLE = "results/controllers/pendulum/A.h5"  # an input that exists (written empty: never read)
+# the start of each usage example (its verb and option) -> the command line that makes it
+USAGE_RECIPES = {
+    "mosys bsr-search: error: --seed": ["bsr-search", "jump.bsr", "--seed", "9" * 23]
+    + ["-o", "out.h5"],
+    "mosys run: error: --dt": ["run", "S.anim", "--controllers", "c", "--dt", "0", "-o", "out.h5"],
+    "mosys run: error: argument -o/--output": ["run", "S.anim", "--controllers", "results"]
+    + ["-o", "results/controllers"],
+    "mosys plot controller: error: --portrait and --torque": ["plot", "controller", A_TABLE]
+    + ["--dynamics", "link1.py", "--portrait", "out.png", "--torque", "out.png"],
+}
+
+
+@pytest.mark.parametrize("start", list(USAGE_RECIPES))
+def test_the_usage_example_is_what_mosys_prints(start, tmp_path, monkeypatch, capsys):
+    """The error line (the last) of what the verb prints; argparse prints its usage first."""
+    [expected] = [text for text in USAGE_EXAMPLES if text.startswith(start)]
+    monkeypatch.chdir(tmp_path)
+    write(tmp_path / A_TABLE, "")
+    with pytest.raises(SystemExit) as exit_:
+        main(USAGE_RECIPES[start])
+    err = capsys.readouterr().err
+    assert (exit_.value.code, err.splitlines()[-1]) == (2, expected)
+    assert err.startswith(f"usage: {expected.split(':')[0]} [-h]")
+    assert not list(tmp_path.glob("out.*")), "an output was written"
+
+
 def test_every_example_has_a_recipe():
     starts = [*RECIPES, *EXEMPT]
     for text in EXAMPLES:
@@ -246,3 +282,6 @@ def test_every_example_has_a_recipe():
         assert len(matching) == 1, f"{len(matching)} recipes or exemptions for {text!r}"
     for start in EXEMPT:
         example(start)  # each exemption is of an example still there
+    for text in USAGE_EXAMPLES:
+        matching = [start for start in USAGE_RECIPES if text.startswith(start)]
+        assert len(matching) == 1, f"{len(matching)} recipes for {text!r}"
