@@ -3,8 +3,8 @@ now: the same sections, root attribute names, groups, datasets and group attribu
 values, such as hashes, timings and fitness, may differ). Three examples had drifted unnoticed
 (a table and a search without ``policy_sweeps`` and ``compile_seconds``, a trajectory's
 ``/state`` without its units), found by reading the pages against real files on 2026-12-07.
-The files are conftest's ``made`` (``mosys info``'s tests share them); the car's examples are
-left out: their files take a minute to make."""
+The files are conftest's ``made`` (``mosys info``'s tests share them), and for the car's two
+examples a table and a run of a small scene (the shipped files take a minute to make)."""
 
 from __future__ import annotations
 
@@ -95,3 +95,31 @@ def test_the_bsr_result_example(made, capsys):
 def test_the_composite_result_example(made, capsys):
     marker = "mosys info results/composite/starman_show.h5"
     same_structure("composite_result.md", marker, made["composite result"], capsys)
+
+
+def test_the_cars_examples(car, tmp_path, capsys):
+    """The car's table and trajectory, made from the car test's small scene with the shipped
+    table's known_weight and policy lines (so the same datasets; seconds, not a minute)."""
+    from test_car import SMALL
+
+    from mosys.animation.trajectory_file import run_animation_script
+    from mosys.dynamics.compile import compile_figure
+    from mosys.parsing.controller import parse_controller_text
+    from mosys.ssc.generate import generate_controller
+
+    shipped = (SPECS / "controllers" / "car" / "park.ssc").read_text().splitlines()
+    lines = [line for line in shipped if line.startswith(("known_weight", "policy"))]
+    spec = parse_controller_text(SMALL + "\n".join(lines) + "\n", "park.ssc")
+    (tmp_path / "controllers").mkdir()
+    table = tmp_path / "controllers" / "park.h5"
+    generate_controller(spec, car, table, quiet=True)
+    marker = "mosys info results/controllers/car/park.h5"
+    same_structure("controller_table.md", marker, table, capsys, partial=True)
+    (tmp_path / "dynamics").mkdir()
+    compile_figure(SPECS / "figures" / "car.fig", tmp_path / "dynamics" / "car.py")
+    script = tmp_path / "park_1.anim"
+    script.write_text("state car 1,1.5,0,-30,0\nswapcon car conpark.ctab\nsim 0.5\n")
+    trajectory = tmp_path / "park_1.h5"
+    controllers, dynamics = tmp_path / "controllers", tmp_path / "dynamics"
+    run_animation_script(script, controllers, dynamics, trajectory, 0.01)
+    same_structure("trajectory.md", "A car trajectory", trajectory, capsys, partial=True)
