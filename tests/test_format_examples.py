@@ -3,8 +3,9 @@ now: the same sections, root attribute names, groups, datasets and group attribu
 values, such as hashes, timings and fitness, may differ). Three examples had drifted unnoticed
 (a table and a search without ``policy_sweeps`` and ``compile_seconds``, a trajectory's
 ``/state`` without its units), found by reading the pages against real files on 2026-12-07.
-The files are conftest's ``made`` (``mosys info``'s tests share them), and for the car's two
-examples a table and a run of a small scene (the shipped files take a minute to make)."""
+The files are conftest's ``made`` (``mosys info``'s tests share them), and for the car's three
+examples a table, a run and a start grid of a small scene (the shipped files take a minute to
+make)."""
 
 from __future__ import annotations
 
@@ -98,8 +99,9 @@ def test_the_composite_result_example(made, capsys):
 
 
 def test_the_cars_examples(car, tmp_path, capsys):
-    """The car's table and trajectory, made from the car test's small scene with the shipped
-    table's known_weight and policy lines (so the same datasets; seconds, not a minute)."""
+    """The car's table, trajectory and start grid, made from the car test's small scene with
+    the shipped table's known_weight and policy lines (so the same datasets; seconds, not a
+    minute)."""
     from test_car import SMALL
 
     from mosys.animation.trajectory_file import run_animation_script
@@ -123,3 +125,9 @@ def test_the_cars_examples(car, tmp_path, capsys):
     controllers, dynamics = tmp_path / "controllers", tmp_path / "dynamics"
     run_animation_script(script, controllers, dynamics, trajectory, 0.01)
     same_structure("trajectory.md", "A car trajectory", trajectory, capsys, partial=True)
+    grid = tmp_path / "start_grid.h5"
+    axes = ["--x", "-1", "1", "2", "--y", "1.5", "1.5", "1", "--heading", "0", "--steer", "0"]
+    argv = ["starts", str(table), "--dynamics", str(dynamics / "car.py"), *axes]
+    assert main([*argv, "--seconds", "2", "--quiet", "-o", str(grid)]) == 0
+    capsys.readouterr()  # its line of results
+    same_structure("start_grid.md", "mosys info results/car/start_grid.h5", grid, capsys)
