@@ -3,7 +3,8 @@
 the example describes (a shipped spec with a line edited, or a short text for a file that does
 not ship), written at the example's own path in an empty directory, and the verb a user would
 run on it. The verb must exit 2 and print the example, word for word as the README has it
-(an inline example wrapped across lines read as one line). The examples are read from the
+(an inline example wrapped across lines read as one line; the memory limit's example with this
+machine's memory for the README's). The examples are read from the
 README at test time, so a message changed in either place fails here; an example added without
 a recipe fails ``test_every_example_has_a_recipe``. Until this test they were compared by hand,
 and six had gone stale.
@@ -28,6 +29,7 @@ from test_car import SMALL
 from test_car_lookahead import ARRIVAL
 
 from mosys.cli import main
+from mosys.limits import physical_memory_bytes
 from mosys.parsing.motor import parse_motor_program
 from mosys.parsing.tokens import SpecError
 
@@ -178,15 +180,17 @@ RECIPES: dict[str, str | Special] = {
     "jump.bsr:7:9:": edited(JUMP, 7, "seeds 1 2", "seeds 1 99999999999999999999999"),
     # "Limits": a sim line past the steps limit at mosys run's dt, 1 ms
     "pendulum.anim:3:1:": edited("scripts/pendulum.anim", 3, "sim 0.4", "sim 100000"),
+    # "Limits": a million torque samples against a limit of 4 GiB (ENVIRONMENT)
+    "A.ssc:9:6:": edited(PENDULUM_A, 9, "10.0 11 0.1", "10.0 1000000 0.1"),
     # "Files in the wrong place"
     "specs/x.anim:1:1:": Special.FIFO,
 }
 
 # Examples with no recipe, and why.
-EXEMPT = {
-    # "Limits": the message gives this machine's memory
-    "A.ssc:9:6:",
-}
+# The environment a recipe runs in: the memory example's limit (its message also gives this
+# machine's memory, which the comparison takes from this machine)
+ENVIRONMENT = {"A.ssc:9:6:": {"MOSYS_MAX_MEMORY_GIB": "4"}}
+MACHINE_MEMORY = re.compile(r"this machine has [\d,.]+ GiB")
 
 
 def write(path: Path, text: str | Special) -> None:
@@ -229,10 +233,13 @@ def command(path: str, text: str | Special, request: pytest.FixtureRequest) -> l
 
 @pytest.mark.parametrize("start", list(RECIPES), ids=[start.rstrip(":") for start in RECIPES])
 def test_the_example_is_what_mosys_prints(start, tmp_path, monkeypatch, capsys, request):
-    expected = example(start)
+    machine = f"this machine has {physical_memory_bytes() / 2**30:,.2f} GiB"
+    expected = MACHINE_MEMORY.sub(machine, example(start))
     path = start.split(":", 1)[0]
     text = RECIPES[start]
     monkeypatch.chdir(tmp_path)
+    for variable, value in ENVIRONMENT.get(start, {}).items():
+        monkeypatch.setenv(variable, value)
     write(tmp_path / path, text)
     if path.endswith(".mot"):
         # no verb reads a motor program alone: `mosys run` reads DIR/FIGURE/NAME.mot for a
@@ -282,12 +289,9 @@ def test_the_usage_example_is_what_mosys_prints(start, tmp_path, monkeypatch, ca
 
 
 def test_every_example_has_a_recipe():
-    starts = [*RECIPES, *EXEMPT]
     for text in EXAMPLES:
-        matching = [start for start in starts if text.startswith(start)]
-        assert len(matching) == 1, f"{len(matching)} recipes or exemptions for {text!r}"
-    for start in EXEMPT:
-        example(start)  # each exemption is of an example still there
+        matching = [start for start in RECIPES if text.startswith(start)]
+        assert len(matching) == 1, f"{len(matching)} recipes for {text!r}"
     for text in USAGE_EXAMPLES:
         matching = [start for start in USAGE_RECIPES if text.startswith(start)]
         assert len(matching) == 1, f"{len(matching)} recipes for {text!r}"
