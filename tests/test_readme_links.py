@@ -1,6 +1,7 @@
-"""The README's and the format documents' links lead somewhere: every ``(#anchor)`` names a
-heading of its own file (as GitHub makes anchors of headings), every relative link an existing
-file, and the README's contents list names every section, in order."""
+"""The README's, CHANGES.md's and the format documents' links lead somewhere: every
+``(#anchor)`` names a heading of its own file (as GitHub makes anchors of headings), every
+relative link an existing file (and a heading of it, with ``#anchor``), and the README's
+contents list names every section, in order."""
 
 from __future__ import annotations
 
@@ -10,7 +11,11 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-DOCUMENTS = [ROOT / "README.md", *sorted((ROOT / "docs" / "formats").glob("*.md"))]
+DOCUMENTS = [
+    ROOT / "README.md",
+    ROOT / "CHANGES.md",
+    *sorted((ROOT / "docs" / "formats").glob("*.md")),
+]
 LINK = re.compile(r"\]\(([^)\s]+)\)")
 HEADING = re.compile(r"^(#{1,6}) (.+)$")
 
@@ -55,13 +60,15 @@ def test_anchor_follows_github():
 @pytest.mark.parametrize("path", DOCUMENTS, ids=lambda path: path.name)
 def test_links_lead_somewhere(path: Path):
     text = path.read_text(encoding="utf-8")
-    known = set(anchors(text))
     broken = []
     for target in LINK.findall(text):
         if target.startswith(("http://", "https://", "mailto:")):
             continue
         file, _, fragment = target.partition("#")
-        leads = (path.parent / file).exists() if file else fragment in known
+        linked = path.parent / file if file else path
+        leads = linked.exists() and (
+            not fragment or fragment in anchors(linked.read_text(encoding="utf-8"))
+        )
         if not leads:
             broken.append(target)
     assert not broken, f"{path.name}: links to nowhere: {broken}"
