@@ -141,7 +141,6 @@ def generate_controller(
     kernel_load_seconds = solution.kernel_load_seconds
     if arrival is not None and arrival is not solution:
         kernel_load_seconds += arrival.kernel_load_seconds
-    generation_seconds = time.perf_counter() - started - kernel_load_seconds
     grid = problem.grid
     lower = np.array([c.minimum for c in spec.controls])
     upper = np.array([c.maximum for c in spec.controls])
@@ -150,6 +149,7 @@ def generate_controller(
     torque[unreachable] = np.clip(0.0, lower, upper)
     if spec.hold is not None:
         torque[problem.is_destination] = holding_torques(problem, dynamics)
+    generation_seconds = time.perf_counter() - started - kernel_load_seconds
     table = ControllerTable(
         state_order=grid.names,
         control_names=tuple(c.name for c in spec.controls),
