@@ -171,9 +171,10 @@ def add_table_outputs(parser: argparse.ArgumentParser) -> None:
 class Verb:
     """A verb. ``name`` is what the user types after ``mosys``: ``"dp"``, or ``"plot car"`` for a
     kind of ``plot``. ``add_arguments`` fills the verb's parser; ``check`` returns the usage error
-    of arguments that parse but do not go together (``None`` when they do), which ``mosys``
-    reports as argparse does, exit 2; ``handler`` does the work, importing what it needs inside
-    so that ``mosys --help`` stays fast."""
+    of arguments that parse but do not go together (``None`` when they do; the message alone,
+    without the verb's name), which ``mosys`` reports under the verb's usage as argparse reports
+    its own (``mosys VERB: error: ...``), exit 2; ``handler`` does the work, importing what it
+    needs inside so that ``mosys --help`` stays fast."""
 
     name: str
     summary: str
