@@ -221,6 +221,24 @@ def test_the_job_server_replaces_only_a_socket(tmp_path, capsys):
     )
 
 
+def test_the_job_server_names_which_socket_path_is_too_long(tmp_path, capsys):
+    """A path within a socket's 107 bytes whose folder leaves no room for the name the server
+    binds first (``.mosys-job-server-PID``) was refused as itself too long."""
+    folder = tmp_path / ("d" * (100 - len(str(tmp_path))))
+    folder.mkdir()
+    path = folder / "s"
+    assert len(str(path)) <= 107
+    message = refused(["job-server", path], capsys)
+    unready = f"{folder}/.mosys-job-server-{os.getpid()}"
+    assert message == (
+        f"mosys job-server: error: {path}: its folder's path is too long: the server binds the "
+        f"socket first as {unready} ({len(unready)} bytes; a socket's path is at most 107)"
+    )
+    long = folder / ("s" * 10)
+    message = refused(["job-server", long], capsys)
+    assert message == f"mosys job-server: error: {long}: a socket's path is at most 107 bytes"
+
+
 @pytest.mark.parametrize(
     ("argv", "message"),
     [

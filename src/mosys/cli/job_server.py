@@ -527,14 +527,21 @@ def _arguments(parser: argparse.ArgumentParser) -> None:
 
 def _check(args: argparse.Namespace) -> str | None:
     """Usage errors: a bad --idle; a socket path in no folder, longer than a Unix socket's
-    path may be, naming a file that is not a socket (a stale socket is replaced; anything else
-    would be destroyed), or where a server already answers."""
+    path may be (itself, or the name it is bound at first, ``_unready_path``), naming a file
+    that is not a socket (a stale socket is replaced; anything else would be destroyed), or
+    where a server already answers."""
     folder = os.path.dirname(args.socket) or "."
     if not os.path.isdir(folder):
         return f"{args.socket}: expected a path in an existing folder ({folder})"
-    longest = max(len(os.fsencode(args.socket)), len(os.fsencode(_unready_path(args.socket))))
-    if longest > SOCKET_PATH_BYTES:
+    if len(os.fsencode(args.socket)) > SOCKET_PATH_BYTES:
         return f"{args.socket}: a socket's path is at most {SOCKET_PATH_BYTES} bytes"
+    unready = _unready_path(args.socket)
+    if len(os.fsencode(unready)) > SOCKET_PATH_BYTES:
+        return (
+            f"{args.socket}: its folder's path is too long: the server binds the socket first "
+            f"as {unready} ({len(os.fsencode(unready))} bytes; a socket's path is at most "
+            f"{SOCKET_PATH_BYTES})"
+        )
     with contextlib.suppress(OSError):
         if not stat.S_ISSOCK(os.lstat(args.socket).st_mode):
             return f"{args.socket} exists and is not a socket; not replaced"
