@@ -1,5 +1,5 @@
 """Car benchmark: generating the parking controller (the 1990 paper's §6) at the paper's size
-(about 13,250 states after removing collisions), at about 8x as many states, and at the grid
+(about 13,250 states after removing collisions), at about 7x as many states, and at the grid
 specs/controllers/car/park.ssc ships.
 
     python benchmarks/car.py            # all three, warm numba cache (after one filling run)
@@ -8,7 +8,7 @@ specs/controllers/car/park.ssc ships.
 Writes results/benchmarks/car.{csv,md} (car_smoke.* with --smoke) and prints them. The paper
 gives only its table's size (13,250 states) and none of its steps; the paper's size here is
 park.ssc (its scene, controls and destination) on steps chosen to come near it: 0.5 m in x,
-0.25 m in y, 15 deg of heading, 15 deg of steer and 0.5 m/s. The 8x grid halves the step of x, y and
+0.25 m in y, 15 deg of heading, 15 deg of steer and 0.5 m/s. The 7x grid halves the step of x, y and
 heading over the same ranges (2n - 1 nodes on each of those axes). dp_s_warm is the DP's time,
 split into its exit transitions and its value iteration (transitions_s_warm,
 value_iteration_s_warm), so that the table shows where the time goes. Each table then runs the

@@ -1,5 +1,6 @@
 """Compare two results/ trees built by the pipeline, file by file: every HDF5 dataset and
-attribute, every CSV cell, every generated module, every other file's bytes.
+attribute, every CSV and Markdown table cell, every PNG's and GIF's pixels (frame by frame),
+every generated module, every other file's bytes.
 
     python tools/compare_results.py OLD/results NEW/results
 

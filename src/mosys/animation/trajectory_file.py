@@ -1,5 +1,5 @@
-"""Steps of the pipeline that join parsing, simulation and file writing (one per ``mosys`` verb
-that is more than a single call)."""
+"""``mosys run``'s step of the pipeline: an animation script parsed, run and written as a
+trajectory file."""
 
 from __future__ import annotations
 
