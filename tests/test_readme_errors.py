@@ -11,8 +11,9 @@ and six had gone stale.
 
 Only the errors mosys raises before it computes anything are reproduced (no DP or search runs);
 runtime errors (``the state became non-finite``) and warnings have no ``expected`` and are not
-collected. The usage errors the README shows (``mosys VERB: error: ...``) are held to what
-their command lines print the same way.
+collected. The usage errors the README shows (``mosys VERB: error: ...``) and its errors of
+input files (``mosys: FILE: ...``, the wrong kind of file) are held to what their command lines
+print the same way.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ import re
 import shutil
 from pathlib import Path
 
+import h5py
 import pytest
 from conftest import ROOT, SPECS, SpecLines
 from test_car import SMALL
@@ -288,10 +290,84 @@ def test_the_usage_example_is_what_mosys_prints(start, tmp_path, monkeypatch, ca
     assert not list(tmp_path.glob("out.*")), "an output was written"
 
 
+# --- input files (``mosys: FILE: ...``): the wrong kind of file, a file that is not HDF5 -----
+
+INPUT_EXAMPLE = re.compile(r"^ +(mosys: (?!error:)\S+: .*)$", re.MULTILINE)
+INPUT_EXAMPLES = [
+    match.group(1)
+    for document in DOCUMENTS
+    for match in INPUT_EXAMPLE.finditer(document.read_text(encoding="utf-8"))
+]
+
+
+def placed(source: Path, path: str) -> str:
+    """A copy of ``source`` at ``path`` (below the working directory)."""
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    shutil.copy(source, path)
+    return path
+
+
+def a_trajectory_as_a_table(request: pytest.FixtureRequest) -> list[str]:
+    trajectory = placed(
+        request.getfixturevalue("made")["trajectory"], "results/trajectories/park_1.h5"
+    )
+    return ["plot", "controller", trajectory, "--torque", "out.png"]
+
+
+def an_odd_file_as_a_composite(request: pytest.FixtureRequest) -> list[str]:
+    with h5py.File("odd.h5", "w") as h5:
+        h5["x"] = [1.0, 2.0]
+    return ["composite-table", "odd.h5", "--csv", "out.csv", "--md", "out.md"]
+
+
+def text_as_a_table(request: pytest.FixtureRequest) -> list[str]:
+    Path("A.h5").write_text("not HDF5\n")
+    return ["plot", "controller", "A.h5", "--torque", "out.png"]
+
+
+def the_cars_table_on_the_pendulums_dynamics(request: pytest.FixtureRequest) -> list[str]:
+    car = request.getfixturevalue("car_park")
+    table = placed(car / "controllers" / "park.h5", "results/controllers/car/park.h5")
+    link1 = f"{dynamics('link1', request)}/link1.py"
+    return ["plot", "controller", table, "--dynamics", link1, "--portrait", "out.png"]
+
+
+def a_run_writing_a_table_it_reads(request: pytest.FixtureRequest) -> list[str]:
+    shutil.copytree(request.getfixturevalue("pendulum_tables"), "results/controllers/pendulum")
+    script = placed(SPECS / "scripts" / "pendulum.anim", "pendulum.anim")
+    places = ["--controllers", "results/controllers/pendulum"]
+    places += ["--dynamics-dir", dynamics("link1", request)]
+    return ["run", script, *places, "-o", "results/controllers/pendulum/A.h5"]
+
+
+# the start of each example (``mosys: FILE: the first words``) -> what makes it
+INPUT_RECIPES = {
+    "mosys: results/trajectories/park_1.h5: not a": a_trajectory_as_a_table,
+    "mosys: odd.h5: not a": an_odd_file_as_a_composite,
+    "mosys: A.h5: cannot read": text_as_a_table,
+    "mosys: results/controllers/car/park.h5: controller park": (
+        the_cars_table_on_the_pendulums_dynamics
+    ),
+    "mosys: results/controllers/pendulum/A.h5: cannot write": a_run_writing_a_table_it_reads,
+}
+
+
+@pytest.mark.parametrize("start", list(INPUT_RECIPES))
+def test_the_input_example_is_what_mosys_prints(start, tmp_path, monkeypatch, capsys, request):
+    [expected] = [text for text in INPUT_EXAMPLES if text.startswith(start)]
+    monkeypatch.chdir(tmp_path)
+    argv = INPUT_RECIPES[start](request)
+    before = {path: path.read_bytes() for path in tmp_path.rglob("*.h5")}
+    assert (main(argv), capsys.readouterr().err.splitlines()[-1]) == (2, expected)
+    assert not list(tmp_path.glob("out.*")), "an output was written"
+    assert {path: path.read_bytes() for path in before} == before, "an input was changed"
+
+
 def test_every_example_has_a_recipe():
     for text in EXAMPLES:
         matching = [start for start in RECIPES if text.startswith(start)]
         assert len(matching) == 1, f"{len(matching)} recipes for {text!r}"
-    for text in USAGE_EXAMPLES:
-        matching = [start for start in USAGE_RECIPES if text.startswith(start)]
-        assert len(matching) == 1, f"{len(matching)} recipes for {text!r}"
+    for examples, recipes in ((USAGE_EXAMPLES, USAGE_RECIPES), (INPUT_EXAMPLES, INPUT_RECIPES)):
+        for text in examples:
+            matching = [start for start in recipes if text.startswith(start)]
+            assert len(matching) == 1, f"{len(matching)} recipes for {text!r}"
