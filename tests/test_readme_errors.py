@@ -258,11 +258,18 @@ def test_the_example_is_what_mosys_prints(start, tmp_path, monkeypatch, capsys, 
 # --- usage errors (``mosys VERB: error: ...``, shown without the usage argparse prints first) -
 
 USAGE_EXAMPLE = re.compile(r"^ *(mosys [a-z][a-z0-9 -]*: error: .*)$", re.MULTILINE)
-USAGE_EXAMPLES = [
-    match.group(1)
-    for document in DOCUMENTS
-    for match in USAGE_EXAMPLE.finditer(document.read_text(encoding="utf-8"))
-]
+
+
+def lines_matching(pattern: re.Pattern) -> list[str]:
+    """The first group of every line of the README and docs/ that ``pattern`` matches."""
+    return [
+        match.group(1)
+        for document in DOCUMENTS
+        for match in pattern.finditer(document.read_text(encoding="utf-8"))
+    ]
+
+
+USAGE_EXAMPLES = lines_matching(USAGE_EXAMPLE)
 A_TABLE = "results/controllers/pendulum/A.h5"  # an input that exists (written empty: never read)
 # the start of each usage example (its verb and option) -> the command line that makes it
 USAGE_RECIPES = {
@@ -293,11 +300,7 @@ def test_the_usage_example_is_what_mosys_prints(start, tmp_path, monkeypatch, ca
 # --- input files (``mosys: FILE: ...``): the wrong kind of file, a file that is not HDF5 -----
 
 INPUT_EXAMPLE = re.compile(r"^ +(mosys: (?!error:)\S+: .*)$", re.MULTILINE)
-INPUT_EXAMPLES = [
-    match.group(1)
-    for document in DOCUMENTS
-    for match in INPUT_EXAMPLE.finditer(document.read_text(encoding="utf-8"))
-]
+INPUT_EXAMPLES = lines_matching(INPUT_EXAMPLE)
 
 
 def placed(source: Path, path: str) -> str:
