@@ -13,11 +13,11 @@ import re
 import shutil
 from pathlib import Path
 
+from conftest import ROOT, SPECS
+
 from mosys.cli import main
 
-ROOT = Path(__file__).resolve().parents[1]
 FORMATS = ROOT / "docs" / "formats"
-SPECS = ROOT / "specs"
 
 
 def example(page: str, marker: str) -> list[str]:
