@@ -168,6 +168,11 @@ ERRORS = {
     "for rod 'b' (line 2), found end of file",
     ROD + ROD_B + "pin a angle=theta\nhinge b on=a angle=theta\n": "bad.fig:4:20: expected a "
     "coordinate name not used by another coordinate, rate or actuator (line 3), found 'theta'",
+    ROD + ROD_B + "pin a\nhinge b on=a angle=e rate=e_rate actuator=e_rate\n": "bad.fig:4:43: "
+    "expected an actuator name not used by another coordinate, rate or actuator (line 4), "
+    "found 'e_rate'",
+    ROD + "pin a actuator=\n": "bad.fig:2:16: expected a name for the pin's actuator, found "
+    "end of line",
     ROD + ROD_B + "pin a\nhinge b on=a at=1.5\n": "bad.fig:4:17: expected a number from 0 to "
     "1 (the length of 'a') for at (m along the parent), found '1.5'",
     ROD + "free a\nlimit a lower=-10 stiffness=5\n": "bad.fig:3:7: expected a rod with a 'pin' "

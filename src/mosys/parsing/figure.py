@@ -634,7 +634,7 @@ class _Parser:
                 "at": "the pivot 'x,y' in metres",
                 "offset": _PLACEMENT_KEYS["offset"],
                 **_ANGLE_KEYS,
-                "actuator": _ACTUATOR_KEY,
+                "actuator": "a name for the pin's actuator",
             },
         )
         pivot = (0.0, 0.0)
@@ -1038,7 +1038,8 @@ class _Parser:
                         self.path,
                         token.line,
                         token.column,
-                        f"a {what} name not used by another coordinate, rate or actuator "
+                        f"{'an' if what[0] in 'aeiou' else 'a'} {what} name not used by another "
+                        "coordinate, rate or actuator "
                         f"(line {seen[name]})",
                         name,
                     )
