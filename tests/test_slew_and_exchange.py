@@ -116,6 +116,24 @@ def test_a_slew_on_a_control_the_figure_lacks_and_a_breakpoint_on_an_unknown_sta
         assert not out.exists() and not (tmp_path / "bad.h5").exists()
 
 
+@pytest.mark.parametrize(
+    ("values", "why"),
+    [("-135", "the only value"), ("-135,350,0", "the first of 3 values")],
+)
+def test_a_state_of_the_wrong_length_says_how_many_values_it_has(
+    tmp_path, dynamics_dir, pendulum_tables, values, why
+):
+    """It named only the first value, which is not what is wrong."""
+    text = f"state link {values}\nswapcon link conB.ctab\nsim 0.1\n"
+    with pytest.raises(SpecError) as raised:
+        run(tmp_path, dynamics_dir, pendulum_tables, text, "bad")
+    assert str(raised.value) == (
+        f"{tmp_path / 'bad.anim'}:1:12: expected 2 values in the order angle,omega, "
+        f"found '-135' ({why})"
+    )
+    assert not (tmp_path / "bad.h5").exists()
+
+
 # --------------------------------------------------------------------------- slew limitation
 
 

@@ -528,9 +528,11 @@ def _figure_state(
             "state values by name (NAME=VALUE): no controller gives an order",
         )
     if len(command.values) != len(controller.state_order):
+        given = len(command.values)
         raise script.error(
             command.value_tokens[0],
             f"{len(controller.state_order)} values in the order {','.join(controller.state_order)}",
+            "the only value" if given == 1 else f"the first of {given} values",
         )
     return controller.figure_state(np.array(command.values))
 

@@ -217,10 +217,11 @@ class AnimationScript:
         """The longest simulated time of its ``sim`` lines, s (motor programs add their own)."""
         return sum(c.seconds for c in self.commands if isinstance(c, Simulate))
 
-    def error(self, token: Token, expected: str) -> SpecError:
-        """A SpecError at ``token`` of this script, found its text: for checks made after
-        parsing (a controller that does not exist, a state of the wrong length)."""
-        return SpecError.at(self.path, token, expected)
+    def error(self, token: Token, expected: str, why: str | None = None) -> SpecError:
+        """A SpecError at ``token`` of this script, found its text (and ``why`` it will not do):
+        for checks made after parsing (a controller that does not exist, a state of the wrong
+        length)."""
+        return SpecError.at(self.path, token, expected, why)
 
 
 def parse_script(path: str | Path) -> AnimationScript:
