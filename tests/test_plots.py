@@ -607,6 +607,8 @@ def test_controls_figure_draws_a_single_sample_and_says_it_has_no_rate(trajector
     assert legend_labels(figure) == ["at_destination.anim (no limit; a single sample)"]
     (note,) = bottom.texts
     assert note.get_text() == "no rate of change: no two samples apart in time"
+    # the control's name as the figure spells it (it was capitalised: 'Elbow_torque')
+    assert top.get_title().startswith("torque against time: at_destination.anim\n")
     both = controls_figure([trajectory, lone])
     assert not both.axes[1].texts and both.axes[0].lines[0].get_marker() in ("", "None", None)
 
@@ -737,6 +739,71 @@ def test_phase_planes_pair_each_coordinate_with_its_rate():
     )
 
 
+def write_double_pendulum_table(path: Path) -> None:
+    """A 4-D controller table H (shoulder, elbow and their rates) at path: zero torques."""
+    names = ("shoulder", "elbow", "shoulder_rate", "elbow_rate")
+    angles = np.arange(-180.0, 91.0, 90.0)
+    rates = np.linspace(-200.0, 200.0, 5)
+    shape = (4, 4, 5, 5)
+    write_controller_table(
+        path,
+        ControllerTable(
+            state_order=names,
+            control_names=("shoulder_torque", "elbow_torque"),
+            axes=(angles, angles, rates, rates),
+            axis_units=("deg", "deg", "deg/s", "deg/s"),
+            wrap=(True, True, False, False),
+            torque=np.zeros((*shape, 2)),
+            value=np.ones(shape),
+            control_min=np.array([-40.0, -20.0]),
+            control_max=np.array([40.0, 20.0]),
+            effort_weight=np.array([0.01, 0.01]),
+            dest={"shoulder": -90.0, "elbow": 0.0, "shoulder_rate": 0.0, "elbow_rate": 0.0},
+            figure="double_pendulum",
+            attrs={"dt": DT},
+        ),
+    )
+
+
+def test_a_controller_plot_of_a_four_dimensional_table_is_refused_with_its_dimensions(
+    tmp_path, capsys
+):
+    """A portrait or torque map is drawn over a coordinate and its rate: a double pendulum's
+    table is refused, exit 2, naming its state (it used to say 'a pendulum plot needs a 2-D
+    controller table' of any figure), and nothing is written."""
+    table = tmp_path / "H.h5"
+    write_double_pendulum_table(table)
+    assert main(["plot", "controller", str(table), "--torque", str(tmp_path / "t.png")]) == 2
+    assert capsys.readouterr().err == (
+        f"mosys: {table}: a controller's portrait and torque map need a table of 2 state "
+        "dimensions (a coordinate and its rate), this one has 4: shoulder, elbow, "
+        "shoulder_rate, elbow_rate\n"
+    )
+    assert not (tmp_path / "t.png").exists()
+
+
+def test_a_trajectory_without_units_is_drawn_only_as_an_angle_and_its_rate():
+    """A file without state units (written before they were kept) is read as an angle and
+    its rate; any other width is refused, naming the columns."""
+    trajectory = Trajectory(
+        t=np.zeros(2),
+        state=np.zeros((2, 3)),
+        control=np.zeros((2, 1)),
+        controller=np.zeros(2, dtype=np.int64),
+        state_order=("x", "y", "theta"),
+        control_names=("torque",),
+        controllers=("A",),
+        attrs={},
+        motion=None,
+    )
+    with pytest.raises(PlotInputError) as error:
+        script_plots.trajectory_axes(trajectory)
+    assert str(error.value) == (
+        "a trajectory without state units is drawn as an angle and its rate (2 columns), "
+        "this one has x, y, theta"
+    )
+
+
 def test_script_path_of_a_four_dimensional_state_draws_a_plane_per_joint(tmp_path):
     """A double pendulum's script (shoulder, elbow and their rates) is drawn in two panels,
     each coordinate against its rate, with the controller's destination in each and one title
@@ -763,28 +830,8 @@ def test_script_path_of_a_four_dimensional_state_draws_a_plane_per_joint(tmp_pat
             control_units=("N*m", "N*m"),
         ),
     )
-    angles = np.arange(-180.0, 91.0, 90.0)
-    rates = np.linspace(-200.0, 200.0, 5)
-    shape = (4, 4, 5, 5)
     table = tmp_path / "H.h5"
-    write_controller_table(
-        table,
-        ControllerTable(
-            state_order=names,
-            control_names=("shoulder_torque", "elbow_torque"),
-            axes=(angles, angles, rates, rates),
-            axis_units=("deg", "deg", "deg/s", "deg/s"),
-            wrap=(True, True, False, False),
-            torque=np.zeros((*shape, 2)),
-            value=np.ones(shape),
-            control_min=np.array([-40.0, -20.0]),
-            control_max=np.array([40.0, 20.0]),
-            effort_weight=np.array([0.01, 0.01]),
-            dest={"shoulder": -90.0, "elbow": 0.0, "shoulder_rate": 0.0, "elbow_rate": 0.0},
-            figure="double_pendulum",
-            attrs={"dt": DT},
-        ),
-    )
+    write_double_pendulum_table(table)
     figure = script_path_figure(trajectory, [table])
     shoulder, elbow = figure.axes
     assert (shoulder.get_xlabel(), shoulder.get_ylabel()) == (
@@ -817,7 +864,7 @@ def test_script_path_of_a_four_dimensional_state_draws_a_plane_per_joint(tmp_pat
             dataclasses.replace(
                 read_controller_table(table),
                 state_order=names_,
-                axes=(angles, rates),
+                axes=read_controller_table(table).axes[1::2],
                 axis_units=("deg", "deg/s"),
                 wrap=(True, False),
                 torque=np.zeros((4, 5, 2)),

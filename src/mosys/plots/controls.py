@@ -99,9 +99,7 @@ def controls_figure(trajectory_paths: Sequence[str | Path], control: str | None 
         scripts = " and ".join(
             _script_name(t, p) for t, p in zip(trajectories, trajectory_paths, strict=True)
         )
-        top.set_title(
-            f"{name.capitalize()} against time: {scripts}\nthin lines: controller exchanges"
-        )
+        top.set_title(f"{name} against time: {scripts}\nthin lines: controller exchanges")
         add_legend(figure, legend, ncols=1)
     return figure
 

@@ -89,7 +89,10 @@ def trajectory_axes(trajectory: Trajectory) -> tuple[StateAxis, ...]:
     units = trajectory.state_units
     if units is None:
         if state.ndim != 2 or state.shape[1] != 2:
-            raise PlotInputError(f"a pendulum plot needs a 2-D state, got {trajectory.state_order}")
+            raise PlotInputError(
+                "a trajectory without state units is drawn as an angle and its rate (2 columns), "
+                f"this one has {', '.join(trajectory.state_order)}"
+            )
         units = ("deg", "deg/s")
     axes = []
     for name, unit, column in zip(names, units, state.T, strict=True):

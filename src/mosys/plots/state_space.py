@@ -97,7 +97,8 @@ def table_axes(table: ControllerTable, path: str | Path = "") -> tuple[StateAxis
     """The two plot axes of a 2-D controller table; PlotInputError for any other dimension."""
     if len(table.state_order) != 2:
         raise PlotInputError(
-            f"{path}: a pendulum plot needs a 2-D controller table, this one has state "
+            f"{path}: a controller's portrait and torque map need a table of 2 state "
+            f"dimensions (a coordinate and its rate), this one has {len(table.state_order)}: "
             f"{', '.join(table.state_order)}" + car_hint(table.state_order, table.figure)
         )
     return state_axes(table)
