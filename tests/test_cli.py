@@ -3,6 +3,7 @@ bad arguments an argparse error, exit 2; ``--version`` and the top-level help.""
 
 from __future__ import annotations
 
+import argparse
 import shutil
 import subprocess
 import sys
@@ -12,7 +13,7 @@ import pytest
 from conftest import SPECS
 
 import mosys
-from mosys.cli import FAMILIES, main
+from mosys.cli import FAMILIES, build_parser, main
 
 
 def mosys_command(*args: str, cwd: Path) -> subprocess.CompletedProcess:
@@ -428,6 +429,30 @@ def test_every_verb_is_declared_once_and_has_its_own_usage(capsys):
             main([*name.split(), "--help"])
         assert exit_.value.code == 0
         assert capsys.readouterr().out.startswith(f"usage: mosys {name} [-h]")
+
+
+def test_every_argument_of_every_verb_says_what_it_is_and_its_default(capsys):
+    """``mosys VERB --help`` explains each argument, and an option with a default shows it
+    (``mosys dp --help`` listed spec, -o, --max-iterations and --quiet bare, and no verb said
+    its defaults)."""
+    parser = build_parser()
+    for name in VERBS:
+        verb_parser = parser
+        for word in name.split():
+            (verbs,) = [
+                a for a in verb_parser._actions if isinstance(a, argparse._SubParsersAction)
+            ]
+            verb_parser = verbs.choices[word]
+        bare = [a.dest for a in verb_parser._actions if not a.help]
+        assert not bare, f"mosys {name}: {bare} have no help"
+    with pytest.raises(SystemExit):
+        main(["run", "--help"])
+    shown = " ".join(capsys.readouterr().out.split())
+    assert "--dt DT simulator step, s (default: 0.001)" in shown
+    assert "-o OUTPUT, --output OUTPUT trajectory (.h5)" in shown  # required: no default
+    with pytest.raises(SystemExit):
+        main(["starts", "--help"])
+    assert "start headings, deg (default: 0.0)" in " ".join(capsys.readouterr().out.split())
 
 
 def test_help_imports_no_numerical_library():

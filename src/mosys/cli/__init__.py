@@ -25,7 +25,7 @@ from contextlib import contextmanager
 
 from mosys import __version__
 from mosys.cli import animation, bsr, composite, dynamics, index, info, paper_tables, plots, ssc
-from mosys.cli.verb import Family, file_options, same_file_problem
+from mosys.cli.verb import DefaultsHelpFormatter, Family, file_options, same_file_problem
 from mosys.errors import Stopped, forget_stops, note_stop, stop_received
 
 # In `mosys --help` order: the pipeline's steps, then what is drawn and tabulated from them.
@@ -106,7 +106,9 @@ def build_parser() -> argparse.ArgumentParser:
             group, _, name = verb.name.rpartition(" ")
             if group and group not in groups:  # "plot car": a kind of the verb "plot"
                 groups[group] = verbs.add_parser(group).add_subparsers(dest="kind", required=True)
-            subparser = (groups[group] if group else verbs).add_parser(name, help=verb.summary)
+            subparser = (groups[group] if group else verbs).add_parser(
+                name, help=verb.summary, formatter_class=DefaultsHelpFormatter
+            )
             verb.add_arguments(subparser)
             subparser.set_defaults(
                 command=verb, file_options=file_options(subparser), verb_parser=subparser

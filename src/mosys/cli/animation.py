@@ -8,14 +8,20 @@ from mosys.cli.verb import HDF5, Family, OutputPath, Verb, positive_number_probl
 
 
 def _run_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("script")
+    parser.add_argument("script", help="animation script (.anim)")
     parser.add_argument("--controllers", required=True, help="directory of controller tables")
-    parser.add_argument("--dynamics-dir", default="results/dynamics", help="generated dynamics")
+    parser.add_argument(
+        "--dynamics-dir",
+        default="results/dynamics",
+        help="where the generated dynamics modules FIGURE.py are",
+    )
     parser.add_argument(
         "--motor-dir", default="specs/motor", help="motor programs: DIR/FIGURE/NAME.mot"
     )
     parser.add_argument("--dt", type=float, default=0.001, help="simulator step, s")
-    parser.add_argument("-o", "--output", required=True, type=OutputPath(*HDF5))
+    parser.add_argument(
+        "-o", "--output", required=True, type=OutputPath(*HDF5), help="trajectory (.h5)"
+    )
 
 
 def _run_check(args: argparse.Namespace) -> str | None:

@@ -30,7 +30,9 @@ def _bsr_search_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="RESULT",
         help="3-D: the result files of the search the spec's 'chain' line continues",
     )
-    parser.add_argument("-o", "--output", required=True, type=OutputPath(*HDF5))
+    parser.add_argument(
+        "-o", "--output", required=True, type=OutputPath(*HDF5), help="result file (.h5)"
+    )
 
 
 def _bsr_search_check(args: argparse.Namespace) -> str | None:

@@ -32,7 +32,9 @@ def _composite_arguments(parser: argparse.ArgumentParser) -> None:
     for key, what in (("q", "Q arrays"), ("g", "G generations"), ("h", "H mutations")):
         parser.add_argument(f"--{key}", type=int, help=f"override the script's {what}")
     add_budget(parser)
-    parser.add_argument("-o", "--output", required=True, type=OutputPath(*HDF5))
+    parser.add_argument(
+        "-o", "--output", required=True, type=OutputPath(*HDF5), help="result file (.h5)"
+    )
 
 
 def _composite_check(args: argparse.Namespace) -> str | None:

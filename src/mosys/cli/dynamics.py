@@ -8,8 +8,10 @@ from mosys.cli.verb import Family, OutputPath, Verb
 
 
 def _compile_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("spec")
-    parser.add_argument("-o", "--output", required=True, type=OutputPath(".py"))
+    parser.add_argument("spec", help="figure spec (.fig)")
+    parser.add_argument(
+        "-o", "--output", required=True, type=OutputPath(".py"), help="dynamics module (.py)"
+    )
 
 
 def _compile(args: argparse.Namespace) -> None:

@@ -10,8 +10,10 @@ from mosys.cli.verb import Family, OutputPath, Verb
 
 
 def _index_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("inputs", nargs="*")
-    parser.add_argument("-o", "--output", required=True, type=OutputPath())
+    parser.add_argument("inputs", nargs="*", help="the files the target stands for")
+    parser.add_argument(
+        "-o", "--output", required=True, type=OutputPath(), help="the list, one path a line"
+    )
 
 
 def _index(args: argparse.Namespace) -> None:

@@ -9,8 +9,8 @@ from mosys.cli.verb import Family, Verb, add_budget, add_table_outputs
 
 
 def _pendulum_table_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("controllers", nargs="+")
-    parser.add_argument("--dynamics", required=True)
+    parser.add_argument("controllers", nargs="+", help="the controller tables (.h5)")
+    parser.add_argument("--dynamics", required=True, help="their figure's dynamics module (.py)")
     add_table_outputs(parser)
     add_budget(parser)
 

@@ -36,7 +36,7 @@ def _controller(args: argparse.Namespace) -> None:
 
 
 def _script_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("trajectory")
+    parser.add_argument("trajectory", help="trajectory (.h5)")
     parser.add_argument("tables", nargs="*", help="the controller tables (their destinations)")
     parser.add_argument("--path", type=OutputPath(*PLOT), help="state-space path PNG")
     parser.add_argument(

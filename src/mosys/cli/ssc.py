@@ -25,12 +25,20 @@ if TYPE_CHECKING:  # for the annotations only: the command loads these when a ve
 
 
 def _dp_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("spec")
-    parser.add_argument("--dynamics-dir", default="results/dynamics", help="generated dynamics")
-    parser.add_argument("-o", "--output", required=True, type=OutputPath(*HDF5))
+    parser.add_argument("spec", help="controller spec (.ssc)")
+    parser.add_argument(
+        "--dynamics-dir",
+        default="results/dynamics",
+        help="where the generated dynamics module FIGURE.py of the spec's dyn line is",
+    )
+    parser.add_argument(
+        "-o", "--output", required=True, type=OutputPath(*HDF5), help="controller table (.h5)"
+    )
     parser.add_argument("--tol", type=float, default=None, help="override the spec's tolerance, s")
-    parser.add_argument("--max-iterations", type=int, default=None)
-    parser.add_argument("--quiet", action="store_true")
+    parser.add_argument(
+        "--max-iterations", type=int, default=None, help="override the spec's maxiter"
+    )
+    parser.add_argument("--quiet", action="store_true", help="no progress lines")
 
 
 def _dp_check(args: argparse.Namespace) -> str | None:
@@ -74,12 +82,18 @@ def _starts_arguments(parser: argparse.ArgumentParser) -> None:
             metavar=("MIN", "MAX", "COUNT"),
             help=f"start {axis} values, {unit}",
         )
-    parser.add_argument("--heading", nargs="+", type=float, default=[0.0], help="deg")
-    parser.add_argument("--steer", nargs="+", type=float, default=[0.0], help="deg")
-    parser.add_argument("--seconds", type=float, default=20.0, help="simulated time per start")
+    parser.add_argument(
+        "--heading", nargs="+", type=float, default=[0.0], help="start headings, deg"
+    )
+    parser.add_argument(
+        "--steer", nargs="+", type=float, default=[0.0], help="start wheel angles, deg"
+    )
+    parser.add_argument("--seconds", type=float, default=20.0, help="simulated time per start, s")
     parser.add_argument("--dt", type=float, default=0.01, help="simulator step, s")
     parser.add_argument("--threads", type=int, default=1, help="runs at once")
-    parser.add_argument("-o", "--output", required=True, type=OutputPath(*HDF5))
+    parser.add_argument(
+        "-o", "--output", required=True, type=OutputPath(*HDF5), help="start grid (.h5)"
+    )
     parser.add_argument("--quiet", action="store_true", help="no progress lines")
 
 

@@ -12,6 +12,25 @@ from mosys.files import output_problem
 from mosys.parsing.tokens import MAX_WHOLE
 
 
+class DefaultsHelpFormatter(argparse.HelpFormatter):
+    """A verb's ``--help``: each option's default after its help, where it has one worth
+    saying (not None, False or an empty list) and the help does not say it already."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        text = action.help
+        default = action.default
+        if (
+            text is None
+            or not action.option_strings
+            or default in (None, False, argparse.SUPPRESS)
+            or (isinstance(default, list) and not default)
+            or "default" in text
+        ):
+            return text
+        shown = " ".join(map(str, default)) if isinstance(default, list) else str(default)
+        return f"{text} (default: {shown.replace('%', '%%')})"
+
+
 def no_check(args: argparse.Namespace) -> str | None:
     """A verb's check when its arguments need none beyond argparse's: no problem."""
     return None
@@ -163,8 +182,8 @@ def add_budget(parser: argparse.ArgumentParser, default: str | None = "paper") -
 
 def add_table_outputs(parser: argparse.ArgumentParser) -> None:
     """``--csv`` and ``--md``: the two files every paper table is written to."""
-    parser.add_argument("--csv", required=True, type=OutputPath(".csv"))
-    parser.add_argument("--md", required=True, type=OutputPath(".md"))
+    parser.add_argument("--csv", required=True, type=OutputPath(".csv"), help="the table as CSV")
+    parser.add_argument("--md", required=True, type=OutputPath(".md"), help="the table as Markdown")
 
 
 @dataclass(frozen=True)
