@@ -312,3 +312,22 @@ def test_a_motions_camera_reaches_its_plot_only(work, tmp_path):
     code, output = dry_run(work, targets[0], "--config", "bsr3d={cameras: {rex: {azimuth: -30}}}")
     assert code == 0, output
     assert "--rest results/plots/bsr3d/rex/rest.png --azimuth -30.0" in output
+
+
+def test_a_3d_search_of_ones_own_takes_the_bsr3d_budget(tmp_path):
+    """A user's own 3-D search, asked for by its file and listed in no config list, is capped by
+    bsr3d.generations and bsr3d.seeds (README: "bsr3d.seeds for a 3-D search"): it took the 2-D
+    block's (bsr), so --config bsr3d='{generations: 20, seeds: 1}' ran every seed at the spec's
+    own G."""
+    work = copy_workflow(tmp_path)
+    spec = (work / "specs/bsr/cujo_bound.bsr").read_text(encoding="utf-8")
+    (work / "specs/bsr/my_bound.bsr").write_text(spec, encoding="utf-8")
+    target = "results/plots/bsr3d/my_bound/learning.png"
+    code, output = dry_run(work, target, "--config", "bsr3d={generations: 20, seeds: 1}")
+    assert code == 0, output
+    searches = re.findall(r"mosys bsr-search specs/bsr/my_bound\.bsr [^\n]*", output)
+    assert len(searches) == 1 and "--generations 20" in searches[0], output
+    code, output = dry_run(work, target, "--config", "bsr={generations: 20, seeds: 1}")
+    assert code == 0, output
+    searches = re.findall(r"mosys bsr-search specs/bsr/my_bound\.bsr [^\n]*", output)
+    assert len(searches) == 3 and "--generations" not in " ".join(searches), output

@@ -616,8 +616,12 @@ def luxo_targets():
 
 
 def bsr_settings(name):
-    """The config section of a search's budget: bsr3d for the 3-D searches, else bsr."""
-    return config["bsr3d"] if name in config["bsr3d"]["searches"] else config["bsr"]
+    """The config section of a search's budget: bsr3d for the 3-D searches (those config
+    bsr3d.searches lists, and a search of a 3-D figure the config does not list: a user's own,
+    asked for by its file), else bsr."""
+    if name in config["bsr3d"]["searches"] or search_dimensions(name) == 3:
+        return config["bsr3d"]
+    return config["bsr"]
 
 
 def bsr_seeds(name):
