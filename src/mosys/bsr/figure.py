@@ -201,7 +201,9 @@ def check_bsr_figure(figure: Figure) -> Joint:
     if figure.rods[0].name != root.rod:
         raise SpecError.at(figure.path, figure.rods[0].token, f"the root rod '{root.rod}' first")
     if figure.terrain.kind not in ("none", "floor"):
-        raise SpecError(figure.path, 1, 1, "a flat 'terrain floor' for a BSR figure", None)
+        raise SpecError.at(
+            figure.path, figure.terrain.token, "a flat 'terrain floor' for a BSR figure"
+        )
     return root
 
 

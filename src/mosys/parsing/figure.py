@@ -201,6 +201,7 @@ class Terrain:
     kind: str = "none"
     height: float = 0.0
     points: tuple[tuple[float, float], ...] = ()
+    token: Token = field(default=_NO_TOKEN, compare=False, repr=False)  # the kind's word
 
     @property
     def vertices(self) -> tuple[tuple[float, float], ...]:
@@ -908,7 +909,7 @@ class _Parser:
             self.check_polyline(line, points, point_tokens)
         elif kind == "steps":
             self.check_steps(line, points, point_tokens)
-        self.terrain = Terrain(kind, height, tuple(points))
+        self.terrain = Terrain(kind, height, tuple(points), kind_token)
 
     def check_polyline(
         self, line: Line, points: list[tuple[float, float]], tokens: list[Token]
