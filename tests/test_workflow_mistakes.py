@@ -331,3 +331,16 @@ def test_a_3d_search_of_ones_own_takes_the_bsr3d_budget(tmp_path):
     assert code == 0, output
     searches = re.findall(r"mosys bsr-search specs/bsr/my_bound\.bsr [^\n]*", output)
     assert len(searches) == 3 and "--generations" not in " ".join(searches), output
+
+
+def test_a_search_capped_under_the_paper_config_is_labelled_custom(work):
+    """A G cut by --config under config.yaml (budget: paper) was labelled 'paper' in the result
+    and the runs tables, which say paper means each spec's own G."""
+    code, output = dry_run(
+        work, "results/bsr/starman_jump/seed1.h5", "--config", "bsr={generations: 20}"
+    )
+    assert code == 0, output
+    assert "--generations 20 --budget custom" in output, output
+    code, output = dry_run(work, "results/bsr/starman_jump/seed1.h5", "--config", "bsr={seeds: 1}")
+    assert code == 0, output
+    assert "--budget paper" in output and "--generations" not in output, output

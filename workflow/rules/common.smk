@@ -754,10 +754,17 @@ def bsr_generations_option(wildcards):
 
 def bsr_budget(wildcards):
     """The budget a search's result is labelled with: the config's, or 'paper' for a search
-    the config exempts from its cap."""
+    the config exempts from its cap; 'custom' for one capped under the config's name 'paper'
+    (config.yaml's, with generations given by --config or a --configfile that names no budget
+    of its own), as mosys bsr-search labels a --generations without --budget: a G of 20 is not
+    the paper's."""
     exempt = (bsr_settings(wildcards.name)["generations"] is not None
               and bsr_full_budget(wildcards.name))
-    return "paper" if exempt else config["budget"]
+    if exempt:
+        return "paper"
+    if not bsr_full_budget(wildcards.name) and config["budget"] == "paper":
+        return "custom"
+    return config["budget"]
 
 
 def bsr_table_targets():
