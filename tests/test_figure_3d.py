@@ -637,6 +637,11 @@ BINDING_ERRORS = {
     # at the terrain line's kind (it was bad.fig:1:1, found end of line)
     BINDING.replace("terrain floor", "terrain steps 1,0.1"): "bad.fig:10:9: expected a flat "
     "'terrain floor' for a BSR figure, found 'steps'",
+    # a raised floor: the fitness terms, falls and senses measure heights from y = 0, so it ran
+    # and scored the figure as standing 0.3 m higher
+    BINDING.replace("terrain floor", "terrain floor height=0.3"): "bad.fig:10:22: expected a "
+    "floor at height 0 for a BSR figure (its heights, falls and senses are measured from y = 0), "
+    "found '0.3'",
 }
 
 

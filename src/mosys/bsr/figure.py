@@ -194,7 +194,8 @@ def rod_figure_motion(
 
 def check_bsr_figure(figure: Figure) -> Joint:
     """The checks every BSR figure (2-D or 3-D) passes: a ``free`` root listed first and a flat
-    floor (or no terrain); returns the root's joint, raises SpecError at the offending line."""
+    floor at height 0 (or no terrain); returns the root's joint, raises SpecError at the
+    offending line."""
     root = figure.root
     if root.kind != "free":
         raise SpecError.at(figure.path, root.token, "a 'free' root, as BSR figures fly and fall")
@@ -203,6 +204,13 @@ def check_bsr_figure(figure: Figure) -> Joint:
     if figure.terrain.kind not in ("none", "floor"):
         raise SpecError.at(
             figure.path, figure.terrain.token, "a flat 'terrain floor' for a BSR figure"
+        )
+    if figure.terrain.height != 0.0:
+        raise SpecError.at(
+            figure.path,
+            figure.terrain.height_token,
+            "a floor at height 0 for a BSR figure (its heights, falls and senses are measured "
+            "from y = 0)",
         )
     return root
 

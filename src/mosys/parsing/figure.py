@@ -202,6 +202,7 @@ class Terrain:
     height: float = 0.0
     points: tuple[tuple[float, float], ...] = ()
     token: Token = field(default=_NO_TOKEN, compare=False, repr=False)  # the kind's word
+    height_token: Token = field(default=_NO_TOKEN, compare=False, repr=False)  # height='s value
 
     @property
     def vertices(self) -> tuple[tuple[float, float], ...]:
@@ -895,13 +896,15 @@ class _Parser:
                 )
                 point_tokens.append(token)
         height = 0.0
+        height_token = _NO_TOKEN
         if kind != "polyline":
             found = self.options(reader, {"height": "the ground height in metres"})
             if "height" in found:
                 height = self.number(found["height"], "height", "height (m)")
+                height_token = value_token(found["height"], "height")
                 if abs(height) > MAX_PIVOT:
                     raise self.error(
-                        value_token(found["height"], "height"),
+                        height_token,
                         f"a height within {MAX_PIVOT:g} m of 0, as terrain vertices are",
                     )
         reader.end()
@@ -909,7 +912,7 @@ class _Parser:
             self.check_polyline(line, points, point_tokens)
         elif kind == "steps":
             self.check_steps(line, points, point_tokens)
-        self.terrain = Terrain(kind, height, tuple(points), kind_token)
+        self.terrain = Terrain(kind, height, tuple(points), kind_token, height_token)
 
     def check_polyline(
         self, line: Line, points: list[tuple[float, float]], tokens: list[Token]
