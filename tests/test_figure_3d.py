@@ -642,6 +642,14 @@ BINDING_ERRORS = {
     BINDING.replace("terrain floor", "terrain floor height=0.3"): "bad.fig:10:22: expected a "
     "floor at height 0 for a BSR figure (its heights, falls and senses are measured from y = 0), "
     "found '0.3'",
+    # every angle fixed: the search ran, scoring a figure no rule could move
+    BINDING.replace(
+        "lower=-10 upper=10 swing_lower=-5 swing_upper=5",
+        "lower=0 upper=0 swing_lower=0 swing_upper=0",
+    ).replace(
+        "limit c lower=-10 upper=10", "limit c lower=0 upper=0"
+    ): "bad.fig:4:6: expected a figure with an angle free to move (every limit here "
+    "fixes its angles: a search would have nothing to move), found 'a'",
 }
 
 

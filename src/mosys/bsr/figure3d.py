@@ -130,7 +130,8 @@ class BsrFigure3D:
 def bsr_figure3d(figure: Figure) -> BsrFigure3D:
     """Lay out the 3-D ``figure`` for the 3-D BSR simulator; a figure it cannot simulate raises
     SpecError at the offending line (a planar figure, a pinned root, a joint before its parent's
-    rod, an angle without a finite range, terrain that is not a flat floor)."""
+    rod, an angle without a finite range, no angle free to move, terrain that is not a flat
+    floor)."""
     if figure.dimensions != 3:
         raise SpecError.at(figure.path, figure.root.token, "a 3-D figure (one with 'ball' joints)")
     root = check_bsr_figure(figure)
@@ -166,6 +167,13 @@ def bsr_figure3d(figure: Figure) -> BsrFigure3D:
     endpoints = distinct_endpoints(parent, hinge, length)
     bounds = np.array(ranges).reshape(-1, 2) + 0.0  # a limit written -0 is 0 (numpy's uniform
     # takes max -0 below min 0 and refuses the range)
+    if not (bounds[:, 1] > bounds[:, 0]).any():
+        raise SpecError.at(
+            figure.path,
+            root.token,
+            "a figure with an angle free to move (every limit here fixes its angles: a search "
+            "would have nothing to move)",
+        )
     return BsrFigure3D(
         figure=figure,
         parent=parent,
