@@ -260,7 +260,9 @@ def test_load_bsr_figure3d(tmp_path: Path) -> None:
     assert load_bsr_figure3d(FIGURES, "walk.bsr", token).figure.name == "rex"
     with pytest.raises(SpecError) as error:
         load_bsr_figure3d(tmp_path, "walk.bsr", token)
-    assert str(error.value) == f"walk.bsr:1:8: expected a figure in {tmp_path}, found 'rex'"
+    assert str(error.value) == (
+        f"walk.bsr:1:8: expected a figure in {tmp_path}, found 'rex' (no {tmp_path / 'rex.fig'})"
+    )
     with pytest.raises(SpecError) as error:
         load_bsr_figure3d(FIGURES, "walk.bsr", Token("car", 1, 8))
     assert str(error.value) == "walk.bsr:1:8: expected a figure of rods, not a vehicle, found 'car'"

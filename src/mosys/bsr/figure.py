@@ -222,7 +222,7 @@ def load_rod_figure(figures_dir: str | Path, spec_path: str, token: Token) -> Fi
     raised at the sound .fig, as if that were wrong)."""
     figure_path = Path(figures_dir) / f"{token.text}.fig"
     if not figure_path.is_file():
-        raise SpecError.at(spec_path, token, f"a figure in {figures_dir}")
+        raise SpecError.at(spec_path, token, f"a figure in {figures_dir}", f"no {figure_path}")
     parsed = parse_figure_spec(figure_path)
     if not isinstance(parsed, Figure):
         raise SpecError.at(spec_path, token, "a figure of rods, not a vehicle")
