@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import assert_png
-from hypothesis import event, given
+from hypothesis import event, example, given
 from hypothesis import strategies as st
 from matplotlib.collections import LineCollection, PolyCollection
 from PIL import Image
@@ -551,3 +551,19 @@ def test_counts_read_as_words():
     from mosys.plots.style import counted
 
     assert [counted(n, "seed") for n in (1, 2)] == ["1 seed", "2 seeds"]  # "1 seeds" in a title
+
+
+@given(st.floats(allow_nan=False, allow_infinity=False, min_value=-1e6, max_value=1e6))
+@example(-0.004)
+@example(-1.5)
+def test_a_measured_term_that_rounds_to_zero_has_no_minus(value):
+    """A 3-D filmstrip's legend printed 'distance −0.00 m' for a figure that went nowhere."""
+    from mosys.plots.bsr3d import TERMS_3D
+    from mosys.plots.bsr_results import terms_text
+    from mosys.plots.style import number_text
+
+    text = number_text(value, ".2f")
+    assert text == format(value, ".2f").replace("-", "−") or text == "0.00"
+    assert text != "−0.00"
+    if value == -0.004:
+        assert terms_text({"distance": value}, TERMS_3D) == "distance +0.00 m"

@@ -54,6 +54,7 @@ from mosys.plots.style import (
     frame_samples,
     minus_signs,
     new_figure,
+    number_text,
     plot_style,
     save_figure,
     scene_figure,
@@ -269,7 +270,7 @@ def filmstrip_figure(result_path: str | Path, interval: float | None = None) -> 
         subtitle += (
             f"\neach pose shifted {side} by {spacing:g} m more than the one before, so that "
             "they do not overlap (unshifted, the poses' middles move "
-            f"{minus_signs(f'{travel:+.2f}')} m)"
+            f"{number_text(travel, '+.2f')} m)"
         )
     title = _result_title(result, result_path) + "\n" + subtitle
     title_lines = title.count("\n") + 1

@@ -43,8 +43,8 @@ from mosys.plots.style import (
     add_legend,
     controller_colors,
     counted,
-    minus_signs,
     new_figure,
+    number_text,
     plot_style,
     save_figure,
     spread_labels,
@@ -152,7 +152,7 @@ def cut_off_start(ax: Axes, results: Sequence[BsrResult], last: int) -> None:
         0.985,
         0.03,
         f"↓ below the axis: the best of the first {cut.evaluations:,} evaluations, "
-        f"down to {minus_signs(f'{cut.lowest:.3g}')}",
+        f"down to {number_text(cut.lowest, '.3g')}",
         transform=ax.transAxes,
         ha="right",
         va="bottom",
@@ -249,7 +249,7 @@ def seed_labels(seeds: Sequence[int], values: np.ndarray) -> list[str]:
     (``shared_decimals``)."""
     decimals = shared_decimals(values)
     return [
-        f"seed {seed}: {minus_signs(f'{value:.{decimals}f}')}"
+        f"seed {seed}: {number_text(value, f'.{decimals}f')}"
         for seed, value in zip(seeds, values, strict=True)
     ]
 

@@ -14,7 +14,7 @@ from pathlib import Path
 from mosys.errors import InputError
 from mosys.io.bsr_result import BsrResult, read_bsr_result
 from mosys.io.contracts import open_hdf5
-from mosys.plots.style import PlotInputError, minus_signs
+from mosys.plots.style import PlotInputError, number_text
 
 KIND_TEXT = {"sense": "sense-based", "time": "time-based"}
 # fitness terms: (label, unit, format) for the titles; other terms show by name, unitless
@@ -140,7 +140,7 @@ def terms_text(
     parts = []
     for name in shown:
         label, unit, fmt = known.get(name, (name.replace("_", " "), "", ".3g"))
-        value = minus_signs(format(float(terms[name]), fmt))
+        value = number_text(float(terms[name]), fmt)
         parts.append(f"{label} {value}{' ' + unit if unit else ''}")
     return ", ".join(parts)
 

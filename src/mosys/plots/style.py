@@ -170,6 +170,15 @@ def minus_signs(text: str) -> str:
     return text.replace("-", "−")
 
 
+def number_text(value: float, fmt: str) -> str:
+    """``value`` formatted by ``fmt`` with a true minus sign, and no minus on a value that
+    rounds to zero (-0.004 as '.2f' is '0.00', not '−0.00')."""
+    text = format(value, fmt)
+    if float(text) == 0.0:
+        text = format(0.0, fmt)
+    return minus_signs(text)
+
+
 def axis_label(name: str, unit: str) -> str:
     """Axis label of a state variable: its symbol and unit, e.g. ``angle θ (deg)``."""
     symbol = SYMBOLS.get(name)
