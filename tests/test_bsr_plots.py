@@ -12,6 +12,7 @@ import json
 import math
 from pathlib import Path
 
+import h5py
 import numpy as np
 import pytest
 from conftest import assert_png
@@ -217,6 +218,22 @@ def test_best_result_is_the_highest_fitness_ties_to_the_lowest_seed(
 ) -> None:
     assert best_result_path(searches["star_sense"]).name == "seed2.h5"  # 2 and 3 tie at 2.5
     assert best_result_path(searches["star_time"]).name == "seed1.h5"
+
+
+def test_a_perturbed_search_is_drawn_and_titled_by_its_nominal_fitness(tmp_path: Path) -> None:
+    """A search with a perturb line records the best controller's motion from the nominal
+    start, whose fitness_terms add up to nominal_fitness; its best_fitness is one lucky
+    perturbed draw's. The best seed (the one the composite chooses) and the title's fitness
+    are the nominal ones: the filmstrip of a Beryl search with perturb said 'fitness 6.052'
+    beside terms that add up to 2.052, and ranked the seeds by the lucky draws."""
+    paths = write_search(tmp_path, "robust", "sense", {1: 6.0, 2: 5.0})
+    for path, nominal in zip(paths, (2.0, 3.0), strict=True):
+        with h5py.File(path, "r+") as file:
+            file.attrs["nominal_fitness"] = nominal
+            file.attrs["perturbed"] = True
+    assert best_result_path(paths).name == "seed2.h5"
+    title = filmstrip_figure(paths[0]).get_suptitle()
+    assert "\nfitness 2: " in title and "6" not in title.split("\n")[1].split(":")[0]
 
 
 def test_group_by_search_reads_the_name_attribute(searches: dict[str, list[Path]]) -> None:

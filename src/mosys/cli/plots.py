@@ -202,7 +202,8 @@ def _bsr(args: argparse.Namespace) -> None:
     if args.learning:
         bsr_learning.plot_learning(args.results, args.learning)
     if args.filmstrip or args.gif:
-        best = bsr_results.best_result_path(args.results)  # highest fitness, ties to lowest seed
+        # the best recorded motion (nominal fitness), ties to the lowest seed
+        best = bsr_results.best_result_path(args.results)
         if args.filmstrip:
             bsr.plot_filmstrip(best, args.filmstrip)
         if args.gif:

@@ -25,6 +25,7 @@ from matplotlib.figure import Figure
 from mosys.io.bsr_result import BsrResult
 from mosys.plots.bsr_results import (
     KIND_TEXT,
+    motion_fitness,
     read_result,
     result_kind,
     search_name,
@@ -52,7 +53,6 @@ from mosys.plots.style import (
     fit_aspect,
     frame_indices,
     frame_samples,
-    minus_signs,
     new_figure,
     number_text,
     plot_style,
@@ -191,7 +191,7 @@ def _result_title(result: BsrResult, path: str | Path) -> str:
     figure_name = result.attrs.get("figure", "")
     on = f" ({figure_name})" if figure_name else ""
     seed = int(result.attrs["seed"])
-    fitness = minus_signs(f"{float(result.attrs['best_fitness']):.4g}")
+    fitness = number_text(motion_fitness(result.attrs), ".4g")
     return (
         f"BSR search {name}{on}, seed {seed}: {_controller_text(result)}\n"
         f"fitness {fitness}: {terms_text(result.fitness_terms)}"

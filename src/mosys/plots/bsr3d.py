@@ -41,6 +41,7 @@ from mosys.plots.bsr_results import (
     TERMS,
     best_result_path,
     group_by_search,
+    motion_fitness,
     read_result,
     root_attrs,
     search_name,
@@ -87,7 +88,7 @@ from mosys.plots.style import (
     frame_samples,
     lighten,
     mark_start,
-    minus_signs,
+    number_text,
     pan,
     plot_style,
     samples_to_the_end,
@@ -306,7 +307,7 @@ def _segment_label(chain: ChainMotion, k: int) -> str:
     t = chain.motion.t
     start = float(t[chain.starts[k]])
     end = float(t[chain.starts[k + 1]] if k + 1 < len(chain.starts) else t[-1])
-    fitness = minus_signs(f"{float(result.attrs['best_fitness']):.4g}")
+    fitness = number_text(motion_fitness(result.attrs), ".4g")
     label = (
         f"{chain.names[k]}: {KIND_TEXT.get(kind, kind)} controller, seed "
         f"{int(result.attrs['seed'])}, t {start:g}–{end:.3g} s, fitness {fitness}"

@@ -86,8 +86,19 @@ def search_name(attrs: Mapping, path: str | Path) -> str:
     return str(attrs["name"]) if "name" in attrs else Path(path).parent.name
 
 
+def motion_fitness(attrs: Mapping) -> float:
+    """The fitness of the motion a result records: ``nominal_fitness`` (the best controller
+    run from the spec's start), else ``best_fitness``. They are the same unless the search's
+    starts were perturbed (a ``perturb`` line); then ``best_fitness`` is one lucky perturbed
+    draw's, not that of the recorded motion, whose ``fitness_terms`` add up to
+    ``nominal_fitness`` (and the composite chooses its seed by it)."""
+    key = "nominal_fitness" if "nominal_fitness" in attrs else "best_fitness"
+    return float(attrs[key])
+
+
 def best_result_path(paths: Sequence[str | Path]) -> Path:
-    """The result with the highest ``best_fitness`` attribute, ties to the lowest ``seed``."""
+    """The result whose recorded motion scores best (``motion_fitness``: from the nominal
+    start, as the composite chooses), ties to the lowest ``seed``."""
     if not paths:
         raise PlotInputError("no BSR result files given")
     ranked = []
@@ -96,7 +107,7 @@ def best_result_path(paths: Sequence[str | Path]) -> Path:
         for key in ("best_fitness", "seed"):
             if key not in attrs:
                 raise PlotInputError(f"{path}: not a BSR result file: no root attribute {key!r}")
-        ranked.append((-float(attrs["best_fitness"]), int(attrs["seed"]), str(path)))
+        ranked.append((-motion_fitness(attrs), int(attrs["seed"]), str(path)))
     return Path(min(ranked)[2])
 
 
