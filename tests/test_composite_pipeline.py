@@ -151,8 +151,8 @@ def test_seed_files_of_two_builds_of_a_search_are_refused(composite_workspace, t
     [
         (
             ("controller=starman_jump_robust", "controller=starman_hop"),
-            ":9:28: expected a built BSR search (no results/bsr/starman_hop/seed*.h5: "
-            "build it with snakemake results/bsr_all or a composite target), found 'starman_hop'",
+            f":9:28: expected a BSR search (no spec {SPECS / 'bsr/starman_hop.bsr'}), "
+            "found 'starman_hop'",
         ),
         (
             ("controller=starman_jump_robust", "controller=starman_jump_robust seed=7"),
@@ -182,8 +182,8 @@ def test_a_phase_whose_search_is_not_among_the_controllers_given_says_so(
     assert main([str(arg) for arg in argv]) == 2
     assert capsys.readouterr().err.strip() == (
         f"{script}:8:28: expected a built BSR search (no --controllers file "
-        "starman_cartwheel_robust/seedK.h5: build it with snakemake results/bsr_all or a "
-        "composite target), found 'starman_cartwheel_robust'"
+        "starman_cartwheel_robust/seedK.h5: snakemake results/composite/SCRIPT.h5 builds a "
+        "script's searches first), found 'starman_cartwheel_robust'"
     )
     assert not list(tmp_path.iterdir())
 
@@ -266,21 +266,20 @@ def test_a_search_the_pipeline_has_no_results_for_is_named_at_its_column(
     output = tmp_path / "out.h5"
     assert main(["composite", str(script), "--controllers", *files, "-o", str(output)]) == 2
     assert capsys.readouterr().err == (
-        f"{script}:9:28: expected a built BSR search (no --controllers file "
-        "starman_jmp/seedK.h5: build it with snakemake results/bsr_all or a composite target), "
+        f"{script}:9:28: expected a BSR search (no spec specs/bsr/starman_jmp.bsr), "
         "found 'starman_jmp'\n"
     )
     assert main(["composite", str(script), "--controllers", "-o", str(output)]) == 2
     assert capsys.readouterr().err == (
         f"{script}:8:28: expected a built BSR search (no --controllers file "
-        "starman_cartwheel_robust/seedK.h5: build it with snakemake results/bsr_all or a "
-        "composite target), found 'starman_cartwheel_robust'\n"
+        "starman_cartwheel_robust/seedK.h5: snakemake results/composite/SCRIPT.h5 builds a "
+        "script's searches first), found 'starman_cartwheel_robust'\n"
     )
     empty = tmp_path / "bsr"
     assert main(["composite", str(script), "--bsr-results", str(empty), "-o", str(output)]) == 2
     assert capsys.readouterr().err == (
         f"{script}:8:28: expected a built BSR search (no {empty}/starman_cartwheel_robust/"
-        "seed*.h5: build it with snakemake results/bsr_all or a composite target), "
+        "seed*.h5: snakemake results/composite/SCRIPT.h5 builds a script's searches first), "
         "found 'starman_cartwheel_robust'\n"
     )
     assert not output.exists()

@@ -186,11 +186,14 @@ def open_session(
             if match:
                 candidates[int(match.group(1))] = Path(path)
         if not candidates:
+            spec = Path(bsr_specs_dir) / f"{phase.controller}.bsr"
+            if not spec.is_file():
+                raise SpecError.at(script.path, token, f"a BSR search (no spec {spec})")
             raise SpecError.at(
                 script.path,
                 token,
-                f"a built BSR search (no {looked_in.format(search=phase.controller)}: build it "
-                f"with snakemake results/bsr_all or a composite target)",
+                f"a built BSR search (no {looked_in.format(search=phase.controller)}: "
+                "snakemake results/composite/SCRIPT.h5 builds a script's searches first)",
             )
         if phase.seed is not None:
             if phase.seed not in candidates:
