@@ -269,6 +269,8 @@ def test_a_search_the_pipeline_has_no_results_for_is_named_at_its_column(
         f"{script}:9:28: expected a BSR search (no spec specs/bsr/starman_jmp.bsr), "
         "found 'starman_jmp'\n"
     )
+    # the specs are checked first, then the results: the shipped script with none given
+    script = composite_workspace.script
     assert main(["composite", str(script), "--controllers", "-o", str(output)]) == 2
     assert capsys.readouterr().err == (
         f"{script}:8:28: expected a built BSR search (no --controllers file "

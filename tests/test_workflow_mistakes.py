@@ -237,6 +237,31 @@ def test_a_chain_line_naming_no_search_stops_the_dag_at_that_line(work):
     ) in output
 
 
+@pytest.mark.parametrize(
+    ("search", "expected"),
+    [
+        ("starman_shufle", "a BSR search (no spec specs/bsr/starman_shufle.bsr)"),
+        ("beryl_shuffle", "a search of figure 'starman' (beryl_shuffle moves 'beryl')"),
+    ],
+)
+def test_a_composite_phase_naming_no_search_or_another_figures_stops_the_dag(
+    work, search, expected
+):
+    """Both ran the composite's searches first (at the paper's budget, five of them) and failed
+    in the composite's job; a misspelt search stopped at the missing .bsr's line 1."""
+    script = work / "specs/composite/mine.comp"
+    text = (work / "specs/composite/starman_show.comp").read_text(encoding="utf-8")
+    line = next(n for n, row in enumerate(text.splitlines(), 1) if row.startswith("phase shuffle"))
+    script.write_text(text.replace("=starman_shuffle_robust", f"={search}"), encoding="utf-8")
+    try:
+        code, output = dry_run(work, "results/composite/mine.h5")
+    finally:
+        script.unlink()
+    assert code != 0
+    assert f"specs/composite/mine.comp:{line}:28: expected {expected}, found '{search}'" in output
+    assert "bsr_search" not in output
+
+
 def test_a_3d_search_of_your_own_is_drawn_without_registering_it(work):
     """A motion's plots for a search the config does not name: the search and the searches
     its chain lines continue, in order (it was a KeyError); its seeds' learning curves."""

@@ -846,9 +846,18 @@ def composite_searches(name):
 
 def composite_inputs(wildcards):
     """A composite search's inputs: the script, its figure, its phases' search specs (the first
-    one's start pose starts the motion) and their seed files."""
+    one's start pose starts the motion) and their seed files. A phase whose search has no spec,
+    or one of another figure, stops the DAG with mosys's message, before any search runs."""
+    from mosys.composite.phase_searches import check_phase_searches
+    from mosys.parsing.tokens import SpecError
+
+    script = parsed_spec(f"specs/composite/{wildcards.name}.comp")
+    try:
+        check_phase_searches(script, "specs/bsr")
+    except SpecError as error:
+        raise WorkflowError(str(error)) from None
     searches = composite_searches(wildcards.name)
-    figure = parsed_spec(f"specs/composite/{wildcards.name}.comp").figure
+    figure = script.figure
     return {
         "script": f"specs/composite/{wildcards.name}.comp",
         "figure": [f"specs/figures/{figure}.fig"],

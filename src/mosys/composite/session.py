@@ -26,6 +26,7 @@ from mosys.bsr.search import bind_search, describe_planar_state, unsound_state_m
 from mosys.bsr.start import standing_state
 from mosys.composite.concatenation import ConcatenatedMotion, run_concatenation
 from mosys.composite.evaluate import PhaseMotion, score_script
+from mosys.composite.phase_searches import check_phase_searches
 from mosys.composite.transitions import equal_split
 from mosys.errors import NonFiniteStateError
 from mosys.io.bsr_result import BsrController, read_bsr_result
@@ -177,6 +178,7 @@ def open_session(
     of the script that names it; ``looked_in`` says where a search's files were looked for
     (``{search}``: its name)."""
     figure = load_bsr_figure(figures_dir, script.path, script.tokens["figure"])
+    check_phase_searches(script, bsr_specs_dir)
     controllers, seeds, files, dts, lengths = [], [], [], [], []
     for phase in script.phases:
         token = script.tokens[f"phase.{phase.name}.controller"]
@@ -186,9 +188,6 @@ def open_session(
             if match:
                 candidates[int(match.group(1))] = Path(path)
         if not candidates:
-            spec = Path(bsr_specs_dir) / f"{phase.controller}.bsr"
-            if not spec.is_file():
-                raise SpecError.at(script.path, token, f"a BSR search (no spec {spec})")
             raise SpecError.at(
                 script.path,
                 token,
