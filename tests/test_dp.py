@@ -216,6 +216,19 @@ def test_value_iterations_eta_is_an_upper_bound(capsys):
     capped.update(8, "largest change 3.2 s")
     line = capsys.readouterr().err
     assert line.startswith("value iteration: 8/3000 sweeps, 3000 at most (")
-    assert ", ETA at most " in line and line.rstrip().endswith(" s) largest change 3.2 s")
+    assert ", ETA at most " in line and line.rstrip().endswith(" s), largest change 3.2 s")
     Progress("starts", 100, "runs", interval=0.0).update(8)
     assert "ETA at most" not in capsys.readouterr().err
+
+
+def test_a_progress_lines_note_follows_a_comma_or_stands_in_brackets(capsys):
+    """A search's last line ran two fields together: 'done, 30 generations in 0.24 s best
+    fitness 6.052'."""
+    from mosys.io.progress import Progress
+
+    Progress("search", 30, "generations").finish("best fitness 6.052")
+    assert capsys.readouterr().err.endswith(" s, best fitness 6.052\n")
+    Progress("starts", 3, "runs").finish("(1 start that cannot park not run)")
+    assert capsys.readouterr().err.endswith(" s (1 start that cannot park not run)\n")
+    Progress("exits", 3, "segments").finish()
+    assert capsys.readouterr().err.endswith(" s\n")

@@ -45,7 +45,7 @@ class Progress:
         elapsed = max(now - self.start, 1e-9)
         rate = self.done / elapsed
         eta = (self.total - self.done) / rate if rate > 0 else float("inf")
-        extra = f" {note}" if note else ""
+        extra = _after(note)
         cap, bound = (f", {self.total} at most", "at most ") if self.at_most else ("", "")
         print(
             f"{self.label}: {self.done}/{self.total} {self.unit}{cap} "
@@ -57,9 +57,17 @@ class Progress:
     def finish(self, note: str = "") -> None:
         now = time.perf_counter()
         elapsed = now - self.start
-        extra = f" {note}" if note else ""
+        extra = _after(note)
         print(
             f"{self.label}: done, {self.done} {self.unit} in {elapsed:.2f} s{extra}",
             file=sys.stderr,
             flush=True,
         )
+
+
+def _after(note: str) -> str:
+    """A progress line's note as it follows the counts: after a comma ('..., best fitness
+    0.812'), or a space where it is a remark in brackets; nothing for none."""
+    if not note:
+        return ""
+    return f" {note}" if note.startswith("(") else f", {note}"
