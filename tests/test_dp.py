@@ -232,3 +232,5 @@ def test_a_progress_lines_note_follows_a_comma_or_stands_in_brackets(capsys):
     assert capsys.readouterr().err.endswith(" s (1 start that cannot park not run)\n")
     Progress("exits", 3, "segments").finish()
     assert capsys.readouterr().err.endswith(" s\n")
+    Progress("first population", 1, "rounds", interval=0.0).update(1)  # all done: finish says
+    assert capsys.readouterr().err == ""

@@ -35,9 +35,12 @@ class Progress:
         self.done = 0
 
     def update(self, done: int, note: str = "") -> None:
+        """``done`` of ``total`` so far: a line if ``interval`` has passed since the last, and
+        the work is not yet all done (its end is ``finish``'s to say: a first population of one
+        round, slow to compile, printed '1/1 rounds (0.0 rounds/s, ETA 0.0 s)')."""
         self.done = done
         now = time.perf_counter()
-        if now - self.last >= self.interval:
+        if now - self.last >= self.interval and done < self.total:
             self.last = now
             self._print(now, note)
 
