@@ -282,9 +282,11 @@ def finals_range(values: np.ndarray, low: float, high: float) -> tuple[float, fl
     together on the curves' axis (low, high): their span padded by FINALS_PAD of it on each
     side and at least FINALS_LEAST of (high - low), so that the seeds' differences can be read
     (Bob's five finals, 3.2 to 3.9, were one blot on a scale from -50); None where that range
-    would be more than FINALS_ZOOM of the curves' (the panel keeps the curves' scale)."""
+    would be more than FINALS_ZOOM of the curves' (the panel keeps the curves' scale), and
+    where fewer than two are finite (one seed's dot has no neighbours to tell apart: it was
+    drawn alone on a scale of a thousandth)."""
     finite = values[np.isfinite(values)]
-    if finite.size == 0 or not high > low:
+    if finite.size < 2 or not high > low:
         return None
     smallest, largest = float(finite.min()), float(finite.max())
     span = max((largest - smallest) * (1 + 2 * FINALS_PAD), FINALS_LEAST * (high - low))
