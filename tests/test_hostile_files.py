@@ -247,6 +247,8 @@ def test_the_job_server_names_which_socket_path_is_too_long(tmp_path, capsys):
         (["plot", "controls", "t.h5", "--control", "", "-o", "c.png"],
          "mosys plot controls: error: --control must name a control (default: the first)"),
         (["plot", "luxo", "t.h5"], "mosys plot luxo: error: give --strip, --forces and/or --gif"),
+        (["plot", "luxo", "t.h5", "--motion", "hop", "--forces", "f.png"],
+         "mosys plot luxo: error: --motion names the motion --strip draws: give --strip too"),
         (["plot", "bsr3d", "r.h5", "--filmstrip", "f.png", "--interval", "inf"],
          "mosys plot bsr3d: error: --interval must be a positive number of seconds, got inf"),
         (["plot", "car", "--map", "g.h5", "map.gif"],

@@ -161,6 +161,8 @@ def _luxo_arguments(parser: argparse.ArgumentParser) -> None:
 def _luxo_check(args: argparse.Namespace) -> str | None:
     if not (args.strip or args.forces or args.gif):
         return "give --strip, --forces and/or --gif"
+    if args.motion is not None and not args.strip:
+        return "--motion names the motion --strip draws: give --strip too"
     return None
 
 
