@@ -130,6 +130,33 @@ def test_motions_reuse_in_a_new_script_without_a_new_controller(luxo_results: Pa
     assert math.isclose(measured[0].rotation_deg, -360, abs_tol=30)
 
 
+def test_a_motion_that_never_leaves_the_ground_has_no_flight(luxo_results: Path, tmp_path):
+    """A keyframed nod from the script's start state, the base resting on the floor with no
+    contact force yet: that first sample counted as a flight (airborne 0.0005 s, touch-down at
+    0.0005 s, landed), although the lamp never left the ground."""
+    motor = tmp_path / "motor" / "luxo"
+    motor.mkdir(parents=True)
+    (motor / "nod.mot").write_text(
+        "figure luxo\nlimit hip_torque=5 elbow_torque=5\ngains kp=6 kd=0.25\n"
+        "key 0.0 hip=0 elbow=120\nkey 0.6 hip=12 elbow=105\nkey 1.2 hip=-10 elbow=140\n"
+        "key 1.8 hip=0 elbow=120\n"
+    )
+    script = tmp_path / "nod.anim"
+    script.write_text(
+        "object luxo figure=luxo\nstate luxo x=1 hip=0 elbow=120\nswapcon luxo conland.ctab\n"
+        "motor luxo nod\nsim 3 until=dest\n"
+    )
+    out = tmp_path / "nod.h5"
+    run_animation_script(
+        script, luxo_results / "controllers", luxo_results / "dynamics", out, DT, motor.parent
+    )
+    trajectory = read_trajectory(out)
+    standing = read_controller_table(luxo_results / "controllers" / "land.h5").dest
+    (nod,) = [measure(trajectory, m, standing) for m in motions(trajectory)]
+    assert math.isnan(nod.airborne_s) and math.isnan(nod.touchdown_s) and not nod.landed
+    assert nod.max_penetration_m < PENETRATION_TOLERANCE
+
+
 def test_the_tuning_tool_writes_a_program_that_runs(
     luxo_results: Path, tmp_path, capsys, monkeypatch
 ):

@@ -159,7 +159,13 @@ def measure(trajectory: Trajectory, motion: Motion, standing: dict[str, float]) 
     base = figure.endpoints[span, 0]
     centre = base.mean(axis=1)
     rotation = _column(trajectory, trajectory.state_order[2])[span]
-    touching = np.linalg.norm(contacts.force[span], axis=2).max(axis=1) > 0.0
+    terrain = figure.terrain
+    points = contacts.position[span]
+    surface = ground_height(terrain, points[..., 0])
+    in_contact = np.linalg.norm(contacts.force[span], axis=2) > 0.0
+    # a point resting on the surface with no force yet (a script's start state) is not flying:
+    # a motion that never left the ground had one sample of flight
+    touching = (in_contact | (points[..., 1] <= surface)).any(axis=1)
     takeoff, touchdown = longest_flight(touching)
     good = settled(trajectory, standing)[span]
     settle = np.nan
@@ -168,12 +174,8 @@ def measure(trajectory: Trajectory, motion: Motion, standing: dict[str, float]) 
         first_good = len(good) - int(np.argmin(good[::-1])) if not good.all() else 0
         settle = max(0.0, float(t[first_good] - t[touchdown]))
         landed = settle <= SETTLE_WITHIN
-    terrain = figure.terrain
-    points = contacts.position[span]
-    surface = ground_height(terrain, points[..., 0])
     depth = ground_depth(terrain, points)
     rods = ground_depth(terrain, rod_points(figure.endpoints[span]))
-    in_contact = np.linalg.norm(contacts.force[span], axis=2) > 0.0
     touched = surface[in_contact]
     off_root = np.array([rod != figure.rod_names[0] for rod in contacts.rods], dtype=bool)
     return MotionMeasures(
