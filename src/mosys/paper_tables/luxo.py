@@ -31,7 +31,8 @@ def motions_frame(trajectory_path: str, landing_table_path: str, budget: str) ->
         row = dataclasses.asdict(measure(trajectory, motion, standing))
         rows.append(
             {
-                key: round(value, 4) if isinstance(value, float) else value
+                # + 0.0: a value that rounds to -0 is written 0
+                key: round(value, 4) + 0.0 if isinstance(value, float) else value
                 for key, value in row.items()
             }
         )

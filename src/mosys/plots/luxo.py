@@ -51,8 +51,8 @@ from mosys.plots.style import (
     fit_aspect,
     frame_indices,
     frame_samples,
-    minus_signs,
     new_figure,
+    number_text,
     pan,
     plot_style,
     save_figure,
@@ -297,7 +297,7 @@ def motion_strip_figure(
         np.concatenate([endpoints[samples].reshape(-1, 2), shades.reshape(-1, 2), com]),
         figure_motion.terrain,
     )
-    rotation = minus_signs(f"{net_rotation(trajectory, chosen):.0f}")
+    rotation = number_text(net_rotation(trajectory, chosen), ".0f")
     title = (
         f"Luxo: {chosen.name} (net base rotation {rotation}°)\n"
         f"poses every {every:g} s from t = {t[first]:.2f} s to {t[last]:.2f} s, "
