@@ -203,6 +203,23 @@ def test_a_script_naming_a_controller_without_a_spec_is_caught_in_the_dag(work):
     (work / "specs/scripts/q.anim").unlink()
 
 
+def test_a_script_naming_a_motor_program_without_a_spec_is_caught_in_the_dag(work):
+    """It was Snakemake's MissingInputException naming the .mot, not the script's line."""
+    script = work / "specs/scripts/my_luxo.anim"
+    text = (work / "specs/scripts/luxo_show.anim").read_text(encoding="utf-8")
+    line = next(n for n, row in enumerate(text.splitlines(), 1) if "motor luxo long_jump" in row)
+    script.write_text(text.replace("motor luxo long_jump", "motor luxo long_jmp"), encoding="utf-8")
+    try:
+        code, output = dry_run(work, "results/trajectories/my_luxo.h5")
+    finally:
+        script.unlink()
+    assert code != 0
+    assert (
+        f"specs/scripts/my_luxo.anim:{line}:12: expected a motor program "
+        "(specs/motor/luxo/long_jmp.mot does not exist), found 'long_jmp'"
+    ) in output
+
+
 def test_a_script_of_the_cars_figure_draws_on_the_cars_controllers(work):
     """A parking script of your own was sent to a controller folder of its own name."""
     script = work / "specs/scripts/my_park.anim"

@@ -533,6 +533,13 @@ def script_inputs(wildcards):
     if figure is not None:
         figures.add(f"results/dynamics/{figure}.py")
         programs = [f"specs/motor/{figure}/{name}.mot" for name in script.motor_programs()]
+        from mosys.parsing.script import RunMotorProgram
+
+        for command in script.commands:  # mosys run's message, before its job would fail
+            program = f"specs/motor/{figure}/{getattr(command, 'program', '')}.mot"
+            if isinstance(command, RunMotorProgram) and not Path(program).is_file():
+                expected = f"a motor program ({program} does not exist)"
+                raise WorkflowError(str(script.error(command.program_token, expected)))
     return [f"results/controllers/{group}/{name}.h5" for name in names] + sorted(figures) + programs
 
 
