@@ -625,6 +625,37 @@ def test_starts_that_are_not_free_are_drawn_by_what_they_overlap(tmp_path):
     )
 
 
+def test_more_kinds_of_not_free_starts_than_colours_still_look_apart(tmp_path):
+    """A scene of several obstacles (a garage: three walls and a bin) has more kinds of starts
+    that are not free than there are colours: past the last colour, the kinds take the colours
+    again with another shape, so no two share a marker (they shared a colour and the +, and
+    the map could not say which start overlapped the bin and which the right wall)."""
+    count = len(car_starts.NOT_FREE_DETAIL_COLORS) + 3
+    path = write_start_grid(tmp_path / "grid.h5", headings=tuple(10.0 * k for k in range(count)))
+    with h5py.File(path, "a") as h5:
+        excluded = h5["excluded"].asstr()[()]
+        detail = np.full(len(excluded), "", dtype=object)
+        not_free = np.flatnonzero(excluded == NOT_FREE)
+        detail[not_free] = [f"overlaps wall_{k}" for k in range(count)]
+        h5.create_dataset("excluded_detail", data=detail, dtype=h5py.string_dtype())
+    figure = success_map_figure(path)
+    (legend,) = figure.legends
+    handles = dict(zip(legend_labels(figure), legend.legend_handles, strict=True))
+    looks = set()
+    for k in range(count):
+        handle = handles[f"cannot park: start overlaps wall_{k}"]
+        looks.add((handle.get_marker(), matplotlib.colors.to_hex(handle.get_markerfacecolor())))
+    assert len(looks) == count, looks
+    drawn = set()
+    for ax in figure.axes[:count]:
+        for c in ax.collections:
+            if isinstance(c, PathCollection) and str(c.get_gid()).startswith("cannot park: start"):
+                drawn.add((c.get_gid(), matplotlib.colors.to_hex(c.get_facecolor()[0])))
+    assert len(drawn) == count and len({color for _, color in drawn}) == len(
+        car_starts.NOT_FREE_DETAIL_COLORS
+    )
+
+
 def test_only_the_exclusion_reasons_present_are_in_the_legend(tmp_path):
     path = write_start_grid(tmp_path / "grid.h5")
     with h5py.File(path, "a") as h5:

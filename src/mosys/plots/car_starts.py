@@ -69,6 +69,10 @@ PARKING_TIMES = LinearSegmentedColormap.from_list(
 NOT_FREE_COLOR, NO_WAY_COLOR = "0.2", "0.3"  # the markers of the starts that cannot park
 # a NOT_FREE start's + by what makes it so (the start grid's excluded_detail), in turn
 NOT_FREE_DETAIL_COLORS = (NOT_FREE_COLOR, "#2c6fbb", "#8e44ad", "#a6611a", "#018571")
+# past the last colour, the colours again with the next shape (a scene of a few obstacles has
+# more kinds than colours: a garage of three walls and a bin, 8), so that no two kinds look alike,
+# up to 25 kinds; unfilled like the + (the x is a collision's)
+NOT_FREE_DETAIL_SHAPES = ("+", "1", "2", "3", "4")
 MARKER_DIAMETER_RANGE = (3.5, 7.5)  # pt, a start-grid map's markers
 MAP_LEGEND_COLUMNS = 3
 CONSISTENCY_BIN = 0.05  # width of a consistency histogram bin
@@ -379,7 +383,8 @@ def _exclusion_kinds(grid: StartGrid) -> list[tuple[str, _Marker, np.ndarray]]:
     starts (n,) bool), each reason present once; the ``NOT_FREE`` starts of a grid that says
     what makes them so (``excluded_detail``) a kind per detail instead, each a + of its own
     colour (NOT_FREE_DETAIL_COLORS in turn: the overlaps in alphabetical order, then
-    ``OUTSIDE_DOMAIN``)."""
+    ``OUTSIDE_DOMAIN``; past the last colour, the colours again with the next of
+    NOT_FREE_DETAIL_SHAPES, so that no two kinds share a marker)."""
     kinds = []
     for reason, (label, marker) in EXCLUSIONS.items():
         which = grid.excluded == reason
@@ -392,12 +397,15 @@ def _exclusion_kinds(grid: StartGrid) -> list[tuple[str, _Marker, np.ndarray]]:
         present = sorted(set(details[which]), key=lambda text: (text == OUTSIDE_DOMAIN, text))
         for k, detail in enumerate(present):
             color = NOT_FREE_DETAIL_COLORS[k % len(NOT_FREE_DETAIL_COLORS)]
+            shape = NOT_FREE_DETAIL_SHAPES[
+                k // len(NOT_FREE_DETAIL_COLORS) % len(NOT_FREE_DETAIL_SHAPES)
+            ]
             kinds.append(
                 (
                     f"cannot park: start{'’s' if detail == OUTSIDE_DOMAIN else ''} {detail}"
                     if detail
                     else label,
-                    replace(marker, face=color, edge=color),
+                    replace(marker, marker=shape, face=color, edge=color),
                     which & (details == detail),
                 )
             )
