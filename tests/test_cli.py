@@ -497,3 +497,20 @@ def test_starts_off_the_tables_heading_or_steer_axis_are_refused():
         )
     wrapped = SimpleNamespace(**{**vars(table), "wrap": (False, False, True, False, False)})
     off_table_problem(wrapped, {"heading": np.array([-70.0])})
+
+
+def test_starts_from_a_table_that_is_not_a_cars_is_refused(tmp_path, pendulum):
+    """The pendulum's table with its own dynamics ran into a KeyError ('angle'): a traceback,
+    exit 1. It is a bad input file: one line, exit 2, nothing written."""
+    table = pendulum / "controllers" / "A.h5"
+    done = mosys_command(
+        "starts", str(table), "--dynamics", str(pendulum / "dynamics" / "link1.py"),
+        "--x", "0", "1", "2", "--y", "3", "3", "1", "--quiet", "-o", "grid.h5", cwd=tmp_path,
+    )  # fmt: skip
+    assert done.returncode == 2, done.stderr
+    assert done.stderr == (
+        f"mosys: {table}: controller A (a table of figure 'link1', state angle, omega) is not a "
+        "car's: mosys starts runs a car controller, whose state is x, y and heading (and steer "
+        "and speed if it has them)\n"
+    )
+    assert list(tmp_path.iterdir()) == []

@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from mosys.cli.verb import (
@@ -145,6 +146,7 @@ def _starts(args: argparse.Namespace) -> None:
         "speed": np.array([0.0]),
     }
     order = controller.state_order
+    not_a_car_problem(args.table, controller.table, axes)
     off_table_problem(controller.table, {name: axes[name] for name in ("heading", "steer")})
     starts = np.array(list(itertools.product(*(axes[name] for name in order))))
     grid = evaluate_starts(
@@ -157,6 +159,22 @@ def _starts(args: argparse.Namespace) -> None:
             file=sys.stderr,
         )
     write_start_grid(args.output, grid)
+
+
+def not_a_car_problem(path: str, table: ControllerTable, axes: dict[str, np.ndarray]) -> None:
+    """InputError for a table whose state is not a car's pose and motion (x, y, heading and
+    maybe steer and speed): the pendulum's table with its own dynamics raised a KeyError
+    ('angle') with a traceback, exit 1."""
+    from mosys.errors import InputError
+
+    order = tuple(table.state_order)
+    if {"x", "y", "heading"} <= set(order) <= set(axes):
+        return
+    raise InputError(
+        f"{path}: controller {Path(path).stem} (a table of figure '{table.figure}', state "
+        f"{', '.join(order)}) is not a car's: mosys starts runs a car controller, whose state "
+        "is x, y and heading (and steer and speed if it has them)"
+    )
 
 
 def off_table_problem(table: ControllerTable, values: dict[str, np.ndarray]) -> None:
