@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from mosys.errors import InputError
 from mosys.io.controller_table import ControllerTable, write_controller_table
 from mosys.io.start_grid import OUTSIDE_DOMAIN, StartGrid, write_start_grid
 from mosys.io.trajectory import Trajectory, write_trajectory
@@ -144,7 +145,9 @@ def write_table(path: Path) -> Path:
     return path
 
 
-def write_run(path: Path, parked: bool, collision_index: int) -> Path:
+def write_run(
+    path: Path, parked: bool, collision_index: int, controllers: tuple[str, ...] = ("park",)
+) -> Path:
     t = np.array([0.0, 0.1])
     write_trajectory(
         path,
@@ -155,7 +158,7 @@ def write_run(path: Path, parked: bool, collision_index: int) -> Path:
             controller=np.zeros(2, dtype=np.int64),
             state_order=STATE_ORDER,
             control_names=("steer_rate", "wheel_accel"),
-            controllers=("park",),
+            controllers=controllers,
             attrs={"parked": parked, "collision_index": collision_index},
             motion=None,
         ),
@@ -190,3 +193,24 @@ def test_write_car_table(tmp_path):
     assert "arrival_consistency: the same against the table's cost-to-go to the whole" in text
     rows = {line.split("|")[1].strip() for line in text.splitlines() if line.startswith("|")}
     assert {"consistency_within_25pct", "arrival_consistency_within_25pct"} <= rows
+
+
+def test_a_start_grid_or_a_run_of_another_controller_is_refused(tmp_path):
+    """A scene's table beside another scene's start grid gave that grid's figures under the
+    table's name, exit 0; so would another controller's runs."""
+    table = write_table(tmp_path / "garage.h5")
+    grid = tmp_path / "start_grid.h5"
+    write_start_grid(grid, start_grid())  # of controller park
+    run = str(write_run(tmp_path / "park_1.h5", True, -1))
+    csv, md = tmp_path / "car.csv", tmp_path / "car.md"
+    with pytest.raises(InputError) as error:
+        write_car_table(str(table), str(grid), [run], str(csv), str(md), "paper")
+    assert str(error.value) == (
+        f"{grid}: a start grid of controller park, not of garage, the table's"
+    )
+    park = write_table(tmp_path / "park.h5")
+    other = str(write_run(tmp_path / "far_1.h5", True, -1, controllers=("farside",)))
+    with pytest.raises(InputError) as error:
+        write_car_table(str(park), str(grid), [run, other], str(csv), str(md), "paper")
+    assert str(error.value) == f"{other}: a run of controller farside, not of park, the table's"
+    assert not csv.exists() and not md.exists()

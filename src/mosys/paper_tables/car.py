@@ -77,13 +77,19 @@ def consistency_columns(prefix: str, ratios: np.ndarray | None) -> dict:
     return dict(zip(names, (round(v, 3) for v in consistency_summary(ratios)), strict=True))
 
 
-def parking_run(path: str | Path) -> dict:
+def parking_run(path: str | Path, controller: str) -> dict:
     """The root attributes of a car script's trajectory, with its parking outcome
     (``ssc.parking.ParkingOutcome.attributes``); InputError naming the file for another
-    trajectory."""
-    attrs = read_trajectory(path).attrs
+    trajectory, or for a run that ``controller`` (a table's stem) did not drive."""
+    trajectory = read_trajectory(path)
+    attrs = trajectory.attrs
     if "parked" not in attrs or "collision_index" not in attrs:
         raise InputError(f"{path}: not a parking run (a trajectory with no parking outcome)")
+    if controller not in trajectory.controllers:
+        raise InputError(
+            f"{path}: a run of controller {', '.join(trajectory.controllers)}, not of "
+            f"{controller}, the table's"
+        )
     return attrs
 
 
@@ -93,9 +99,10 @@ def car_row(
     """One row: the controller table, its start grid and its Figure 19 trajectories."""
     table = read_controller_table(table_path)
     attrs = table.attrs
-    figure19 = [parking_run(path) for path in trajectory_paths]
+    name = Path(table_path).stem
+    figure19 = [parking_run(path, name) for path in trajectory_paths]
     row = {
-        "controller": str(table_path).rsplit("/", 1)[-1].removesuffix(".h5"),
+        "controller": name,
         "grid": " x ".join(
             f"{name} {len(axis)}" for name, axis in zip(table.state_order, table.axes, strict=True)
         ),
@@ -128,8 +135,15 @@ def write_car_table(
     md_path: str,
     budget: str,
 ) -> pd.DataFrame:
-    """Write the car table as CSV and Markdown (each atomically)."""
+    """Write the car table as CSV and Markdown (each atomically). InputError for a start grid
+    or a run of another controller than the table's (a scene's table beside another's grid gave
+    that grid's figures under its name)."""
     grid = read_start_grid(start_grid_path)
+    if str(grid.attrs.get("controller")) != Path(table_path).stem:
+        raise InputError(
+            f"{start_grid_path}: a start grid of controller {grid.attrs.get('controller')}, not "
+            f"of {Path(table_path).stem}, the table's"
+        )
     frame = car_row(table_path, grid, trajectory_paths, budget)
     tolerance = json.loads(grid.attrs["parking_tolerance"])
     write_text_atomically(csv_path, frame.to_csv(index=False))
