@@ -570,3 +570,28 @@ def test_replaying_each_class_gives_the_transitions_of_integrating_every_node(ca
         )
     if policy:  # some segments end braking into the arrival box, at the destination
         assert integrated.to_destination.sum() > 0
+
+
+def test_mosys_dp_tells_removed_nodes_from_unreachable_ones(car, tmp_path, capsys):
+    """Its line counted the nodes removed for obstacles or the domain as unreachable: '1035827
+    unreachable' for a table of which 980,350 nodes were removed and 55,477 states were out of
+    reach."""
+    import shutil
+
+    from mosys.cli import main
+    from mosys.io.controller_table import read_controller_table
+
+    spec = tmp_path / "small.ssc"
+    spec.write_text(SMALL)
+    out = tmp_path / "small.h5"
+    (tmp_path / "dynamics").mkdir()
+    shutil.copy(car.__file__, tmp_path / "dynamics" / "car.py")  # the fixture's, compiled
+    argv = ["dp", str(spec), "--dynamics-dir", str(tmp_path / "dynamics"), "--quiet"]
+    assert main([*argv, "-o", str(out)]) == 0
+    attrs = read_controller_table(out).attrs
+    removed, states = int(attrs["removed_nodes"]), int(attrs["table_states"])
+    out_of_reach = int(attrs["unreachable_nodes"]) - removed
+    assert removed > 0 and 0 <= out_of_reach <= states
+    assert (
+        f", {out_of_reach} of {states} table states unreachable ({removed} nodes removed), "
+    ) in capsys.readouterr().out

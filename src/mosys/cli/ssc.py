@@ -64,10 +64,16 @@ def _dp(args: argparse.Namespace) -> None:
         quiet=args.quiet,
     )
     attrs = table.attrs
+    removed = int(attrs["removed_nodes"])
+    unreachable = f"{attrs['unreachable_nodes']} unreachable"
+    if removed:  # the removed nodes (value inf) are among the unreachable ones: say which is which
+        unreachable = (
+            f"{int(attrs['unreachable_nodes']) - removed} of {attrs['table_states']} table states "
+            f"unreachable ({removed} nodes removed)"
+        )
     print(
         f"{args.output}: {table.value.size} nodes, {attrs['iterations']} sweeps, residual "
-        f"{attrs['residual']:.3g} s, {attrs['unreachable_nodes']} unreachable, "
-        f"{attrs['generation_seconds']:.3f} s"
+        f"{attrs['residual']:.3g} s, {unreachable}, {attrs['generation_seconds']:.3f} s"
     )
 
 
