@@ -256,8 +256,24 @@ domain -3,0.5 3,0.5 3,2.5 -3,2.5
         ),
         (
             "domain -3,0.5 3,0.5 3,2.5 -3,2.5",
-            "domain 0,0 1,1 1,0 0,1",
+            "domain 0,0 1,0 2,0",
             "x.ssc:14:8: expected vertices enclosing a non-zero area, found '0,0'",
+        ),
+        (  # a bow-tie encloses no net area: its edges crossing is what is wrong
+            "domain -3,0.5 3,0.5 3,2.5 -3,2.5",
+            "domain 0,0 1,1 1,0 0,1",
+            "x.ssc:14:16: expected a simple polygon (its edges cross here), found '1,0'",
+        ),
+        (  # it said that edges crossed
+            "domain -3,0.5 3,0.5 3,2.5 -3,2.5",
+            "domain 0,0 1,0 1,1 1,1 0,1",
+            "x.ssc:14:20: expected a vertex other than the one before it, found '1,1'",
+        ),
+        (
+            "domain -3,0.5 3,0.5 3,2.5 -3,2.5",
+            "domain 0,0 1,0 1,1 0,0",
+            "x.ssc:14:20: expected a vertex other than the first (a polygon closes itself), "
+            "found '0,0'",
         ),
         (
             "domain -3,0.5 3,0.5 3,2.5 -3,2.5",

@@ -604,12 +604,18 @@ class _Parser:
                 f"a vertex 'x,y' (a polygon has at least 3; {len(vertices)} given)",
                 None,
             )
-        if abs(polygon_area(vertices)) < 1e-12:
-            raise self.error(tokens[0], "vertices enclosing a non-zero area", tokens[0].text)
+        for k in range(1, len(vertices)):
+            if vertices[k] == vertices[k - 1]:
+                raise self.error(tokens[k], "a vertex other than the one before it", tokens[k].text)
+        if vertices[-1] == vertices[0]:
+            expected = "a vertex other than the first (a polygon closes itself)"
+            raise self.error(tokens[-1], expected, tokens[-1].text)
         crossing = first_self_crossing(vertices)
         if crossing is not None:
             token = tokens[crossing]
             raise self.error(token, "a simple polygon (its edges cross here)", token.text)
+        if abs(polygon_area(vertices)) < 1e-12:
+            raise self.error(tokens[0], "vertices enclosing a non-zero area", tokens[0].text)
         return tuple(vertices)
 
     def line_tol(self, line: Line) -> None:
