@@ -326,8 +326,9 @@ def test_an_obstacle_beyond_the_cars_reach_is_kept_with_a_warning(car, capsys):
     problem = build_problem(parse_controller_text(text, "x.ssc"), car)
     assert problem is not None
     assert capsys.readouterr().err == (
-        "warning: x.ssc:13:10: obstacle 'front' lies beyond the car's reach (3.31 m) of the "
-        "domain (x -2..2 m, y 1..2 m): no run can touch it\n"
+        "warning: x.ssc:13:10: obstacle 'front' lies beyond the car's reach (3.31 m) of where "
+        "its reference point can be (the table's axes within the domain: x -2..2 m, y 1..2 m): "
+        "no run can touch it\n"
     )
 
 

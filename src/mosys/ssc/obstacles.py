@@ -96,9 +96,9 @@ def spec_obstacles(spec: ControllerSpec, dynamics: ModuleType, grid: FigureGrid)
             # refused: a scene's rear car moved 0.1 m back stopped the table)
             print(
                 f"warning: {location(spec.path, obstacle.token)}: obstacle "
-                f"'{obstacle.token.text}' lies beyond the car's reach ({reach:.3g} m) of the "
-                f"domain (x {low[0]:g}..{high[0]:g} m, y {low[1]:g}..{high[1]:g} m): no run "
-                "can touch it",
+                f"'{obstacle.token.text}' lies beyond the car's reach ({reach:.3g} m) of where "
+                f"its reference point can be (the table's axes within the domain: x "
+                f"{low[0]:g}..{high[0]:g} m, y {low[1]:g}..{high[1]:g} m): no run can touch it",
                 file=sys.stderr,
             )
     names = figure_state_names(dynamics)
