@@ -23,6 +23,25 @@ def dry_run(work: Path, *args: str):
     return done.returncode, done.stdout + done.stderr
 
 
+def dry_run_with_spec(work: Path, spec: str, text: str, target: str):
+    """``dry_run`` of ``target`` with ``text`` written to the spec ``spec`` (a path in the
+    workflow) for the run only."""
+    path = work / spec
+    path.write_text(text, encoding="utf-8")
+    try:
+        return dry_run(work, target)
+    finally:
+        path.unlink()
+
+
+def dry_run_with_edit(work: Path, shipped: str, copy: str, edit: tuple[str, str], target: str):
+    """``dry_run_with_spec`` of a copy (``copy``) of the shipped spec ``shipped`` with one edit
+    (old, new): (the number of the line edited, return code, output)."""
+    text = (work / shipped).read_text(encoding="utf-8")
+    line = next(n for n, row in enumerate(text.splitlines(), 1) if edit[0] in row)
+    return (line, *dry_run_with_spec(work, copy, text.replace(*edit), target))
+
+
 def test_a_mistyped_config_key_is_refused_before_anything_runs(work):
     code, output = dry_run(work, "results/pendulum_all", "--config", "bsr={generation: 5}")
     assert code != 0
@@ -205,14 +224,13 @@ def test_a_script_naming_a_controller_without_a_spec_is_caught_in_the_dag(work):
 
 def test_a_script_naming_a_motor_program_without_a_spec_is_caught_in_the_dag(work):
     """It was Snakemake's MissingInputException naming the .mot, not the script's line."""
-    script = work / "specs/scripts/my_luxo.anim"
-    text = (work / "specs/scripts/luxo_show.anim").read_text(encoding="utf-8")
-    line = next(n for n, row in enumerate(text.splitlines(), 1) if "motor luxo long_jump" in row)
-    script.write_text(text.replace("motor luxo long_jump", "motor luxo long_jmp"), encoding="utf-8")
-    try:
-        code, output = dry_run(work, "results/trajectories/my_luxo.h5")
-    finally:
-        script.unlink()
+    line, code, output = dry_run_with_edit(
+        work,
+        "specs/scripts/luxo_show.anim",
+        "specs/scripts/my_luxo.anim",
+        ("motor luxo long_jump", "motor luxo long_jmp"),
+        "results/trajectories/my_luxo.h5",
+    )
     assert code != 0
     assert (
         f"specs/scripts/my_luxo.anim:{line}:12: expected a motor program "
@@ -222,15 +240,10 @@ def test_a_script_naming_a_motor_program_without_a_spec_is_caught_in_the_dag(wor
 
 def test_a_script_of_the_cars_figure_draws_on_the_cars_controllers(work):
     """A parking script of your own was sent to a controller folder of its own name."""
-    script = work / "specs/scripts/my_park.anim"
-    script.write_text(
-        "object car figure=car\nstate car 6.5,3.25,-10,0,0\nswapcon car conpark.ctab\nsim 30\n",
-        encoding="utf-8",
+    text = "object car figure=car\nstate car 6.5,3.25,-10,0,0\nswapcon car conpark.ctab\nsim 30\n"
+    code, output = dry_run_with_spec(
+        work, "specs/scripts/my_park.anim", text, "results/trajectories/my_park.h5"
     )
-    try:
-        code, output = dry_run(work, "results/trajectories/my_park.h5")
-    finally:
-        script.unlink()
     assert code == 0, output
     assert "mosys run specs/scripts/my_park.anim --controllers results/controllers/car " in output
     assert "--dt 0.01 " in output  # the car's step
@@ -239,14 +252,13 @@ def test_a_script_of_the_cars_figure_draws_on_the_cars_controllers(work):
 def test_a_chain_line_naming_no_search_stops_the_dag_at_that_line(work):
     """It stopped at the missing spec's line 1 (``specs/bsr/rex_wlak.bsr:1:1: expected an
     existing spec file``), a file the user never wrote."""
-    spec = work / "specs/bsr/my_turn.bsr"
-    text = (work / "specs/bsr/rex_turn.bsr").read_text(encoding="utf-8")
-    line = next(n for n, row in enumerate(text.splitlines(), 1) if row.startswith("chain "))
-    spec.write_text(text.replace("chain rex_walk", "chain rex_wlak"), encoding="utf-8")
-    try:
-        code, output = dry_run(work, "results/bsr/my_turn/seed1.h5")
-    finally:
-        spec.unlink()
+    line, code, output = dry_run_with_edit(
+        work,
+        "specs/bsr/rex_turn.bsr",
+        "specs/bsr/my_turn.bsr",
+        ("chain rex_walk", "chain rex_wlak"),
+        "results/bsr/my_turn/seed1.h5",
+    )
     assert code != 0
     assert (
         f"specs/bsr/my_turn.bsr:{line}:7: expected the name of a search in specs/bsr/ to "
@@ -266,14 +278,13 @@ def test_a_composite_phase_naming_no_search_or_another_figures_stops_the_dag(
 ):
     """Both ran the composite's searches first (at the paper's budget, five of them) and failed
     in the composite's job; a misspelt search stopped at the missing .bsr's line 1."""
-    script = work / "specs/composite/mine.comp"
-    text = (work / "specs/composite/starman_show.comp").read_text(encoding="utf-8")
-    line = next(n for n, row in enumerate(text.splitlines(), 1) if row.startswith("phase shuffle"))
-    script.write_text(text.replace("=starman_shuffle_robust", f"={search}"), encoding="utf-8")
-    try:
-        code, output = dry_run(work, "results/composite/mine.h5")
-    finally:
-        script.unlink()
+    line, code, output = dry_run_with_edit(
+        work,
+        "specs/composite/starman_show.comp",
+        "specs/composite/mine.comp",
+        ("controller=starman_shuffle_robust", f"controller={search}"),
+        "results/composite/mine.h5",
+    )
     assert code != 0
     assert f"specs/composite/mine.comp:{line}:28: expected {expected}, found '{search}'" in output
     assert "bsr_search" not in output
