@@ -11,11 +11,13 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from glob import escape as glob_escape
 from pathlib import Path
-
-import h5py
+from typing import TYPE_CHECKING
 
 from mosys.errors import InputError, raise_if_stopped
 from mosys.files import output_problem
+
+if TYPE_CHECKING:  # for the annotation only: verbs that write text (index) start without h5py
+    import h5py
 
 PARTIAL_NAME_BYTES = 120  # of the final name kept in the partial's: NAME_MAX is 255 bytes
 _PARTIAL_TAIL = re.compile(r"\.(\d+)\.[0-9a-f]{8}\.partial")  # what follows .NAME: PID, RANDOM
@@ -154,6 +156,8 @@ def write_hdf5_atomically(path: str | Path, fill: Callable[[h5py.File], None]) -
     memory (HDF5's core driver, nothing on disk) and written as plain bytes: a write the system
     refuses (no room left) is then an OSError like any other file's, where HDF5 failing to
     flush a file on disk crashed the process as it tore the file's objects down."""
+    import h5py
+
     name = f"mosys-{secrets.token_hex(8)}.h5"  # HDF5 knows an open file by its name
     with h5py.File(name, "w", driver="core", backing_store=False) as h5:
         fill(h5)
