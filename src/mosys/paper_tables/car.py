@@ -164,7 +164,9 @@ def write_car_table(
         f"{100 * CONSISTENCY_BAND:.0f} % (|ratio - 1| <= {CONSISTENCY_BAND}); "
         "arrival_consistency: the same against the table's cost-to-go to the whole arrival box "
         "(/arrival_value: the runtime descends the cost-to-go to the box scaled by the table's "
-        "aim); mean_parking_s over the same starts; NaN where no start parked.\n\n"
+        "aim; NaN for a table without /arrival_value, one whose policy line does not ask for "
+        "it, as park.ssc's does not); mean_parking_s over the same starts; NaN where no start "
+        "parked.\n\n"
     )
     write_text_atomically(md_path, caption + frame.T.to_markdown(headers=["", "value"]) + "\n")
     return frame
