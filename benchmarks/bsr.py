@@ -6,9 +6,9 @@ install (cold numba cache: JIT compilation included).
     python benchmarks/bsr.py            # full: the paper's C = 10, G = 4000
     python benchmarks/bsr.py --smoke    # CI: the same code paths, G = 20
 
-Writes results/benchmarks/bsr.{csv,md} and prints them. Each case runs ``mosys bsr-search`` in a
-new process with a warm numba cache (filled first), timed by the search's own wall clock (the
-search alone, not the imports) and by the process.
+Writes results/benchmarks/bsr.{csv,md} (bsr_smoke.* with --smoke) and prints them. Each case runs
+``mosys bsr-search`` in a new process with a warm numba cache (filled first), timed by the search's
+own wall clock (the search alone, not the imports) and by the process.
 """
 
 from __future__ import annotations
