@@ -233,14 +233,9 @@ def open_session(
             script.tokens[f"phase.{script.phases[-1].name}.controller"],
             f"searches with one time step (their dt: {', '.join(map(str, dts))} s)",
         )
-    first = script.phases[0]
-    spec_path = Path(bsr_specs_dir) / f"{first.controller}.bsr"
-    if not spec_path.is_file():
-        raise SpecError.at(
-            script.path,
-            script.tokens[f"phase.{first.name}.controller"],
-            f"a BSR spec {spec_path} (its start pose starts the motion)",
-        )
+    # the first phase's search's start pose starts the motion (check_phase_searches: its spec
+    # is there)
+    spec_path = Path(bsr_specs_dir) / f"{script.phases[0].controller}.bsr"
     setup = bind_search(parse_bsr_spec(spec_path), figure)
     return CompositeSession(
         script=script,
