@@ -532,14 +532,13 @@ def script_inputs(wildcards):
     programs = []
     if figure is not None:
         figures.add(f"results/dynamics/{figure}.py")
-        programs = [f"specs/motor/{figure}/{name}.mot" for name in script.motor_programs()]
-        from mosys.parsing.script import RunMotorProgram
+        from mosys.parsing.tokens import SpecError
 
-        for command in script.commands:  # mosys run's message, before its job would fail
-            program = f"specs/motor/{figure}/{getattr(command, 'program', '')}.mot"
-            if isinstance(command, RunMotorProgram) and not Path(program).is_file():
-                expected = f"a motor program ({program} does not exist)"
-                raise WorkflowError(str(script.error(command.program_token, expected)))
+        try:  # mosys run's message, before its job would fail
+            files = script.motor_program_files("specs/motor", figure)
+        except SpecError as error:
+            raise WorkflowError(str(error)) from None
+        programs = [str(path) for path in files.values()]
     return [f"results/controllers/{group}/{name}.h5" for name in names] + sorted(figures) + programs
 
 

@@ -149,17 +149,12 @@ def load_programs(
 ) -> dict[str, BoundMotorProgram]:
     """Every motor program the script runs, ``motor_dir/FIGURE/NAME.mot``, bound to the
     figure; a missing file raises SpecError at the ``motor`` line."""
-    programs: dict[str, BoundMotorProgram] = {}
-    for command in script.commands:
-        if not isinstance(command, RunMotorProgram) or command.program in programs:
-            continue
-        path = Path(motor_dir) / figure / f"{command.program}.mot"
-        if not path.exists():
-            raise script.error(command.program_token, f"a motor program ({path} does not exist)")
-        from mosys.animation.motor_program import load_motor_program
+    files = script.motor_program_files(motor_dir, figure)
+    if not files:
+        return {}
+    from mosys.animation.motor_program import load_motor_program
 
-        programs[command.program] = load_motor_program(path, figure, dynamics)
-    return programs
+    return {name: load_motor_program(path, figure, dynamics) for name, path in files.items()}
 
 
 class _Recorder:

@@ -213,6 +213,20 @@ class AnimationScript:
             dict.fromkeys(c.program for c in self.commands if isinstance(c, RunMotorProgram))
         )
 
+    def motor_program_files(self, motor_dir: str | Path, figure: str) -> dict[str, Path]:
+        """Each motor program the script runs, in order of first use, and its file,
+        ``motor_dir/FIGURE/NAME.mot``; SpecError at the first ``motor`` line whose file is not
+        there (``mosys run`` and the pipeline's planning both check it so)."""
+        files: dict[str, Path] = {}
+        for command in self.commands:
+            if isinstance(command, RunMotorProgram) and command.program not in files:
+                path = Path(motor_dir) / figure / f"{command.program}.mot"
+                if not path.exists():
+                    expected = f"a motor program ({path} does not exist)"
+                    raise self.error(command.program_token, expected)
+                files[command.program] = path
+        return files
+
     def duration(self) -> float:
         """The longest simulated time of its ``sim`` lines, s (motor programs add their own)."""
         return sum(c.seconds for c in self.commands if isinstance(c, Simulate))
