@@ -464,6 +464,23 @@ def test_a_joint_range_written_minus_zero_is_zero(tmp_path: Path) -> None:
     assert out.exists()
 
 
+def test_a_script_of_motor_programs_alone_needs_an_object_line(
+    tmp_path: Path, pendulum: Path, capsys
+) -> None:
+    """With no swapcon, nothing named the object's figure: a StopIteration traceback, exit 1."""
+    script = tmp_path / "nomot.anim"
+    script.write_text("state link -90,0\nmotor link swing\n")
+    out = tmp_path / "nomot.h5"
+    argv = ["run", str(script), "--controllers", str(pendulum / "controllers")]
+    argv += ["--dynamics-dir", str(pendulum / "dynamics"), "-o", str(out)]
+    assert main(argv) == 2
+    assert capsys.readouterr().err == (
+        f"{script}:2:1: expected an 'object link figure=FIGURE' line before it (with no "
+        "swapcon, nothing else names the object's figure), found 'motor'\n"
+    )
+    assert not out.exists()
+
+
 def test_run_says_where_the_motion_ends(tmp_path: Path, pendulum: Path, capsys) -> None:
     """A run whose controller never brought the figure to its destination was written without
     a word: the command's line now says whether it ends in the last controller's arrival box."""

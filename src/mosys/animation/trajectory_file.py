@@ -20,7 +20,7 @@ from mosys.dynamics.load import figure_dynamics
 from mosys.io.attributes import string_list
 from mosys.io.controller_table import read_controller_table
 from mosys.io.trajectory import Trajectory, write_trajectory
-from mosys.parsing.script import SwapController, parse_script
+from mosys.parsing.script import RunMotorProgram, SwapController, parse_script
 from mosys.ssc.grid import control_units, state_unit
 from mosys.ssc.regions import regions
 
@@ -43,7 +43,14 @@ def run_animation_script(
     if declared is not None:
         figure, token = declared.figure, declared.figure_token
     else:
-        first = next(c for c in script.commands if isinstance(c, SwapController))
+        first = next((c for c in script.commands if isinstance(c, SwapController)), None)
+        if first is None:  # motor programs alone: only an object line names the figure
+            motor = next(c for c in script.commands if isinstance(c, RunMotorProgram))
+            raise script.error(
+                motor.token,
+                f"an 'object {motor.object} figure=FIGURE' line before it (with no swapcon, "
+                "nothing else names the object's figure)",
+            )
         figure = read_controller_table(controller_table_path(script, first, controller_dir)).figure
         token = first.table_token
     dynamics = figure_dynamics(figure, dynamics_dir, script.error, token)
