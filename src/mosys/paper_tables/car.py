@@ -139,10 +139,11 @@ def write_car_table(
     or a run of another controller than the table's (a scene's table beside another's grid gave
     that grid's figures under its name)."""
     grid = read_start_grid(start_grid_path)
-    if str(grid.attrs.get("controller")) != Path(table_path).stem:
+    controller = Path(table_path).stem
+    if str(grid.attrs.get("controller")) != controller:
         raise InputError(
             f"{start_grid_path}: a start grid of controller {grid.attrs.get('controller')}, not "
-            f"of {Path(table_path).stem}, the table's"
+            f"of {controller}, the table's"
         )
     frame = car_row(table_path, grid, trajectory_paths, budget)
     tolerance = json.loads(grid.attrs["parking_tolerance"])
