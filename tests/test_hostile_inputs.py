@@ -519,3 +519,25 @@ def test_a_car_started_on_an_obstacle_is_told_so() -> None:
     assert run_summary("T.h5", run, None, later).endswith("not parked, hit bollard")
     parked = {"parked": True, "parking_seconds": 11.79}
     assert run_summary("T.h5", run, None, parked).endswith("parked after 11.79 s")
+
+
+@pytest.mark.parametrize(
+    ("state", "column", "found"),
+    [("1.5,2,0,-50,0", 19, "-50"), ("x=1.5 y=2 steer=35.5", 27, "35.5")],
+)
+def test_a_start_steered_past_the_cars_limit_is_refused(
+    tmp_path, car_park, state, column, found, capsys
+):
+    """A car started with its wheels at -50° (car.fig: steer_limit=35) kept them there and
+    drove, exit 0: the steer rate only stops the wheels turning further past the limit."""
+    script = tmp_path / "steer.anim"
+    script.write_text(f"object car figure=car\nstate car {state}\nswapcon car park\nsim 1\n")
+    out = tmp_path / "steer.h5"
+    argv = ["run", str(script), "--controllers", str(car_park / "controllers")]
+    argv += ["--dynamics-dir", str(car_park / "dynamics"), "--dt", "0.01", "-o", str(out)]
+    assert main(argv) == 2
+    assert capsys.readouterr().err == (
+        f"{script}:2:{column}: expected a steer within ±35 deg (the figure's limit), "
+        f"found '{found}'\n"
+    )
+    assert not out.exists()

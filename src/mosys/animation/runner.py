@@ -39,9 +39,9 @@ from mosys.parsing.script import (
     SlewLimit,
     SwapController,
 )
-from mosys.parsing.tokens import Token, location
+from mosys.parsing.tokens import Token, format_number, location
 from mosys.ssc.controller import Controller, non_finite_message
-from mosys.ssc.grid import control_scale, figure_state_names, state_unit
+from mosys.ssc.grid import control_scale, figure_state_names, state_limit, state_unit
 from mosys.ssc.regions import Bounds, regions
 
 if TYPE_CHECKING:  # motor programs are imported when a script runs one
@@ -515,6 +515,7 @@ def _figure_state(
                     token, f"a state variable of the object's figure (one of {', '.join(names)})"
                 )
             state[names.index(name)] = value * state_unit(dynamics, name)[1]
+        _check_limits(script, command, dynamics, command.names)
         return state
     controller = active or next(iter(sources.controllers.values()), None)
     if controller is None:
@@ -529,7 +530,21 @@ def _figure_state(
             f"{len(controller.state_order)} values in the order {','.join(controller.state_order)}",
             "the only value" if given == 1 else f"the first of {given} values",
         )
+    _check_limits(script, command, dynamics, controller.state_order)
     return controller.figure_state(np.array(command.values))
+
+
+def _check_limits(
+    script: AnimationScript, command: SetState, dynamics: ModuleType, names: tuple[str, ...]
+) -> None:
+    """SpecError at a ``state`` value the model cannot take (a car's steer beyond its
+    ``steer_limit``: the wheels would stay there, turned further than they can turn)."""
+    for name, value, token in zip(names, command.values, command.value_tokens, strict=True):
+        limit = state_limit(dynamics, name)
+        unit, scale = state_unit(dynamics, name)
+        if limit is not None and abs(value) * scale > limit * (1.0 + 1e-12):
+            largest = format_number(round(limit / scale, 9))
+            raise script.error(token, f"a {name} within ±{largest} {unit} (the figure's limit)")
 
 
 def _state_columns(

@@ -24,6 +24,14 @@ def state_unit(dynamics: ModuleType, name: str) -> tuple[str, float]:
     return unit, DEGREE if unit.startswith("deg") else 1.0
 
 
+def state_limit(dynamics: ModuleType, name: str) -> float | None:
+    """The largest magnitude, SI, that a state variable can take, or None where the model sets
+    none: a vehicle's road wheels turn within ±STEER_LIMIT rad."""
+    if name == "steer" and hasattr(dynamics, "STEER_LIMIT"):
+        return float(dynamics.STEER_LIMIT)
+    return None
+
+
 def control_scale(dynamics: ModuleType, name: str) -> float:
     """The spec unit -> SI factor of a control (π/180 for deg/s or deg/s², else 1); a model
     without INPUT_UNITS takes its controls in SI."""
