@@ -165,9 +165,10 @@ KEYWORDS = (
     "'chain'"
 )
 TERMS = (
-    "'distance=', 'max_height=', 'contact_distance=', 'rotations=', 'fall=', 'sideways=', "
-    "'heading_change=', 'heading_deviation=', 'feet_distance=', 'foot_steps=', 'min_height=', "
-    "'heading_sine=', 'final_spin=', 'net_rotation='"
+    "TERM=WEIGHT, TERM a 2-D figure's fitness term (distance, max_height, contact_distance, "
+    "rotations, fall) or a 3-D figure's (distance, sideways, heading_change, max_height, fall, "
+    "heading_deviation, feet_distance, foot_steps, min_height, heading_sine, final_spin, "
+    "net_rotation)"
 )
 FALL_LINE = (
     "a 'fall' line naming the endpoints whose ground contact the fall term measures "
@@ -352,7 +353,7 @@ ERRORS = [
     # fitness
     (
         replace_line(9, "fitness distance=1 height=0.5"),
-        f"x.bsr:9:20: expected one of {TERMS}, found 'height=0.5'",
+        f"x.bsr:9:20: expected {TERMS}, found 'height=0.5'",
     ),
     (
         replace_line(9, "fitness distance=far"),
@@ -367,7 +368,7 @@ ERRORS = [
         "x.bsr:9:31: expected a number from -1e+06 to 1e+06 for max_height= (weight), found "
         "'-1.7e308'",
     ),
-    (replace_line(9, "fitness"), f"x.bsr:9:8: expected one of {TERMS}, found end of line"),
+    (replace_line(9, "fitness"), f"x.bsr:9:8: expected {TERMS}, found end of line"),
     (
         replace_line(9, "fitness fall=1 fall=2"),
         "x.bsr:9:16: expected 'fall=' only once, found 'fall=2'",

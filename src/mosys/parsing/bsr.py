@@ -184,6 +184,12 @@ _FITNESS_KEYS = {
     for term in dict.fromkeys(FITNESS_TERMS + FITNESS_TERMS_3D)
 }
 
+# what an unknown fitness term should have been: the figure is not read yet, so both lists
+_FITNESS_CHOICES = (
+    f"TERM=WEIGHT, TERM a 2-D figure's fitness term ({', '.join(FITNESS_TERMS)}) or a 3-D "
+    f"figure's ({', '.join(FITNESS_TERMS_3D)})"
+)
+
 
 def _expected(check: int | str | None, what: str) -> str:
     """What a value of ``check`` (a minimum whole number or a number check) is, for errors."""
@@ -292,13 +298,18 @@ class _Parser:
     # --- values ---------------------------------------------------------------------------
 
     def settings(
-        self, line: Line, reader: LineReader, keys: dict[str, tuple], required: tuple[str, ...]
+        self,
+        line: Line,
+        reader: LineReader,
+        keys: dict[str, tuple],
+        required: tuple[str, ...],
+        unknown: str | None = None,
     ) -> dict[str, Token]:
         """The ``key=value`` tokens of the rest of the line (``keys`` as ``_SEARCH_KEYS``),
         key -> the whole token. Unknown or repeated keys, an empty value and a missing
-        ``required`` key are errors."""
+        ``required`` key are errors; ``unknown`` says what an unknown key should have been."""
         allowed = {key: _expected(check, what) for key, (check, what) in keys.items()}
-        found = {key: token for key, (token, _) in reader.key_values(allowed).items()}
+        found = {key: token for key, (token, _) in reader.key_values(allowed, unknown).items()}
         for key in required:
             if key not in found:
                 raise SpecError(
@@ -331,11 +342,13 @@ class _Parser:
         """Each found key's value, checked in the order of ``keys``."""
         return {key: self.value(found[key], key, *keys[key]) for key in keys if key in found}
 
-    def at_least_one(self, line: Line, keys: dict[str, tuple]) -> None:
-        """Fail on a line with nothing after its keyword, expecting one of ``keys``."""
+    def at_least_one(self, line: Line, keys: dict[str, tuple], expected: str | None = None) -> None:
+        """Fail on a line with nothing after its keyword, expecting one of ``keys`` (or what
+        ``expected`` says)."""
         if len(line.tokens) == 1:
-            choices = ", ".join(f"'{key}='" for key in keys)
-            raise SpecError(self.path, line.number, line.end_column, f"one of {choices}", None)
+            if expected is None:
+                expected = "one of " + ", ".join(f"'{key}='" for key in keys)
+            raise SpecError(self.path, line.number, line.end_column, expected, None)
 
     # --- lines ----------------------------------------------------------------------------
 
@@ -451,8 +464,8 @@ class _Parser:
         self.perturbation = Perturbation(**{key: float(value) for key, value in values.items()})
 
     def line_fitness(self, line: Line) -> None:
-        self.at_least_one(line, _FITNESS_KEYS)
-        found = self.settings(line, line.reader(), _FITNESS_KEYS, ())
+        self.at_least_one(line, _FITNESS_KEYS, _FITNESS_CHOICES)
+        found = self.settings(line, line.reader(), _FITNESS_KEYS, (), _FITNESS_CHOICES)
         for term, token in found.items():  # file order
             self.weights[term] = float(self.value(token, term, *_FITNESS_KEYS[term]))
             self.tokens[f"fitness.{term}"] = token

@@ -254,18 +254,20 @@ class LineReader:
         while not self.at_end():
             yield self._take("a token")
 
-    def key_values(self, allowed: dict[str, str]) -> dict[str, tuple[Token, str]]:
+    def key_values(
+        self, allowed: dict[str, str], unknown: str | None = None
+    ) -> dict[str, tuple[Token, str]]:
         """Consume every remaining token as ``key=value``. ``allowed`` maps each permitted key to
-        a description used in errors. Returns key -> (token, value text); repeated keys and
+        a description used in errors; ``unknown`` says what was expected of an unknown key
+        (default: one of the keys). Returns key -> (token, value text); repeated keys and
         unknown keys are errors."""
         found: dict[str, tuple[Token, str]] = {}
-        choices = ", ".join(f"'{key}='" for key in allowed)
+        if unknown is None:
+            unknown = "one of " + ", ".join(f"'{key}='" for key in allowed)
         for token in self.remaining():
             key, sep, value = token.text.partition("=")
             if not sep or key not in allowed:
-                raise SpecError(
-                    self.path, token.line, token.column, f"one of {choices}", token.text
-                )
+                raise SpecError(self.path, token.line, token.column, unknown, token.text)
             if key in found:
                 raise SpecError(
                     self.path, token.line, token.column, f"'{key}=' only once", token.text
