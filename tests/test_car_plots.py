@@ -429,6 +429,22 @@ def test_parking_frames_figure(parks, crashes, lost):
     assert not [p for p in panels[0].patches if same_color(p.get_edgecolor(), FAILURE_COLOR)]
 
 
+def test_the_collision_entry_and_a_lone_starts_steer_are_shown_only_when_there(
+    parks, crashes, lost
+):
+    """Without a collision the legend had its red swatch all the same; a lone run's title (the
+    frames', the GIF's) named its position and heading but not its wheels turned 20°."""
+    figure = parking_frames_figure([parks, lost], interval=0.3)
+    assert "first collision" not in legend_labels(figure)
+    for path, title in (
+        (lost, "park_3: from (−2, 6) m, heading 0°, steer 20°"),
+        (parks, "park_1: from (7.88, 3.46) m, heading 0°, steer −30°, speed −1.2 m/s"),
+        (crashes, "park_2: from (−6, 4.5) m, heading −15°"),  # wheels straight, at rest
+    ):
+        (panel,) = [ax for ax in parking_frames_figure([path]).axes if ax.get_title()]
+        assert panel.get_title().splitlines()[0] == title
+
+
 def test_a_long_run_draws_at_most_outlines_max_outlines(tmp_path, parks):
     """A 200 s loop at 0.3 s would draw 667 outlines (the verb fuzz's 2,000 s run drew 6,667,
     a black disk, in 15 s): a round interval that draws 100 to 150 instead, in the legend; a

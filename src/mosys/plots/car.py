@@ -245,13 +245,17 @@ def wheel_segments(trajectory: CarTrajectory, sample: int) -> np.ndarray:
 
 def _start_summary(runs: Sequence[CarTrajectory]) -> list[list[str]]:
     """Per run, its start state in brief, as parts to join with commas: the variables in which
-    the runs' starts differ (position, heading, steer, speed; position and heading when none
-    differ), e.g. ``["steer −30°"]`` or ``["from (7.9, 3.5) m", "heading 0°"]``."""
+    the runs' starts differ (position, heading, steer, speed; when none differ, as for one run:
+    position, heading, and steer and speed where not 0), e.g. ``["steer −30°"]`` or
+    ``["from (7.9, 3.5) m", "heading 0°", "steer −30°"]``."""
     names = [n for n in STATE_UNITS if all(n in run.start() for run in runs)]
     starts = np.array([[run.start()[n] for n in names] for run in runs])
     varying = {n for k, n in enumerate(names) if np.ptp(starts[:, k]) > 1e-6}
     if not varying:
-        varying = {"x", "heading"}
+        moving = ("steer", "speed")
+        varying = {"x", "heading"} | {
+            n for n in moving if n in names and abs(starts[0, names.index(n)]) > 1e-6
+        }
     summaries = []
     for run in runs:
         start, parts = run.start(), []
@@ -368,6 +372,14 @@ def plot_parking_frames(
         save_figure(parking_frames_figure(trajectory_paths, interval), out_path)
 
 
+def _collision_entries(runs: Sequence[CarTrajectory]) -> list[tuple[object, str]]:
+    """The legend entry of a collision's red outline, if any run collides."""
+    if not any(run.collided for run in runs):
+        return []
+    patch = Patch(facecolor=(1, 0, 0, 0.25), edgecolor=FAILURE_COLOR, linewidth=2.0)
+    return [(patch, "first collision")]
+
+
 def parking_frames_figure(
     trajectory_paths: Sequence[str | Path], interval: float = FRAME_INTERVAL
 ) -> Figure:
@@ -422,10 +434,7 @@ def parking_frames_figure(
         ),
         (Line2D([], [], color=_shade(1.0), linewidth=2.0), "final outline"),
         (Line2D([], [], color=PATH_COLOR, linewidth=0.8), "path of the front-axle midpoint"),
-        (
-            Patch(facecolor=(1, 0, 0, 0.25), edgecolor=FAILURE_COLOR, linewidth=2.0),
-            "first collision",
-        ),
+        *_collision_entries(runs),
         *domain_entries([run.scene for run in runs]),
     ]
     width = _title_chars(SINGLE_PANEL_WIDTH if len(runs) == 1 else PANEL_WIDTH)
