@@ -193,6 +193,26 @@ def test_motion_strip_names_the_motions_there_are(hop_path: Path, tmp_path: Path
     assert not out.exists()
 
 
+def test_a_motion_run_twice_is_picked_by_its_count(lamp: ModuleType) -> None:
+    """``--motion hop`` drew the first of two hops and nothing drew the second."""
+
+    def controller(count: int) -> np.ndarray:  # hop, land, hop, land: a quarter each
+        return (np.arange(count) * 4 // count) % 2
+
+    trajectory = hop_trajectory(lamp, ("hop", "land"), ["motor", "controller"], controller)
+    halfway = -(-len(trajectory.t) // 2)  # the first sample with 4 k // count = 2
+    first, second = (luxo.find_motion(trajectory, name) for name in ("hop", "hop:2"))
+    assert (first.start, second.start) == (0, halfway)
+    assert luxo.find_motion(trajectory, "hop:1") == first
+    for wrong in ("hop:3", "hop:0", "hop:x", "land"):
+        with pytest.raises(ValueError) as raised:
+            luxo.find_motion(trajectory, wrong, "show.h5")
+        assert str(raised.value) == (
+            f"show.h5: no motion called {wrong!r} (--motion); its motions: hop (runs 2 times: "
+            "hop:1..hop:2)"
+        )
+
+
 @pytest.mark.parametrize("fixture", ["hop_path", "landed_path"])
 def test_torques_and_forces_figure(fixture: str, request) -> None:
     path = request.getfixturevalue(fixture)

@@ -148,7 +148,9 @@ def _luxo_arguments(parser: argparse.ArgumentParser) -> None:
         "--strip", type=OutputPath(*PLOT), help="PNG: the lamp every few frames of one motion"
     )
     parser.add_argument(
-        "--motion", help="the motion (motor program) the strip draws (default: the first)"
+        "--motion",
+        help="the motion (motor program) the strip draws: NAME its first run, NAME:K its K-th "
+        "(default: the script's first motion)",
     )
     parser.add_argument(
         "--forces", type=OutputPath(*PLOT), help="PNG: joint torques and contact forces over time"

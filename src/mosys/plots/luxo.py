@@ -17,6 +17,7 @@ start to the next one's, the landing included.
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -123,15 +124,26 @@ def read_luxo_trajectory(path: str | Path, contacts: bool = False) -> Trajectory
 
 
 def find_motion(trajectory: Trajectory, name: str | None, path: str | Path = "") -> Motion:
-    """The first motion called ``name`` (None: the trajectory's first motion); ValueError (a
-    PlotInputError) listing the motions there are when there is none."""
+    """The motion called ``name``: ``NAME`` its first run, ``NAME:K`` its K-th (a script that
+    runs ``hop`` twice: ``hop:2``); None: the trajectory's first motion. ValueError (a
+    PlotInputError) listing the motions there are, with how often each runs, when there is
+    none such."""
     found = motions(trajectory)
     if not found:
         raise PlotInputError(f"{path}: no motion to draw: it runs no motor program")
-    for motion in found:
-        if name is None or motion.name == name:
-            return motion
-    there = ", ".join(dict.fromkeys(m.name for m in found))
+    if name is None:
+        return found[0]
+    wanted, _, count = name.partition(":")
+    runs = [motion for motion in found if motion.name == wanted]
+    if not count:
+        count = "1"
+    if count.isdecimal() and 1 <= int(count) <= len(runs):
+        return runs[int(count) - 1]
+    times = Counter(motion.name for motion in found)
+    there = ", ".join(
+        motion if n == 1 else f"{motion} (runs {n} times: {motion}:1..{motion}:{n})"
+        for motion, n in times.items()
+    )
     raise PlotInputError(f"{path}: no motion called {name!r} (--motion); its motions: {there}")
 
 
