@@ -29,9 +29,9 @@ rule bsr_plots:
         results=bsr_seed_results,
         code=code_inputs("mosys.cli.plots", "mosys.plots.bsr", "mosys.plots.bsr_learning"),  # mosys plot bsr
     output:
-        learning=report("results/plots/bsr/{name}/learning.png", caption="../report/bsr_learning.rst", category="1995 paper: BSR controllers (2-D)", subcategory="{name}"),
-        filmstrip=report("results/plots/bsr/{name}/filmstrip.png", caption="../report/bsr_filmstrip.rst", category="1995 paper: BSR controllers (2-D)", subcategory="{name}"),
-        gif=report("results/plots/bsr/{name}/motion.gif", caption="../report/bsr_gif.rst", category="1995 paper: BSR controllers (2-D)", subcategory="{name}"),
+        learning=report("results/plots/bsr/{name}/learning.png", caption="../report/bsr_learning.rst", category="1995 paper — BSR controllers (2-D)", subcategory="{name}"),
+        filmstrip=report("results/plots/bsr/{name}/filmstrip.png", caption="../report/bsr_filmstrip.rst", category="1995 paper — BSR controllers (2-D)", subcategory="{name}"),
+        gif=report("results/plots/bsr/{name}/motion.gif", caption="../report/bsr_gif.rst", category="1995 paper — BSR controllers (2-D)", subcategory="{name}"),
     log:
         "results/logs/plots/bsr/{name}.log",
     benchmark:
@@ -47,7 +47,7 @@ rule bsr_learning_curves:
         results=lambda wildcards: bsr_all_results(),
         code=code_inputs("mosys.cli.plots", "mosys.plots.bsr_learning"),  # mosys plot bsr-learning
     output:
-        report("results/plots/bsr/learning_curves.png", caption="../report/bsr_curves.rst", category="1995 paper: BSR controllers (2-D)", subcategory="all searches"),
+        report("results/plots/bsr/learning_curves.png", caption="../report/bsr_curves.rst", category="1995 paper — BSR controllers (2-D)", subcategory="all searches"),
     log:
         "results/logs/plots/bsr/learning_curves.log",
     benchmark:
@@ -62,7 +62,7 @@ rule bsr_runs_table:
         results=lambda wildcards: bsr_all_results(),
         code=code_inputs("mosys.cli.paper_tables", "mosys.paper_tables.bsr"),  # mosys bsr-table
     output:
-        csv=report("results/tables/bsr_runs.csv", caption="../report/bsr_table.rst", category="1995 paper: BSR controllers (2-D)", subcategory="all searches"),
+        csv=report("results/tables/bsr_runs.csv", caption="../report/bsr_table.rst", category="1995 paper — BSR controllers (2-D)", subcategory="all searches"),
         md="results/tables/bsr_runs.md",
     log:
         "results/logs/tables/bsr_runs.log",

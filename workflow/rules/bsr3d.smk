@@ -8,9 +8,9 @@ rule bsr3d_motion_plots:
         results=bsr3d_motion_results,
         code=code_inputs("mosys.cli.plots", "mosys.plots.bsr3d", "mosys.plots.figure_at_rest"),  # mosys plot bsr3d
     output:
-        filmstrip=report("results/plots/bsr3d/{motion}/filmstrip.png", caption="../report/bsr3d_filmstrip.rst", category="1995 paper: 3-D figures", subcategory="{motion}"),
-        gif=report("results/plots/bsr3d/{motion}/motion.gif", caption="../report/bsr3d_gif.rst", category="1995 paper: 3-D figures", subcategory="{motion}"),
-        rest=report("results/plots/bsr3d/{motion}/rest.png", caption="../report/bsr3d_rest.rst", category="1995 paper: 3-D figures", subcategory="{motion}"),
+        filmstrip=report("results/plots/bsr3d/{motion}/filmstrip.png", caption="../report/bsr3d_filmstrip.rst", category="1995 paper — 3-D figures", subcategory="{motion}"),
+        gif=report("results/plots/bsr3d/{motion}/motion.gif", caption="../report/bsr3d_gif.rst", category="1995 paper — 3-D figures", subcategory="{motion}"),
+        rest=report("results/plots/bsr3d/{motion}/rest.png", caption="../report/bsr3d_rest.rst", category="1995 paper — 3-D figures", subcategory="{motion}"),
     log:
         "results/logs/plots/bsr3d/{motion}.log",
     benchmark:
@@ -29,7 +29,7 @@ rule bsr3d_learning_kinds:
         sense=bsr3d_results(config["bsr3d"]["kinds"]["sense"]),
         code=code_inputs("mosys.cli.plots", "mosys.plots.bsr3d_learning"),  # mosys plot bsr3d-kinds
     output:
-        report("results/plots/bsr3d/learning_kinds.png", caption="../report/bsr3d_kinds.rst", category="1995 paper: 3-D figures", subcategory="Figures 7 and 8"),
+        report("results/plots/bsr3d/learning_kinds.png", caption="../report/bsr3d_kinds.rst", category="1995 paper — 3-D figures", subcategory="Figures 7 and 8"),
     log:
         "results/logs/plots/bsr3d/learning_kinds.log",
     benchmark:
@@ -44,7 +44,7 @@ rule bsr3d_seeds:
         results=bsr3d_results(*variability_searches()),
         code=code_inputs("mosys.cli.plots", "mosys.plots.bsr3d_learning"),  # mosys plot bsr3d-seeds
     output:
-        report("results/plots/bsr3d/seeds.png", caption="../report/bsr3d_seeds.rst", category="1995 paper: 3-D figures", subcategory="Figures 7 and 8"),
+        report("results/plots/bsr3d/seeds.png", caption="../report/bsr3d_seeds.rst", category="1995 paper — 3-D figures", subcategory="Figures 7 and 8"),
     log:
         "results/logs/plots/bsr3d/seeds.log",
     benchmark:
@@ -59,7 +59,7 @@ rule bsr3d_search_learning:
         results=bsr_seed_results,
         code=code_inputs("mosys.cli.plots", "mosys.plots.bsr3d_learning"),  # mosys plot bsr3d-seeds
     output:
-        report("results/plots/bsr3d/{name}/learning.png", caption="../report/bsr3d_learning.rst", category="1995 paper: 3-D figures", subcategory="{name}"),
+        report("results/plots/bsr3d/{name}/learning.png", caption="../report/bsr3d_learning.rst", category="1995 paper — 3-D figures", subcategory="{name}"),
     log:
         "results/logs/plots/bsr3d/{name}_learning.log",
     benchmark:
@@ -74,7 +74,7 @@ rule bsr3d_runs_table:
         results=lambda wildcards: bsr3d_results(),
         code=code_inputs("mosys.cli.paper_tables", "mosys.paper_tables.bsr3d"),  # bsr3d-table
     output:
-        csv=report("results/tables/bsr3d_runs.csv", caption="../report/bsr3d_table.rst", category="1995 paper: 3-D figures", subcategory="tables"),
+        csv=report("results/tables/bsr3d_runs.csv", caption="../report/bsr3d_table.rst", category="1995 paper — 3-D figures", subcategory="tables"),
         md="results/tables/bsr3d_runs.md",
     log:
         "results/logs/tables/bsr3d_runs.log",
@@ -90,7 +90,7 @@ rule bsr3d_targets_table:
         results=lambda wildcards: bsr3d_results(),
         code=code_inputs("mosys.cli.paper_tables", "mosys.paper_tables.bsr3d_targets"),
     output:
-        csv=report("results/tables/bsr3d_targets.csv", caption="../report/bsr3d_targets.rst", category="1995 paper: 3-D figures", subcategory="tables"),
+        csv=report("results/tables/bsr3d_targets.csv", caption="../report/bsr3d_targets.rst", category="1995 paper — 3-D figures", subcategory="tables"),
         md="results/tables/bsr3d_targets.md",
     log:
         "results/logs/tables/bsr3d_targets.log",

@@ -39,7 +39,7 @@ rule car_frames:
         trajectories=car_trajectories(),
         code=code_inputs("mosys.cli.plots", "mosys.plots.car"),  # mosys plot car
     output:
-        report("results/plots/car/figure19_frames.png", caption="../report/car_frames.rst", category="1990 paper: the self-parking car"),
+        report("results/plots/car/figure19_frames.png", caption="../report/car_frames.rst", category="1990 paper — the self-parking car"),
     log:
         "results/logs/plots/car/figure19_frames.log",
     benchmark:
@@ -54,7 +54,7 @@ rule car_gif:
         trajectory=f"results/trajectories/{config['car']['gif_script']}.h5",
         code=code_inputs("mosys.cli.plots", "mosys.plots.car"),  # mosys plot car
     output:
-        report("results/plots/car/manoeuvre.gif", caption="../report/car_gif.rst", category="1990 paper: the self-parking car"),
+        report("results/plots/car/manoeuvre.gif", caption="../report/car_gif.rst", category="1990 paper — the self-parking car"),
     log:
         "results/logs/plots/car/manoeuvre.log",
     benchmark:
@@ -69,7 +69,7 @@ rule car_start_map:
         grid="results/car/start_grid.h5",
         code=code_inputs("mosys.cli.plots", "mosys.plots.car_starts"),  # mosys plot car
     output:
-        report("results/plots/car/start_map.png", caption="../report/car_map.rst", category="1990 paper: the self-parking car"),
+        report("results/plots/car/start_map.png", caption="../report/car_map.rst", category="1990 paper — the self-parking car"),
     log:
         "results/logs/plots/car/start_map.log",
     benchmark:
@@ -84,7 +84,7 @@ rule car_consistency:
         grid="results/car/start_grid.h5",
         code=code_inputs("mosys.cli.plots", "mosys.plots.car_starts"),  # mosys plot car
     output:
-        report("results/plots/car/consistency.png", caption="../report/car_consistency.rst", category="1990 paper: the self-parking car"),
+        report("results/plots/car/consistency.png", caption="../report/car_consistency.rst", category="1990 paper — the self-parking car"),
     log:
         "results/logs/plots/car/consistency.log",
     benchmark:
@@ -101,7 +101,7 @@ rule car_controller_table:
         trajectories=car_trajectories(),
         code=code_inputs("mosys.cli.paper_tables", "mosys.paper_tables.car"),  # mosys car-table
     output:
-        csv=report("results/tables/car_controller.csv", caption="../report/car_table.rst", category="1990 paper: the self-parking car"),
+        csv=report("results/tables/car_controller.csv", caption="../report/car_table.rst", category="1990 paper — the self-parking car"),
         md="results/tables/car_controller.md",
     log:
         "results/logs/tables/car_controller.log",

@@ -32,9 +32,9 @@ rule composite_plots:
         result="results/composite/{name}.h5",
         code=code_inputs("mosys.cli.plots", "mosys.plots.composite"),  # mosys plot composite
     output:
-        filmstrips=report("results/plots/composite/{name}/filmstrips.png", caption="../report/composite_filmstrips.rst", category="1995 paper: composite motion", subcategory="{name}"),
-        search=report("results/plots/composite/{name}/search.png", caption="../report/composite_search.rst", category="1995 paper: composite motion", subcategory="{name}"),
-        gif=report("results/plots/composite/{name}/motion.gif", caption="../report/composite_gif.rst", category="1995 paper: composite motion", subcategory="{name}"),
+        filmstrips=report("results/plots/composite/{name}/filmstrips.png", caption="../report/composite_filmstrips.rst", category="1995 paper — composite motion", subcategory="{name}"),
+        search=report("results/plots/composite/{name}/search.png", caption="../report/composite_search.rst", category="1995 paper — composite motion", subcategory="{name}"),
+        gif=report("results/plots/composite/{name}/motion.gif", caption="../report/composite_gif.rst", category="1995 paper — composite motion", subcategory="{name}"),
     log:
         "results/logs/plots/composite/{name}.log",
     benchmark:
@@ -50,7 +50,7 @@ rule composite_table:
         results=expand("results/composite/{name}.h5", name=config["composite"]["scripts"]),
         code=code_inputs("mosys.cli.paper_tables", "mosys.paper_tables.composite"),  # mosys composite-table
     output:
-        csv=report("results/tables/composite.csv", caption="../report/composite_table.rst", category="1995 paper: composite motion", subcategory="tables"),
+        csv=report("results/tables/composite.csv", caption="../report/composite_table.rst", category="1995 paper — composite motion", subcategory="tables"),
         md="results/tables/composite.md",
     log:
         "results/logs/tables/composite.log",
@@ -67,7 +67,7 @@ rule composite_robustness_table:
         specs=[f"specs/bsr/{search}.bsr" for pair in robustness_pairs() for search in pair],
         code=code_inputs("mosys.cli.paper_tables", "mosys.paper_tables.robustness"),  # mosys robustness-table
     output:
-        csv=report("results/tables/composite_robustness.csv", caption="../report/robustness_table.rst", category="1995 paper: composite motion", subcategory="tables"),
+        csv=report("results/tables/composite_robustness.csv", caption="../report/robustness_table.rst", category="1995 paper — composite motion", subcategory="tables"),
         md="results/tables/composite_robustness.md",
     log:
         "results/logs/tables/composite_robustness.log",

@@ -7,9 +7,9 @@ rule luxo_plots:
         trajectory="results/trajectories/{script}.h5",
         code=code_inputs("mosys.cli.plots", "mosys.plots.luxo"),  # mosys plot luxo
     output:
-        strip=report("results/plots/luxo/{script}_strip.png", caption="../report/luxo_strip.rst", category="1990 paper: Luxo the lamp"),
-        gif=report("results/plots/luxo/{script}.gif", caption="../report/luxo_gif.rst", category="1990 paper: Luxo the lamp"),
-        forces=report("results/plots/luxo/{script}_forces.png", caption="../report/luxo_forces.rst", category="1990 paper: Luxo the lamp"),
+        strip=report("results/plots/luxo/{script}_strip.png", caption="../report/luxo_strip.rst", category="1990 paper — Luxo the lamp"),
+        gif=report("results/plots/luxo/{script}.gif", caption="../report/luxo_gif.rst", category="1990 paper — Luxo the lamp"),
+        forces=report("results/plots/luxo/{script}_forces.png", caption="../report/luxo_forces.rst", category="1990 paper — Luxo the lamp"),
     log:
         "results/logs/plots/luxo/{script}.log",
     benchmark:
@@ -28,7 +28,7 @@ rule luxo_motions_table:
         landing=f"results/controllers/{config['luxo']['group']}/{config['luxo']['controller']}.h5",
         code=code_inputs("mosys.cli.paper_tables", "mosys.paper_tables.luxo"),  # mosys luxo-table
     output:
-        csv=report("results/tables/luxo_motions.csv", caption="../report/luxo_table.rst", category="1990 paper: Luxo the lamp"),
+        csv=report("results/tables/luxo_motions.csv", caption="../report/luxo_table.rst", category="1990 paper — Luxo the lamp"),
         md="results/tables/luxo_motions.md",
     log:
         "results/logs/tables/luxo_motions.log",

@@ -10,8 +10,8 @@ rule controller_plots:
         dynamics=plotted_controller_dynamics,
         code=code_inputs("mosys.cli.plots", "mosys.plots.controller", "mosys.dynamics.load"),  # mosys plot controller
     output:
-        portrait=report("results/plots/{group}/{name}_portrait.png", caption="../report/portrait.rst", category="1990 paper: the pendulum", subcategory="Figure 14 portraits"),
-        torque=report("results/plots/{group}/{name}_torque.png", caption="../report/torque.rst", category="1990 paper: the pendulum", subcategory="torque tables"),
+        portrait=report("results/plots/{group}/{name}_portrait.png", caption="../report/portrait.rst", category="1990 paper — the pendulum", subcategory="Figure 14 portraits"),
+        torque=report("results/plots/{group}/{name}_torque.png", caption="../report/torque.rst", category="1990 paper — the pendulum", subcategory="torque tables"),
     log:
         "results/logs/plots/{group}/{name}.log",
     benchmark:
@@ -30,8 +30,8 @@ rule script_plots:
         tables=lambda wildcards: [p for p in script_inputs(wildcards) if p.endswith(".h5")],
         code=code_inputs("mosys.cli.plots", "mosys.plots.script"),  # mosys plot script
     output:
-        path=report("results/plots/{group}/{script}_path.png", caption="../report/script_path.rst", category="1990 paper: the pendulum", subcategory="scripts"),
-        gif=report("results/plots/{group}/{script}.gif", caption="../report/script_gif.rst", category="1990 paper: the pendulum", subcategory="scripts"),
+        path=report("results/plots/{group}/{script}_path.png", caption="../report/script_path.rst", category="1990 paper — the pendulum", subcategory="scripts"),
+        gif=report("results/plots/{group}/{script}.gif", caption="../report/script_gif.rst", category="1990 paper — the pendulum", subcategory="scripts"),
     log:
         "results/logs/plots/{group}/{script}.log",
     benchmark:
@@ -53,7 +53,7 @@ rule compared_controls:
         ],
         code=code_inputs("mosys.cli.plots", "mosys.plots.controls"),  # mosys plot controls
     output:
-        report("results/plots/{group}/slew_torque.png", caption="../report/slew_torque.rst", category="1990 paper: the pendulum", subcategory="scripts"),
+        report("results/plots/{group}/slew_torque.png", caption="../report/slew_torque.rst", category="1990 paper — the pendulum", subcategory="scripts"),
     log:
         "results/logs/plots/{group}/slew_torque.log",
     benchmark:
@@ -70,7 +70,7 @@ rule free_swing:
         dynamics=lambda wildcards: f"results/dynamics/{config['pendulum']['figure']}.py",
         code=code_inputs("mosys.cli.plots", "mosys.plots.free_swing"),  # mosys plot free-swing
     output:
-        report("results/plots/{group}/free_swing.png", caption="../report/free_swing.rst", category="1990 paper: the pendulum", subcategory="Figure 5"),
+        report("results/plots/{group}/free_swing.png", caption="../report/free_swing.rst", category="1990 paper — the pendulum", subcategory="Figure 5"),
     log:
         "results/logs/plots/{group}/free_swing.log",
     benchmark:

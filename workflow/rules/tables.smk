@@ -4,7 +4,7 @@ rule pendulum_table:
         dynamics=f"results/dynamics/{config['pendulum']['figure']}.py",
         code=code_inputs("mosys.cli.paper_tables", "mosys.paper_tables.pendulum"),  # mosys pendulum-table
     output:
-        csv=report("results/tables/pendulum_controllers.csv", caption="../report/pendulum_table.rst", category="1990 paper: the pendulum", subcategory="Figure 13"),
+        csv=report("results/tables/pendulum_controllers.csv", caption="../report/pendulum_table.rst", category="1990 paper — the pendulum", subcategory="Figure 13"),
         md="results/tables/pendulum_controllers.md",
     log:
         "results/logs/tables/pendulum_controllers.log",
