@@ -325,6 +325,30 @@ def test_a_missing_attribute_or_term_is_named(tmp_path: Path) -> None:
     assert str(error.value) == f"{no_steps}: fitness_terms has no foot_steps"
 
 
+def test_the_2d_table_names_a_missing_attribute_or_term(
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    """``mosys bsr-table`` stopped with a KeyError traceback, exit 1, on a file without a fitness
+    term or a root attribute it reads (the 3-D table named them)."""
+    csv_path, md_path = tmp_path / "runs.csv", tmp_path / "runs.md"
+    terms = json.dumps({"distance": 1.0, "max_height": 0.5, "contact_distance": 0.0})
+    cases = (
+        (
+            write_seed(tmp_path, "no_fall", 1, 2, fitness_terms=terms),
+            "fitness_terms has no rotations, fall",
+        ),
+        (
+            write_seed(tmp_path, "no_rate", 1, 2, steps_per_second=None),
+            "not a 2-D BSR result file: no root attribute steps_per_second",
+        ),
+    )
+    for path, message in cases:
+        argv = ["bsr-table", str(path), "--csv", str(csv_path), "--md", str(md_path)]
+        assert main(argv) == 2
+        assert capsys.readouterr().err == f"mosys: {path}: {message}\n"
+        assert not csv_path.exists() and not md_path.exists()
+
+
 def test_seeds_of_one_search_must_share_their_set_up(tmp_path: Path) -> None:
     paths = [
         write_seed(tmp_path, "rex_turn", 1, chain="rex_walk", chain_seed=2),

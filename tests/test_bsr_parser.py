@@ -566,3 +566,21 @@ def test_a_composite_naming_a_3d_figure_is_refused_at_its_figure_line():
         "x.comp:3:8: expected a planar figure (composite motion is 2-D; 'cujo' is 3-D), "
         "found 'cujo'"
     )
+
+
+@pytest.mark.parametrize(
+    ("kernel", "terms"),
+    [
+        ("mosys.kernels.bsr_controller", FITNESS_TERMS),
+        ("mosys.kernels.bsr3d_controller", FITNESS_TERMS_3D),
+    ],
+)
+def test_the_kernels_term_columns_are_the_parsers_terms_in_order(kernel, terms):
+    """The kernels may not import the parser (layers), so each numbers its terms_out columns
+    itself; the searches size terms_out by the parser's list, and numba does not check bounds:
+    a column the parser's list lacked would be written past the array's end."""
+    import importlib
+
+    module = importlib.import_module(kernel)
+    assert len(terms) == module.TERM_COUNT
+    assert [getattr(module, term.upper()) for term in terms] == list(range(len(terms)))

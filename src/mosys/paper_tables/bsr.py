@@ -6,6 +6,7 @@ table (``mosys.paper_tables.bsr3d``)."""
 
 from __future__ import annotations
 
+import json
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
@@ -110,11 +111,50 @@ def check_dimensions(result: BsrResult, path: str | Path, dimensions: int) -> No
         )
 
 
-def read_planar_result(path: str | Path) -> BsrResult:
-    """A 2-D search's result file; InputError naming the file for a 3-D one."""
-    result = read_bsr_result(path)
-    check_dimensions(result, path, 2)
+def read_table_result(
+    path: str | Path, dimensions: int, attrs: Sequence[str], terms: Sequence[str]
+) -> BsrResult:
+    """Read one seed file for a runs table, checking that it is a ``dimensions``-D search's
+    with the root ``attrs`` and fitness ``terms`` the table reads. Raises InputError naming the
+    file otherwise (a file without one had the table stop with a KeyError traceback)."""
+    result = read_bsr_result(path)  # InputError naming the file if it is not one
+    absent = [key for key in attrs if key not in result.attrs]
+    if absent:
+        raise InputError(
+            f"{path}: not a {dimensions}-D BSR result file: no root attribute {', '.join(absent)}"
+        )
+    check_dimensions(result, path, dimensions)
+    try:
+        found = result.fitness_terms
+    except json.JSONDecodeError as error:
+        raise InputError(f"{path}: fitness_terms is not JSON: {error}") from None
+    absent = [term for term in terms if term not in found]
+    if absent:
+        raise InputError(f"{path}: fitness_terms has no {', '.join(absent)}")
     return result
+
+
+# the root attributes the 2-D table reads
+PLANAR_ATTRS = (
+    "name",
+    "figure",
+    "controller_kind",
+    "rules",
+    "duration",
+    "dt",
+    "budget",
+    "generations",
+    "evaluations",
+    "wall_seconds",
+    "best_fitness",
+    "steps_per_second",
+    "fitness_terms",
+)
+
+
+def read_planar_result(path: str | Path) -> BsrResult:
+    """A 2-D search's result file, checked as ``read_table_result`` does."""
+    return read_table_result(path, 2, PLANAR_ATTRS, FITNESS_TERMS)
 
 
 def speed_up(ratio: float) -> str:

@@ -10,20 +10,19 @@ the 2-D table (``mosys.paper_tables.bsr``)."""
 
 from __future__ import annotations
 
-import json
 from collections.abc import Sequence
 from pathlib import Path
 
 import pandas as pd
 
 from mosys.errors import InputError
-from mosys.io.bsr_result import BsrResult, read_bsr_result
+from mosys.io.bsr_result import BsrResult
 from mosys.paper_tables.bsr import (
-    check_dimensions,
     cost_columns,
     fitness_columns,
     group_by_search,
     median_ms_per_evaluation,
+    read_table_result,
     setup_columns,
     speed_up,
     write_table,
@@ -110,24 +109,8 @@ COLUMNS = (
 
 
 def read_3d_result(path: str | Path) -> BsrResult:
-    """Read one seed file of a 3-D search, checking that it is one: the root attributes and
-    fitness terms the table reads are there and ``best/figure_motion`` is 3-D. Raises
-    InputError naming the file otherwise."""
-    result = read_bsr_result(path)  # InputError naming the file if it is not one
-    absent = [key for key in REQUIRED_ATTRS if key not in result.attrs]
-    if absent:
-        raise InputError(
-            f"{path}: not a 3-D BSR result file: no root attribute {', '.join(absent)}"
-        )
-    check_dimensions(result, path, 3)
-    try:
-        terms = result.fitness_terms
-    except json.JSONDecodeError as error:
-        raise InputError(f"{path}: fitness_terms is not JSON: {error}") from None
-    absent = [term for term in REQUIRED_TERMS if term not in terms]
-    if absent:
-        raise InputError(f"{path}: fitness_terms has no {', '.join(absent)}")
-    return result
+    """Read one seed file of a 3-D search, checking that it is one (``read_table_result``)."""
+    return read_table_result(path, 3, REQUIRED_ATTRS, REQUIRED_TERMS)
 
 
 def _check_seeds_agree(name: str, results: Sequence[BsrResult]) -> None:
