@@ -407,7 +407,10 @@ def composite_result_problems(path: Path, spec: Path | None) -> list[str]:
             out += [f"{name}: {p}" for p in figure_motion_problems(result[name])]
         for name in ("phases", "phases_before"):
             phases = json.loads(result.attrs[name])
-            if any(set(phase) < {"controller", "start", "end"} for phase in phases):
+            if any(
+                not isinstance(phase, dict) or not {"controller", "start", "end"} <= set(phase)
+                for phase in phases
+            ):
                 out.append(f"{name}: a phase without controller, start and end")
             elif any(p["end"] < p["start"] for p in phases) or any(
                 later["start"] < earlier["end"] - 1e-9

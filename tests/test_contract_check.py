@@ -3,12 +3,13 @@ the paper tables' build): its exit codes, and malformed files reported, not rais
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import h5py
 import numpy as np
 import pytest
-from contract_check import main, name_list_problems
+from contract_check import composite_result_problems, main, name_list_problems
 
 
 def test_no_results_folder_is_refused(tmp_path: Path, capsys) -> None:
@@ -69,3 +70,52 @@ def test_the_working_directory_is_the_default(tmp_path: Path, monkeypatch, argv)
     monkeypatch.chdir(tmp_path)
     (tmp_path / "results").mkdir()
     assert main(argv) == 0
+
+
+@pytest.mark.parametrize(
+    "phase",
+    [
+        {"name": "jump", "start": 0.0, "end": 1.0},  # no controller, an extra key of mosys's own
+        {"controller": "jump", "start": 0.0},  # no end
+        ["jump", 0.0, 1.0],  # not an object
+    ],
+)
+def test_a_composite_phase_without_controller_start_and_end_is_a_problem(
+    tmp_path: Path, phase
+) -> None:
+    """DESIGN.md: phases is a JSON list of {controller, start, end}; a phase that lacks one of
+    them is a problem also where it has keys of its own (a strict-subset test let it pass)."""
+    path = tmp_path / "show.h5"
+    good = {"controller": "jump", "start": 0.0, "end": 1.0}
+    with h5py.File(path, "w") as h5:
+        for name, value in {
+            "format_version": 1,
+            "script": "show",
+            "phases": json.dumps([phase]),
+            "phases_before": json.dumps([good]),
+            "score_before": 0.0,
+            "score_after": 0.0,
+            "simulations": 1,
+            "spec_sha256": "0" * 64,
+            "wall_seconds": 0.0,
+        }.items():
+            h5.attrs[name] = value
+        for group in ("figure_motion", "before/figure_motion"):
+            motion = h5.create_group(group)
+            motion["t"] = np.array([0.0, 0.01])
+            motion["endpoints"] = np.array([[[[0.0, 0.0], [0.0, 1.0]]]] * 2)
+            motion["com"] = np.array([[0.0, 0.5]] * 2)
+            for key, value in {
+                "rod_names": np.array(["rod"], dtype=h5py.string_dtype()),
+                "rod_mass": [1.0],
+                "rod_length": [1.0],
+                "rod_com": [0.5],
+                "rod_inertia": [1 / 12],
+                "gravity": 9.81,
+                "terrain": "[[-1000, 0], [1000, 0]]",
+                "contact": "none",
+            }.items():
+                motion.attrs[key] = value
+    assert composite_result_problems(path, None) == [
+        "phases: a phase without controller, start and end"
+    ]
