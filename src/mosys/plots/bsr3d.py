@@ -38,7 +38,6 @@ from mosys.io.bsr_result import BsrResult
 from mosys.io.trajectory import FigureMotion
 from mosys.plots.bsr_results import (
     KIND_TEXT,
-    TERMS,
     best_result_path,
     group_by_search,
     motion_fitness,
@@ -110,7 +109,6 @@ TERMS_3D = {
     "heading_sine": ("sin(heading change)", "", "+.2f"),
     "final_spin": ("final spin", "deg/s", ".0f"),
     "net_rotation": ("net rotation", "deg", ".1f"),
-    **TERMS,
 }
 MAX_POSES = 500  # a filmstrip drawing more is a grey smear: an --interval that short is refused
 LEGEND_WIDTH = 130  # characters of a filmstrip legend's line of terms
