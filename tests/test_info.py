@@ -11,6 +11,7 @@ search of one; the start grid is written by ``write_start_grid`` from outcomes g
 from __future__ import annotations
 
 import dataclasses
+import json
 import shutil
 import subprocess
 import sys
@@ -390,6 +391,13 @@ def test_info_of_each_other_kind(made, capsys):
         "  sense-based controller, 10 rules, joints: arm_a, arm_b, leg_a, leg_b"
     )
     assert "  /best/figure_motion: 251 samples, t 0 … 2.5 s, 2-D, 5 rods (torso, arm_a, " in out
+    # the terms in full (the root attribute's line is cut at 80 characters), with the weights
+    with h5py.File(made["BSR search result"]) as h5:
+        terms = json.loads(h5.attrs["fitness_terms"])
+    listed = " ".join(line.strip() for line in section(out, "search:")[3:])
+    assert listed.startswith("fitness terms of the best motion: distance ")
+    assert [part.split()[0] for part in listed.split(": ", 1)[1].split(", ")] == list(terms)
+    assert f"max_height {terms['max_height']:.6g} (weight 25)" in listed
 
     out = info_of(made["composite result"], capsys)
     refined = section(out, "phases, refined (phases):")

@@ -9,6 +9,7 @@ Values are read a block of rows at a time (about a million elements), so a car t
 from __future__ import annotations
 
 import json
+import textwrap
 from collections import Counter
 from collections.abc import Iterator
 from pathlib import Path
@@ -181,8 +182,27 @@ def _bsr_sections(h5: h5py.File, summaries: dict) -> list[tuple[str, list[str]]]
         f"  learning curve: {h5['learning_curve/evaluations'].size} points, evaluations "
         f"{summaries['learning_curve/evaluations'].range()}, best fitness "
         f"{summaries['learning_curve/best_fitness'].range()}",
+        *_fitness_terms_lines(h5.attrs),
     ]
     return [("search:", search), *_motion_sections(h5, summaries)]
+
+
+def _fitness_terms_lines(attrs: h5py.AttributeManager) -> list[str]:
+    """The measured fitness terms in full, each with its weight where the spec gave one,
+    wrapped at 100 characters (the root attribute's line is cut); none if they are unreadable
+    (the attribute lines below show what is there)."""
+    try:
+        terms = json.loads(string_attr(attrs["fitness_terms"]))
+        weights = json.loads(string_attr(attrs.get("fitness_weights", "{}")))
+        parts = [
+            f"{name} {_number(value)}"
+            + (f" (weight {_number(weights[name])})" if name in weights else "")
+            for name, value in terms.items()
+        ]
+    except (KeyError, ValueError, TypeError, AttributeError):
+        return []
+    text = "fitness terms of the best motion: " + ", ".join(parts)
+    return textwrap.wrap(text, 100, initial_indent="  ", subsequent_indent="    ")
 
 
 def _composite_sections(h5: h5py.File, summaries: dict) -> list[tuple[str, list[str]]]:
