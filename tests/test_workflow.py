@@ -23,10 +23,12 @@ from mosys.io.start_grid import NO_WAY, NOT_FREE, read_start_grid
 
 ROOT = Path(__file__).resolve().parents[1]
 PENDULUM_CONTROLLERS = "ABCDEFG"
+CI = ("--configfile", "config/ci.yaml")  # CI's reduced budget
 
 
 def copy_workflow(work: Path) -> Path:
     """A copy of the workflow, its specs and sources (their mtimes are rule inputs) in work."""
+    work.mkdir(parents=True, exist_ok=True)
     for name in ("Snakefile", "workflow", "config", "profiles", "specs", "src"):
         source = ROOT / name
         if source.is_dir():
@@ -412,10 +414,34 @@ def test_a_new_luxo_script_reuses_the_controller_and_motor_programs(workflow):
         script.unlink()
 
 
+def reuse_checkout_searches(work: Path, checkout: Path = ROOT) -> int:
+    """Copy ``checkout``'s results of the searches that results/bsr_all and
+    results/composite_all run at CI's budget into ``work``, if Snakemake, asked there, would
+    run none of them: as after .ci/run's ``snakemake results/paper_tables --configfile
+    config/ci.yaml``, which runs every one of them before the tests. The same pipeline and
+    seeds make the same files (the searches are deterministic), and they need not run twice
+    (about 2 minutes on 2 cores). Otherwise (none built, one out of date or at another budget:
+    Snakemake there knows from its records) nothing is copied and the work copy runs them all.
+    Returns how many files it copied."""
+    targets = ("results/bsr_all", "results/composite_all", *CI)
+    planned = run_snakemake(checkout, "--dry-run", "--nolock", *targets)
+    if planned.returncode != 0 or "rule bsr_search:" in planned.stdout:
+        return 0
+    wanted = run_snakemake(work, "--dry-run", *targets).stdout
+    outputs = re.findall(r"^rule bsr_search:\n(?:    .*\n)*?    output: (\S+)$", wanted, re.M)
+    for output in outputs:
+        (work / output).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(checkout / output, work / output)  # its time stamp too
+    return len(outputs)
+
+
 @pytest.fixture(scope="module")
 def bsr_built(workflow) -> Path:
-    """results/bsr_all at CI's reduced budget (config/ci.yaml: G = 1500, five seeds)."""
-    snakemake(workflow, "results/bsr_all", "--configfile", "config/ci.yaml")
+    """results/bsr_all at CI's reduced budget (config/ci.yaml: G = 1500, five seeds); its
+    searches taken from this checkout where they are built and up to date at that budget
+    (``reuse_checkout_searches``)."""
+    reuse_checkout_searches(workflow)
+    snakemake(workflow, "results/bsr_all", *CI)
     return workflow
 
 
@@ -455,7 +481,7 @@ def test_editing_one_weight_reruns_only_that_search_and_its_plots(bsr_built):
     edited = re.sub(r"max_height=[\d.]+", "max_height=7.5", text)
     assert edited != text
     with edited_spec(spec, edited):
-        jobs = planned_jobs(bsr_built, "results/bsr_all", "--configfile", "config/ci.yaml")
+        jobs = planned_jobs(bsr_built, "results/bsr_all", *CI)
         assert jobs == {
             "bsr_search": 5,
             "bsr_plots": 1,
@@ -463,9 +489,7 @@ def test_editing_one_weight_reruns_only_that_search_and_its_plots(bsr_built):
             "bsr_runs_table": 1,
             "bsr_all": 1,
         }
-        output = snakemake(
-            bsr_built, "--dry-run", "results/bsr_all", "--configfile", "config/ci.yaml"
-        )
+        output = snakemake(bsr_built, "--dry-run", "results/bsr_all", *CI)
         searched = re.findall(r"wildcards: name=(\w+), seed=(\d+)", output)
         assert sorted(searched) == [("starman_jump", str(seed)) for seed in range(1, 6)]
         assert set(re.findall(r"wildcards: name=(\w+)$", output, re.M)) == {"starman_jump"}
@@ -484,11 +508,30 @@ def edited_spec(path: Path, text: str) -> Iterator[None]:
         os.utime(path, ns=(old.st_atime_ns, old.st_mtime_ns))
 
 
+@pytest.mark.slow
+def test_searches_are_reused_only_from_a_checkout_that_has_them_up_to_date(bsr_built, tmp_path):
+    """The built copy as the checkout: its searches are up to date at CI's budget and are
+    copied, and the build there then runs none; not from a checkout without them, nor after a
+    spec is edited there."""
+    fresh = copy_workflow(tmp_path)
+    assert reuse_checkout_searches(fresh, checkout=copy_workflow(tmp_path / "other")) == 0
+    assert not (fresh / "results").exists()
+    assert reuse_checkout_searches(fresh, checkout=bsr_built) == 5 * 5 + 3 * 3
+    for path in (fresh / "results/bsr").rglob("*.h5"):
+        twin = bsr_built / path.relative_to(fresh)
+        assert path.read_bytes() == twin.read_bytes()
+    assert "bsr_search" not in planned_jobs(fresh, "results/composite_all", *CI)
+    spec = bsr_built / "specs/bsr/starman_jump.bsr"
+    with edited_spec(spec, spec.read_text() + "\n"):
+        assert reuse_checkout_searches(copy_workflow(tmp_path / "again"), checkout=bsr_built) == 0
+
+
 @pytest.fixture(scope="module")
 def composite_built(bsr_built) -> Path:
     """results/composite_all at CI's reduced budget: the robust searches (exempt: the spec's own
-    G = 4000), the transition search of starman_show, its plots and tables."""
-    snakemake(bsr_built, "results/composite_all", "--configfile", "config/ci.yaml")
+    G = 4000; taken from this checkout as ``bsr_built`` says), the transition search of
+    starman_show, its plots and tables."""
+    snakemake(bsr_built, "results/composite_all", *CI)
     return bsr_built
 
 
@@ -583,22 +626,14 @@ def test_editing_the_script_reruns_only_the_transition_search(composite_built):
     jump = "controller=starman_jump_robust      ticks=150"
     assert jump in text
     with edited_spec(script, text.replace(jump, jump.replace("ticks=150", "ticks=155"))):
-        jobs = planned_jobs(
-            composite_built, "results/composite_all", "--configfile", "config/ci.yaml"
-        )
+        jobs = planned_jobs(composite_built, "results/composite_all", *CI)
         assert jobs == {
             "composite_search": 1,
             "composite_plots": 1,
             "composite_table": 1,
             "composite_all": 1,
         }
-    assert (
-        planned_jobs(composite_built, "results/composite_all", "--configfile", "config/ci.yaml")
-        == {}
-    )
-
-
-CI = ("--configfile", "config/ci.yaml")
+    assert planned_jobs(composite_built, "results/composite_all", *CI) == {}
 
 
 @pytest.fixture(scope="module")
