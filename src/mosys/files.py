@@ -2,7 +2,10 @@
 forever, and a directory gives the reader's own confusing message. An output must be a file
 name whose folder can hold it, and never a file the same command read (``mosys run -o`` its own
 script would replace it): the readers record what they read while a command runs
-(``command_files``), and ``io.atomic`` asks ``output_problem`` before it writes."""
+(``command_files``), and ``io.atomic`` asks ``output_problem`` before it writes. An input that
+changes while the command runs (a spec edited during a build) stops its outputs from being
+written (``changed_inputs``): they would be made from the file as it was, and be newer than the
+file as it is, so that Snakemake would never make them again."""
 
 from __future__ import annotations
 
@@ -10,9 +13,12 @@ import os
 import stat
 from collections.abc import Iterator
 from contextlib import contextmanager
+from contextlib import suppress as _suppress
 from pathlib import Path
 
-_read: set[str] | None = None  # the real paths this command has read; None: not recording
+# the real paths this command has read, each with its identity when first read (device, inode,
+# size, modification time); None: not recording
+_read: dict[str, tuple[int, int, int, int]] | None = None
 
 
 @contextmanager
@@ -20,7 +26,7 @@ def command_files() -> Iterator[None]:
     """Record, for the block (one command), every input file the readers open, so that no
     output replaces one of them."""
     global _read
-    outer, _read = _read, set()
+    outer, _read = _read, {}
     try:
         yield
     finally:
@@ -51,8 +57,37 @@ def input_problem(path: str | Path) -> str | None:
     if not stat.S_ISREG(mode):
         return _kind(mode)
     if _read is not None:
-        _read.add(os.path.realpath(path))
+        _read.setdefault(os.path.realpath(path), _identity(os.stat(path)))
     return None
+
+
+def _identity(status: os.stat_result) -> tuple[int, int, int, int]:
+    return status.st_dev, status.st_ino, status.st_size, status.st_mtime_ns
+
+
+def changed_inputs() -> list[str]:
+    """The input files this command has read that have changed since (edited, replaced or
+    removed), relative to the working directory where they are within it: an output made
+    from them would be out of date as it is written."""
+    changed = []
+    for path, identity in (_read or {}).items():
+        try:
+            now = _identity(os.stat(path))
+        except OSError:
+            now = None
+        if now != identity:
+            relative = os.path.relpath(path)
+            changed.append(path if relative.startswith("..") else relative)
+    return changed
+
+
+def note_rewritten(path: str | Path) -> None:
+    """``path``, an input of this command, was written by the command itself (the editor's
+    Save): its new state is the one it stands for."""
+    real = os.path.realpath(path)
+    if _read is not None and real in _read:
+        with _suppress(OSError):
+            _read[real] = _identity(os.stat(real))
 
 
 def output_problem(path: str | Path, may_replace_input: bool = False) -> str | None:

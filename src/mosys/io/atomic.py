@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from mosys.errors import InputError, raise_if_stopped
-from mosys.files import output_problem
+from mosys.files import changed_inputs, note_rewritten, output_problem
 
 if TYPE_CHECKING:  # for the annotation only: verbs that write text (index) start without h5py
     import h5py
@@ -48,6 +48,12 @@ def outputs_together() -> Iterator[None]:
     try:
         yield
         raise_if_stopped()  # a stop whose exception a library swallowed: none are renamed
+        changed = changed_inputs() if held.partials else []
+        if changed:  # made from the file as it was, the outputs would look newer than it is
+            raise InputError(
+                f"{changed[0]}: changed while this command ran (it read the file as it was "
+                "before); nothing written: run it again"
+            )
         for partial, path in held.partials:
             try:
                 os.replace(partial, path)
@@ -116,6 +122,8 @@ def write_atomically(
             held_back = True
         else:
             os.replace(partial, path)
+            if saves_opened_file:
+                note_rewritten(path)
         written = True
     except OSError as error:  # the partial's name in the system's message means nothing to a user
         raise InputError(f"{path}: cannot write it: {error.strerror or error}") from None
