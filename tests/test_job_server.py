@@ -389,18 +389,29 @@ def test_the_socket_appears_only_once_it_listens(tmp_path, monkeypatch):
         listener.accept()[0].close()
 
 
-def test_a_stopped_server_waits_for_its_jobs_and_reports_their_codes(server, tmp_path):
+@pytest.mark.parametrize(
+    "stop, code, message",
+    [
+        (signal.SIGINT, 130, "mosys: interrupted; nothing written"),
+        (signal.SIGTERM, 143, ""),
+    ],
+)
+def test_a_stopped_server_waits_for_its_jobs_and_reports_their_codes(
+    server, tmp_path, stop, code, message
+):
     """Ctrl-C on a build reaches the server too: it left at once, and a job that ended in that
     moment had nobody to send its code ('the job server ended before job N did', exit 1). Now
-    it takes no more jobs, tells those running to stop and reports each one's code."""
+    it takes no more jobs, tells those running to stop and reports each one's code. It tells
+    them with the signal that stopped it: after Ctrl-C it sent SIGTERM, and a build's jobs
+    ended with 143 and no word in their logs instead of 'interrupted' and 130."""
     client = served_sleeper(server, tmp_path, 30)
     ((job, _),) = server.jobs()
-    server.process.send_signal(signal.SIGINT)
+    server.process.send_signal(stop)
     _, stderr = client.communicate(timeout=60)
-    assert client.returncode == 143, stderr  # the job's own code: stopped by SIGTERM
-    assert "ended before" not in stderr
+    assert client.returncode == code, stderr  # the job's own code
+    assert stderr.strip() == message
     assert server.process.wait(timeout=20) == 0
-    assert server.wait_for_end(job) == "ended: exit 143"  # reported by the server itself
+    assert server.wait_for_end(job) == f"ended: exit {code}"  # reported by the server itself
     assert not (tmp_path / "x.png").exists()
 
 

@@ -15,8 +15,9 @@ itself) when any other of them, the interpreter or the mosys package differs fro
 since the kernels' caches were set up at import. The server never runs a kernel itself: a numba
 thread pool started before a fork would not survive it.
 
-It stops on SIGTERM or SIGINT and when the process that started it exits (its running jobs
-are sent SIGTERM and their exit codes reported as they end, for ``STOP_WAIT_S`` at most), after
+It stops on SIGTERM, SIGINT or SIGHUP and when the process that started it exits (its running
+jobs are sent the signal that stopped it, SIGTERM when its parent exited, and their exit codes
+reported as they end, for ``STOP_WAIT_S`` at most), after
 ``--idle`` seconds without a job, or, once no job runs, when its socket file is removed or
 replaced; a job whose client goes away is sent SIGTERM. A job whose server has gone (killed
 meanwhile) sends its exit code to its client itself. A request is declined when a file of the
@@ -178,8 +179,11 @@ def _serve_requests(
                 # their codes reach their clients (gone at once, it left them to say 'the job
                 # server ended before job N did', exit 1, for a job stopped by Ctrl-C)
                 selector.unregister(listener)
+                # with the signal that stopped the server: Ctrl-C reaches the server and the
+                # jobs at once, and a SIGTERM from here made them stop as if terminated (exit
+                # 143, no word in their logs) rather than say 'interrupted' and exit 130
                 for pid in jobs:
-                    forward(pid, signal.SIGTERM)
+                    forward(pid, stopping[0] if stopping else signal.SIGTERM)
                 deadline = time.monotonic() + STOP_WAIT_S
         elif not jobs and time.monotonic() - last_activity > idle_seconds:
             break
