@@ -7,6 +7,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -541,3 +542,35 @@ def test_a_start_steered_past_the_cars_limit_is_refused(
         f"found '{found}'\n"
     )
     assert not out.exists()
+
+
+def test_a_damaged_table_is_named_as_a_file_and_another_figures_at_the_line(
+    tmp_path, pendulum, car_park, capsys
+):
+    """A damaged table that a ``when`` line named was reported as the line's mistake (the
+    same file named by a ``swapcon`` was reported as a file); a table of another figure is."""
+    controllers = tmp_path / "controllers"
+    controllers.mkdir()
+    shutil.copy(pendulum / "controllers" / "A.h5", controllers / "A.h5")
+    (controllers / "B.h5").write_bytes((pendulum / "controllers" / "A.h5").read_bytes()[:5000])
+    shutil.copy(car_park / "controllers" / "park.h5", controllers / "park.h5")
+    script = tmp_path / "catch.anim"
+    out = tmp_path / "catch.h5"
+    argv = ["run", str(script), "--controllers", str(controllers)]
+    argv += ["--dynamics-dir", str(pendulum / "dynamics"), "-o", str(out)]
+    for table, expected in (
+        ("conB.ctab", f"mosys: {controllers / 'B.h5'}: cannot read it as HDF5 ("),
+        (
+            "park",
+            f"{script}:3:38: expected a controller over state variables and actuators of the "
+            f"object's figure ({controllers / 'park.h5'}: controller park (a table of figure "
+            "'car'): the dynamics have no state variables",
+        ),
+    ):
+        script.write_text(
+            f"state link -90,0\nswapcon link conA.ctab\nwhen link angle>75 angle<105 swapcon "
+            f"{table} once\nsim 0.1\n"
+        )
+        assert main(argv) == 2
+        assert capsys.readouterr().err.startswith(expected)
+        assert not out.exists()

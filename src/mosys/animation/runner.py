@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from mosys.errors import NonFiniteStateError, SimulationError
+from mosys.io.controller_table import read_controller_table
 from mosys.limits import check_job
 from mosys.parsing.script import (
     AnimationScript,
@@ -126,7 +127,8 @@ def load_controllers(
 ) -> dict[str, Controller]:
     """Every controller the script names, from ``controller_dir/NAME.h5``, bound to the
     object's ``dynamics`` by state-variable and actuator names. A missing table, or one whose
-    variables the figure lacks, raises SpecError at the line that names it."""
+    variables the figure lacks, raises SpecError at the line that names it; a file that is not
+    a controller table raises InputError naming the file."""
     controllers: dict[str, Controller] = {}
     for command in script.commands:
         if not isinstance(command, SwapController | Breakpoint):
@@ -134,12 +136,14 @@ def load_controllers(
         if command.controller in controllers:
             continue
         path = controller_table_path(script, command, controller_dir)
+        table = read_controller_table(path)  # a damaged file: its own message, not the line's
         try:
-            controllers[command.controller] = Controller.load(path, dynamics)
+            controllers[command.controller] = Controller(Path(path).stem, table, dynamics)
         except ValueError as error:  # a state variable or actuator the figure does not have
             raise script.error(
                 command.table_token,
-                f"a controller over state variables and actuators of the object's figure ({error})",
+                "a controller over state variables and actuators of the object's figure "
+                f"({path}: {error})",
             ) from None
     return controllers
 
