@@ -4,13 +4,15 @@ Snakemake would never make them again."""
 
 from __future__ import annotations
 
+import io
 import shutil
+import sys
 from pathlib import Path
 
 import pytest
 
 import mosys.dynamics.compile
-from mosys.cli import main
+from mosys.cli import error_code, main, stopped_code
 from mosys.errors import InputError
 from mosys.files import command_files, input_problem
 from mosys.io.atomic import outputs_together, write_text_atomically
@@ -59,3 +61,30 @@ def test_a_spec_edited_while_compile_runs_is_one_line_and_exit_2(tmp_path, monke
         "before); nothing written: run it again\n"
     )
     assert not (tmp_path / "link1.py").exists()
+
+
+@pytest.mark.parametrize(
+    "stop", [lambda: error_code(InputError("A.ssc: changed")), lambda: stopped_code(2)]
+)
+def test_what_the_command_printed_is_put_out_before_its_error(monkeypatch, stop):
+    """In the job server's fork stdout is a buffered file until the command ends: ``mosys dp``'s
+    summary (which names its output) came after the error saying nothing was written."""
+    events = []
+
+    class Stream(io.StringIO):
+        def __init__(self, name):
+            super().__init__()
+            self.name = name
+
+        def write(self, text):
+            events.append((self.name, text))
+            return len(text)
+
+        def flush(self):
+            events.append((self.name, "flush"))
+
+    monkeypatch.setattr(sys, "stdout", Stream("out"))
+    monkeypatch.setattr(sys, "stderr", Stream("err"))
+    assert stop() in (2, 130)
+    first_error = next(k for k, (name, text) in enumerate(events) if name == "err")
+    assert ("out", "flush") in events[:first_error]

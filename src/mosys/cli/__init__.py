@@ -14,6 +14,7 @@ closing its pipe (141).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import select
 import signal
@@ -177,6 +178,8 @@ def error_code(error: Exception) -> int:
     from mosys.errors import InputError, SimulationError
     from mosys.parsing.tokens import SpecError
 
+    if not isinstance(error, BrokenPipeError):
+        flush_stdout()
     if isinstance(error, (SpecError, SimulationError)):
         print(error, file=sys.stderr)  # file:line:column: first, as compilers do
         return 2
@@ -195,8 +198,17 @@ def stopped_code(number: int) -> int:
     """The exit code of a command stopped by signal ``number``, nothing written: Ctrl-C says
     so; SIGTERM and SIGHUP, whose sender knows, stop without a word."""
     if number == signal.SIGINT:
+        flush_stdout()
         print("mosys: interrupted; nothing written", file=sys.stderr)
     return 128 + number
+
+
+def flush_stdout() -> None:
+    """Put out what the command printed before its error (a summary printed before its outputs
+    failed to be written): in a log of both streams the error then comes last, as it happened,
+    rather than before that summary, which read as if the file were written."""
+    with contextlib.suppress(OSError, ValueError):  # a closed pipe or stream
+        sys.stdout.flush()
 
 
 def stdout_closed() -> bool:
