@@ -613,7 +613,8 @@ class _Parser:
         crossing = first_self_crossing(vertices)
         if crossing is not None:
             token = tokens[crossing]
-            raise self.error(token, "a simple polygon (its edges cross here)", token.text)
+            expected = "a simple polygon (its edges cross or touch here)"
+            raise self.error(token, expected, token.text)
         if abs(polygon_area(vertices)) < 1e-12:
             raise self.error(tokens[0], "vertices enclosing a non-zero area", tokens[0].text)
         return tuple(vertices)
@@ -717,25 +718,40 @@ def polygon_area(vertices: Sequence[tuple[float, float]]) -> float:
     return total / 2.0
 
 
-def _segments_cross(a, b, c, d) -> bool:
-    """True when the open segments ab and cd cross at a single interior point."""
+def _segments_meet(
+    a: tuple[float, float], b: tuple[float, float], c: tuple[float, float], d: tuple[float, float]
+) -> bool:
+    """True when segments ab and cd (m) share a point: they cross, an end of one lies on the
+    other, or they overlap along a line, as ``kernels.geometry.segments_cross`` decides (which
+    the parser may not import). The order of each segment's ends does not matter: a side of 0
+    had counted as negative, so a vertex lying on another edge was refused in one direction
+    and not in the other."""
 
     def side(p, q, r) -> float:
         return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
 
-    return (side(c, d, a) > 0) != (side(c, d, b) > 0) and (side(a, b, c) > 0) != (side(a, b, d) > 0)
+    def opposite(u: float, v: float) -> bool:  # opposite signs, or either 0
+        return (u <= 0.0 <= v) or (v <= 0.0 <= u)
+
+    d1, d2, d3, d4 = side(c, d, a), side(c, d, b), side(a, b, c), side(a, b, d)
+    if d1 == 0.0 and d2 == 0.0:  # on one line: do their extents overlap?
+        return all(
+            max(min(a[k], b[k]), min(c[k], d[k])) <= min(max(a[k], b[k]), max(c[k], d[k]))
+            for k in (0, 1)
+        )
+    return opposite(d1, d2) and opposite(d3, d4)
 
 
 def first_self_crossing(vertices: Sequence[tuple[float, float]]) -> int | None:
-    """The index of the vertex that starts the first edge crossing an earlier non-adjacent edge,
-    or None for a simple polygon."""
+    """The index of the vertex that starts the first edge crossing or touching an earlier
+    non-adjacent edge, or None for a simple polygon (whichever way round its vertices go)."""
     n = len(vertices)
     edges = [(vertices[i], vertices[(i + 1) % n]) for i in range(n)]
     for j in range(n):
         for i in range(j - 1):
             if i == 0 and j == n - 1:
                 continue  # the first and last edges share vertex 0
-            if _segments_cross(*edges[i], *edges[j]):
+            if _segments_meet(*edges[i], *edges[j]):
                 return j
     return None
 
