@@ -613,6 +613,26 @@ def test_controls_figure_draws_a_single_sample_and_says_it_has_no_rate(trajector
     assert not both.axes[1].texts and both.axes[0].lines[0].get_marker() in ("", "None", None)
 
 
+def test_controls_figure_labels_each_control_in_the_unit_its_file_records(trajectory, tmp_path):
+    """The unit came from the control's name (N·m for a torque, "spec unit" for anything
+    else), though the file records it: a car's steer_rate was labelled "spec unit"."""
+    assert controls_figure([trajectory]).axes[0].get_ylabel() == "torque (N·m)"
+    whole = read_trajectory(trajectory)
+    steered = tmp_path / "steered.h5"
+    write_trajectory(
+        steered,
+        dataclasses.replace(
+            whole,
+            control_names=("steer_rate",),
+            control_units=("deg/s^2",),
+            attrs={**whole.attrs, "script": "steered.anim"},
+        ),
+    )
+    top, bottom = controls_figure([steered]).axes
+    assert top.get_ylabel() == "steer_rate (deg/s²)"
+    assert bottom.get_ylabel() == "|dsteer_rate/dt| (deg/s²/s)"
+
+
 def test_a_colour_few_frames_show_keeps_its_own_palette_entry():
     """A GIF's palette was cut from 8 sampled frames: a rule active in none of them was drawn in
     another rule's colour (Star-Man's cartwheel: rule D red drawn brown). Here 300 shades fill

@@ -21,6 +21,7 @@ from mosys.plots.style import (
     new_figure,
     plot_style,
     save_figure,
+    unit_text,
 )
 
 SCRIPT_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple")
@@ -105,7 +106,10 @@ def controls_figure(trajectory_paths: Sequence[str | Path], control: str | None 
 
 
 def _control_unit(trajectory: Trajectory, name: str) -> str:
-    """The unit of a control: trajectories do not record it; a torque's is N·m."""
+    """The unit of a control as the trajectory's ``/control`` records it (a car's steer_rate
+    deg/s); a file written before it recorded them: a torque's N·m, else "spec unit"."""
+    if trajectory.control_units is not None:
+        return unit_text(trajectory.control_units[trajectory.control_names.index(name)])
     return "N·m" if "torque" in name else "spec unit"
 
 

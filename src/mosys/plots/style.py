@@ -179,6 +179,12 @@ def number_text(value: float, fmt: str) -> str:
     return minus_signs(text)
 
 
+def unit_text(unit: str) -> str:
+    """A unit as the files write it (``N*m``, ``deg/s^2``) as a label shows it (``N·m``,
+    ``deg/s²``)."""
+    return unit.replace("*", "·").replace("^2", "²").replace("^3", "³")
+
+
 def axis_label(name: str, unit: str) -> str:
     """Axis label of a state variable: its symbol and unit, e.g. ``angle θ (deg)``."""
     symbol = SYMBOLS.get(name)
