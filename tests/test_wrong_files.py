@@ -108,3 +108,27 @@ def test_a_verb_given_the_wrong_file_says_which_and_what_it_is(
     shown = refused(argv(files, out), capsys, out)
     expected = message.format(**{name.replace(" ", "_"): path for name, path in files.items()})
     assert shown.startswith(expected) if expected.endswith("(") else shown == expected
+
+
+@pytest.mark.parametrize(
+    ("kind", "argv", "attribute", "message"),
+    [
+        ("composite result", ["composite-table"], "budget", "no root attribute 'budget', which "
+         "mosys reads here"),
+        ("BSR search result", ["bsr-table"], "steps_per_second", "not a 2-D BSR result file: no "
+         "root attribute steps_per_second"),
+    ],
+)  # fmt: skip
+def test_a_table_of_a_file_without_an_attribute_it_reads_names_both(
+    made, tmp_path, capsys, kind, argv, attribute, message
+):
+    """A file that keeps its contract but lacks an attribute of mosys's own that a table reads
+    (one written before the attribute was added) stopped the table with a KeyError traceback."""
+    old = tmp_path / "old.h5"
+    old.write_bytes(made[kind].read_bytes())
+    with h5py.File(old, "a") as h5:
+        del h5.attrs[attribute]
+    csv, md = tmp_path / "t.csv", tmp_path / "t.md"
+    assert main([*argv, str(old), "--csv", str(csv), "--md", str(md)]) == 2
+    assert capsys.readouterr().err == f"mosys: {old}: {message}\n"
+    assert not csv.exists() and not md.exists()

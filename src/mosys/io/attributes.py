@@ -18,12 +18,33 @@ import h5py
 import numpy as np
 from numpy.typing import ArrayLike
 
+from mosys.errors import InputError
+
 DIMENSIONLESS = "1"
 INDEX = "index"
 TEXT = "text"
 SI_STATE = "SI"
 SPEC = "spec"
 MIXED = "mixed"
+
+
+class FileAttributes(dict):
+    """A file's root attributes as read, name -> value; looking up one the file lacks raises
+    InputError naming the file and the attribute (a table made from a file written before an
+    attribute was added stopped with a KeyError traceback). ``get`` and ``in`` are a dict's."""
+
+    def __init__(self, path: str, items: Iterable[tuple[str, object]]):
+        super().__init__(items)
+        self.path = path
+
+    def __missing__(self, key: str) -> object:
+        raise InputError(f"{self.path}: no root attribute {key!r}, which mosys reads here")
+
+
+def root_attributes(h5: h5py.File, skip: Iterable[str] = ()) -> FileAttributes:
+    """The root attributes of an open file but those in ``skip`` (read into their own fields)."""
+    skipped = set(skip)
+    return FileAttributes(h5.filename, ((k, h5.attrs[k]) for k in h5.attrs if k not in skipped))
 
 
 def string_attr(value: object) -> str:

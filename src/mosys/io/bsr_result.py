@@ -25,6 +25,7 @@ from mosys.io.attributes import (
     INDEX,
     SI_STATE,
     create_with_unit,
+    root_attributes,
     string_list,
     string_tuple,
 )
@@ -175,7 +176,7 @@ def read_bsr_result(path: str | Path) -> BsrResult:
             active_rule=h5["best/active_rule"][()],
             joint_names=string_tuple(group.attrs["joint_names"]),
             sense_names=string_tuple(group.attrs["sense_names"]),
-            attrs={key: h5.attrs[key] for key in h5.attrs},
+            attrs=root_attributes(h5),
             final_state=h5["best/final_state"][()] if "best/final_state" in h5 else None,
             final_force=h5["best/final_force"][()] if "best/final_force" in h5 else None,
         )

@@ -27,7 +27,7 @@ import h5py
 import numpy as np
 
 from mosys.io.atomic import write_hdf5_atomically
-from mosys.io.attributes import DIMENSIONLESS, INDEX, create_with_unit
+from mosys.io.attributes import DIMENSIONLESS, INDEX, create_with_unit, root_attributes
 from mosys.io.contracts import open_contract
 from mosys.io.provenance import provenance_attributes
 from mosys.io.trajectory import FigureMotion, read_figure_motion, write_figure_motion
@@ -128,5 +128,5 @@ def read_composite_result(path: str | Path) -> CompositeResult:
             after=_read_motion(h5),
             before=_read_motion(h5["before"]),
             best_by_generation=h5["search/best_score"][()],
-            attrs={key: h5.attrs[key] for key in h5.attrs},
+            attrs=root_attributes(h5),
         )

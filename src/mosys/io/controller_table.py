@@ -20,6 +20,7 @@ from mosys.io.attributes import (
     INDEX,
     column_units,
     create_with_unit,
+    root_attributes,
     set_column_units,
     string_list,
     string_tuple,
@@ -169,7 +170,7 @@ def read_controller_table(path: str | Path) -> ControllerTable:
             "dest",
             "destinations",
         }
-        attrs = {key: h5.attrs[key] for key in h5.attrs if key not in known}
+        attrs = root_attributes(h5, known)
         return ControllerTable(
             state_order=state_order,
             control_names=string_tuple(h5.attrs["control_names"]),

@@ -28,6 +28,7 @@ from mosys.io.attributes import (
     TEXT,
     column_units,
     create_with_unit,
+    root_attributes,
     set_column_units,
     string_list,
     string_tuple,
@@ -209,7 +210,7 @@ def read_start_grid(path: str | Path) -> StartGrid:
             excluded=_texts(h5, "excluded", path),
             cost_to_go=h5["cost_to_go"][()],
             path_length=h5["path_length"][()],
-            attrs={k: h5.attrs[k] for k in h5.attrs if k != "state_order"},
+            attrs=root_attributes(h5, ("state_order",)),
             state_units=column_units(h5["start"]),
             arrival_cost_to_go=h5["arrival_cost_to_go"][()] if "arrival_cost_to_go" in h5 else None,
             excluded_detail=(
