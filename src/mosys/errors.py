@@ -29,7 +29,7 @@ class NonFiniteStateError(SimulationError):
 class Stopped(BaseException):
     """A stop signal (SIGTERM, SIGHUP) received while a command ran, raised where it arrived as
     Ctrl-C raises KeyboardInterrupt, so that the command's partial outputs are removed on the
-    way out (``cli.stops_as_exit``); ``code`` is the exit code, 128 + the signal's number. Not
+    way out (``cli.stop_signals_raise``); ``code`` is the exit code, 128 + the signal's number. Not
     an Exception: nothing on the way catches it as an error."""
 
     def __init__(self, number: int):

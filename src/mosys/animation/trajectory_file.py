@@ -6,7 +6,6 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from mosys import __version__
 from mosys.animation.runner import (
     ScriptRun,
     ScriptSources,
@@ -110,7 +109,6 @@ def run_animation_script(
             ),
             "slew": json.dumps(run.slew or {}),
             "simulated_seconds": float(run.t[-1] - run.t[0]),
-            "mosys_version": __version__,
             **extra,
         },
         motion=motion,

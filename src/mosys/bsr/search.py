@@ -37,7 +37,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING, Literal, Protocol
 
 import numpy as np
 
@@ -66,7 +66,6 @@ if TYPE_CHECKING:  # the 3-D figure, for an annotation only
     from mosys.bsr.figure3d import BsrFigure3D
 
 CORNER_INSIDE = 0.98  # a re-initialised box's corner: this fraction of the half-side out
-RELEVANCE = ("corner", "contain")
 SEGMENT_WEIGHT_MIN = 0.2
 SEGMENT_WEIGHT_MAX = 1.0
 CREEP_TARGET = 0.1  # of the joint's range
@@ -101,9 +100,9 @@ class Simulation(Protocol):
 class SearchSetup:
     """A spec bound to its figure: the nominal start pose (root angle rad, joints (J,) rad, x
     m), the fall endpoints' indices, the term weights in the order of the simulation's terms,
-    the budget, the simulation, the relevance heuristic (``RELEVANCE``), how many rounds of it
-    enrich the first population, and how many controllers that first population has
-    (``first_set``; 0: C) before the best C of them are kept."""
+    the budget, the simulation, the relevance heuristic (``corner`` or ``contain``), how many
+    rounds of it enrich the first population, and how many controllers that first population
+    has (``first_set``; 0: C) before the best C of them are kept."""
 
     spec: BsrSpec
     figure: BsrFigure
@@ -114,7 +113,7 @@ class SearchSetup:
     weights: np.ndarray
     generations: int
     simulation: Simulation
-    relevance: str = "corner"
+    relevance: Literal["corner", "contain"] = "corner"
     enrich_rounds: int = 0
     first_set: int = 0
 

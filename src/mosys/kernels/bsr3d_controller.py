@@ -10,7 +10,7 @@ v0)``, ``0.5 + ω / (2 ω0)`` and ``0.5 + up / 2``; per endpoint the ground's no
 the step ``f / (2 M g)`` (every contact of this simulator is an impulse, so an endpoint's force
 over a step is its collision impulse over dt: one sense carries both of the paper's); and the
 angle of each free (flexible) joint angle ``(θ - min) / (max - min)``. ``h0`` is the standing
-centre-of-mass height, ``v0 = sqrt(g h0)`` and ``ω0 = v0 / h0`` (``SenseScales``). The physical
+centre-of-mass height, ``v0 = sqrt(g h0)`` and ``ω0 = v0 / h0`` (``Task.scales``). The physical
 senses (all but the joint angles) pass through a first-order low-pass filter of time constant
 ``filter_time`` s (§4.2: "to remove noise and high-frequency variation").
 

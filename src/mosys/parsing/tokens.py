@@ -1,4 +1,4 @@
-"""The one tokenizer and error type shared by every spec kind (.fig, .ssc, .anim, .bsr, .comp).
+"""The one tokenizer and error type of every spec kind (.fig, .ssc, .anim, .mot, .bsr, .comp).
 
 Specs are line based: ``keyword positional-args key=value ...``; ``#`` starts a comment, blank lines
 are ignored. Tokens are separated by whitespace and keep their 1-based line and column, so every

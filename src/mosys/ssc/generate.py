@@ -18,7 +18,6 @@ from types import ModuleType
 import numpy as np
 from numba import float64
 
-from mosys import __version__
 from mosys.io.attributes import string_list
 from mosys.io.controller_table import ControllerTable, write_controller_table
 from mosys.kernels.dp_exits import node_coordinates
@@ -205,7 +204,6 @@ def generate_controller(
             "table_states": int(problem.node_valid.sum()),
             "peak_rss_bytes": peak_rss_bytes(),
             "hold": spec.hold is not None,
-            "mosys_version": __version__,
             **figure_attributes(problem, dynamics),
             **policy_attributes(spec),
         },
