@@ -44,6 +44,11 @@ BYTES_PER_CELL = 40  # pose (3 float64) + path length (float64) + queue slot (in
 _POSE_SLOT = np.arange(3, dtype=np.int64)  # pose_is_free's slots of x, y, heading in a pose
 
 
+class PoseSearchError(ValueError):
+    """A scene the pose search cannot take: its lattice too big for memory, or the destination
+    itself not free (the other ValueErrors of ``pose_reach`` are a caller's mistakes)."""
+
+
 @dataclass(frozen=True)
 class PoseReach:
     """The answer for n query poses. path_length: (n,) float64 m, the length of the path found
@@ -229,8 +234,8 @@ def pose_reach(
     wheelbase m; steer_max rad; cell m; step m (> the cell's diagonal); steer_values (S,) rad,
     default -steer_max, -steer_max/2, 0, steer_max/2, steer_max; probe_levels 0..3: how deep
     to probe from a free query whose cell was not reached (``lookup``; 0: not at all).
-    ValueError when the lattice would take more than max_bytes, or the destination is not
-    free."""
+    PoseSearchError when the lattice would take more than max_bytes, or the destination is
+    not free; ValueError for arguments out of their ranges."""
     destination = np.ascontiguousarray(destination, dtype=np.float64).reshape(3)
     queries = np.ascontiguousarray(queries, dtype=np.float64).reshape(-1, 3)
     domain = np.ascontiguousarray(domain, dtype=np.float64)
@@ -251,7 +256,7 @@ def pose_reach(
     counts = [max(1, math.ceil(float(e) / cell)) for e in extent] + [int(heading_cells)]
     cells = counts[0] * counts[1] * counts[2]  # Python int: no overflow
     if cells * BYTES_PER_CELL > max_bytes:
-        raise ValueError(
+        raise PoseSearchError(
             f"the lattice would take {cells * BYTES_PER_CELL} bytes ({cells} cells requested: "
             f"{counts[0]} x {counts[1]} x {counts[2]}, {BYTES_PER_CELL} bytes each), "
             f"more than max_bytes {max_bytes}; use a larger cell or fewer heading_cells"
@@ -265,7 +270,7 @@ def pose_reach(
     )
     body = np.empty_like(scene[0])
     if not pose_is_free(destination, _POSE_SLOT, *scene, body):
-        raise ValueError(f"the destination {destination.tolist()} is not free")
+        raise PoseSearchError(f"the destination {destination.tolist()} is not free")
     substeps = max(MIN_SUBSTEPS, math.ceil(step / SUBSTEP))
     path_length = np.empty(cells)
     reached = search(

@@ -88,10 +88,15 @@ def classify_starts(controller: Controller, starts: np.ndarray) -> tuple[np.ndar
     (n,) str, "" for none, ``NOT_FREE`` or ``NO_WAY``, computed by ``kernels.pose_reach`` (a
     search over poses with the steer axis's largest angle, forward and back); and the length of
     the shortest path it found (n,) m (inf: none; nan: not free)."""
-    from mosys.kernels.pose_reach import pose_reach
+    from mosys.kernels.pose_reach import PoseSearchError, pose_reach
 
     scene = controller_table_scene(controller.table)
     order = controller.state_order
+    if "steer" not in order:  # the search turns the wheels as far as the table's steer axis
+        raise InputError(
+            f"controller {controller.name}: the pose search needs the table's steer axis (its "
+            f"state: {', '.join(order)})"
+        )
     poses = starts[:, [order.index(name) for name in ("x", "y", "heading")]].copy()
     poses[:, 2] = np.radians(poses[:, 2])
     destination = scene.destination
@@ -107,7 +112,7 @@ def classify_starts(controller: Controller, starts: np.ndarray) -> tuple[np.ndar
             float(controller.table.attrs["wheelbase"]),
             math.radians(float(np.max(np.abs(controller.table.axes[order.index("steer")])))),
         )
-    except ValueError as error:  # a lattice too big for memory, a destination in collision
+    except PoseSearchError as error:  # a lattice too big for memory, a destination not free
         raise InputError(f"controller {controller.name}: the pose search: {error}") from None
     reason = np.where(~reach.free, NOT_FREE, np.where(~reach.reachable, NO_WAY, ""))
     return reason.astype(object), reach.path_length
