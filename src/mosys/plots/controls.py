@@ -21,15 +21,12 @@ from mosys.plots.style import (
     new_figure,
     plot_style,
     save_figure,
+    script_file_name,
     unit_text,
 )
 
 SCRIPT_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple")
 RATE_CLIP = 5.0  # the rate panel shows up to this many times the largest slew limit
-
-
-def _script_name(trajectory: Trajectory, path: str | Path) -> str:
-    return Path(str(trajectory.attrs.get("script", path))).name
 
 
 def controls_figure(trajectory_paths: Sequence[str | Path], control: str | None = None) -> Figure:
@@ -66,7 +63,7 @@ def controls_figure(trajectory_paths: Sequence[str | Path], control: str | None 
             largest_rate = max(largest_rate, float(np.abs(rate).max(initial=0.0)))
             notes = [f"slew limit {limit:g} {unit}/s" if limit is not None else "no limit"]
             notes += ["a single sample"] if lone else []
-            label = f"{_script_name(trajectory, path)} ({'; '.join(notes)})"
+            label = f"{script_file_name(trajectory, path)} ({'; '.join(notes)})"
             legend.append((Line2D([], [], color=color, linewidth=2), label))
             if limit is not None:
                 bottom.axhline(limit, color=color, linestyle="--", linewidth=1.4)
@@ -98,7 +95,7 @@ def controls_figure(trajectory_paths: Sequence[str | Path], control: str | None 
         bottom.set_ylabel(f"|d{name}/dt| ({unit}/s)")
         bottom.set_xlabel("time t (s)")
         scripts = " and ".join(
-            _script_name(t, p) for t, p in zip(trajectories, trajectory_paths, strict=True)
+            script_file_name(t, p) for t, p in zip(trajectories, trajectory_paths, strict=True)
         )
         top.set_title(f"{name} against time: {scripts}\nthin lines: controller exchanges")
         add_legend(figure, legend, ncols=1)

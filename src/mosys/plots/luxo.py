@@ -59,6 +59,7 @@ from mosys.plots.style import (
     save_figure,
     scene_figure,
     scene_limits,
+    script_file_name,
     write_real_time_gif,
 )
 
@@ -199,10 +200,6 @@ def strip_samples(
     if last != kept[-1]:
         kept.append(last)
     return np.asarray(kept, dtype=np.int64)
-
-
-def _script_name(trajectory: Trajectory, path: str | Path) -> str:
-    return Path(str(trajectory.attrs.get("script", path))).name
 
 
 # --------------------------------------------------------------------------- drawing the lamp
@@ -400,7 +397,7 @@ def write_show_gif(
         )
         draw_terrain(ax, figure_motion.terrain, limits[0, 1] - 1.0)
         figure.suptitle(
-            f"Luxo: {_script_name(trajectory, trajectory_path)}",
+            f"Luxo: {script_file_name(trajectory, trajectory_path)}",
             y=1 - 0.08 / figure.get_size_inches()[1],
             va="top",
         )
@@ -540,9 +537,8 @@ def torques_and_forces_figure(trajectory_path: str | Path) -> Figure:
         timeline.set_yticks([])
         timeline.grid(False)
         timeline.set_ylabel("motion", rotation=0, ha="right", va="center")
-        timeline.set_title(
-            f"Luxo's joint torques and ground forces: {_script_name(trajectory, trajectory_path)}"
-        )
+        script = script_file_name(trajectory, trajectory_path)
+        timeline.set_title(f"Luxo's joint torques and ground forces: {script}")
         if entries:
             timeline.legend(
                 *zip(*entries, strict=True),

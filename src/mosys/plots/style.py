@@ -15,6 +15,7 @@ import math
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import matplotlib
 import numpy as np
@@ -34,6 +35,9 @@ from matplotlib.typing import ColorType
 from mosys.errors import InputError
 from mosys.io.atomic import write_atomically
 from mosys.plots.frame_text import draw_text, drawable
+
+if TYPE_CHECKING:  # the annotation only: a plot of a table need not import h5py
+    from mosys.io.trajectory import Trajectory
 
 DPI = 120  # dots per inch of every PNG
 STYLE = {
@@ -177,6 +181,12 @@ def number_text(value: float, fmt: str) -> str:
     if float(text) == 0.0:
         text = format(0.0, fmt)
     return minus_signs(text)
+
+
+def script_file_name(trajectory: Trajectory, path: str | Path) -> str:
+    """The file name of the animation script a trajectory ran (its ``script`` attribute), else
+    the trajectory file's name."""
+    return Path(str(trajectory.attrs.get("script", path))).name
 
 
 def unit_text(unit: str) -> str:
