@@ -50,7 +50,7 @@ from mosys.plots.car_starts import (
     consistency_figure,
     plot_consistency,
     plot_success_map,
-    read_start_grid,
+    read_drawn_start_grid,
     success_map_figure,
 )
 from mosys.plots.style import GIF_HOLD_MS, PlotInputError, frame_indices
@@ -936,7 +936,7 @@ def refusal(path: Path, change) -> str:
     with h5py.File(path, "a") as h5:
         change(h5)
     with pytest.raises(PlotInputError) as error:
-        read_start_grid(path)
+        read_drawn_start_grid(path)
     return str(error.value)
 
 

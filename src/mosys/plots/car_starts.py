@@ -31,8 +31,8 @@ from mosys.io.start_grid import (
     OUTSIDE_DOMAIN,
     StartGrid,
     consistency_summary,
+    read_start_grid,
 )
-from mosys.io.start_grid import read_start_grid as read_start_grid_file
 from mosys.plots.car_scene import (
     COLUMNS,
     FAILURE_COLOR,
@@ -135,7 +135,7 @@ EXCLUSIONS = {
 
 @dataclass(frozen=True)
 class DrawnStartGrid:
-    """A start grid checked for drawing (``read_start_grid``): its starts and outcomes
+    """A start grid checked for drawing (``read_drawn_start_grid``): its starts and outcomes
     (``io.start_grid.StartGrid``, arrays of the right shapes and types), the scene they were
     run in, the controller's name and how long each run was simulated (s)."""
 
@@ -145,13 +145,13 @@ class DrawnStartGrid:
     simulated_seconds: float
 
 
-def read_start_grid(path: str | Path) -> DrawnStartGrid:
+def read_drawn_start_grid(path: str | Path) -> DrawnStartGrid:
     """Read ``results/car/start_grid.h5`` (see ``success_map_figure``); PlotInputError naming the
     file and what is missing or malformed: a dataset of the wrong shape, a parked start without
     a finite parking time, an exclusion reason other than ``NOT_FREE`` and ``NO_WAY``, an
     excluded start that was run."""
     try:
-        grid = read_start_grid_file(path)
+        grid = read_start_grid(path)
     except InputError as error:  # a dataset or state_order missing, texts that are not strings
         raise PlotInputError(str(error)) from None
     attrs = grid.attrs
@@ -301,7 +301,7 @@ def success_map_figure(start_grid_path: str | Path) -> Figure:
     (n,) s and ``path_length`` (n,) m; root attributes ``body_outline``, ``obstacles``,
     ``obstacle_names``, ``destination`` (JSON, as in a car trajectory), ``controller`` and
     ``simulated_seconds`` (s)."""
-    drawn = read_start_grid(start_grid_path)
+    drawn = read_drawn_start_grid(start_grid_path)
     grid = drawn.outcomes
     column = {name: k for k, name in enumerate(grid.state_order)}
     xy = grid.start[:, [column["x"], column["y"]]]
@@ -431,7 +431,7 @@ def consistency_figure(start_grid_path: str | Path) -> Figure:
     (``StartGrid.arrival_consistency``) adds the ratios against it as an outlined histogram
     and a title line (share within the band and median). Reads the start grid as
     ``success_map_figure`` does."""
-    drawn = read_start_grid(start_grid_path)
+    drawn = read_drawn_start_grid(start_grid_path)
     grid = drawn.outcomes
     ratios = grid.consistency
     median, p90, within = consistency_summary(ratios)
