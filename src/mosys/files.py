@@ -12,8 +12,7 @@ from __future__ import annotations
 import os
 import stat
 from collections.abc import Iterator
-from contextlib import contextmanager
-from contextlib import suppress as _suppress
+from contextlib import contextmanager, suppress
 from pathlib import Path
 
 # the real paths this command has read, each with its identity when first read (device, inode,
@@ -86,7 +85,7 @@ def note_rewritten(path: str | Path) -> None:
     Save): its new state is the one it stands for."""
     real = os.path.realpath(path)
     if _read is not None and real in _read:
-        with _suppress(OSError):
+        with suppress(OSError):
             _read[real] = _identity(os.stat(real))
 
 
