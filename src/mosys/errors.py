@@ -5,8 +5,9 @@ import signal
 
 
 class InputError(ValueError):
-    """An input file that exists but cannot be used (wrong shape, missing group, ...). The CLI
-    prints the message and exits 2."""
+    """A file a command cannot use: an input that is missing, unreadable or not what it should
+    be (wrong shape, missing group or attribute, ...), or an output that cannot be written there.
+    The message names the file. The CLI prints it and exits 2."""
 
 
 class SimulationError(InputError):
