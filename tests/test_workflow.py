@@ -508,24 +508,6 @@ def edited_spec(path: Path, text: str) -> Iterator[None]:
         os.utime(path, ns=(old.st_atime_ns, old.st_mtime_ns))
 
 
-@pytest.mark.slow
-def test_searches_are_reused_only_from_a_checkout_that_has_them_up_to_date(bsr_built, tmp_path):
-    """The built copy as the checkout: its searches are up to date at CI's budget and are
-    copied, and the build there then runs none; not from a checkout without them, nor after a
-    spec is edited there."""
-    fresh = copy_workflow(tmp_path)
-    assert reuse_checkout_searches(fresh, checkout=copy_workflow(tmp_path / "other")) == 0
-    assert not (fresh / "results").exists()
-    assert reuse_checkout_searches(fresh, checkout=bsr_built) == 5 * 5 + 3 * 3
-    for path in (fresh / "results/bsr").rglob("*.h5"):
-        twin = bsr_built / path.relative_to(fresh)
-        assert path.read_bytes() == twin.read_bytes()
-    assert "bsr_search" not in planned_jobs(fresh, "results/composite_all", *CI)
-    spec = bsr_built / "specs/bsr/starman_jump.bsr"
-    with edited_spec(spec, spec.read_text() + "\n"):
-        assert reuse_checkout_searches(copy_workflow(tmp_path / "again"), checkout=bsr_built) == 0
-
-
 @pytest.fixture(scope="module")
 def composite_built(bsr_built) -> Path:
     """results/composite_all at CI's reduced budget: the robust searches (exempt: the spec's own
@@ -533,6 +515,28 @@ def composite_built(bsr_built) -> Path:
     starman_show, its plots and tables."""
     snakemake(bsr_built, "results/composite_all", *CI)
     return bsr_built
+
+
+@pytest.mark.slow
+def test_searches_are_reused_only_from_a_checkout_that_has_them_up_to_date(
+    composite_built, tmp_path
+):
+    """The built copy (both targets: the robust searches too) as the checkout: its searches are
+    up to date at CI's budget and are copied, and the build there then runs none; not from a
+    checkout without them, nor after a spec is edited there. (On a fresh clone the module's
+    own searches ran in the copy: it is the checkout that has them all.)"""
+    fresh = copy_workflow(tmp_path / "fresh")
+    assert reuse_checkout_searches(fresh, checkout=copy_workflow(tmp_path / "other")) == 0
+    assert not (fresh / "results").exists()
+    assert reuse_checkout_searches(fresh, checkout=composite_built) == 5 * 5 + 3 * 3
+    for path in (fresh / "results/bsr").rglob("*.h5"):
+        twin = composite_built / path.relative_to(fresh)
+        assert path.read_bytes() == twin.read_bytes()
+    assert "bsr_search" not in planned_jobs(fresh, "results/composite_all", *CI)
+    spec = composite_built / "specs/bsr/starman_jump.bsr"
+    again = copy_workflow(tmp_path / "again")
+    with edited_spec(spec, spec.read_text() + "\n"):
+        assert reuse_checkout_searches(again, checkout=composite_built) == 0
 
 
 JUMP_CLEARANCE = 0.75  # m: the refined jump's own flight lifts every endpoint at least this high
